@@ -1,0 +1,211 @@
+//! Equilibria of eqs. (1).
+//!
+//! Every equilibrium has `ω_u = ω_l = ω` (from α̇ = 0). For ω ≠ 0 both discs slip and
+//!
+//! ```text
+//! k_θ α = T_fl(ω),     k_m u = T_fl(ω) + T_fu(ω)
+//! ```
+//!
+//! so the slipping branch is explicit in ω: `u(ω) = (T_fl(ω) + T_fu(ω))/k_m`, `α(ω) = T_fl(ω)/k_θ`.
+//! For ω = 0 (both discs stuck) the equilibria form the set of α with
+//! `k_θ α ∈ I_l` and `k_m u − k_θ α ∈ I_u` (the stick intervals), possibly a segment.
+
+use nalgebra::Complex;
+use serde::Serialize;
+
+use crate::dynamics::{DiscMode, Mode, Model, State};
+
+/// A slipping equilibrium (both discs at the same velocity ω ≠ 0).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct SlipEquilibrium {
+    pub u: f64,
+    pub omega: f64,
+    pub alpha: f64,
+}
+
+impl SlipEquilibrium {
+    /// As a state `[α, ω, ω]`.
+    pub fn state(&self) -> State {
+        State::new(self.alpha, self.omega, self.omega)
+    }
+}
+
+/// The set of stuck equilibria `α ∈ [alpha_min, alpha_max]`, `ω_u = ω_l = 0`.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct StuckSet {
+    pub alpha_min: f64,
+    pub alpha_max: f64,
+}
+
+impl Model {
+    /// The slipping branch at velocity ω ≠ 0: `u(ω)`, `α(ω)`.
+    pub fn slip_equilibrium_at(&self, omega: f64) -> SlipEquilibrium {
+        let s = if omega < 0.0 { -1.0 } else { 1.0 };
+        let tl = self.friction(crate::Disc::Lower).torque(omega, s);
+        let tu = self.friction(crate::Disc::Upper).torque(omega, s);
+        SlipEquilibrium {
+            u: (tl + tu) / self.params.k_m,
+            omega,
+            alpha: tl / self.params.k_theta,
+        }
+    }
+
+    /// `du/dω` along the slipping branch.
+    pub fn du_domega(&self, omega: f64) -> f64 {
+        let s = if omega < 0.0 { -1.0 } else { 1.0 };
+        (self.friction(crate::Disc::Lower).dtorque(omega, s)
+            + self.friction(crate::Disc::Upper).dtorque(omega, s))
+            / self.params.k_m
+    }
+
+    /// All slipping equilibria at input u, ordered by ω. The branch `u(ω)` can fold
+    /// (falling friction), so several may exist; each is refined to machine precision.
+    pub fn slip_equilibria(&self, u: f64) -> Vec<SlipEquilibrium> {
+        if u == 0.0 {
+            return Vec::new();
+        }
+        let s = u.signum();
+        let bt = self.friction(crate::Disc::Lower).viscous()
+            + self.friction(crate::Disc::Upper).viscous();
+        // Beyond ω_max the viscous growth dominates every bounded friction term.
+        let bound = self.params.upper.t_s.abs()
+            + self.params.upper.dt_s.abs()
+            + self.friction(crate::Disc::Lower).level(0.0).abs()
+            + match self.params.lower {
+                crate::LowerFriction::Exponential { t_1, t_2, .. } => t_1.abs() + t_2.abs(),
+                crate::LowerFriction::Stribeck { t_c, .. } => t_c.abs(),
+            };
+        let w_max = if bt > 0.0 {
+            2.0 * (self.params.k_m * u).abs().max(bound) / bt + 1.0
+        } else {
+            1e4
+        };
+        let g = |w: f64| self.slip_equilibrium_at(s * w).u - u;
+        // Grid dense near 0 (where the friction varies fastest), then linear.
+        let n = 4000;
+        let mut ws: Vec<f64> = (0..=n)
+            .map(|i| {
+                let t = i as f64 / n as f64;
+                1e-12 + w_max * t * t
+            })
+            .collect();
+        ws.dedup();
+        let mut out = Vec::new();
+        let mut prev = (ws[0], g(ws[0]));
+        for &w in &ws[1..] {
+            let gw = g(w);
+            if prev.1 == 0.0 {
+                out.push(self.slip_equilibrium_at(s * prev.0));
+            } else if prev.1 * gw < 0.0 {
+                let root = bisect(&g, prev.0, w, prev.1, gw);
+                out.push(self.slip_equilibrium_at(s * root));
+            }
+            prev = (w, gw);
+        }
+        out.sort_by(|a, b| a.omega.total_cmp(&b.omega));
+        out
+    }
+
+    /// Eigenvalues of the Jacobian at a slipping equilibrium.
+    pub fn equilibrium_eigenvalues(&self, e: &SlipEquilibrium) -> [Complex<f64>; 3] {
+        let m = DiscMode::slip_of(e.omega);
+        let j = self.jacobian(&e.state(), e.u, Mode { upper: m, lower: m });
+        let ev = j.complex_eigenvalues();
+        [ev[0], ev[1], ev[2]]
+    }
+
+    /// Whether a slipping equilibrium is asymptotically stable (all eigenvalues in the open
+    /// left half-plane).
+    pub fn equilibrium_is_stable(&self, e: &SlipEquilibrium) -> bool {
+        self.equilibrium_eigenvalues(e).iter().all(|l| l.re < 0.0)
+    }
+
+    /// The set of equilibria with both discs at rest, if non-empty.
+    pub fn stuck_equilibria(&self, u: f64) -> Option<StuckSet> {
+        let k = self.params.k_theta;
+        let (ll, lh) = self.friction(crate::Disc::Lower).static_interval();
+        let (ul, uh) = self.friction(crate::Disc::Upper).static_interval();
+        let km_u = self.params.k_m * u;
+        let lo = (ll / k).max((km_u - uh) / k);
+        let hi = (lh / k).min((km_u - ul) / k);
+        (lo <= hi).then_some(StuckSet {
+            alpha_min: lo,
+            alpha_max: hi,
+        })
+    }
+}
+
+/// Bisection to the last representable bracket (robust; the function is cheap).
+fn bisect(g: &impl Fn(f64) -> f64, mut a: f64, mut b: f64, mut ga: f64, _gb: f64) -> f64 {
+    for _ in 0..200 {
+        let m = 0.5 * (a + b);
+        if m <= a || m >= b {
+            break;
+        }
+        let gm = g(m);
+        if gm == 0.0 {
+            return m;
+        }
+        if ga * gm < 0.0 {
+            b = m;
+        } else {
+            a = m;
+            ga = gm;
+        }
+    }
+    0.5 * (a + b)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use approx::assert_relative_eq;
+
+    #[test]
+    fn slip_equilibria_are_fixed_points() {
+        let m = Model::table1();
+        for u in [0.3, 1.5, 2.5, 4.5, 6.0, -1.5] {
+            let eqs = m.slip_equilibria(u);
+            assert!(!eqs.is_empty(), "u = {u}");
+            for e in eqs {
+                assert_relative_eq!(e.u, u, epsilon = 1e-13);
+                let mode = m.mode_at(&e.state(), u);
+                let f = m.rhs(&e.state(), u, mode);
+                // Residual of the equilibrium equations at a bisected root: rounding level.
+                assert!(f.norm() < 1e-12, "u = {u}: |f| = {}", f.norm());
+            }
+        }
+    }
+
+    #[test]
+    fn table1_is_unstable_at_2_5_and_stable_at_6() {
+        // MODEL.md: with Table 1 the 2.5 V equilibrium is unstable (a cycle surrounds it),
+        // 6 V lies above the subcritical Hopf point (stable).
+        let m = Model::table1();
+        let e = m.slip_equilibria(2.5);
+        assert_eq!(e.len(), 1);
+        assert!(!m.equilibrium_is_stable(&e[0]));
+        let e = m.slip_equilibria(6.0);
+        assert_eq!(e.len(), 1);
+        assert!(m.equilibrium_is_stable(&e[0]));
+    }
+
+    #[test]
+    fn stuck_sets() {
+        let m = Model::table1();
+        // Upper disc smooth: a single α = k_m u / k_θ while k_m u ≤ T_sl.
+        let s = m.stuck_equilibria(0.02).unwrap();
+        assert_relative_eq!(s.alpha_min, 3.995 * 0.02 / 0.0727, epsilon = 1e-12);
+        assert_relative_eq!(s.alpha_min, s.alpha_max, epsilon = 1e-12);
+        assert!(m.stuck_equilibria(0.05).is_none()); // k_m u = 0.2 > T_sl = 0.1642
+    }
+
+    #[test]
+    fn u_branch_derivative_matches_fd() {
+        let m = Model::table1();
+        for w in [0.1, 1.0, 5.0] {
+            let fd = (m.slip_equilibrium_at(w + 1e-6).u - m.slip_equilibrium_at(w - 1e-6).u) / 2e-6;
+            assert_relative_eq!(m.du_domega(w), fd, epsilon = 1e-8);
+        }
+    }
+}

@@ -1,0 +1,245 @@
+//! Set-valued friction laws, split as
+//!
+//! ```text
+//! T_f(ω) ∈ a(ω) + b·ω + N(|ω|)·Sign(ω)
+//! ```
+//!
+//! with a smooth offset `a` (the upper disc's asymmetry ΔT_su + Δb_u|ω|), a viscous
+//! coefficient `b`, and an even friction *level* `N ≥ 0` at ω = 0 (the normal force of the
+//! Lagrangian form's Coulomb contact). `Sign(0) = [−1, 1]`.
+//!
+//! A solver that tracks a slip branch `s ∈ {+1, −1}` evaluates the branch torque
+//! `T_f^s(ω) = a^s(ω) + b ω + s·N(sω)`, a smooth continuation of the law from the side `sω > 0`
+//! across ω = 0, so that event location can evaluate the field slightly past the surface.
+
+use crate::params::{LowerFriction, UpperFriction};
+
+/// Friction law of one disc.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Friction {
+    /// Eq. (4): `T_f = ΔT_su + Δb_u|ω| + b_u ω + T_su·Sign(ω)`.
+    Upper(UpperFriction),
+    /// Lower disc: exponential or Stribeck level, plus `b_l ω`.
+    Lower(LowerFriction),
+}
+
+impl Friction {
+    /// Viscous coefficient `b` (the C matrix entry of the Lagrangian form).
+    pub fn viscous(&self) -> f64 {
+        match self {
+            Friction::Upper(p) => p.b,
+            Friction::Lower(l) => l.viscous(),
+        }
+    }
+
+    /// Friction level `N(|ω|)` (even in ω); `N(0)` is the half-width of the stick interval.
+    ///
+    /// Exponential family: `T_sl + T_1 tanh(w_1|ω|/2) + T_2 tanh(w_2|ω|/2)`
+    /// (since `1 − 2/(1+e^x) = tanh(x/2)`); Stribeck: `T_cl + (T_sl − T_cl) e^{−|ω/ω_s|^δ}`;
+    /// upper disc: `T_su`.
+    ///
+    /// Note: with Table 1, N turns negative above |ω| ≈ 18 rad/s (T_sl + T_1 + T_2 < 0);
+    /// the viscous term keeps the total torque dissipative.
+    pub fn level(&self, w: f64) -> f64 {
+        self.level_ext(w.abs())
+    }
+
+    /// The level as a function of `x = s·ω` continued to `x < 0`: analytic for the exponential
+    /// family (tanh is odd), even (|x|^δ) for the Stribeck family, constant for the upper disc.
+    /// Equals `N(|ω|)` for `x ≥ 0`.
+    pub fn level_ext(&self, x: f64) -> f64 {
+        match *self {
+            Friction::Upper(p) => p.t_s,
+            Friction::Lower(LowerFriction::Exponential {
+                t_s, t_1, t_2, w_1, w_2, ..
+            }) => t_s + t_1 * (0.5 * w_1 * x).tanh() + t_2 * (0.5 * w_2 * x).tanh(),
+            Friction::Lower(LowerFriction::Stribeck {
+                t_s,
+                t_c,
+                omega_s,
+                delta,
+                ..
+            }) => t_c + (t_s - t_c) * (-(x.abs() / omega_s).powf(delta)).exp(),
+        }
+    }
+
+    /// `d level_ext / dx`.
+    pub fn dlevel_ext(&self, x: f64) -> f64 {
+        match *self {
+            Friction::Upper(_) => 0.0,
+            Friction::Lower(LowerFriction::Exponential {
+                t_1, t_2, w_1, w_2, ..
+            }) => {
+                let s1 = 1.0 / (0.5 * w_1 * x).cosh();
+                let s2 = 1.0 / (0.5 * w_2 * x).cosh();
+                0.5 * t_1 * w_1 * s1 * s1 + 0.5 * t_2 * w_2 * s2 * s2
+            }
+            Friction::Lower(LowerFriction::Stribeck {
+                t_s,
+                t_c,
+                omega_s,
+                delta,
+                ..
+            }) => {
+                let a = x.abs();
+                if a == 0.0 {
+                    // d/da e^{-(a/ω_s)^δ} at 0: 0 for δ > 1, −1/ω_s for δ = 1, −∞ for δ < 1.
+                    return if delta > 1.0 {
+                        0.0
+                    } else if delta == 1.0 {
+                        -(t_s - t_c) / omega_s
+                    } else {
+                        f64::NEG_INFINITY * (t_s - t_c).signum()
+                    };
+                }
+                let r = (a / omega_s).powf(delta);
+                -(t_s - t_c) * (-r).exp() * delta * r / a * x.signum()
+            }
+        }
+    }
+
+    /// Smooth offset `a^s(ω)` on branch s: `ΔT_su + s·Δb_u·ω` for the upper disc, 0 for the lower.
+    pub fn offset(&self, w: f64, s: f64) -> f64 {
+        match self {
+            Friction::Upper(p) => p.dt_s + s * p.db * w,
+            Friction::Lower(_) => 0.0,
+        }
+    }
+
+    /// Branch torque `T_f^s(ω) = a^s(ω) + b ω + s·N(sω)` (see the module docs).
+    #[inline]
+    pub fn torque(&self, w: f64, s: f64) -> f64 {
+        self.offset(w, s) + self.viscous() * w + s * self.level_ext(s * w)
+    }
+
+    /// `dT_f^s/dω`.
+    #[inline]
+    pub fn dtorque(&self, w: f64, s: f64) -> f64 {
+        let da = match self {
+            Friction::Upper(p) => s * p.db,
+            Friction::Lower(_) => 0.0,
+        };
+        // d/dω [s·N(sω)] = s·s·N'(sω) = N'(sω).
+        da + self.viscous() + self.dlevel_ext(s * w)
+    }
+
+    /// The stick interval `[T_f(0⁻), T_f(0⁺)] = a(0) + N(0)·[−1, 1]`.
+    pub fn static_interval(&self) -> (f64, f64) {
+        let a0 = self.offset(0.0, 1.0);
+        let n0 = self.level(0.0);
+        (a0 - n0, a0 + n0)
+    }
+
+    /// Whether the law has a set-valued part at ω = 0 (an interval of positive width).
+    pub fn is_set_valued(&self) -> bool {
+        self.level(0.0) > 0.0
+    }
+
+    /// The single-valued law for ω ≠ 0, `T_f(ω) = T_f^{sign ω}(ω)`; at ω = 0 the midpoint of
+    /// the stick interval (for plotting).
+    pub fn curve(&self, w: f64) -> f64 {
+        if w > 0.0 {
+            self.torque(w, 1.0)
+        } else if w < 0.0 {
+            self.torque(w, -1.0)
+        } else {
+            self.offset(0.0, 1.0)
+        }
+    }
+
+    /// The magnitude `T_c(ω)` of eqs. (4)–(5): `T_f(ω) = T_c(ω)·sign(ω)`.
+    pub fn magnitude(&self, w: f64) -> f64 {
+        let s = if w < 0.0 { -1.0 } else { 1.0 };
+        s * self.torque(w, s)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::params::Params;
+    use approx::assert_relative_eq;
+
+    fn laws() -> Vec<Friction> {
+        let t1 = Params::table1();
+        let st = Params::from_toml_str(
+            include_str!("../../../fixtures/params/stribeck.toml"),
+            std::path::Path::new("s"),
+        )
+        .unwrap();
+        vec![
+            Friction::Upper(t1.upper),
+            Friction::Lower(t1.lower),
+            Friction::Upper(st.upper),
+            Friction::Lower(st.lower),
+        ]
+    }
+
+    #[test]
+    fn exponential_matches_source_form() {
+        // The tanh form against the source's 1 − 2/(1+e^x) form, evaluated literally.
+        let LowerFriction::Exponential {
+            t_s, t_1, t_2, w_1, w_2, b,
+        } = Params::table1().lower
+        else {
+            unreachable!()
+        };
+        let f = Friction::Lower(Params::table1().lower);
+        for w in [0.0, 0.01, 0.3, 1.0, 4.0, 12.0, 30.0] {
+            let src = t_s
+                + t_1 * (1.0 - 2.0 / (1.0 + (w_1 * w).exp()))
+                + t_2 * (1.0 - 2.0 / (1.0 + (w_2 * w).exp()))
+                + b * w;
+            // Both forms in double precision: agree to a few ulps of the O(0.2) value.
+            assert_relative_eq!(f.magnitude(w), src, epsilon = 1e-15);
+            assert_relative_eq!(f.magnitude(-w), src, epsilon = 1e-15);
+        }
+        assert_eq!(f.static_interval(), (-t_s, t_s));
+    }
+
+    #[test]
+    fn upper_matches_eq4() {
+        let p = UpperFriction {
+            t_s: 0.37975,
+            dt_s: -0.00575,
+            b: 2.4245,
+            db: -0.0084,
+        };
+        let f = Friction::Upper(p);
+        for w in [-3.0, -0.2, 0.2, 3.0_f64] {
+            let tcu = p.t_s + p.dt_s * w.signum() + p.b * w.abs() + p.db * w;
+            assert_relative_eq!(f.curve(w), tcu * w.signum(), epsilon = 1e-15);
+        }
+        // T_cu(0+) = T_su + ΔT_su and −T_cu(0−) = −T_su + ΔT_su (source, below eq. 5).
+        let (lo, hi) = f.static_interval();
+        assert_relative_eq!(hi, p.t_s + p.dt_s);
+        assert_relative_eq!(lo, -p.t_s + p.dt_s);
+    }
+
+    #[test]
+    fn derivatives_match_finite_differences() {
+        for f in laws() {
+            for s in [1.0, -1.0] {
+                for w in [0.05, 0.4, 1.3, 5.0, 17.0] {
+                    let w = s * w;
+                    let d = 1e-6;
+                    let fd = (f.torque(w + d, s) - f.torque(w - d, s)) / (2.0 * d);
+                    // Central difference: truncation O(d²·T''') ~ 1e-10, rounding ~1e-16/d ~ 1e-10.
+                    assert_relative_eq!(f.dtorque(w, s), fd, epsilon = 1e-8, max_relative = 1e-7);
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn branch_continuation_is_smooth_at_zero() {
+        // The branch torque is continuous across ω = 0 (needed for event location).
+        for f in laws() {
+            for s in [1.0, -1.0] {
+                let l = f.torque(-1e-9, s);
+                let r = f.torque(1e-9, s);
+                assert!((l - r).abs() < 1e-7, "{f:?} s={s}: {l} vs {r}");
+            }
+        }
+    }
+}

@@ -1,0 +1,27 @@
+//! The two-disc rotor benchmark model (drill-string set-up) with set-valued friction.
+//!
+//! See `../shared/MODEL.md`: state `x = [α, ω_u, ω_l]`, equations
+//! `α̇ = ω_u − ω_l`, `J_u ω̇_u = k_m u − k_θ α − T_fu(ω_u)`, `J_l ω̇_l = k_θ α − T_fl(ω_l)`.
+//!
+//! This crate is shared by all solvers and holds no integration code.
+
+pub mod dynamics;
+pub mod equilibrium;
+pub mod friction;
+pub mod lagrangian;
+pub mod params;
+pub mod scenario;
+pub mod scene;
+pub mod steady;
+
+pub use dynamics::{ALPHA, Disc, DiscMode, Mode, Model, OMEGA_L, OMEGA_U, State};
+pub use equilibrium::{SlipEquilibrium, StuckSet};
+pub use friction::Friction;
+pub use lagrangian::{Coords, Lagrangian};
+pub use params::{LowerFriction, Params, ParamsError, UpperFriction};
+pub use scenario::{Scenario, ScenarioError};
+pub use scene::{
+    Event, EventKind, Output, OutputGrid, Sample, Scene, SolveError, Solver, Stats, Trajectory,
+    check_finite,
+};
+pub use steady::{MetricsAccumulator, SteadyState};

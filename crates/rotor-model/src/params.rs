@@ -1,0 +1,553 @@
+//! Parameter sets: TOML files with every value and its unit, validated into [`Params`].
+//!
+//! The file format (see `fixtures/params/table1.toml`):
+//!
+//! ```toml
+//! name = "table1"
+//! j_u = 0.4765      # kg m^2
+//! k_m = 3.9950      # N m / V
+//! k_theta = 0.0727  # N m / rad
+//! j_l = 0.0326      # kg m^2
+//! [upper]           # eq. (4): T_su, ΔT_su, b_u, Δb_u
+//! t_s = 0.0
+//! dt_s = 0.0
+//! b = 2.2247
+//! db = 0.0
+//! [lower]
+//! family = "exponential"   # or "stribeck"
+//! t_s = 0.1642
+//! t_1 = 0.0603
+//! t_2 = -0.2267
+//! w_1 = 5.7468
+//! w_2 = 0.2941
+//! b = 0.0109
+//! ```
+
+use std::path::{Path, PathBuf};
+
+use serde::{Deserialize, Serialize};
+use thiserror::Error;
+
+/// A parameter file could not be read or is not an admissible parameter set.
+#[derive(Debug, Error, Clone, PartialEq)]
+pub enum ParamsError {
+    /// The file could not be read.
+    #[error("{path}: cannot read parameter file: {message}")]
+    Io { path: PathBuf, message: String },
+    /// The file is not valid TOML, or a key is unknown, missing or of the wrong type.
+    #[error("{path}: {message}")]
+    Parse { path: PathBuf, message: String },
+    /// A value is out of its admissible range.
+    #[error("{path}: {field} = {value}: {reason}")]
+    Invalid {
+        path: PathBuf,
+        field: String,
+        value: String,
+        reason: String,
+    },
+}
+
+/// Friction law of the upper disc, eq. (4) of the source:
+/// `T_cu(ω) = T_su + ΔT_su·sgn(ω) + b_u·|ω| + Δb_u·ω`.
+///
+/// The friction torque is `T_fu = T_cu(ω)·sign(ω) = ΔT_su + Δb_u|ω| + b_u ω + T_su sign(ω)`,
+/// so its set at ω = 0 is `ΔT_su + T_su·[−1, 1]`.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct UpperFriction {
+    /// T_su [N m]: static level (half-width of the stick interval).
+    pub t_s: f64,
+    /// ΔT_su [N m]: asymmetry of the static level.
+    #[serde(default)]
+    pub dt_s: f64,
+    /// b_u [N m s/rad]: viscous coefficient.
+    pub b: f64,
+    /// Δb_u [N m s/rad]: asymmetry of the viscous coefficient.
+    #[serde(default)]
+    pub db: f64,
+}
+
+/// Friction law of the lower disc: one of the two families of MODEL.md.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+#[serde(tag = "family", rename_all = "lowercase")]
+pub enum LowerFriction {
+    /// `T_cl(ω) = T_sl + T_1(1 − 2/(1+e^{w_1|ω|})) + T_2(1 − 2/(1+e^{w_2|ω|})) + b_l|ω|`
+    /// (the family of Table 1).
+    Exponential {
+        t_s: f64,
+        t_1: f64,
+        t_2: f64,
+        w_1: f64,
+        w_2: f64,
+        b: f64,
+    },
+    /// `T_cl(ω) = T_cl + (T_sl − T_cl)·exp(−|ω/ω_sl|^δ_sl) + b_l|ω|` (eq. 5 of the source).
+    Stribeck {
+        t_s: f64,
+        t_c: f64,
+        omega_s: f64,
+        delta: f64,
+        b: f64,
+    },
+}
+
+impl LowerFriction {
+    /// Static level T_sl: half-width of the stick interval.
+    pub fn static_level(&self) -> f64 {
+        match *self {
+            LowerFriction::Exponential { t_s, .. } | LowerFriction::Stribeck { t_s, .. } => t_s,
+        }
+    }
+
+    /// Viscous coefficient b_l.
+    pub fn viscous(&self) -> f64 {
+        match *self {
+            LowerFriction::Exponential { b, .. } | LowerFriction::Stribeck { b, .. } => b,
+        }
+    }
+
+    /// Name of the family as written in parameter files.
+    pub fn family(&self) -> &'static str {
+        match self {
+            LowerFriction::Exponential { .. } => "exponential",
+            LowerFriction::Stribeck { .. } => "stribeck",
+        }
+    }
+}
+
+/// A validated parameter set of the two-disc rotor.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct Params {
+    /// J_u [kg m²]: inertia of the upper disc.
+    pub j_u: f64,
+    /// k_m [N m/V]: motor constant.
+    pub k_m: f64,
+    /// k_θ [N m/rad]: torsional stiffness.
+    pub k_theta: f64,
+    /// J_l [kg m²]: inertia of the lower disc.
+    pub j_l: f64,
+    /// Upper-disc friction, eq. (4).
+    pub upper: UpperFriction,
+    /// Lower-disc friction.
+    pub lower: LowerFriction,
+}
+
+/// The on-disk form; every field optional in the lower table so that the family decides
+/// which keys are required, and every key unknown to all families is rejected by serde.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawParams {
+    #[serde(default)]
+    #[allow(dead_code)]
+    name: Option<String>,
+    #[serde(default)]
+    #[allow(dead_code)]
+    description: Option<String>,
+    j_u: f64,
+    k_m: f64,
+    k_theta: f64,
+    j_l: f64,
+    upper: UpperFriction,
+    lower: RawLower,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawLower {
+    family: String,
+    t_s: Option<f64>,
+    t_1: Option<f64>,
+    t_2: Option<f64>,
+    w_1: Option<f64>,
+    w_2: Option<f64>,
+    t_c: Option<f64>,
+    omega_s: Option<f64>,
+    delta: Option<f64>,
+    b: Option<f64>,
+}
+
+impl Params {
+    /// The source's Table 1 (exponential family; T_su = ΔT_su = Δb_u = 0).
+    pub fn table1() -> Params {
+        Params {
+            j_u: 0.4765,
+            k_m: 3.9950,
+            k_theta: 0.0727,
+            j_l: 0.0326,
+            upper: UpperFriction {
+                t_s: 0.0,
+                dt_s: 0.0,
+                b: 2.2247,
+                db: 0.0,
+            },
+            lower: LowerFriction::Exponential {
+                t_s: 0.1642,
+                t_1: 0.0603,
+                t_2: -0.2267,
+                w_1: 5.7468,
+                w_2: 0.2941,
+                b: 0.0109,
+            },
+        }
+    }
+
+    /// Reads and validates a parameter file.
+    pub fn from_file(path: &Path) -> Result<Params, ParamsError> {
+        let bytes = std::fs::read(path).map_err(|e| ParamsError::Io {
+            path: path.to_owned(),
+            message: e.to_string(),
+        })?;
+        let text = String::from_utf8(bytes).map_err(|_| ParamsError::Parse {
+            path: path.to_owned(),
+            message: "not a UTF-8 text file".into(),
+        })?;
+        Params::from_toml_str(&text, path)
+    }
+
+    /// Parses and validates parameter TOML; `path` is only used in messages.
+    pub fn from_toml_str(text: &str, path: &Path) -> Result<Params, ParamsError> {
+        if text.trim().is_empty() {
+            return Err(ParamsError::Parse {
+                path: path.to_owned(),
+                message: "the file is empty".into(),
+            });
+        }
+        let raw: RawParams = toml::from_str(text).map_err(|e| ParamsError::Parse {
+            path: path.to_owned(),
+            message: one_line(&e.to_string()),
+        })?;
+        let bad = |field: &str, value: f64, reason: &str| ParamsError::Invalid {
+            path: path.to_owned(),
+            field: field.to_owned(),
+            value: value.to_string(),
+            reason: reason.to_owned(),
+        };
+        let lower = match raw.lower.family.as_str() {
+            "exponential" => {
+                let l = &raw.lower;
+                for (name, v) in [
+                    ("t_c", l.t_c),
+                    ("omega_s", l.omega_s),
+                    ("delta", l.delta),
+                ] {
+                    if let Some(v) = v {
+                        return Err(bad(
+                            &format!("lower.{name}"),
+                            v,
+                            "not a parameter of the 'exponential' family",
+                        ));
+                    }
+                }
+                let need = |name: &str, v: Option<f64>| {
+                    v.ok_or_else(|| ParamsError::Parse {
+                        path: path.to_owned(),
+                        message: format!(
+                            "lower.{name}: missing (required by family 'exponential')"
+                        ),
+                    })
+                };
+                LowerFriction::Exponential {
+                    t_s: need("t_s", l.t_s)?,
+                    t_1: need("t_1", l.t_1)?,
+                    t_2: need("t_2", l.t_2)?,
+                    w_1: need("w_1", l.w_1)?,
+                    w_2: need("w_2", l.w_2)?,
+                    b: need("b", l.b)?,
+                }
+            }
+            "stribeck" => {
+                let l = &raw.lower;
+                for (name, v) in [
+                    ("t_1", l.t_1),
+                    ("t_2", l.t_2),
+                    ("w_1", l.w_1),
+                    ("w_2", l.w_2),
+                ] {
+                    if let Some(v) = v {
+                        return Err(bad(
+                            &format!("lower.{name}"),
+                            v,
+                            "not a parameter of the 'stribeck' family",
+                        ));
+                    }
+                }
+                let need = |name: &str, v: Option<f64>| {
+                    v.ok_or_else(|| ParamsError::Parse {
+                        path: path.to_owned(),
+                        message: format!("lower.{name}: missing (required by family 'stribeck')"),
+                    })
+                };
+                LowerFriction::Stribeck {
+                    t_s: need("t_s", l.t_s)?,
+                    t_c: need("t_c", l.t_c)?,
+                    omega_s: need("omega_s", l.omega_s)?,
+                    delta: need("delta", l.delta)?,
+                    b: need("b", l.b)?,
+                }
+            }
+            other => {
+                return Err(ParamsError::Invalid {
+                    path: path.to_owned(),
+                    field: "lower.family".into(),
+                    value: format!("{other:?}"),
+                    reason: "unknown friction family (expected \"exponential\" or \"stribeck\")"
+                        .into(),
+                });
+            }
+        };
+        let p = Params {
+            j_u: raw.j_u,
+            k_m: raw.k_m,
+            k_theta: raw.k_theta,
+            j_l: raw.j_l,
+            upper: raw.upper,
+            lower,
+        };
+        p.validate()
+            .map_err(|(field, value, reason)| bad(&field, value, &reason))?;
+        Ok(p)
+    }
+
+    /// Checks that every value is finite and in its admissible range.
+    /// Returns `(field, value, reason)` for the first violation.
+    pub fn validate(&self) -> Result<(), (String, f64, String)> {
+        let mut fields: Vec<(&str, f64)> = vec![
+            ("j_u", self.j_u),
+            ("k_m", self.k_m),
+            ("k_theta", self.k_theta),
+            ("j_l", self.j_l),
+            ("upper.t_s", self.upper.t_s),
+            ("upper.dt_s", self.upper.dt_s),
+            ("upper.b", self.upper.b),
+            ("upper.db", self.upper.db),
+        ];
+        match self.lower {
+            LowerFriction::Exponential {
+                t_s,
+                t_1,
+                t_2,
+                w_1,
+                w_2,
+                b,
+            } => fields.extend([
+                ("lower.t_s", t_s),
+                ("lower.t_1", t_1),
+                ("lower.t_2", t_2),
+                ("lower.w_1", w_1),
+                ("lower.w_2", w_2),
+                ("lower.b", b),
+            ]),
+            LowerFriction::Stribeck {
+                t_s,
+                t_c,
+                omega_s,
+                delta,
+                b,
+            } => fields.extend([
+                ("lower.t_s", t_s),
+                ("lower.t_c", t_c),
+                ("lower.omega_s", omega_s),
+                ("lower.delta", delta),
+                ("lower.b", b),
+            ]),
+        }
+        let err = |f: &str, v: f64, r: &str| Err((f.to_owned(), v, r.to_owned()));
+        for (f, v) in &fields {
+            if !v.is_finite() {
+                return err(f, *v, "must be a finite number");
+            }
+        }
+        for (f, v) in [
+            ("j_u", self.j_u),
+            ("j_l", self.j_l),
+            ("k_theta", self.k_theta),
+        ] {
+            if v <= 0.0 {
+                return err(f, v, "must be positive");
+            }
+        }
+        if self.k_m == 0.0 {
+            return err("k_m", self.k_m, "must be non-zero");
+        }
+        if self.upper.t_s < 0.0 {
+            return err("upper.t_s", self.upper.t_s, "static level must be >= 0");
+        }
+        if self.upper.dt_s.abs() > self.upper.t_s {
+            return err(
+                "upper.dt_s",
+                self.upper.dt_s,
+                "|dt_s| must not exceed t_s (T_cu(0+) and T_cu(0-) must be >= 0)",
+            );
+        }
+        if self.upper.b < 0.0 {
+            return err("upper.b", self.upper.b, "viscous coefficient must be >= 0");
+        }
+        if self.upper.db.abs() > self.upper.b {
+            return err(
+                "upper.db",
+                self.upper.db,
+                "|db| must not exceed b (both viscous slopes must be >= 0)",
+            );
+        }
+        match self.lower {
+            LowerFriction::Exponential {
+                t_s, w_1, w_2, b, ..
+            } => {
+                if t_s < 0.0 {
+                    return err("lower.t_s", t_s, "static level must be >= 0");
+                }
+                if w_1 <= 0.0 {
+                    return err("lower.w_1", w_1, "must be positive");
+                }
+                if w_2 <= 0.0 {
+                    return err("lower.w_2", w_2, "must be positive");
+                }
+                if b < 0.0 {
+                    return err("lower.b", b, "viscous coefficient must be >= 0");
+                }
+            }
+            LowerFriction::Stribeck {
+                t_s,
+                t_c,
+                omega_s,
+                delta,
+                b,
+            } => {
+                if t_s < 0.0 {
+                    return err("lower.t_s", t_s, "static level must be >= 0");
+                }
+                if t_c < 0.0 {
+                    return err("lower.t_c", t_c, "Coulomb level must be >= 0");
+                }
+                if omega_s <= 0.0 {
+                    return err("lower.omega_s", omega_s, "Stribeck velocity must be positive");
+                }
+                if delta <= 0.0 {
+                    return err("lower.delta", delta, "Stribeck exponent must be positive");
+                }
+                if b < 0.0 {
+                    return err("lower.b", b, "viscous coefficient must be >= 0");
+                }
+            }
+        }
+        Ok(())
+    }
+}
+
+/// Collapses a multi-line parser message into one line. toml prints a source excerpt
+/// (`6 | j_u = "heavy"` and a caret line); the excerpt's source line is kept, since it shows
+/// the offending key and value.
+pub(crate) fn one_line(s: &str) -> String {
+    let mut head: Vec<&str> = Vec::new();
+    let mut at: Option<&str> = None;
+    for line in s.lines() {
+        let t = line.trim();
+        if t.is_empty() {
+            continue;
+        }
+        if let Some((num, src)) = t.split_once('|') {
+            let num = num.trim();
+            if !num.is_empty() && num.chars().all(|c| c.is_ascii_digit()) {
+                at = Some(src.trim());
+            }
+            // Caret and gutter lines carry nothing more.
+            continue;
+        }
+        head.push(t);
+    }
+    let mut out = head.join(": ");
+    if let Some(src) = at {
+        out.push_str(&format!(" (in `{src}`)"));
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const TABLE1: &str = include_str!("../../../fixtures/params/table1.toml");
+    const STRIBECK: &str = include_str!("../../../fixtures/params/stribeck.toml");
+
+    #[test]
+    fn fixture_table1_matches_builtin() {
+        let p = Params::from_toml_str(TABLE1, Path::new("table1.toml")).unwrap();
+        assert_eq!(p, Params::table1());
+    }
+
+    #[test]
+    fn fixture_stribeck_parses() {
+        let p = Params::from_toml_str(STRIBECK, Path::new("stribeck.toml")).unwrap();
+        assert_eq!(p.lower.family(), "stribeck");
+        assert!(p.upper.t_s > 0.0);
+    }
+
+    fn err_of(text: &str) -> String {
+        Params::from_toml_str(text, Path::new("p.toml"))
+            .unwrap_err()
+            .to_string()
+    }
+
+    #[test]
+    fn unknown_key_is_named() {
+        let t = TABLE1.replace("j_u =", "j_uu =");
+        let e = err_of(&t);
+        assert!(e.contains("j_uu"), "{e}");
+        assert!(e.starts_with("p.toml"), "{e}");
+        assert!(!e.contains('\n'), "one line: {e}");
+    }
+
+    #[test]
+    fn negative_inertia_is_named_with_value() {
+        let t = TABLE1.replace("j_l = 0.0326", "j_l = -0.5");
+        let e = err_of(&t);
+        assert!(e.contains("j_l = -0.5"), "{e}");
+    }
+
+    #[test]
+    fn non_finite_is_rejected() {
+        let t = TABLE1.replace("k_theta = 0.0727", "k_theta = nan");
+        assert!(err_of(&t).contains("k_theta = NaN"));
+        let t = TABLE1.replace("k_theta = 0.0727", "k_theta = inf");
+        assert!(err_of(&t).contains("k_theta = inf"));
+    }
+
+    #[test]
+    fn unknown_family_is_named() {
+        let t = TABLE1.replace("\"exponential\"", "\"dahl\"");
+        let e = err_of(&t);
+        assert!(e.contains("lower.family") && e.contains("dahl"), "{e}");
+    }
+
+    #[test]
+    fn wrong_family_key_is_named() {
+        let t = STRIBECK.replace("delta =", "w_1 = 1.0\ndelta =");
+        let e = err_of(&t);
+        assert!(e.contains("lower.w_1"), "{e}");
+    }
+
+    #[test]
+    fn missing_key_is_named() {
+        let t = TABLE1.replace("w_2 = 0.2941", "");
+        let e = err_of(&t);
+        assert!(e.contains("w_2"), "{e}");
+        let t = TABLE1.replace("k_m = 3.9950", "");
+        let e = err_of(&t);
+        assert!(e.contains("k_m"), "{e}");
+    }
+
+    #[test]
+    fn stribeck_exponent_must_be_positive() {
+        let t = STRIBECK.replace("delta = 2.0575", "delta = 0.0");
+        let e = err_of(&t);
+        assert!(e.contains("lower.delta = 0"), "{e}");
+    }
+
+    #[test]
+    fn wrong_type_and_empty_file() {
+        let t = TABLE1.replace("j_u = 0.4765", "j_u = \"heavy\"");
+        let e = err_of(&t);
+        assert!(e.contains("j_u"), "{e}");
+        assert!(err_of("  \n").contains("empty"));
+    }
+}

@@ -1,0 +1,332 @@
+//! Scenario files: one scene, run by all three solvers (DESIGN.md §3).
+//!
+//! ```toml
+//! name = "t1-u1.5-rest"
+//! params = "../params/table1.toml"   # relative to this file
+//! u = 1.5                            # V
+//! x0 = [0.0, 0.0, 0.0]               # or: x0_from_equilibrium = [0.0, 0.0, 1e-3]
+//! t_end = 200.0                      # s
+//! [compare]
+//! transient = [0.0, 20.0]            # s, compared sample by sample
+//! steady_from = 100.0                # s, steady-state metrics over [steady_from, t_end]
+//! [tolerance.event-switch]           # per solver pair; each value with its origin
+//! transient_max = 1e-6
+//! ```
+
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+
+use serde::Deserialize;
+use thiserror::Error;
+
+use crate::dynamics::{Model, State};
+use crate::params::{Params, ParamsError, one_line};
+
+/// A scenario file could not be read or is not admissible.
+#[derive(Debug, Error, Clone, PartialEq)]
+pub enum ScenarioError {
+    /// The file could not be read.
+    #[error("{path}: cannot read scenario file: {message}")]
+    Io { path: PathBuf, message: String },
+    /// Not valid TOML, or a key is unknown, missing or of the wrong type.
+    #[error("{path}: {message}")]
+    Parse { path: PathBuf, message: String },
+    /// A value is out of range.
+    #[error("{path}: {field} = {value}: {reason}")]
+    Invalid {
+        path: PathBuf,
+        field: String,
+        value: String,
+        reason: String,
+    },
+    /// The parameter file it names is bad.
+    #[error("{path}: params: {source}")]
+    Params {
+        path: PathBuf,
+        #[source]
+        source: ParamsError,
+    },
+}
+
+/// What the comparison harness compares for this scene.
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CompareSpec {
+    /// Window `[t0, t1]` compared sample by sample on a common grid.
+    #[serde(default)]
+    pub transient: Option<[f64; 2]>,
+    /// Grid step of the transient comparison and of the report's CSVs [s].
+    #[serde(default = "default_dt")]
+    pub dt: f64,
+    /// Steady-state metrics over `[steady_from, t_end]`; `None`: no steady comparison.
+    #[serde(default)]
+    pub steady_from: Option<f64>,
+}
+
+fn default_dt() -> f64 {
+    0.01
+}
+
+impl Default for CompareSpec {
+    fn default() -> Self {
+        CompareSpec {
+            transient: None,
+            dt: default_dt(),
+            steady_from: None,
+        }
+    }
+}
+
+/// Agreement tolerances for one solver pair (each with its origin in a comment in the file).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PairTolerance {
+    /// Max |Δω| over the transient window [rad/s].
+    pub transient_max: Option<f64>,
+    /// RMS of Δω over the transient window [rad/s].
+    pub transient_rms: Option<f64>,
+    /// Relative difference of each steady-state metric (with `steady_abs` as a floor).
+    pub steady_rel: Option<f64>,
+    /// Absolute floor of the steady-state comparison [s or rad/s].
+    pub steady_abs: Option<f64>,
+    /// Max difference of matched event times [s].
+    pub event_time: Option<f64>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawScenario {
+    name: String,
+    #[serde(default)]
+    description: Option<String>,
+    params: PathBuf,
+    u: f64,
+    #[serde(default)]
+    x0: Option<[f64; 3]>,
+    #[serde(default)]
+    x0_from_equilibrium: Option<[f64; 3]>,
+    t_end: f64,
+    #[serde(default)]
+    tol: Option<f64>,
+    #[serde(default)]
+    h: Option<f64>,
+    #[serde(default)]
+    compare: CompareSpec,
+    #[serde(default)]
+    tolerance: BTreeMap<String, PairTolerance>,
+}
+
+/// A loaded, validated scenario.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Scenario {
+    pub name: String,
+    pub description: String,
+    pub path: PathBuf,
+    pub params_path: PathBuf,
+    pub model: Model,
+    pub u: f64,
+    pub x0: State,
+    pub t_end: f64,
+    /// Tolerance for the adaptive solvers, if the file sets one.
+    pub tol: Option<f64>,
+    /// Step for the time-stepping solver, if the file sets one.
+    pub h: Option<f64>,
+    pub compare: CompareSpec,
+    /// Keyed by pair name, e.g. `"event-switch"`.
+    pub tolerance: BTreeMap<String, PairTolerance>,
+}
+
+impl Scenario {
+    /// Reads and validates a scenario file and the parameter file it names.
+    pub fn from_file(path: &Path) -> Result<Scenario, ScenarioError> {
+        let bytes = std::fs::read(path).map_err(|e| ScenarioError::Io {
+            path: path.to_owned(),
+            message: e.to_string(),
+        })?;
+        let text = String::from_utf8(bytes).map_err(|_| ScenarioError::Parse {
+            path: path.to_owned(),
+            message: "not a UTF-8 text file".into(),
+        })?;
+        Scenario::from_toml_str(&text, path)
+    }
+
+    /// Parses scenario TOML; `path` resolves the params path and names the file in messages.
+    pub fn from_toml_str(text: &str, path: &Path) -> Result<Scenario, ScenarioError> {
+        if text.trim().is_empty() {
+            return Err(ScenarioError::Parse {
+                path: path.to_owned(),
+                message: "the file is empty".into(),
+            });
+        }
+        let raw: RawScenario = toml::from_str(text).map_err(|e| ScenarioError::Parse {
+            path: path.to_owned(),
+            message: one_line(&e.to_string()),
+        })?;
+        let bad = |field: &str, value: String, reason: &str| ScenarioError::Invalid {
+            path: path.to_owned(),
+            field: field.to_owned(),
+            value,
+            reason: reason.to_owned(),
+        };
+        let params_path = path
+            .parent()
+            .unwrap_or(Path::new("."))
+            .join(&raw.params);
+        let params = Params::from_file(&params_path).map_err(|source| ScenarioError::Params {
+            path: path.to_owned(),
+            source,
+        })?;
+        let model = Model::new(params);
+        if !raw.u.is_finite() {
+            return Err(bad("u", raw.u.to_string(), "must be finite"));
+        }
+        if !(raw.t_end > 0.0 && raw.t_end.is_finite()) {
+            return Err(bad("t_end", raw.t_end.to_string(), "must be positive and finite"));
+        }
+        if let Some(tol) = raw.tol
+            && !(tol > 0.0 && tol < 1.0)
+        {
+            return Err(bad("tol", tol.to_string(), "must lie in (0, 1)"));
+        }
+        if let Some(h) = raw.h
+            && !(h > 0.0 && h <= raw.t_end)
+        {
+            return Err(bad("h", h.to_string(), "must lie in (0, t_end]"));
+        }
+        let x0 = match (raw.x0, raw.x0_from_equilibrium) {
+            (Some(_), Some(_)) => {
+                return Err(bad(
+                    "x0_from_equilibrium",
+                    "given".into(),
+                    "give either x0 or x0_from_equilibrium, not both",
+                ));
+            }
+            (Some(x), None) => State::new(x[0], x[1], x[2]),
+            (None, Some(d)) => {
+                let eqs = model.slip_equilibria(raw.u);
+                match eqs.as_slice() {
+                    [e] => e.state() + State::new(d[0], d[1], d[2]),
+                    [] => {
+                        return Err(bad(
+                            "x0_from_equilibrium",
+                            format!("{d:?}"),
+                            "there is no slipping equilibrium at this u",
+                        ));
+                    }
+                    _ => {
+                        return Err(bad(
+                            "x0_from_equilibrium",
+                            format!("{d:?}"),
+                            "several slipping equilibria exist at this u; give x0",
+                        ));
+                    }
+                }
+            }
+            (None, None) => State::zeros(),
+        };
+        for (i, n) in ["x0[0]", "x0[1]", "x0[2]"].iter().enumerate() {
+            if !x0[i].is_finite() {
+                return Err(bad(n, x0[i].to_string(), "must be finite"));
+            }
+        }
+        if !(raw.compare.dt > 0.0 && raw.compare.dt.is_finite()) {
+            return Err(bad("compare.dt", raw.compare.dt.to_string(), "must be positive"));
+        }
+        if let Some([a, b]) = raw.compare.transient
+            && !(0.0 <= a && a < b && b <= raw.t_end)
+        {
+            return Err(bad(
+                "compare.transient",
+                format!("[{a}, {b}]"),
+                "must satisfy 0 <= t0 < t1 <= t_end",
+            ));
+        }
+        if let Some(t) = raw.compare.steady_from
+            && !(t >= 0.0 && t < raw.t_end)
+        {
+            return Err(bad("compare.steady_from", t.to_string(), "must lie in [0, t_end)"));
+        }
+        for (pair, tol) in &raw.tolerance {
+            for (name, v) in [
+                ("transient_max", tol.transient_max),
+                ("transient_rms", tol.transient_rms),
+                ("steady_rel", tol.steady_rel),
+                ("steady_abs", tol.steady_abs),
+                ("event_time", tol.event_time),
+            ] {
+                if let Some(v) = v
+                    && !(v > 0.0 && v.is_finite())
+                {
+                    return Err(bad(
+                        &format!("tolerance.{pair}.{name}"),
+                        v.to_string(),
+                        "must be positive and finite",
+                    ));
+                }
+            }
+        }
+        Ok(Scenario {
+            name: raw.name,
+            description: raw.description.unwrap_or_default(),
+            path: path.to_owned(),
+            params_path,
+            model,
+            u: raw.u,
+            x0,
+            t_end: raw.t_end,
+            tol: raw.tol,
+            h: raw.h,
+            compare: raw.compare,
+            tolerance: raw.tolerance,
+        })
+    }
+
+    /// All `*.toml` scenario files in a directory, sorted by file name.
+    pub fn list_dir(dir: &Path) -> std::io::Result<Vec<PathBuf>> {
+        let mut v: Vec<PathBuf> = std::fs::read_dir(dir)?
+            .filter_map(|e| e.ok().map(|e| e.path()))
+            .filter(|p| p.extension().is_some_and(|x| x == "toml"))
+            .collect();
+        v.sort();
+        Ok(v)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn fixtures() -> PathBuf {
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("../../fixtures/scenarios")
+    }
+
+    #[test]
+    fn every_fixture_scenario_loads() {
+        let files = Scenario::list_dir(&fixtures()).unwrap();
+        assert!(files.len() >= 14, "found {}", files.len());
+        for f in files {
+            let s = Scenario::from_file(&f).unwrap_or_else(|e| panic!("{e}"));
+            assert!(!s.name.is_empty());
+        }
+    }
+
+    fn err(text: &str) -> String {
+        Scenario::from_toml_str(text, &fixtures().join("x.toml"))
+            .unwrap_err()
+            .to_string()
+    }
+
+    #[test]
+    fn bad_scenarios_name_the_field() {
+        let ok = "name = \"a\"\nparams = \"../params/table1.toml\"\nu = 1.5\nt_end = 10.0\n";
+        assert!(Scenario::from_toml_str(ok, &fixtures().join("x.toml")).is_ok());
+        assert!(err(&ok.replace("t_end = 10.0", "t_end = -1.0")).contains("t_end = -1"));
+        assert!(err(&ok.replace("t_end = 10.0", "t_end = 10.0\nh = 0.0")).contains("h = 0"));
+        assert!(err(&ok.replace("t_end = 10.0", "t_end = 10.0\nh = 20.0")).contains("h = 20"));
+        assert!(err(&ok.replace("t_end = 10.0", "t_end = 10.0\ntol = 1.0")).contains("tol = 1"));
+        assert!(err(&ok.replace("u = 1.5", "uu = 1.5")).contains("uu"));
+        let e = err(&ok.replace("table1", "nothere"));
+        assert!(e.contains("nothere.toml") && e.contains("params"), "{e}");
+        assert!(err("").contains("empty"));
+    }
+}

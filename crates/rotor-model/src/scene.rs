@@ -1,0 +1,341 @@
+//! The solver seam: what a solver is asked ([`Scene`]) and what it returns ([`Trajectory`]).
+
+use serde::Serialize;
+use thiserror::Error;
+
+use crate::dynamics::{Disc, Mode, Model, State};
+use crate::steady::SteadyState;
+
+/// What a solver keeps while it runs. Every level keeps the final state and the counters.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Output {
+    /// Only the final state and counters: no samples, no event list.
+    Final,
+    /// The list of events (stick onsets and exits, reversals, and extrema when metrics are
+    /// asked), no samples.
+    Events,
+    /// Samples at `t = k·dt` for `k = 0, 1, …` and at `t_end`, plus events.
+    Grid { dt: f64 },
+    /// The state after every step, plus events.
+    Steps,
+}
+
+/// One simulation request: input, initial state, horizon, accuracy, and what to keep.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Scene {
+    /// Motor input voltage u [V].
+    pub u: f64,
+    /// Initial state `[α, ω_u, ω_l]`.
+    pub x0: State,
+    /// Horizon [s]; the run covers `[0, t_end]`.
+    pub t_end: f64,
+    /// Tolerance of the adaptive solvers (relative = absolute).
+    pub tol: f64,
+    /// Step size of the time-stepping solver [s].
+    pub h: f64,
+    /// What to keep.
+    pub output: Output,
+    /// If set, steady-state metrics over `[metrics_from, t_end]` (extrema located between
+    /// steps, period from successive stick exits or ω_l maxima).
+    pub metrics_from: Option<f64>,
+}
+
+impl Default for Scene {
+    fn default() -> Self {
+        Scene {
+            u: 1.5,
+            x0: State::zeros(),
+            t_end: 100.0,
+            tol: 1e-10,
+            h: 1e-3,
+            output: Output::Grid { dt: 0.01 },
+            metrics_from: None,
+        }
+    }
+}
+
+impl Scene {
+    /// Checks the scene; the error names the field and the bad value.
+    pub fn validate(&self) -> Result<(), SolveError> {
+        let bad = |field: &'static str, value: f64, reason: &'static str| {
+            Err(SolveError::InvalidScene {
+                field,
+                value,
+                reason,
+            })
+        };
+        if !self.u.is_finite() {
+            return bad("u", self.u, "must be finite");
+        }
+        for (i, name) in ["x0[alpha]", "x0[omega_u]", "x0[omega_l]"].iter().enumerate() {
+            if !self.x0[i].is_finite() {
+                return bad(name, self.x0[i], "must be finite");
+            }
+        }
+        if !(self.t_end > 0.0 && self.t_end.is_finite()) {
+            return bad("t_end", self.t_end, "must be positive and finite");
+        }
+        if !(self.tol > 0.0 && self.tol < 1.0) {
+            return bad("tol", self.tol, "must lie in (0, 1)");
+        }
+        if !(self.h > 0.0 && self.h <= self.t_end) {
+            return bad("h", self.h, "must lie in (0, t_end]");
+        }
+        if let Output::Grid { dt } = self.output
+            && !(dt > 0.0 && dt.is_finite())
+        {
+            return bad("dt", dt, "must be positive and finite");
+        }
+        if let Some(t) = self.metrics_from
+            && !(t >= 0.0 && t < self.t_end)
+        {
+            return bad("metrics_from", t, "must lie in [0, t_end)");
+        }
+        Ok(())
+    }
+
+    /// Number of grid intervals for `Output::Grid { dt }`: sample times are `k·dt` for
+    /// `k = 0..=n` where `n·dt ≤ t_end` (within rounding), plus `t_end` if not on the grid.
+    pub fn grid(&self) -> Option<OutputGrid> {
+        match self.output {
+            Output::Grid { dt } => Some(OutputGrid::new(dt, self.t_end)),
+            _ => None,
+        }
+    }
+
+    /// Whether the event list is kept.
+    pub fn keeps_events(&self) -> bool {
+        !matches!(self.output, Output::Final)
+    }
+}
+
+/// The output grid `0, dt, 2dt, …, t_end`, walked without allocation.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct OutputGrid {
+    dt: f64,
+    t_end: f64,
+    n: u64,
+    k: u64,
+    done: bool,
+}
+
+impl OutputGrid {
+    /// The grid for step `dt` over `[0, t_end]`.
+    pub fn new(dt: f64, t_end: f64) -> OutputGrid {
+        // A time within 1e-9·dt of t_end counts as t_end (so 200/0.01 gives 20001 rows).
+        let n = ((t_end / dt) * (1.0 + 1e-12) + 1e-9).floor() as u64;
+        OutputGrid {
+            dt,
+            t_end,
+            n,
+            k: 0,
+            done: false,
+        }
+    }
+
+    /// The next output time, if any.
+    pub fn peek(&self) -> Option<f64> {
+        if self.done {
+            return None;
+        }
+        if self.k <= self.n {
+            let t = self.k as f64 * self.dt;
+            // The last grid point snaps to t_end when it is t_end up to rounding.
+            Some(if (t - self.t_end).abs() <= 1e-9 * self.dt { self.t_end } else { t.min(self.t_end) })
+        } else {
+            Some(self.t_end)
+        }
+    }
+
+    /// Advances past the current output time.
+    pub fn advance(&mut self) {
+        if let Some(t) = self.peek() {
+            if t >= self.t_end {
+                self.done = true;
+            }
+            self.k += 1;
+        }
+    }
+
+    /// Total number of rows the grid produces.
+    pub fn len(&self) -> usize {
+        let last = self.n as f64 * self.dt;
+        self.n as usize + 1 + usize::from((last - self.t_end).abs() > 1e-9 * self.dt)
+    }
+
+    /// Whether the grid is empty (never: it always holds t = 0).
+    pub fn is_empty(&self) -> bool {
+        false
+    }
+}
+
+/// One output sample.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct Sample {
+    pub t: f64,
+    pub x: State,
+}
+
+/// What happened at an event.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum EventKind {
+    /// The disc's velocity reached 0 and it sticks.
+    StickStart(Disc),
+    /// The stuck disc's applied torque left the stick interval; it slips again.
+    StickEnd(Disc),
+    /// The disc's velocity crossed 0 without sticking.
+    Reversal(Disc),
+    /// A local maximum of the disc's velocity (only when metrics are asked).
+    Max(Disc),
+    /// A local minimum of the disc's velocity (only when metrics are asked).
+    Min(Disc),
+}
+
+/// An event with its time and the state there.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct Event {
+    pub t: f64,
+    pub x: State,
+    pub kind: EventKind,
+}
+
+/// Work counters, for benchmarks and snapshots.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize)]
+pub struct Stats {
+    /// Accepted steps.
+    pub steps: u64,
+    /// Rejected steps (adaptive solvers).
+    pub rejected: u64,
+    /// Right-hand-side evaluations.
+    pub rhs_evals: u64,
+    /// Jacobian evaluations.
+    pub jac_evals: u64,
+    /// Located events (mode switches and extrema).
+    pub events: u64,
+    /// One-step complementarity problems solved (Moreau–Jean).
+    pub lcp_solves: u64,
+    /// Steps on which the complementarity solve was skipped (no contact could change state).
+    pub lcp_skipped: u64,
+    /// Newton iterations (implicit steps, shooting).
+    pub newton_iters: u64,
+}
+
+/// The result of a run.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Trajectory {
+    /// Samples, as asked by the scene's [`Output`].
+    pub samples: Vec<Sample>,
+    /// Events, unless the scene asked for [`Output::Final`].
+    pub events: Vec<Event>,
+    /// Final time (= t_end).
+    pub t_final: f64,
+    /// Final state.
+    pub x_final: State,
+    /// Final mode.
+    pub mode_final: Mode,
+    /// Steady-state metrics, if the scene asked for them.
+    pub metrics: Option<SteadyState>,
+    /// Work counters.
+    pub stats: Stats,
+}
+
+/// Why a solver could not finish.
+#[derive(Debug, Error, Clone, PartialEq)]
+pub enum SolveError {
+    /// The scene is not admissible.
+    #[error("invalid scene: {field} = {value}: {reason}")]
+    InvalidScene {
+        field: &'static str,
+        value: f64,
+        reason: &'static str,
+    },
+    /// The step size fell below what floating point resolves.
+    #[error("step size underflow at t = {t}: h = {h:e} (state {x:?})")]
+    StepSizeUnderflow { t: f64, h: f64, x: [f64; 3] },
+    /// The state became NaN or infinite.
+    #[error("non-finite state at t = {t}: {x:?}")]
+    NonFinite { t: f64, x: [f64; 3] },
+    /// The one-step complementarity problem had no admissible solution.
+    #[error("complementarity failure at t = {t}: {detail}")]
+    Complementarity { t: f64, detail: String },
+    /// Events accumulate (Zeno-like): too many in too short a time.
+    #[error("Zeno-like event accumulation at t = {t}: {count} events within {window:e} s")]
+    Zeno { t: f64, count: u32, window: f64 },
+    /// The run needed more steps than allowed.
+    #[error("step limit {max_steps} reached at t = {t}")]
+    TooManySteps { t: f64, max_steps: u64 },
+    /// A steady-state computation (shooting, Newton) did not converge.
+    #[error("no convergence: {detail}")]
+    NoConvergence { detail: String },
+    /// The solver does not support what was asked.
+    #[error("unsupported: {detail}")]
+    Unsupported { detail: String },
+}
+
+/// A solver: takes a model and a scene and returns a trajectory.
+pub trait Solver: Sync {
+    /// Short name (`"event"`, `"switch"`, `"moreau"`).
+    fn name(&self) -> &'static str;
+    /// Runs the scene.
+    fn simulate(&self, model: &Model, scene: &Scene) -> Result<Trajectory, SolveError>;
+}
+
+/// Checks a state for NaN/∞ and reports it as a [`SolveError::NonFinite`].
+pub fn check_finite(t: f64, x: &State) -> Result<(), SolveError> {
+    if x.iter().all(|v| v.is_finite()) {
+        Ok(())
+    } else {
+        Err(SolveError::NonFinite {
+            t,
+            x: [x[0], x[1], x[2]],
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn walk(dt: f64, t_end: f64) -> Vec<f64> {
+        let mut g = OutputGrid::new(dt, t_end);
+        let mut v = Vec::new();
+        while let Some(t) = g.peek() {
+            v.push(t);
+            g.advance();
+        }
+        assert_eq!(v.len(), OutputGrid::new(dt, t_end).len());
+        v
+    }
+
+    #[test]
+    fn grid_includes_both_ends_once() {
+        let v = walk(0.01, 200.0);
+        assert_eq!(v.len(), 20001);
+        assert_eq!(v[0], 0.0);
+        assert_eq!(*v.last().unwrap(), 200.0);
+        let v = walk(0.3, 1.0);
+        assert_eq!(v, vec![0.0, 0.3, 0.6, 0.8999999999999999, 1.0]);
+        let v = walk(2.0, 1.0);
+        assert_eq!(v, vec![0.0, 1.0]);
+    }
+
+    #[test]
+    fn validation_names_field() {
+        let s = Scene {
+            tol: 0.0,
+            ..Scene::default()
+        };
+        assert!(s.validate().unwrap_err().to_string().contains("tol = 0"));
+        let s = Scene {
+            h: 1000.0,
+            ..Scene::default()
+        };
+        assert!(s.validate().unwrap_err().to_string().contains("h = 1000"));
+        let s = Scene {
+            x0: State::new(0.0, f64::NAN, 0.0),
+            ..Scene::default()
+        };
+        assert!(s.validate().unwrap_err().to_string().contains("x0[omega_u] = NaN"));
+    }
+}

@@ -1,0 +1,286 @@
+//! Steady-state metrics, accumulated from a run's events in O(1) memory.
+//!
+//! Solvers push their located events into a [`MetricsAccumulator`] (stick onsets and exits,
+//! and the extrema of ω_u and ω_l, located between steps). A cycle is the interval between two
+//! successive *anchors*: exits of the lower disc from stick when the orbit sticks, maxima of
+//! ω_l otherwise. The metrics of the last complete cycle are reported.
+
+use serde::Serialize;
+
+use crate::dynamics::{Disc, OMEGA_L, OMEGA_U, State};
+use crate::scene::{Event, EventKind};
+
+/// The steady state as `rotor steady` prints it (DESIGN.md §4).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+#[serde(tag = "kind", rename_all = "snake_case")]
+pub enum SteadyState {
+    /// An equilibrium (rad, rad/s).
+    Equilibrium {
+        omega_u: f64,
+        omega_l: f64,
+        alpha: f64,
+    },
+    /// A periodic orbit: period [s], extremes [rad/s], time per period with ω_l = 0 [s].
+    LimitCycle {
+        period: f64,
+        omega_l_max: f64,
+        omega_l_min: f64,
+        omega_u_max: f64,
+        omega_u_min: f64,
+        stick_time: f64,
+    },
+}
+
+impl SteadyState {
+    /// The metrics as named values, in a fixed order (for comparisons and reports).
+    pub fn values(&self) -> Vec<(&'static str, f64)> {
+        match *self {
+            SteadyState::Equilibrium {
+                omega_u,
+                omega_l,
+                alpha,
+            } => vec![("omega_u", omega_u), ("omega_l", omega_l), ("alpha", alpha)],
+            SteadyState::LimitCycle {
+                period,
+                omega_l_max,
+                omega_l_min,
+                omega_u_max,
+                omega_u_min,
+                stick_time,
+            } => vec![
+                ("period", period),
+                ("omega_l_max", omega_l_max),
+                ("omega_l_min", omega_l_min),
+                ("omega_u_max", omega_u_max),
+                ("omega_u_min", omega_u_min),
+                ("stick_time", stick_time),
+            ],
+        }
+    }
+
+    /// `"equilibrium"` or `"limit_cycle"`.
+    pub fn kind(&self) -> &'static str {
+        match self {
+            SteadyState::Equilibrium { .. } => "equilibrium",
+            SteadyState::LimitCycle { .. } => "limit_cycle",
+        }
+    }
+}
+
+/// Summary of one cycle between two anchors.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct Cycle {
+    start: f64,
+    end: f64,
+    wl_max: f64,
+    wl_min: f64,
+    wu_max: f64,
+    wu_min: f64,
+    stick: f64,
+}
+
+/// One anchor stream (stick exits, or ω_l maxima) with the cycle in progress.
+#[derive(Debug, Clone, Copy)]
+struct Stream {
+    open: Option<Cycle>,
+    last: [Option<Cycle>; 2],
+    count: u64,
+}
+
+impl Stream {
+    const fn new() -> Stream {
+        Stream {
+            open: None,
+            last: [None, None],
+            count: 0,
+        }
+    }
+
+    fn anchor(&mut self, t: f64, x: &State) {
+        if let Some(mut c) = self.open.take() {
+            c.end = t;
+            c.include(x);
+            self.last = [Some(c), self.last[0]];
+            self.count += 1;
+        }
+        let mut c = Cycle {
+            start: t,
+            end: t,
+            wl_max: f64::NEG_INFINITY,
+            wl_min: f64::INFINITY,
+            wu_max: f64::NEG_INFINITY,
+            wu_min: f64::INFINITY,
+            stick: 0.0,
+        };
+        c.include(x);
+        self.open = Some(c);
+    }
+}
+
+impl Cycle {
+    fn include(&mut self, x: &State) {
+        self.wl_max = self.wl_max.max(x[OMEGA_L]);
+        self.wl_min = self.wl_min.min(x[OMEGA_L]);
+        self.wu_max = self.wu_max.max(x[OMEGA_U]);
+        self.wu_min = self.wu_min.min(x[OMEGA_U]);
+    }
+}
+
+/// Accumulates steady-state metrics from events, in constant memory.
+#[derive(Debug, Clone, Copy)]
+pub struct MetricsAccumulator {
+    t_from: f64,
+    stick_exits: Stream,
+    maxima: Stream,
+    /// Start of the lower disc's current stick phase (if stuck).
+    stick_since: Option<f64>,
+}
+
+/// Amplitude of ω_l [rad/s] below which an oscillation counts as an equilibrium: far below
+/// any cycle of the source's diagram (the smallest slipping cycles near the Hopf point that
+/// matter have amplitudes ≥ 1e-3) and far above what solver noise at an equilibrium gives.
+pub const EQUILIBRIUM_AMPLITUDE: f64 = 1e-6;
+
+impl MetricsAccumulator {
+    /// Metrics over events at `t ≥ t_from`.
+    pub fn new(t_from: f64) -> MetricsAccumulator {
+        MetricsAccumulator {
+            t_from,
+            stick_exits: Stream::new(),
+            maxima: Stream::new(),
+            stick_since: None,
+        }
+    }
+
+    /// Feeds one event (in time order).
+    pub fn push(&mut self, e: &Event) {
+        if e.t < self.t_from {
+            return;
+        }
+        for s in [&mut self.stick_exits, &mut self.maxima] {
+            if let Some(c) = s.open.as_mut() {
+                c.include(&e.x);
+            }
+        }
+        match e.kind {
+            EventKind::StickStart(Disc::Lower) => self.stick_since = Some(e.t),
+            EventKind::StickEnd(Disc::Lower) => {
+                if let Some(t0) = self.stick_since.take() {
+                    for s in [&mut self.stick_exits, &mut self.maxima] {
+                        if let Some(c) = s.open.as_mut() {
+                            c.stick += e.t - t0.max(c.start);
+                        }
+                    }
+                }
+                self.stick_exits.anchor(e.t, &e.x);
+            }
+            EventKind::Max(Disc::Lower) => self.maxima.anchor(e.t, &e.x),
+            _ => {}
+        }
+    }
+
+    /// The steady state after a run ending at `(t, x)`: the last complete cycle if the orbit
+    /// still oscillates with amplitude above [`EQUILIBRIUM_AMPLITUDE`], else the final state.
+    pub fn finish(&self, x_final: &State) -> SteadyState {
+        let stream = if self.stick_exits.count >= 1 {
+            &self.stick_exits
+        } else {
+            &self.maxima
+        };
+        match stream.last[0] {
+            Some(c) if c.wl_max - c.wl_min > EQUILIBRIUM_AMPLITUDE => SteadyState::LimitCycle {
+                period: c.end - c.start,
+                omega_l_max: c.wl_max,
+                omega_l_min: c.wl_min,
+                omega_u_max: c.wu_max,
+                omega_u_min: c.wu_min,
+                stick_time: c.stick,
+            },
+            _ => SteadyState::Equilibrium {
+                omega_u: x_final[OMEGA_U],
+                omega_l: x_final[OMEGA_L],
+                alpha: x_final[0],
+            },
+        }
+    }
+
+    /// Relative change of the period between the last two complete cycles (a convergence
+    /// indicator), if two exist.
+    pub fn period_drift(&self) -> Option<f64> {
+        let stream = if self.stick_exits.count >= 1 {
+            &self.stick_exits
+        } else {
+            &self.maxima
+        };
+        match stream.last {
+            [Some(a), Some(b)] => {
+                let ta = a.end - a.start;
+                let tb = b.end - b.start;
+                Some(((ta - tb) / ta).abs())
+            }
+            _ => None,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn ev(t: f64, x: [f64; 3], kind: EventKind) -> Event {
+        Event {
+            t,
+            x: State::new(x[0], x[1], x[2]),
+            kind,
+        }
+    }
+
+    #[test]
+    fn stick_slip_cycle_from_events() {
+        let mut m = MetricsAccumulator::new(1.0);
+        let l = Disc::Lower;
+        let evs = [
+            ev(0.5, [0.0, 1.0, 0.0], EventKind::StickEnd(l)), // before t_from: ignored
+            ev(2.0, [2.2, 1.0, 0.0], EventKind::StickEnd(l)),
+            ev(3.0, [1.0, 1.1, 3.0], EventKind::Max(l)),
+            ev(4.0, [1.0, 0.9, 0.0], EventKind::StickStart(l)),
+            ev(5.0, [2.2, 1.0, 0.0], EventKind::StickEnd(l)),
+            ev(6.0, [1.0, 1.1, 3.0], EventKind::Max(l)),
+            ev(7.5, [1.0, 0.9, 0.0], EventKind::StickStart(l)),
+            ev(8.0, [2.2, 1.0, 0.0], EventKind::StickEnd(l)),
+        ];
+        for e in &evs {
+            m.push(e);
+        }
+        let SteadyState::LimitCycle {
+            period,
+            omega_l_max,
+            omega_l_min,
+            omega_u_max,
+            omega_u_min,
+            stick_time,
+        } = m.finish(&State::zeros())
+        else {
+            panic!("expected a cycle")
+        };
+        assert_eq!(period, 3.0);
+        assert_eq!(stick_time, 0.5);
+        assert_eq!((omega_l_max, omega_l_min), (3.0, 0.0));
+        assert_eq!((omega_u_max, omega_u_min), (1.1, 0.9));
+        assert_eq!(m.period_drift(), Some(0.0));
+    }
+
+    #[test]
+    fn no_events_is_an_equilibrium() {
+        let m = MetricsAccumulator::new(0.0);
+        let x = State::new(1.0, 2.0, 2.0);
+        assert_eq!(
+            m.finish(&x),
+            SteadyState::Equilibrium {
+                omega_u: 2.0,
+                omega_l: 2.0,
+                alpha: 1.0
+            }
+        );
+    }
+}
