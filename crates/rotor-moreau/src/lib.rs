@@ -1,1 +1,510 @@
-//! placeholder
+//! Moreau–Jean time-stepping of the rotor model on its Lagrangian form (solver 3 of
+//! rotorbench), after Siconos' `MoreauJeanOSI` with an exact one-step friction problem.
+//!
+//! # The Lagrangian form and how it maps onto eqs. (1)–(5)
+//!
+//! [`rotor_model::Lagrangian`]: `q = [θ_u, θ_l, x_u, x_l]`,
+//!
+//! ```text
+//! M q̈ + C q̇ + K_s q + F_int(q̇) = F_ext + r,   M = diag(J_u, J_l, 1, 1), C = diag(b_u, b_l, 0, 0),
+//! K_s q = k_θ [α, −α, 0, 0],  F_ext = [k_m u, 0, 0, 0],
+//! F_int = [ΔT_su + Δb_u|θ̇_u|, 0, N_u, N_l(θ̇_l)]
+//! ```
+//!
+//! Contact i (i = u, l) has the gap `x_i ≥ 0`, normal reaction `r_N,i` (on x_i) and tangential
+//! reaction `r_T,i` (on θ_i, tangential velocity θ̇_i), Coulomb with μ = 1:
+//! Signorini `0 ≤ x_i ⊥ r_N,i ≥ 0` (at velocity level in the scheme) and
+//! `r_T,i ∈ −μ r_N,i Sign(θ̇_i)`. The extra DOF x_i is pressed onto its contact by the level
+//! `N_i` ([`rotor_model::Friction::level`]: `T_su` for the upper disc,
+//! `T_cl(ω_l) − b_l|ω_l|` for the lower). While the contact stays closed, `ẍ_i = 0` gives
+//! `r_N,i = N_i`, hence `r_T,i ∈ −N_i Sign(θ̇_i)` and
+//!
+//! ```text
+//! J_u θ̈_u = k_m u − k_θ α − b_u θ̇_u − (ΔT_su + Δb_u|θ̇_u|) − T_su Sign(θ̇_u)
+//! J_l θ̈_l =         k_θ α − b_l θ̇_l − N_l(θ̇_l) Sign(θ̇_l)
+//! ```
+//!
+//! which is eq. (1) with the friction laws (2)–(5): `T_f = a(ω) + bω + N(|ω|) Sign(ω)`.
+//! Only `α = θ_u − θ_l` enters, so the stepper carries `[α, θ̇_u, θ̇_l]`; `x_u ≡ x_l ≡ 0` and
+//! `ẋ_u ≡ ẋ_l ≡ 0` (the contacts never open, see below), and the normal impulse of each step
+//! is `h·N_θ,i` (θ-weighted level) in closed form: the normal and tangential blocks of the
+//! Delassus matrix are uncoupled (`M̂` is block diagonal between θ and x), and the normal
+//! Signorini problem `ẋ⁺ = −hN_θ + r_N ≥ 0 ⊥ r_N ≥ 0` has the solution `r_N = h N_θ` when
+//! `N_θ ≥ 0`.
+//!
+//! **Negative level.** With Table 1, `N_l(ω) = T_sl + T_1 tanh(w_1|ω|/2) + T_2 tanh(w_2|ω|/2)`
+//! is negative for `|ω_l| ≳ 18 rad/s` (`T_sl + T_1 + T_2 < 0`). A unilateral contact pulled
+//! by a negative normal force would open and lose that (negative) friction, which eq. (1)
+//! keeps. So the contact carries `N⁺ = max(N, 0)` and the remainder is a smooth force:
+//! `−N Sign(ω) = −N⁺ Sign(ω) − min(N, 0)·sign(ω)`, the last term single-valued because
+//! `N < 0` only far from ω = 0. Both parts are θ-weighted like the rest. The scheme thus
+//! integrates eq. (1) exactly as written. A contact with zero normal force (Table 1's upper
+//! disc, `T_su = 0`) has zero friction: its disc just moves under its smooth forces.
+//!
+//! # The scheme
+//!
+//! Velocity-level θ-method (Jean & Moreau; Acary & Brogliato 2008, ch. 10), as
+//! `MoreauJeanOSI`:
+//!
+//! ```text
+//! M(v⁺ − v) + hK q_θ + hC v_θ + hF_int,θ = hF_ext + p,     v_θ = (1−θ)v + θv⁺,
+//! q⁺ = q + h v_θ,   q_θ = (1−θ)q + θq⁺ = q + θh v_θ,    F_int,θ = (1−θ)F_int(v) + θF_int(v⁺)
+//! ⇒ M̂ v⁺ = (M − (1−θ)hC − θ(1−θ)h²K) v − hKq + hF_ext − hF_int,θ + p,   M̂ = M + θhC + θ²h²K
+//! ```
+//!
+//! θ ∈ [1/2, 1], default 1/2 (trapezoidal on the smooth part). With
+//! [`FrictionLevel::Implicit`] (default) the level in `F_int` (hence the cone bound
+//! `μ r_N = hN_θ`) and the smooth friction forces are θ-weighted between the two ends of the
+//! step and solved *together* with the one-step problem by Newton on the step
+//! ([`stepper`]); with [`FrictionLevel::Explicit`] the level is taken at the start of the step
+//! (the step problem is then piecewise linear and solved in one pass). The one-step problem
+//! (Signorini + Coulomb on both contacts) is solved exactly by enumerating the nine
+//! stick/slip± modes ([`onestep`]), never by an iteration with a tolerance.
+//!
+//! **Skipping the complementarity solve.** When both discs' frozen-bound free velocities
+//! `v_free,i` satisfy `|v_free,i| > 2 Σ_j |W_ij| P_j` (W = M̂⁻¹, P_j the cone bounds), no
+//! admissible impulse can bring a velocity to zero: the slip mode `sign(v)` is taken,
+//! Newton runs in that mode only, and its result is checked against the sign conditions
+//! (a failed check falls back to the enumeration). Counted in [`Stats::lcp_skipped`]
+//! (vs [`Stats::lcp_solves`]).
+//!
+//! # Orders measured (tests/convergence.rs)
+//!
+//! Self-convergence on Table 1, u = 1.5 V from rest, steady-state period and max ω_l over
+//! h = 1e-2 … 1e-4 (Richardson differences between successive h/2):
+//! see the table in `tests/convergence.rs` and the crate README-style notes in the final
+//! report. θ = 1/2 with the implicit level: second order; explicit level or θ = 1: first.
+//!
+//! # Output and events
+//!
+//! Dense output is linear interpolation of the state between step ends (the scheme's own:
+//! `q⁺ = q + h v_θ` is linear in time inside a step). Events, located between steps:
+//!
+//! * `StickEnd(d)`: a stuck disc slips at the end of the step. Located where the applied
+//!   torque `T_ex` ([`rotor_model::Model::applied_torque`]) leaves the stick interval
+//!   ([`rotor_model::Friction::static_interval`]) — equivalently where the tangential impulse
+//!   leaves the cone — by linear interpolation (or extrapolation, by at most one step) of the
+//!   excess between the two step ends: O(h²).
+//! * `StickStart(d)`: a slipping disc ends the step stuck. Located at the zero of the
+//!   velocity's first-order Taylor expansion from the last slipping step end, with the
+//!   model's acceleration there ([`rotor_model::Model::disc_accel`]), clamped to the step: O(h²).
+//! * `Reversal(d)`: the velocity changes sign without sticking; linear interpolation: O(h²).
+//! * `Max(d)` / `Min(d)` (only when `scene.metrics_from` is set): a sign change of the
+//!   discrete velocity increments while slipping; vertex of the parabola through the three
+//!   step values.
+//!
+//! Events are fed in time order to a [`rotor_model::MetricsAccumulator`] when metrics are asked.
+
+pub mod onestep;
+pub mod stepper;
+
+use rotor_model::{
+    Disc, DiscMode, Event, EventKind, MetricsAccumulator, Mode, Model, Output, Sample, Scene,
+    SolveError, Solver, State, Stats, Trajectory, check_finite,
+};
+
+pub use onestep::{Branch, EnumError, OneStepProblem, OneStepSolution, StickData};
+pub use stepper::{StepOutcome, Stepper};
+
+/// How the friction level (the contacts' normal force) enters a step.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum FrictionLevel {
+    /// θ-weighted between the start and the end of the step, solved together with the
+    /// one-step problem by Newton (as Siconos does with `F_int` in its Newton loop).
+    /// Second order with θ = 1/2.
+    #[default]
+    Implicit,
+    /// Taken at the start of the step: first order, one linear pass per step.
+    Explicit,
+}
+
+/// Options of [`MoreauSolver`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct MoreauOptions {
+    /// θ ∈ [1/2, 1] of the θ-scheme (default 1/2).
+    pub theta: f64,
+    /// Implicit (default) or explicit friction level.
+    pub friction_level: FrictionLevel,
+    /// Maximum Newton iterations per step (default 50).
+    pub max_newton: u32,
+    /// Maximum number of steps of one run (default 1e9).
+    pub max_steps: u64,
+}
+
+impl Default for MoreauOptions {
+    fn default() -> Self {
+        MoreauOptions {
+            theta: 0.5,
+            friction_level: FrictionLevel::Implicit,
+            max_newton: 50,
+            max_steps: 1_000_000_000,
+        }
+    }
+}
+
+/// The Moreau–Jean solver; step size `scene.h`.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct MoreauSolver {
+    pub options: MoreauOptions,
+}
+
+impl MoreauSolver {
+    /// A solver with the given options.
+    pub fn new(options: MoreauOptions) -> MoreauSolver {
+        MoreauSolver { options }
+    }
+}
+
+/// Capacity of the reorder buffer for events (a step detects at most six).
+const PENDING: usize = 16;
+
+/// Events detected but not yet released in time order.
+struct Pending {
+    buf: [Option<Event>; PENDING],
+    len: usize,
+}
+
+impl Pending {
+    fn new() -> Pending {
+        Pending {
+            buf: [None; PENDING],
+            len: 0,
+        }
+    }
+
+    fn push(&mut self, e: Event, sink: &mut Sink) {
+        if self.len == PENDING {
+            self.release_before(f64::INFINITY, sink, 1);
+        }
+        // Insertion into the time-ordered buffer.
+        let mut i = self.len;
+        while i > 0 && self.buf[i - 1].is_some_and(|p| p.t > e.t) {
+            self.buf[i] = self.buf[i - 1];
+            i -= 1;
+        }
+        self.buf[i] = Some(e);
+        self.len += 1;
+    }
+
+    /// Releases up to `max` events with `t < t_limit`, earliest first.
+    fn release_before(&mut self, t_limit: f64, sink: &mut Sink, max: usize) {
+        let mut n = 0;
+        while n < max.min(self.len) && self.buf[n].is_some_and(|e| e.t < t_limit) {
+            if let Some(e) = self.buf[n] {
+                sink.take(&e);
+            }
+            n += 1;
+        }
+        if n > 0 {
+            for i in n..self.len {
+                self.buf[i - n] = self.buf[i];
+            }
+            for i in self.len - n..self.len {
+                self.buf[i] = None;
+            }
+            self.len -= n;
+        }
+    }
+}
+
+/// Where released events go.
+struct Sink {
+    events: Option<Vec<Event>>,
+    metrics: Option<MetricsAccumulator>,
+    count: u64,
+}
+
+impl Sink {
+    fn take(&mut self, e: &Event) {
+        self.count += 1;
+        if let Some(v) = self.events.as_mut() {
+            v.push(*e);
+        }
+        if let Some(m) = self.metrics.as_mut() {
+            m.push(e);
+        }
+    }
+}
+
+/// A step end kept for event location.
+#[derive(Debug, Clone, Copy)]
+struct Point {
+    t: f64,
+    x: State,
+    mode: [DiscMode; 2],
+}
+
+fn lerp(a: &Point, b: &Point, t: f64) -> State {
+    let dt = b.t - a.t;
+    if dt <= 0.0 {
+        return b.x;
+    }
+    let s = (t - a.t) / dt;
+    a.x + (b.x - a.x) * s
+}
+
+/// Quadratic (Lagrange) interpolation through three points.
+fn quad(p: [&Point; 3], t: f64) -> State {
+    let [a, b, c] = p;
+    let la = (t - b.t) * (t - c.t) / ((a.t - b.t) * (a.t - c.t));
+    let lb = (t - a.t) * (t - c.t) / ((b.t - a.t) * (b.t - c.t));
+    let lc = (t - a.t) * (t - b.t) / ((c.t - a.t) * (c.t - b.t));
+    a.x * la + b.x * lb + c.x * lc
+}
+
+fn to_mode(m: &[DiscMode; 2]) -> Mode {
+    Mode {
+        upper: m[0],
+        lower: m[1],
+    }
+}
+
+impl Solver for MoreauSolver {
+    fn name(&self) -> &'static str {
+        "moreau"
+    }
+
+    fn simulate(&self, model: &Model, scene: &Scene) -> Result<Trajectory, SolveError> {
+        scene.validate()?;
+        check_finite(0.0, &scene.x0)?;
+        let o = &self.options;
+        if !(o.theta >= 0.5 && o.theta <= 1.0) {
+            return Err(SolveError::InvalidScene {
+                field: "theta",
+                value: o.theta,
+                reason: "must lie in [1/2, 1]",
+            });
+        }
+        if o.max_newton == 0 {
+            return Err(SolveError::InvalidScene {
+                field: "max_newton",
+                value: 0.0,
+                reason: "must be at least 1",
+            });
+        }
+        let u = scene.u;
+        let h = scene.h;
+        let t_end = scene.t_end;
+        // Number of steps: the last one is shortened to land on t_end (a remainder below
+        // 1e-9·h is merged into the previous step).
+        let n_f = (t_end / h - 1e-9).ceil().max(1.0);
+        if !(n_f <= o.max_steps as f64) {
+            return Err(SolveError::TooManySteps {
+                t: 0.0,
+                max_steps: o.max_steps,
+            });
+        }
+        let n = n_f as u64;
+        let stepper = Stepper::new(model, u, o);
+        let keep_events = scene.keeps_events();
+        let want_extrema = scene.metrics_from.is_some();
+
+        let mut samples = Vec::new();
+        let mut grid = scene.grid();
+        match scene.output {
+            Output::Grid { .. } => samples.reserve(grid.map_or(0, |g| g.len())),
+            Output::Steps => samples.reserve(n as usize + 1),
+            _ => {}
+        }
+        let mut sink = Sink {
+            events: keep_events.then(Vec::new),
+            metrics: scene.metrics_from.map(MetricsAccumulator::new),
+            count: 0,
+        };
+        let mut pending = Pending::new();
+
+        let m0 = model.mode_at(&scene.x0, u);
+        let mut cur = Point {
+            t: 0.0,
+            x: scene.x0,
+            mode: [m0.upper, m0.lower],
+        };
+        let mut prev: Option<Point> = None;
+        match scene.output {
+            Output::Steps => samples.push(Sample { t: 0.0, x: cur.x }),
+            Output::Grid { .. } => {
+                if let Some(g) = grid.as_mut()
+                    && let Some(tg) = g.peek()
+                    && tg <= 0.0
+                {
+                    samples.push(Sample { t: 0.0, x: cur.x });
+                    g.advance();
+                }
+            }
+            _ => {}
+        }
+
+        let mut stats = Stats::default();
+        for k in 1..=n {
+            let t_next = if k == n { t_end } else { k as f64 * h };
+            let hk = t_next - cur.t;
+            let out = stepper.step(cur.t, &cur.x, hk)?;
+            check_finite(t_next, &out.x)?;
+            stats.steps += 1;
+            stats.newton_iters += u64::from(out.newton_iters);
+            stats.rhs_evals += u64::from(out.evals);
+            if out.used_enumeration {
+                stats.lcp_solves += 1;
+            } else {
+                stats.lcp_skipped += 1;
+            }
+            let next = Point {
+                t: t_next,
+                x: out.x,
+                mode: out.mode,
+            };
+
+            if keep_events || want_extrema {
+                for (i, d) in Disc::BOTH.into_iter().enumerate() {
+                    let wi = d.index();
+                    let (m_a, m_b) = (cur.mode[i], next.mode[i]);
+                    let kind_t = match (m_a, m_b) {
+                        (DiscMode::Stick, DiscMode::Stick) => None,
+                        (DiscMode::Stick, slip) => {
+                            // Excess of the applied torque over the interval, at both ends.
+                            let (lo, hi) = model.friction(d).static_interval();
+                            let z = |x: &State| {
+                                let ta = model.applied_torque(d, x, u);
+                                if slip == DiscMode::SlipPos {
+                                    ta - hi
+                                } else {
+                                    lo - ta
+                                }
+                            };
+                            let (za, zb) = (z(&cur.x), z(&next.x));
+                            let t0 = prev.map_or(cur.t, |p| p.t);
+                            let t = if zb > za {
+                                (cur.t - za * (next.t - cur.t) / (zb - za)).clamp(t0, next.t)
+                            } else {
+                                cur.t + o.theta * (next.t - cur.t)
+                            };
+                            Some((EventKind::StickEnd(d), t))
+                        }
+                        (slip, DiscMode::Stick) => {
+                            // Zero of ω(t_k + Δ) ≈ ω + aΔ + ½jΔ², a and j = ω̈ from the
+                            // model's vector field and Jacobian in the slipping mode.
+                            let w = cur.x[wi];
+                            let mut mode = to_mode(&cur.mode);
+                            mode.set(d, slip);
+                            let f = model.rhs(&cur.x, u, mode);
+                            let acc = f[wi];
+                            let jerk = (model.jacobian(&cur.x, u, mode) * f)[wi];
+                            let t = if acc * w < 0.0 {
+                                let d1 = -w / acc;
+                                let den = acc + jerk * d1;
+                                let d2 = if den * acc > 0.0 {
+                                    d1 - 0.5 * jerk * d1 * d1 / den
+                                } else {
+                                    d1
+                                };
+                                (cur.t + d2).clamp(cur.t, next.t)
+                            } else {
+                                next.t
+                            };
+                            Some((EventKind::StickStart(d), t))
+                        }
+                        (a, b) if a != b => {
+                            let (wa, wb) = (cur.x[wi], next.x[wi]);
+                            let t = if wa != wb {
+                                (cur.t + wa * (next.t - cur.t) / (wa - wb)).clamp(cur.t, next.t)
+                            } else {
+                                next.t
+                            };
+                            Some((EventKind::Reversal(d), t))
+                        }
+                        _ => None,
+                    };
+                    if let Some((kind, t)) = kind_t {
+                        let mut x = if t >= cur.t {
+                            lerp(&cur, &next, t)
+                        } else {
+                            prev.map_or(cur.x, |p| lerp(&p, &cur, t))
+                        };
+                        x[wi] = 0.0;
+                        pending.push(Event { t, x, kind }, &mut sink);
+                    }
+                    // Extrema of the velocity while slipping.
+                    if want_extrema
+                        && let Some(p) = prev
+                        && p.mode[i] != DiscMode::Stick
+                        && m_a != DiscMode::Stick
+                        && m_b != DiscMode::Stick
+                    {
+                        let (y0, y1, y2) = (p.x[wi], cur.x[wi], next.x[wi]);
+                        let (d1, d2) = (y1 - y0, y2 - y1);
+                        // Rounding noise filter: increments of a few ulps are no extremum.
+                        let noise = 8.0 * f64::EPSILON * (1.0 + y1.abs());
+                        let kind = if d1 > 0.0 && d2 <= 0.0 {
+                            Some(EventKind::Max(d))
+                        } else if d1 < 0.0 && d2 >= 0.0 {
+                            Some(EventKind::Min(d))
+                        } else {
+                            None
+                        };
+                        if let Some(kind) = kind
+                            && d1.abs().max(d2.abs()) > noise
+                        {
+                            // Vertex of the parabola through the three points.
+                            let (ha, hb) = (cur.t - p.t, next.t - cur.t);
+                            let s1 = d1 / ha;
+                            let s2 = d2 / hb;
+                            let curv = (s2 - s1) / (0.5 * (ha + hb));
+                            let t = if curv != 0.0 {
+                                let tm1 = p.t + 0.5 * ha; // slope s1 at the midpoint
+                                (tm1 - s1 / curv).clamp(p.t, next.t)
+                            } else {
+                                cur.t
+                            };
+                            let x = quad([&p, &cur, &next], t);
+                            pending.push(Event { t, x, kind }, &mut sink);
+                        }
+                    }
+                }
+                // Events detected later are at t ≥ cur.t.
+                pending.release_before(cur.t, &mut sink, usize::MAX);
+            }
+
+            match scene.output {
+                Output::Steps => samples.push(Sample {
+                    t: next.t,
+                    x: next.x,
+                }),
+                Output::Grid { .. } => {
+                    if let Some(g) = grid.as_mut() {
+                        while let Some(tg) = g.peek() {
+                            if tg > next.t {
+                                break;
+                            }
+                            samples.push(Sample {
+                                t: tg,
+                                x: lerp(&cur, &next, tg.max(cur.t)),
+                            });
+                            g.advance();
+                        }
+                    }
+                }
+                _ => {}
+            }
+            prev = Some(cur);
+            cur = next;
+        }
+        pending.release_before(f64::INFINITY, &mut sink, usize::MAX);
+        if let Some(g) = grid.as_mut() {
+            while let Some(tg) = g.peek() {
+                samples.push(Sample { t: tg, x: cur.x });
+                g.advance();
+            }
+        }
+        stats.events = sink.count;
+        let metrics = sink.metrics.map(|m| m.finish(&cur.x));
+        Ok(Trajectory {
+            samples,
+            events: sink.events.unwrap_or_default(),
+            t_final: t_end,
+            x_final: cur.x,
+            mode_final: to_mode(&cur.mode),
+            metrics,
+            stats,
+        })
+    }
+}

@@ -1,0 +1,357 @@
+//! One Moreau–Jean step: θ-scheme on the Lagrangian form, friction level inside the Newton
+//! loop (or explicit), one-step problem solved by exact enumeration.
+//!
+//! With `v = [ω_u, ω_l]` (the θ-block of q̇), `α = θ_u − θ_l`, and per disc i the smooth
+//! friction force `g_i` and level `N_i` (see the crate docs), the step from `(α, v)` is
+//!
+//! ```text
+//! M̂ v⁺ = b + hθ g(v⁺) + r,     M̂ = M + θhC + θ²h²K
+//! b    = (M − (1−θ)hC − θ(1−θ)h²K) v − hK q + h F_ext + h(1−θ) g(v)
+//! Coulomb: |r_i| ≤ P_i = h[(1−θ) N_i⁺(ω_i) + θ N_i⁺(ω_i⁺)]   (implicit level)
+//!                  P_i = h N_i⁺(ω_i)                          (explicit level)
+//! α⁺   = α + h[(1−θ)(ω_u − ω_l) + θ(ω_u⁺ − ω_l⁺)]
+//! ```
+//!
+//! (`Kq = k_θ[α, −α]`, so only α is needed.) Newton on the step: at the iterate `w`, every
+//! velocity-dependent term of a slip branch is linearised in the disc's own velocity, the
+//! resulting piecewise-linear problem is solved exactly by [`OneStepProblem::solve`], and the
+//! iteration stops when the mode repeats and the velocity update is below
+//! `1e-12·(1 + |w|)` — a semi-smooth Newton method, quadratic once the mode is settled.
+
+use nalgebra::{Matrix2, Vector2};
+use rotor_model::{Disc, DiscMode, Friction, Model, SolveError, State};
+
+use crate::onestep::{Branch, OneStepProblem, OneStepSolution, StickData};
+use crate::{FrictionLevel, MoreauOptions};
+
+/// Result of one step.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct StepOutcome {
+    /// State `[α, ω_u, ω_l]` at the end of the step.
+    pub x: State,
+    /// Contact mode of each disc over the step (upper, lower).
+    pub mode: [DiscMode; 2],
+    /// Tangential contact impulses `r_T` (upper, lower).
+    pub r: Vector2<f64>,
+    /// Cone bounds `μ r_N = P_i` (upper, lower).
+    pub p: Vector2<f64>,
+    /// Whether the enumeration was run (`false`: the slip prediction was verified directly).
+    pub used_enumeration: bool,
+    /// Newton iterations (one linearised solve each).
+    pub newton_iters: u32,
+    /// Evaluations of the smooth friction forces and levels (one per disc and branch).
+    pub evals: u32,
+}
+
+/// The smooth friction of one disc along branch s, its level, and their ω-derivatives.
+#[derive(Debug, Clone, Copy)]
+struct BranchEval {
+    /// Smooth offset force `−a^s(ω)` (enters the right-hand side).
+    off: f64,
+    d_off: f64,
+    /// Level `N^s(ω) = level_ext(sω)`.
+    level: f64,
+    d_level: f64,
+}
+
+fn eval_branch(f: &Friction, db: f64, w: f64, s: f64) -> BranchEval {
+    let x = s * w;
+    BranchEval {
+        off: -f.offset(w, s),
+        d_off: -s * db,
+        level: f.level_ext(x),
+        d_level: s * f.dlevel_ext(x),
+    }
+}
+
+/// Precomputed data of one run: the Lagrangian matrices' entries and the friction laws.
+#[derive(Debug, Clone, Copy)]
+pub struct Stepper {
+    theta: f64,
+    level: FrictionLevel,
+    max_newton: u32,
+    j: [f64; 2],
+    c: [f64; 2],
+    k: f64,
+    f_ext: f64,
+    law: [Friction; 2],
+    db: [f64; 2],
+}
+
+impl Stepper {
+    /// The stepper of a model at input `u`. `M`, `C`, `K`, `F_ext` are read from
+    /// [`rotor_model::Lagrangian`].
+    pub fn new(model: &Model, u: f64, options: &MoreauOptions) -> Stepper {
+        let l = rotor_model::Lagrangian::new(model);
+        let db_u = match model.friction(Disc::Upper) {
+            Friction::Upper(p) => p.db,
+            Friction::Lower(_) => 0.0,
+        };
+        Stepper {
+            theta: options.theta,
+            level: options.friction_level,
+            max_newton: options.max_newton,
+            j: [l.m[(0, 0)], l.m[(1, 1)]],
+            c: [l.c[(0, 0)], l.c[(1, 1)]],
+            k: l.k[(0, 0)],
+            f_ext: l.f_ext(u)[0],
+            law: [*model.friction(Disc::Upper), *model.friction(Disc::Lower)],
+            db: [db_u, 0.0],
+        }
+    }
+
+    /// `M̂ = M + θhC + θ²h²K` on the θ-block.
+    pub fn iteration_matrix(&self, h: f64) -> Matrix2<f64> {
+        let th = self.theta * h;
+        let kk = th * th * self.k;
+        Matrix2::new(
+            self.j[0] + th * self.c[0] + kk,
+            -kk,
+            -kk,
+            self.j[1] + th * self.c[1] + kk,
+        )
+    }
+
+    /// One step of size `h` from `x` (at time `t`, for error reports).
+    pub fn step(&self, t: f64, x: &State, h: f64) -> Result<StepOutcome, SolveError> {
+        let th = self.theta;
+        let implicit = self.level == FrictionLevel::Implicit;
+        let v = Vector2::new(x[1], x[2]);
+        let a = self.iteration_matrix(h);
+        let mut evals = 0u32;
+
+        // Start-of-step terms.
+        let kv = self.k * (v[0] - v[1]);
+        let kq = self.k * x[0];
+        let mut b = Vector2::new(
+            (self.j[0] - (1.0 - th) * h * self.c[0]) * v[0] - th * (1.0 - th) * h * h * kv - h * kq
+                + h * self.f_ext,
+            (self.j[1] - (1.0 - th) * h * self.c[1]) * v[1] + th * (1.0 - th) * h * h * kv + h * kq,
+        );
+        // Start-of-step contact bound part and stick data.
+        let mut p_start = [0.0; 2];
+        let mut stick = [StickData::default(); 2];
+        for i in 0..2 {
+            let s0 = if v[i] < 0.0 { -1.0 } else { 1.0 };
+            let e0 = eval_branch(&self.law[i], self.db[i], v[i], s0);
+            evals += 1;
+            // Negative part of the level, as a smooth force −sign(ω)·min(N, 0).
+            let neg0 = -s0 * e0.level.min(0.0);
+            let npos0 = e0.level.max(0.0);
+            // The level at ω = 0 (stick): N(0) ≥ 0 is the half-width of the interval.
+            let n_zero = self.law[i].level(0.0).max(0.0);
+            let off_zero = -self.law[i].offset(0.0, 1.0);
+            if implicit {
+                b[i] += h * (1.0 - th) * (e0.off + neg0);
+                p_start[i] = h * (1.0 - th) * npos0;
+                stick[i] = StickData {
+                    e: h * th * off_zero,
+                    p: p_start[i] + h * th * n_zero,
+                };
+            } else {
+                b[i] += h * (1.0 - th) * e0.off + h * neg0;
+                p_start[i] = h * npos0;
+                stick[i] = StickData {
+                    e: h * th * off_zero,
+                    p: p_start[i],
+                };
+            }
+        }
+
+        // The affine slip branch of disc i, sign s, linearised at w.
+        let branch = |i: usize, s: f64, w: f64| -> Branch {
+            let e = eval_branch(&self.law[i], self.db[i], w, s);
+            // Total friction impulse φ(ω) = hθ·smooth(ω) − s·P(ω).
+            let (mut phi, mut dphi) = (h * th * e.off, h * th * e.d_off);
+            let (mut p, mut dp) = (p_start[i], 0.0);
+            if implicit {
+                if e.level > 0.0 {
+                    p += h * th * e.level;
+                    dp = h * th * e.d_level;
+                } else {
+                    phi += -s * h * th * e.level;
+                    dphi += -s * h * th * e.d_level;
+                }
+            }
+            phi -= s * p;
+            dphi -= s * dp;
+            Branch {
+                c: phi - dphi * w,
+                d: dphi,
+                pc: p - dp * w,
+                pd: dp,
+            }
+        };
+
+        // Skip test (the spec's criterion): the frozen-bound free velocity of each disc is
+        // more than twice as far from 0 as any admissible impulse can move it.
+        let w_inv = a.try_inverse().ok_or_else(|| SolveError::Complementarity {
+            t,
+            detail: "singular iteration matrix".into(),
+        })?;
+        let mut skip = true;
+        {
+            let mut rhs = b;
+            let mut pmax = [0.0; 2];
+            for i in 0..2 {
+                if v[i] == 0.0 {
+                    skip = false;
+                    break;
+                }
+                let s = v[i].signum();
+                let br = branch(i, s, v[i]);
+                evals += 1;
+                rhs[i] += br.c + br.d * v[i] + s * (br.pc + br.pd * v[i]);
+                pmax[i] = (br.pc + br.pd * v[i]).abs();
+            }
+            if skip {
+                let vf = w_inv * rhs;
+                for i in 0..2 {
+                    let reach =
+                        2.0 * (w_inv[(i, 0)].abs() * pmax[0] + w_inv[(i, 1)].abs() * pmax[1]);
+                    if !(vf[i] * v[i] > 0.0 && vf[i].abs() > reach) {
+                        skip = false;
+                    }
+                }
+            }
+        }
+
+        let mut newton_iters = 0u32;
+        let mut used_enum = false;
+        let mut result: Option<OneStepSolution> = None;
+
+        if skip {
+            // Newton in the fixed slip mode sign(v), verified at convergence.
+            let s = [v[0].signum(), v[1].signum()];
+            let mode = [DiscMode::slip_of(v[0]), DiscMode::slip_of(v[1])];
+            let mut w = v;
+            for _ in 0..self.max_newton {
+                newton_iters += 1;
+                let mut prob = OneStepProblem {
+                    a,
+                    b,
+                    slip: [[Branch::default(); 2]; 2],
+                    stick,
+                };
+                for i in 0..2 {
+                    let bi = if s[i] > 0.0 { 0 } else { 1 };
+                    prob.slip[i][bi] = branch(i, s[i], w[i]);
+                    evals += 1;
+                }
+                let Some(sol) = prob.solve_mode(mode) else {
+                    break;
+                };
+                let dv = (sol.v - w).amax();
+                w = sol.v;
+                if !implicit || dv <= 1e-12 * (1.0 + w.amax()) {
+                    if OneStepProblem::is_admissible(&sol, 0.0, 0.0) {
+                        result = Some(sol);
+                    }
+                    break;
+                }
+            }
+        }
+
+        if result.is_none() {
+            used_enum = true;
+            let mut w = v;
+            let mut prev: Option<[DiscMode; 2]> = None;
+            let mut last: Option<OneStepSolution> = None;
+            let mut last_dv = f64::INFINITY;
+            for _ in 0..self.max_newton {
+                newton_iters += 1;
+                let mut prob = OneStepProblem {
+                    a,
+                    b,
+                    slip: [[Branch::default(); 2]; 2],
+                    stick,
+                };
+                for i in 0..2 {
+                    prob.slip[i] = [branch(i, 1.0, w[i]), branch(i, -1.0, w[i])];
+                    evals += 2;
+                }
+                let sol = match prob.solve() {
+                    Ok(s) => s,
+                    Err(err) => {
+                        // The linearised bound slopes can make a slip branch ill-posed for
+                        // very large h with a falling level; the frozen-bound problem (a
+                        // strictly convex box QP) always has exactly one solution.
+                        for i in 0..2 {
+                            for br in prob.slip[i].iter_mut() {
+                                *br = Branch {
+                                    c: br.c + br.d * w[i],
+                                    d: 0.0,
+                                    pc: br.pc + br.pd * w[i],
+                                    pd: 0.0,
+                                };
+                            }
+                        }
+                        prob.solve().map_err(|e2| SolveError::Complementarity {
+                            t,
+                            detail: format!(
+                                "one-step problem: {err:?}, frozen-bound problem: {e2:?}"
+                            ),
+                        })?
+                    }
+                };
+                let dv = (sol.v - w).amax();
+                let same = prev == Some(sol.mode);
+                w = sol.v;
+                prev = Some(sol.mode);
+                last = Some(sol);
+                last_dv = dv;
+                if !implicit || (same && dv <= 1e-12 * (1.0 + w.amax())) {
+                    break;
+                }
+            }
+            let sol = last.ok_or_else(|| SolveError::NoConvergence {
+                detail: format!("Moreau step at t = {t}: no Newton iterate"),
+            })?;
+            if implicit && last_dv > 1e-8 * (1.0 + sol.v.amax()) {
+                return Err(SolveError::NoConvergence {
+                    detail: format!(
+                        "Moreau step at t = {t}, h = {h:e}: Newton on the step did not converge \
+                         in {} iterations (last update {last_dv:e})",
+                        self.max_newton
+                    ),
+                });
+            }
+            result = Some(sol);
+        }
+        let sol = result.expect("set above");
+        debug_assert!(
+            self.check_complementarity(&sol, &p_start, h),
+            "chosen mode violates complementarity at t = {t}: {sol:?}"
+        );
+
+        let vp = sol.v;
+        let alpha = x[0] + h * ((1.0 - th) * (v[0] - v[1]) + th * (vp[0] - vp[1]));
+        Ok(StepOutcome {
+            x: State::new(alpha, vp[0], vp[1]),
+            mode: sol.mode,
+            r: sol.r,
+            p: sol.p,
+            used_enumeration: used_enum,
+            newton_iters,
+            evals,
+        })
+    }
+
+    /// Checks a converged solution against the exact (not linearised) Coulomb conditions:
+    /// slip s ⇒ `s ω⁺ > 0` and `r = −s P(ω⁺)`; stick ⇒ `ω⁺ = 0` and `|r| ≤ P`.
+    pub fn check_complementarity(&self, sol: &OneStepSolution, p_start: &[f64; 2], h: f64) -> bool {
+        (0..2).all(|i| match sol.mode[i].branch() {
+            None => sol.v[i] == 0.0 && sol.r[i].abs() <= sol.p[i] * (1.0 + 1e-12) + 1e-15 * h,
+            Some(s) => {
+                let p = match self.level {
+                    FrictionLevel::Implicit => {
+                        p_start[i] + h * self.theta * self.law[i].level_ext(s * sol.v[i]).max(0.0)
+                    }
+                    FrictionLevel::Explicit => p_start[i],
+                };
+                // Newton tolerance 1e-12 on ω times |dP/dω| ≤ h·O(1): far below 1e-9·h.
+                s * sol.v[i] > 0.0 && (sol.r[i] + s * p).abs() <= 1e-9 * (h + p.abs())
+            }
+        })
+    }
+}
