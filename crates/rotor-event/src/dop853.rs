@@ -63,6 +63,13 @@ impl<const N: usize> Dense<N> {
         c[0] + (c[1] + (c[2] + (c[3] + par * s1) * s) * s1) * s
     }
 
+    /// The interpolant of a constant state on `[t0, t0 + h]`.
+    pub fn constant(t0: f64, h: f64, y: &SVector<f64, N>) -> Dense<N> {
+        let mut c = [SVector::<f64, N>::zeros(); 8];
+        c[0] = *y;
+        Dense { t0, h, c }
+    }
+
     /// End time `t0 + h`.
     pub fn t1(&self) -> f64 {
         self.t0 + self.h

@@ -1,0 +1,565 @@
+//! Event-driven integration of the Filippov system with exact sliding (stick).
+//!
+//! After Piiroinen & Kuznetsov (ACM TOMS 34(3), 2008): the state carries a *mode* per disc
+//! (slip+, slip−, stick). Between events the smooth field of the mode is integrated with
+//! DOP853. In stick the disc's velocity is held at exactly 0 and its friction is Utkin's
+//! equivalent control (the applied torque); stick ends when that torque leaves the stick
+//! interval `[T_f(0⁻), T_f(0⁺)]`. Guards:
+//!
+//! * slipping disc on branch s: `g = s·ω` (reaches 0: stick or reversal, decided from the
+//!   one-sided accelerations, i.e. whether the applied torque lies inside the interval);
+//! * stuck disc: `g = T_f(0⁺) − T_ex` and `g = T_ex − T_f(0⁻)` (stick exit to slip±);
+//! * when extrema are asked: `g = ω̇` of each slipping disc (maxima and minima);
+//! * when a Poincaré section is asked: `g = ω_l − c`, upward.
+//!
+//! Guards are sampled at interior points of the dense output and, for the velocity guards,
+//! their derivative too, so that a shallow dip below zero inside one step is not missed.
+//! A located root is refined by re-taking the RK step exactly to it (8th-order state) plus a
+//! Newton correction in time.
+
+use rotor_model::{
+    Disc, DiscMode, Event, EventKind, Mode, Model, OMEGA_L, SolveError, State, Stats,
+    check_finite,
+};
+
+use crate::dop853::{Dense, Dop853};
+
+/// Options of the event-driven solver.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct EventOptions {
+    /// Largest step [s]; a quarter of the lower disc's natural period (2π/√(k_θ/J_l) ≈ 4.2 s)
+    /// is far above what the tolerance allows on a cycle, so it only matters on equilibria.
+    pub h_max: f64,
+    /// Limit on accepted + rejected steps.
+    pub max_steps: u64,
+    /// Zeno guard: this many mode switches within `zeno_window` (relative to max(1, t)) is
+    /// an error.
+    pub zeno_count: u32,
+    pub zeno_window: f64,
+    /// Interior sample points per step for guard detection.
+    pub guard_samples: usize,
+}
+
+impl Default for EventOptions {
+    fn default() -> Self {
+        EventOptions {
+            h_max: 1.0,
+            max_steps: 50_000_000,
+            zeno_count: 64,
+            zeno_window: 1e-9,
+            guard_samples: 4,
+        }
+    }
+}
+
+/// What to do with a run as it goes.
+pub(crate) trait Sink {
+    /// An accepted step `[t0, t1]` whose dense output is `dense` (valid on `[t0, t1]`).
+    fn step(&mut self, _dense: &Dense<3>, _t0: f64, _t1: f64, _x1: &State, _mode: Mode) {}
+    /// An event (in time order).
+    fn event(&mut self, _e: &Event) {}
+    /// Whether to stop after this event.
+    fn stop_after(&mut self, _e: &Event) -> bool {
+        false
+    }
+    /// An upward crossing of the Poincaré section; whether to stop there.
+    fn section(&mut self, _t: f64, _x: &State) -> bool {
+        false
+    }
+}
+
+/// A run's end.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct RunEnd {
+    pub t: f64,
+    pub x: State,
+    pub mode: Mode,
+}
+
+/// Which guard fired.
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Guard {
+    /// Velocity of a slipping disc reached 0.
+    Velocity(Disc),
+    /// Applied torque of a stuck disc reached the upper / lower bound.
+    ExitHi(Disc),
+    ExitLo(Disc),
+    /// Extremum of a slipping disc's velocity (max if `true`).
+    Extremum(Disc, bool),
+    /// Upward crossing of ω_l = c.
+    Section,
+}
+
+impl Guard {
+    fn terminal(self) -> bool {
+        matches!(self, Guard::Velocity(_) | Guard::ExitHi(_) | Guard::ExitLo(_))
+    }
+}
+
+/// One integration run of the Filippov system.
+pub(crate) struct Integrator<'a> {
+    pub model: &'a Model,
+    pub u: f64,
+    pub opts: EventOptions,
+    pub ctl: Dop853,
+    pub stats: Stats,
+    pub extrema: bool,
+    pub section: Option<f64>,
+}
+
+impl<'a> Integrator<'a> {
+    pub fn new(model: &'a Model, u: f64, tol: f64, opts: EventOptions) -> Integrator<'a> {
+        let mut ctl = Dop853::new(tol, tol);
+        ctl.h_max = opts.h_max;
+        Integrator {
+            model,
+            u,
+            opts,
+            ctl,
+            stats: Stats::default(),
+            extrema: false,
+            section: None,
+        }
+    }
+
+    #[inline]
+    fn field(&self, x: &State, mode: Mode) -> State {
+        self.model.rhs(x, self.u, mode)
+    }
+
+    /// Value of a guard at state x (in the current mode).
+    fn guard(&self, g: Guard, x: &State, mode: Mode) -> f64 {
+        match g {
+            Guard::Velocity(d) => {
+                let s = mode.of(d).branch().unwrap_or(1.0);
+                s * x[d.index()]
+            }
+            Guard::ExitHi(d) => {
+                let (_, hi) = self.model.friction(d).static_interval();
+                hi - self.model.applied_torque(d, x, self.u)
+            }
+            Guard::ExitLo(d) => {
+                let (lo, _) = self.model.friction(d).static_interval();
+                self.model.applied_torque(d, x, self.u) - lo
+            }
+            Guard::Extremum(d, _) => self.model.disc_accel(d, x, self.u, mode.of(d)),
+            Guard::Section => x[OMEGA_L] - self.section.unwrap_or(0.0),
+        }
+    }
+
+    /// Time derivative of a guard along the mode's field.
+    fn guard_rate(&self, g: Guard, x: &State, mode: Mode) -> f64 {
+        let f = self.field(x, mode);
+        match g {
+            Guard::Velocity(d) => mode.of(d).branch().unwrap_or(1.0) * f[d.index()],
+            Guard::ExitHi(d) | Guard::ExitLo(d) => {
+                let k = self.model.params.k_theta * f[0];
+                let dt = match d {
+                    Disc::Upper => -k,
+                    Disc::Lower => k,
+                };
+                if matches!(g, Guard::ExitHi(_)) { -dt } else { dt }
+            }
+            Guard::Extremum(d, _) => {
+                let j = self.model.jacobian(x, self.u, mode);
+                (j * f)[d.index()]
+            }
+            Guard::Section => f[OMEGA_L],
+        }
+    }
+
+    /// The guards active in a mode (at most 6).
+    fn guards(&self, mode: Mode, out: &mut [Guard; 8]) -> usize {
+        let mut n = 0;
+        for d in Disc::BOTH {
+            match mode.of(d) {
+                DiscMode::Stick => {
+                    out[n] = Guard::ExitHi(d);
+                    out[n + 1] = Guard::ExitLo(d);
+                    n += 2;
+                }
+                _ => {
+                    // Also for a smooth law (zero-width interval): its sign change is reported
+                    // as a reversal and switches the branch (exact for an asymmetric Δb_u).
+                    out[n] = Guard::Velocity(d);
+                    n += 1;
+                    if self.extrema {
+                        out[n] = Guard::Extremum(d, true);
+                        n += 1;
+                    }
+                }
+            }
+        }
+        if self.section.is_some() {
+            out[n] = Guard::Section;
+            n += 1;
+        }
+        n
+    }
+
+    /// Whether a guard's sign change from `a` to `b` is an event, and which.
+    fn fires(g: Guard, a: f64, b: f64) -> Option<Guard> {
+        match g {
+            Guard::Extremum(d, _) => {
+                if a > 0.0 && b <= 0.0 {
+                    Some(Guard::Extremum(d, true))
+                } else if a < 0.0 && b >= 0.0 {
+                    Some(Guard::Extremum(d, false))
+                } else {
+                    None
+                }
+            }
+            Guard::Section => (a < 0.0 && b >= 0.0).then_some(g),
+            _ => (a > 0.0 && b <= 0.0).then_some(g),
+        }
+    }
+
+    /// Finds the earliest guard event in the step `[t0, t1]` of dense output `d`.
+    fn detect(&self, d: &Dense<3>, t0: f64, t1: f64, mode: Mode) -> Option<(f64, Guard)> {
+        let mut gs = [Guard::Section; 8];
+        let n = self.guards(mode, &mut gs);
+        let m = self.opts.guard_samples.max(1);
+        let mut best: Option<(f64, Guard)> = None;
+        for &g in &gs[..n] {
+            let mut ta = t0;
+            let mut xa = d.eval(ta);
+            let mut ga = self.guard(g, &xa, mode);
+            for i in 1..=m {
+                let tb = if i == m {
+                    t1
+                } else {
+                    t0 + (t1 - t0) * i as f64 / m as f64
+                };
+                if let Some((bt, _)) = best
+                    && ta >= bt
+                {
+                    break;
+                }
+                let xb = d.eval(tb);
+                let gb = self.guard(g, &xb, mode);
+                let mut hit = Self::fires(g, ga, gb).map(|kind| (ta, tb, ga, kind));
+                // A shallow dip of a velocity guard between two positive samples: look for
+                // the minimum (root of the guard's rate) and test its value.
+                if hit.is_none() && matches!(g, Guard::Velocity(_)) && ga > 0.0 && gb > 0.0 {
+                    let ra = self.guard_rate(g, &xa, mode);
+                    let rb = self.guard_rate(g, &xb, mode);
+                    if ra < 0.0 && rb > 0.0 {
+                        let rate = |t: f64| self.guard_rate(g, &d.eval(t), mode);
+                        let tm = illinois(&rate, ta, tb, ra, rb);
+                        let gm = self.guard(g, &d.eval(tm), mode);
+                        if gm <= 0.0 {
+                            hit = Some((ta, tm, ga, g));
+                        }
+                    }
+                }
+                if let Some((a, b, fa, kind)) = hit {
+                    let f = |t: f64| self.guard(g, &d.eval(t), mode);
+                    let fb = f(b);
+                    let root = if fb == 0.0 { b } else { illinois(&f, a, b, fa, fb) };
+                    if best.is_none_or(|(bt, _)| root < bt) {
+                        best = Some((root, kind));
+                    }
+                    break;
+                }
+                ta = tb;
+                xa = xb;
+                ga = gb;
+            }
+        }
+        best
+    }
+
+    /// Integrates from `(t, x, mode)` to `t_end`, or until the sink asks to stop.
+    pub fn run(
+        &mut self,
+        t_start: f64,
+        x_start: State,
+        mode_start: Mode,
+        t_end: f64,
+        sink: &mut impl Sink,
+    ) -> Result<RunEnd, SolveError> {
+        let model = self.model;
+        let u = self.u;
+        let mut t = t_start;
+        let mut x = x_start;
+        let mut mode = mode_start;
+        for d in Disc::BOTH {
+            if mode.of(d) == DiscMode::Stick {
+                x[d.index()] = 0.0;
+            }
+        }
+        let mut rhs_evals = 0u64;
+        let mut f = |_t: f64, y: &State, mode: Mode| {
+            rhs_evals += 1;
+            model.rhs(y, u, mode)
+        };
+        let mut f0 = f(t, &x, mode);
+        let mut h = {
+            let mut fm = |tt: f64, y: &State| f(tt, y, mode);
+            self.ctl.initial_step(&mut fm, t, &x, &f0)
+        };
+        self.ctl.restart();
+        let mut recent = [f64::NEG_INFINITY; 64];
+        let mut n_switch: usize = 0;
+        let zeno_n = (self.opts.zeno_count as usize).clamp(2, 64);
+        let mut steps_total = 0u64;
+        // Time of the last mode switch: the acceleration of a disc leaving stick starts at 0,
+        // so its first sign is rounding; extremum roots right at a switch are not extrema.
+        let mut t_switch = f64::NEG_INFINITY;
+        while t < t_end {
+            // Both discs stuck: the state is frozen and the exit guards are constant.
+            if mode.upper == DiscMode::Stick && mode.lower == DiscMode::Stick {
+                let mut stays = true;
+                for d in Disc::BOTH {
+                    if model.stick_exit(d, &x, u).is_some() {
+                        stays = false;
+                    }
+                }
+                if stays {
+                    let d = frozen_dense(t, t_end - t, &x);
+                    sink.step(&d, t, t_end, &x, mode);
+                    t = t_end;
+                    break;
+                }
+            }
+            steps_total += 1;
+            if steps_total > self.opts.max_steps {
+                return Err(SolveError::TooManySteps {
+                    t,
+                    max_steps: self.opts.max_steps,
+                });
+            }
+            let mut last = false;
+            if t + 1.01 * h >= t_end {
+                h = t_end - t;
+                last = true;
+            }
+            if h <= 4.0 * f64::EPSILON * t.abs().max(1.0) {
+                return Err(SolveError::StepSizeUnderflow {
+                    t,
+                    h,
+                    x: [x[0], x[1], x[2]],
+                });
+            }
+            let mut fm = |tt: f64, y: &State| f(tt, y, mode);
+            let tr = self.ctl.trial(&mut fm, t, &x, &f0, h);
+            if !Dop853::acceptable(&tr) {
+                self.stats.rejected += 1;
+                h = self.ctl.reject(tr.err, h);
+                continue;
+            }
+            let h_next = self.ctl.accept(tr.err, h);
+            self.stats.steps += 1;
+            let t1 = if last { t_end } else { t + h };
+            let f1 = fm(t1, &tr.y1);
+            let dense = self.ctl.dense(&mut fm, &tr, &f1);
+            // Earliest event in the step; non-terminal events before it are recorded.
+            let mut t_lo = t;
+            let mut stop_here = None;
+            loop {
+                let Some((te, g)) = self.detect(&dense, t_lo, t1, mode) else {
+                    break;
+                };
+                if g.terminal() {
+                    stop_here = Some((te, g));
+                    break;
+                }
+                if matches!(g, Guard::Extremum(..)) && te - t_switch <= 1e-9 * te.abs().max(1.0) {
+                    t_lo = te + 1e-12 * (t1 - t).abs().max(1e-300);
+                    if t_lo >= t1 {
+                        break;
+                    }
+                    continue;
+                }
+                let xe = refine_state(&dense, te);
+                let kind = match g {
+                    Guard::Extremum(d, true) => EventKind::Max(d),
+                    Guard::Extremum(d, false) => EventKind::Min(d),
+                    _ => EventKind::Max(Disc::Lower),
+                };
+                let ev = Event { t: te, x: xe, kind };
+                if g == Guard::Section {
+                    if sink.section(te, &xe) {
+                        sink.step(&dense, t, te, &xe, mode);
+                        self.stats.rhs_evals += rhs_evals;
+                        return Ok(RunEnd { t: te, x: xe, mode });
+                    }
+                } else {
+                    self.stats.events += 1;
+                    sink.event(&ev);
+                    if sink.stop_after(&ev) {
+                        sink.step(&dense, t, te, &xe, mode);
+                        self.stats.rhs_evals += rhs_evals;
+                        return Ok(RunEnd { t: te, x: xe, mode });
+                    }
+                }
+                // Continue the search just past this root.
+                t_lo = te + 1e-12 * (t1 - t).abs().max(1e-300);
+                if t_lo >= t1 {
+                    break;
+                }
+            }
+            match stop_here {
+                None => {
+                    sink.step(&dense, t, t1, &tr.y1, mode);
+                    t = t1;
+                    x = tr.y1;
+                    f0 = f1;
+                    h = h_next;
+                    check_finite(t, &x)?;
+                }
+                Some((te, g)) => {
+                    // Refine: an exact RK step from t to the root, then a Newton correction.
+                    let mut tev = te;
+                    let mut xe = tr.y1;
+                    for _ in 0..3 {
+                        let hh = tev - t;
+                        xe = if hh > 0.0 {
+                            self.ctl.trial(&mut fm, t, &x, &f0, hh).y1
+                        } else {
+                            x
+                        };
+                        let gv = self.guard(g, &xe, mode);
+                        let gr = self.guard_rate(g, &xe, mode);
+                        if gr == 0.0 || !gr.is_finite() {
+                            break;
+                        }
+                        let dt = -gv / gr;
+                        // Keep the correction inside the step and stop at rounding level.
+                        if dt.abs() <= 1e-15 * tev.abs().max(1.0)
+                            || tev + dt <= t
+                            || tev + dt > t1
+                        {
+                            break;
+                        }
+                        tev += dt;
+                    }
+                    sink.step(&dense, t, tev, &xe, mode);
+                    check_finite(tev, &xe)?;
+                    t = tev;
+                    x = xe;
+                    let (new_mode, kind) = self.transition(g, &mut x, mode);
+                    self.stats.events += u64::from(kind.is_some());
+                    if let Some(kind) = kind {
+                        let ev = Event { t, x, kind };
+                        sink.event(&ev);
+                        recent[n_switch % zeno_n] = t;
+                        n_switch += 1;
+                        if n_switch >= zeno_n {
+                            let oldest = recent[n_switch % zeno_n];
+                            let window = self.opts.zeno_window * t.abs().max(1.0);
+                            if t - oldest < window {
+                                return Err(SolveError::Zeno {
+                                    t,
+                                    count: zeno_n as u32,
+                                    window,
+                                });
+                            }
+                        }
+                        if sink.stop_after(&ev) {
+                            self.stats.rhs_evals += rhs_evals;
+                            return Ok(RunEnd { t, x, mode: new_mode });
+                        }
+                    }
+                    mode = new_mode;
+                    t_switch = t;
+                    f0 = f(t, &x, mode);
+                    self.ctl.restart();
+                    h = h_next.min(h).max(1e-6 * h_next);
+                }
+            }
+        }
+        self.stats.rhs_evals += rhs_evals;
+        Ok(RunEnd { t, x, mode })
+    }
+
+    /// The mode after a terminal guard, and the event to report.
+    fn transition(&self, g: Guard, x: &mut State, mode: Mode) -> (Mode, Option<EventKind>) {
+        let mut m = mode;
+        match g {
+            Guard::Velocity(d) => {
+                let s = mode.of(d).branch().unwrap_or(1.0);
+                x[d.index()] = 0.0;
+                let fr = self.model.friction(d);
+                let t_ex = self.model.applied_torque(d, x, self.u);
+                let (lo, hi) = fr.static_interval();
+                if fr.is_set_valued() && lo <= t_ex && t_ex <= hi {
+                    m.set(d, DiscMode::Stick);
+                    (m, Some(EventKind::StickStart(d)))
+                } else if (s > 0.0 && t_ex < lo) || (s < 0.0 && t_ex > hi) || !fr.is_set_valued() {
+                    // Both one-sided fields point the same way: crossing.
+                    m.set(d, if s > 0.0 { DiscMode::SlipNeg } else { DiscMode::SlipPos });
+                    (m, Some(EventKind::Reversal(d)))
+                } else {
+                    // Grazing from the side the applied torque pushes back to: stay.
+                    (m, None)
+                }
+            }
+            Guard::ExitHi(d) => {
+                x[d.index()] = 0.0;
+                m.set(d, DiscMode::SlipPos);
+                (m, Some(EventKind::StickEnd(d)))
+            }
+            Guard::ExitLo(d) => {
+                x[d.index()] = 0.0;
+                m.set(d, DiscMode::SlipNeg);
+                (m, Some(EventKind::StickEnd(d)))
+            }
+            _ => (m, None),
+        }
+    }
+}
+
+/// State at a non-terminal event: the dense output (7th order, within the tolerance).
+fn refine_state(d: &Dense<3>, t: f64) -> State {
+    d.eval(t)
+}
+
+/// A constant "dense output" for a frozen state.
+fn frozen_dense(t0: f64, h: f64, x: &State) -> Dense<3> {
+    Dense::constant(t0, h, x)
+}
+
+/// Illinois (modified regula falsi) root of `f` on `[a, b]` with `f(a)·f(b) ≤ 0`, to the
+/// last bits of the bracket.
+pub(crate) fn illinois(f: &impl Fn(f64) -> f64, mut a: f64, mut b: f64, mut fa: f64, mut fb: f64) -> f64 {
+    if fa == 0.0 {
+        return a;
+    }
+    if fb == 0.0 {
+        return b;
+    }
+    let mut side = 0i8;
+    for _ in 0..200 {
+        let c = (a * fb - b * fa) / (fb - fa);
+        let c = if c.is_finite() && c > a.min(b) && c < a.max(b) {
+            c
+        } else {
+            0.5 * (a + b)
+        };
+        let fc = f(c);
+        if fc == 0.0 {
+            return c;
+        }
+        if (fc > 0.0) == (fb > 0.0) {
+            b = c;
+            fb = fc;
+            if side == -1 {
+                fa *= 0.5;
+            }
+            side = -1;
+        } else {
+            a = c;
+            fa = fc;
+            if side == 1 {
+                fb *= 0.5;
+            }
+            side = 1;
+        }
+        if (b - a).abs() <= 2.0 * f64::EPSILON * a.abs().max(b.abs()).max(1e-300) {
+            break;
+        }
+    }
+    // The end where the guard has already fired (sign of f(b) at entry).
+    b
+}
