@@ -305,7 +305,7 @@ impl<'a> Integrator<'a> {
         let mut steps_total = 0u64;
         // Time of the last mode switch: the acceleration of a disc leaving stick starts at 0,
         // so its first sign is rounding; extremum roots right at a switch are not extrema.
-        let mut t_switch = f64::NEG_INFINITY;
+        let mut t_switch = t_start;
         while t < t_end {
             // Both discs stuck: the state is frozen and the exit guards are constant.
             if mode.upper == DiscMode::Stick && mode.lower == DiscMode::Stick {

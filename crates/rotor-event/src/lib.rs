@@ -6,10 +6,12 @@
 
 pub mod dop853;
 mod filippov;
+pub mod flow;
 mod solver;
 pub mod steady;
 pub mod tableau;
 
 pub use filippov::EventOptions;
+pub use flow::{FlowEnd, StopAt, flow};
 pub use solver::EventSolver;
 pub use steady::{SteadyOptions, steady_state};
