@@ -125,6 +125,9 @@ pub struct MoreauOptions {
     pub theta: f64,
     /// Implicit (default) or explicit friction level.
     pub friction_level: FrictionLevel,
+    /// Take the slip solution without the complementarity solve when no contact can change
+    /// state in the step (default `true`; `false` enumerates on every step, for checks).
+    pub skip_free_steps: bool,
     /// Maximum Newton iterations per step (default 50).
     pub max_newton: u32,
     /// Maximum number of steps of one run (default 1e9).
@@ -136,6 +139,7 @@ impl Default for MoreauOptions {
         MoreauOptions {
             theta: 0.5,
             friction_level: FrictionLevel::Implicit,
+            skip_free_steps: true,
             max_newton: 50,
             max_steps: 1_000_000_000,
         }

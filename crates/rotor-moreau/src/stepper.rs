@@ -37,6 +37,10 @@ pub struct StepOutcome {
     pub p: Vector2<f64>,
     /// Whether the enumeration was run (`false`: the slip prediction was verified directly).
     pub used_enumeration: bool,
+    /// Whether the step problem was solved exactly (Newton or Picard converged). `false`
+    /// only for very large h with a falling friction level, where the step problem may have
+    /// no or several solutions; the last Picard iterate is then taken.
+    pub exact: bool,
     /// Newton iterations (one linearised solve each).
     pub newton_iters: u32,
     /// Evaluations of the smooth friction forces and levels (one per disc and branch).
@@ -70,6 +74,7 @@ pub struct Stepper {
     theta: f64,
     level: FrictionLevel,
     max_newton: u32,
+    skip_free: bool,
     j: [f64; 2],
     c: [f64; 2],
     k: f64,
@@ -91,6 +96,7 @@ impl Stepper {
             theta: options.theta,
             level: options.friction_level,
             max_newton: options.max_newton,
+            skip_free: options.skip_free_steps,
             j: [l.m[(0, 0)], l.m[(1, 1)]],
             c: [l.c[(0, 0)], l.c[(1, 1)]],
             k: l.k[(0, 0)],
@@ -189,12 +195,12 @@ impl Stepper {
             t,
             detail: "singular iteration matrix".into(),
         })?;
-        let mut skip = true;
+        let mut skip = self.skip_free;
         {
             let mut rhs = b;
             let mut pmax = [0.0; 2];
             for i in 0..2 {
-                if v[i] == 0.0 {
+                if !skip || v[i] == 0.0 {
                     skip = false;
                     break;
                 }
@@ -252,12 +258,13 @@ impl Stepper {
             }
         }
 
+        let mut exact = true;
         if result.is_none() {
             used_enum = true;
+            // Semi-smooth Newton: linearise, solve the piecewise-linear problem exactly.
             let mut w = v;
             let mut prev: Option<[DiscMode; 2]> = None;
-            let mut last: Option<OneStepSolution> = None;
-            let mut last_dv = f64::INFINITY;
+            let mut newton_failed = false;
             for _ in 0..self.max_newton {
                 newton_iters += 1;
                 let mut prob = OneStepProblem {
@@ -270,57 +277,80 @@ impl Stepper {
                     prob.slip[i] = [branch(i, 1.0, w[i]), branch(i, -1.0, w[i])];
                     evals += 2;
                 }
-                let sol = match prob.solve() {
-                    Ok(s) => s,
-                    Err(err) => {
-                        // The linearised bound slopes can make a slip branch ill-posed for
-                        // very large h with a falling level; the frozen-bound problem (a
-                        // strictly convex box QP) always has exactly one solution.
-                        for i in 0..2 {
-                            for br in prob.slip[i].iter_mut() {
-                                *br = Branch {
-                                    c: br.c + br.d * w[i],
-                                    d: 0.0,
-                                    pc: br.pc + br.pd * w[i],
-                                    pd: 0.0,
-                                };
-                            }
-                        }
-                        prob.solve().map_err(|e2| SolveError::Complementarity {
-                            t,
-                            detail: format!(
-                                "one-step problem: {err:?}, frozen-bound problem: {e2:?}"
-                            ),
-                        })?
-                    }
+                let Ok(sol) = prob.solve() else {
+                    newton_failed = true;
+                    break;
                 };
                 let dv = (sol.v - w).amax();
                 let same = prev == Some(sol.mode);
                 w = sol.v;
                 prev = Some(sol.mode);
-                last = Some(sol);
-                last_dv = dv;
                 if !implicit || (same && dv <= 1e-12 * (1.0 + w.amax())) {
+                    result = Some(sol);
                     break;
                 }
             }
-            let sol = last.ok_or_else(|| SolveError::NoConvergence {
-                detail: format!("Moreau step at t = {t}: no Newton iterate"),
-            })?;
-            if implicit && last_dv > 1e-8 * (1.0 + sol.v.amax()) {
-                return Err(SolveError::NoConvergence {
-                    detail: format!(
-                        "Moreau step at t = {t}, h = {h:e}: Newton on the step did not converge \
-                         in {} iterations (last update {last_dv:e})",
-                        self.max_newton
-                    ),
-                });
+            if result.is_none() {
+                // Newton failed: with a level falling faster than M̂ can absorb (very large
+                // h) the linearised slip branches become ill-posed, and the nonlinear step
+                // problem itself may have no or several solutions. Picard iteration on the
+                // frozen problem: every mode of disc i sees the same smooth impulse g_i and
+                // the same bound P_i, evaluated at the iterate; that is the KKT system of a
+                // strictly convex box QP (W = M̂⁻¹ SPD), with exactly one solution. A fixed
+                // point is an exact solution of the step problem.
+                let mut w = if newton_failed { v } else { w };
+                let mut last: Option<OneStepSolution> = None;
+                let mut prev: Option<[DiscMode; 2]> = None;
+                exact = false;
+                for _ in 0..self.max_newton {
+                    newton_iters += 1;
+                    let mut prob = OneStepProblem {
+                        a,
+                        b,
+                        slip: [[Branch::default(); 2]; 2],
+                        stick,
+                    };
+                    for i in 0..2 {
+                        let s = if w[i] < 0.0 { -1.0 } else { 1.0 };
+                        let e = eval_branch(&self.law[i], self.db[i], w[i], s);
+                        evals += 1;
+                        let (mut g, mut p) = (h * th * e.off, p_start[i]);
+                        if implicit {
+                            g -= s * h * th * e.level.min(0.0);
+                            p += h * th * e.level.max(0.0);
+                        }
+                        prob.slip[i] = [1.0, -1.0].map(|sb| Branch {
+                            c: g - sb * p,
+                            d: 0.0,
+                            pc: p,
+                            pd: 0.0,
+                        });
+                        prob.stick[i] = StickData { e: g, p };
+                    }
+                    let sol = prob.solve().map_err(|err| SolveError::Complementarity {
+                        t,
+                        detail: format!("frozen one-step problem (h = {h:e}): {err:?}"),
+                    })?;
+                    let dv = (sol.v - w).amax();
+                    let same = prev == Some(sol.mode);
+                    w = sol.v;
+                    prev = Some(sol.mode);
+                    last = Some(sol);
+                    if same && dv <= 1e-12 * (1.0 + w.amax()) {
+                        exact = true;
+                        break;
+                    }
+                }
+                // Not converged: the last Picard iterate (the exact solution of a frozen
+                // problem, bounded) is taken; `StepOutcome::exact` says so.
+                result = last;
             }
-            result = Some(sol);
         }
-        let sol = result.expect("set above");
+        let sol = result.ok_or_else(|| SolveError::NoConvergence {
+            detail: format!("Moreau step at t = {t}: no iterate (max_newton = 0?)"),
+        })?;
         debug_assert!(
-            self.check_complementarity(&sol, &p_start, h),
+            !exact || self.check_complementarity(&sol, &p_start, h),
             "chosen mode violates complementarity at t = {t}: {sol:?}"
         );
 
@@ -332,6 +362,7 @@ impl Stepper {
             r: sol.r,
             p: sol.p,
             used_enumeration: used_enum,
+            exact,
             newton_iters,
             evals,
         })

@@ -1,0 +1,238 @@
+//! The scene's output levels, events, metrics and errors.
+
+use rotor_model::{Disc, EventKind, Model, Output, OutputGrid, Scene, SolveError, Solver, State};
+use rotor_moreau::{MoreauOptions, MoreauSolver};
+
+fn base() -> Scene {
+    Scene {
+        u: 1.5,
+        x0: State::zeros(),
+        t_end: 1.0,
+        h: 0.003,
+        output: Output::Final,
+        metrics_from: None,
+        ..Scene::default()
+    }
+}
+
+#[test]
+fn name_is_moreau() {
+    assert_eq!(MoreauSolver::default().name(), "moreau");
+}
+
+#[test]
+fn final_keeps_no_samples_and_no_events() {
+    let scene = Scene {
+        t_end: 30.0,
+        metrics_from: Some(10.0),
+        ..base()
+    };
+    let tr = MoreauSolver::default()
+        .simulate(&Model::table1(), &scene)
+        .unwrap();
+    assert!(tr.samples.is_empty());
+    assert!(tr.events.is_empty());
+    assert!(tr.metrics.is_some());
+    assert!(tr.stats.events > 0, "events are located for the metrics");
+    assert_eq!(tr.t_final, 30.0);
+}
+
+#[test]
+fn steps_keep_every_step_and_land_on_t_end() {
+    let scene = Scene {
+        output: Output::Steps,
+        ..base()
+    };
+    let tr = MoreauSolver::default()
+        .simulate(&Model::table1(), &scene)
+        .unwrap();
+    // 1.0 / 0.003 = 333.3: 333 full steps and a shortened last one.
+    assert_eq!(tr.stats.steps, 334);
+    assert_eq!(tr.samples.len(), 335);
+    assert_eq!(tr.samples[0].t, 0.0);
+    let last = tr.samples.last().unwrap();
+    assert_eq!(last.t, 1.0);
+    assert_eq!(last.x, tr.x_final);
+    for w in tr.samples.windows(2) {
+        let dt = w[1].t - w[0].t;
+        assert!(dt > 0.0 && dt <= 0.003 * (1.0 + 1e-12));
+    }
+    assert_eq!(
+        tr.stats.lcp_solves + tr.stats.lcp_skipped,
+        tr.stats.steps,
+        "every step either solves or skips"
+    );
+}
+
+#[test]
+fn grid_matches_output_grid() {
+    let scene = Scene {
+        output: Output::Grid { dt: 0.01 },
+        ..base()
+    };
+    let tr = MoreauSolver::default()
+        .simulate(&Model::table1(), &scene)
+        .unwrap();
+    let mut g = OutputGrid::new(0.01, 1.0);
+    let mut times = Vec::new();
+    while let Some(t) = g.peek() {
+        times.push(t);
+        g.advance();
+    }
+    let got: Vec<f64> = tr.samples.iter().map(|s| s.t).collect();
+    assert_eq!(got, times);
+    assert_eq!(tr.samples.last().unwrap().x, tr.x_final);
+    // Linear interpolation between step ends: a grid sample lies between its neighbours'
+    // step values; check against a Steps run.
+    let steps = MoreauSolver::default()
+        .simulate(
+            &Model::table1(),
+            &Scene {
+                output: Output::Steps,
+                ..base()
+            },
+        )
+        .unwrap();
+    for s in &tr.samples {
+        let k = steps.samples.partition_point(|p| p.t < s.t);
+        let b = steps.samples[k];
+        let a = steps.samples[k.saturating_sub(1)];
+        let x = if b.t == a.t {
+            b.x
+        } else {
+            a.x + (b.x - a.x) * ((s.t - a.t) / (b.t - a.t))
+        };
+        // Same formula, same data: equal to rounding.
+        assert!((x - s.x).amax() <= 1e-13, "t={}: {:?} vs {:?}", s.t, x, s.x);
+    }
+}
+
+#[test]
+fn events_are_ordered_and_stick_phases_alternate() {
+    let scene = Scene {
+        t_end: 40.0,
+        h: 1e-3,
+        output: Output::Events,
+        ..base()
+    };
+    let tr = MoreauSolver::default()
+        .simulate(&Model::table1(), &scene)
+        .unwrap();
+    assert!(tr.samples.is_empty());
+    assert!(tr.events.windows(2).all(|w| w[0].t <= w[1].t));
+    assert!(
+        !tr.events
+            .iter()
+            .any(|e| matches!(e.kind, EventKind::Max(_) | EventKind::Min(_))),
+        "extrema only when metrics are asked"
+    );
+    let lower: Vec<EventKind> = tr
+        .events
+        .iter()
+        .map(|e| e.kind)
+        .filter(|k| {
+            matches!(
+                k,
+                EventKind::StickStart(Disc::Lower) | EventKind::StickEnd(Disc::Lower)
+            )
+        })
+        .collect();
+    // From rest the lower disc starts stuck: exit, onset, exit, …
+    assert!(lower.len() >= 10, "{lower:?}");
+    for (i, k) in lower.iter().enumerate() {
+        let want = if i % 2 == 0 {
+            EventKind::StickEnd(Disc::Lower)
+        } else {
+            EventKind::StickStart(Disc::Lower)
+        };
+        assert_eq!(*k, want, "event {i}");
+    }
+    for e in &tr.events {
+        if let EventKind::StickStart(d) | EventKind::StickEnd(d) | EventKind::Reversal(d) = e.kind {
+            assert_eq!(e.x[d.index()], 0.0);
+        }
+    }
+    let with_metrics = MoreauSolver::default()
+        .simulate(
+            &Model::table1(),
+            &Scene {
+                metrics_from: Some(20.0),
+                ..scene
+            },
+        )
+        .unwrap();
+    let maxima: Vec<_> = with_metrics
+        .events
+        .iter()
+        .filter(|e| e.kind == EventKind::Max(Disc::Lower))
+        .collect();
+    assert!(maxima.len() >= 7, "one per cycle of ~4.6 s");
+    assert!(with_metrics.events.windows(2).all(|w| w[0].t <= w[1].t));
+}
+
+#[test]
+fn skipping_changes_nothing() {
+    let scene = Scene {
+        t_end: 20.0,
+        h: 1e-3,
+        output: Output::Steps,
+        ..base()
+    };
+    let a = MoreauSolver::default()
+        .simulate(&Model::table1(), &scene)
+        .unwrap();
+    let b = MoreauSolver::new(MoreauOptions {
+        skip_free_steps: false,
+        ..MoreauOptions::default()
+    })
+    .simulate(&Model::table1(), &scene)
+    .unwrap();
+    assert!(a.stats.lcp_skipped > a.stats.steps / 2, "{:?}", a.stats);
+    assert!(a.stats.lcp_solves > 0);
+    assert_eq!(b.stats.lcp_skipped, 0);
+    let diff = a
+        .samples
+        .iter()
+        .zip(&b.samples)
+        .map(|(p, q)| (p.x - q.x).amax())
+        .fold(0.0, f64::max);
+    // Both paths converge Newton to 1e-12·(1 + |v|) per step; over 2e4 steps of a
+    // contracting (dissipative) system that stays below 1e-9.
+    assert!(diff < 1e-9, "{diff:e}");
+}
+
+#[test]
+fn typed_errors() {
+    let m = Model::table1();
+    let s = MoreauSolver::default();
+    assert!(matches!(
+        s.simulate(&m, &Scene { h: 0.0, ..base() }),
+        Err(SolveError::InvalidScene { field: "h", .. })
+    ));
+    assert!(matches!(
+        s.simulate(
+            &m,
+            &Scene {
+                x0: State::new(0.0, f64::INFINITY, 0.0),
+                ..base()
+            }
+        ),
+        Err(SolveError::InvalidScene { .. })
+    ));
+    let bad = MoreauSolver::new(MoreauOptions {
+        theta: 0.3,
+        ..MoreauOptions::default()
+    });
+    assert!(matches!(
+        bad.simulate(&m, &base()),
+        Err(SolveError::InvalidScene { field: "theta", .. })
+    ));
+    let few = MoreauSolver::new(MoreauOptions {
+        max_steps: 10,
+        ..MoreauOptions::default()
+    });
+    assert!(matches!(
+        few.simulate(&m, &base()),
+        Err(SolveError::TooManySteps { .. })
+    ));
+}
