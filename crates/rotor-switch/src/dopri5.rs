@@ -342,7 +342,8 @@ impl<const N: usize> Dopri5<N> {
             if !(h.is_finite() && h > 0.0) || 0.1 * h <= self.t.abs() * o.uround {
                 return Err(Dopri5Error::StepSizeUnderflow { t: self.t, h });
             }
-            if self.t + 1.01 * h - t_end > 0.0 {
+            let last = self.t + 1.01 * h - t_end > 0.0;
+            if last {
                 h = t_end - self.t;
             }
             self.counters.attempts += 1;
@@ -354,7 +355,8 @@ impl<const N: usize> Dopri5<N> {
                 t + C5 * h,
                 &(y + (k1 * A51 + k2 * A52 + k3 * A53 + k4 * A54) * h),
             );
-            let tph = t + h;
+            // The last step lands on t_end exactly (t + (t_end − t) may round off it).
+            let tph = if last { t_end } else { t + h };
             let k6 = f(
                 tph,
                 &(y + (k1 * A61 + k2 * A62 + k3 * A63 + k4 * A64 + k5 * A65) * h),

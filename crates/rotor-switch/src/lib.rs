@@ -1,3 +1,46 @@
-//! Leine's switch-model solver for the two-disc rotor (see `../shared/METHODS.md` §1.1).
+//! Leine's switch-model solver for the two-disc rotor (`../shared/METHODS.md` §1.1;
+//! Leine, van Campen, de Kraker & van den Steen, *Nonlinear Dyn.* 16 (1998);
+//! Leine & Nijmeijer, LNACM 18 (2004)).
+//!
+//! The set-valued friction of each disc is replaced by a vector field defined region by
+//! region around a thin velocity band `|ω| ≤ η`. The equations of motion are those of
+//! `rotor_model` (`α̇ = ω_u − ω_l`, `J_i ω̇_i = T_ex,i − T_fi`, with the applied torques
+//! `T_ex,u = k_m u − k_θ α`, `T_ex,l = k_θ α`). For a disc with a stick interval
+//! `[lo, hi]` (`Friction::static_interval`) of positive width the friction `T_f` is:
+//!
+//! | region | where | friction `T_f` | so `ω̇` |
+//! |---|---|---|---|
+//! | `Slip(s)` | `s·ω > η` | `T_f^s(ω)` (`Friction::torque(ω, s)`) | `(T_ex − T_f^s(ω))/J` |
+//! | `Stick` | `|ω| ≤ η`, `lo ≤ T_ex ≤ hi` | `T_ex` | `0` (with `ω` set to 0 on entry) |
+//! | `Trans(s)` | `|ω| ≤ η`, `T_ex` beyond bound `s` | `hi` (`s=+1`) or `lo` (`s=−1`) | `(T_ex − bound)/J` |
+//! | `Edge(s)` | `ω = s·η`, `T_ex` between `bound_s` and `T_f^s(sη)` | `T_ex` | `0` |
+//!
+//! * **Stick relaxation.** Instead of a relaxation term `ω̇ = −ω/τ` (stiff for an explicit
+//!   integrator), the velocity of a disc entering `Stick` is reset to exactly 0 and held
+//!   there by `ω̇ = 0`. The jump is at most η; it makes the stuck state the Filippov sliding
+//!   state itself (`ω = 0`, friction = equivalent control `T_ex`).
+//! * **Edge** is a sliver the band creates: a disc decelerating into the band with `T_ex`
+//!   just beyond the bound on its own side (`hi < T_ex ≤ T_f^+(η)` for `s = +1`) would be
+//!   pushed back out by the transition field and back in by the slip field — a sliding mode
+//!   on `ω = sη`. It is held there (`ω̇ = 0`, `T_f = T_ex`) until `T_ex` leaves the sliver.
+//!   For `η → 0` the sliver is empty.
+//! * A disc whose stick interval has zero width (`Friction::is_set_valued()` false, e.g.
+//!   Table 1's upper disc with `T_su = 0`) has no band: its law is continuous across 0, it is
+//!   always in `Slip(s)` with `s = sign ω`, and `ω = 0` is located only to flip the branch
+//!   (a kink when `Δb_u ≠ 0`) and to report a reversal.
+//! * **Two discs.** Each disc has its own region. The mass matrix is diagonal and each disc's
+//!   applied torque `T_ex,i` contains no friction of the other disc (the discs couple only
+//!   through α), so the stick torques of two stuck discs are independent: no coupled solve
+//!   is needed, and the field above is exact for any combination of regions.
+//! * `η = 0` is allowed: the band collapses, `Trans`/`Edge` are skipped, and the solver is
+//!   an event-driven integration of the exact Filippov solution (sticking at `ω = 0` with the
+//!   equivalent control). The crate's tests use it as the reference for the η study.
+//!
+//! Region changes are located on the dense output of [`dopri5`] (guards sampled at interior
+//! points, then Illinois to `1e-14·max(1, t)` in time), the step is ended there, and the
+//! integration is restarted in the new region.
 
 pub mod dopri5;
+mod switch;
+
+pub use switch::{Region, SwitchOptions, SwitchSolver};
