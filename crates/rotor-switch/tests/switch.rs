@@ -385,3 +385,51 @@ fn bad_input_gives_typed_errors() {
     let e = zeno.simulate(&model, &base).unwrap_err();
     assert!(matches!(e, SolveError::Zeno { count: 3, .. }), "{e}");
 }
+
+/// The band's sliver: a lower disc decelerating into the band with `hi < T_ex < T_f^+(η)`
+/// (the transition field would push it out, the slip field back in). It must be held at
+/// ω_l = η exactly (region Edge) instead of chattering, then leave: to slip when the spring
+/// winds up (ω_u > η), to stick when it unwinds (ω_u < η).
+#[test]
+fn band_edge_sliver_is_held_not_chattered() {
+    let model = Model::table1();
+    let p = model.params;
+    let eta = 1e-3;
+    let f = model.friction(Disc::Lower);
+    let (_, hi) = f.static_interval();
+    let sliver = f.torque(eta, 1.0) - hi; // ≈ 0.15·η N m for Table 1
+    assert!(sliver > 0.0);
+    let alpha0 = (hi + 0.5 * sliver) / p.k_theta;
+    for (w_u, ends_stuck) in [(0.01, false), (-0.01, true)] {
+        // u holds the upper disc at ω_u: k_m u = k_θ α + b_u ω_u.
+        let u = (p.k_theta * alpha0 + p.upper.b * w_u) / p.k_m;
+        let scene = Scene {
+            u,
+            x0: rotor_model::State::new(alpha0, w_u, 1.01 * eta),
+            t_end: 0.5,
+            output: Output::Steps,
+            ..Scene::default()
+        };
+        let t = run(eta, &model, &scene);
+        // Held exactly at the edge for a while (ω̇ = 0 there) …
+        let held = t.samples.iter().filter(|p| p.x[OMEGA_L] == eta).count();
+        assert!(held >= 2, "ω_u = {w_u}: {held} samples at the edge");
+        // … then it leaves the way the applied torque says.
+        if ends_stuck {
+            assert_eq!(t.x_final[OMEGA_L], 0.0, "{:?}", t.x_final);
+            assert!(
+                t.events
+                    .iter()
+                    .any(|e| e.kind == EventKind::StickStart(Disc::Lower))
+            );
+        } else {
+            assert!(t.x_final[OMEGA_L] > eta, "{:?}", t.x_final);
+        }
+        // Few switches: no chattering (a chattering run needs hundreds).
+        assert!(
+            t.stats.events < 10,
+            "ω_u = {w_u}: {} switches",
+            t.stats.events
+        );
+    }
+}
