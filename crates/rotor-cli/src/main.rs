@@ -146,7 +146,11 @@ fn simulate(common: &Common, t_end: f64, dt: f64, csv_path: &Path) -> Result<()>
     writeln!(buf, "t,alpha,omega_u,omega_l")?;
     for s in &traj.samples {
         if !(s.t.is_finite() && s.x.iter().all(|v| v.is_finite())) {
-            bail!("solver {} produced a non-finite sample at t = {}", solver.name(), s.t);
+            bail!(
+                "solver {} produced a non-finite sample at t = {}",
+                solver.name(),
+                s.t
+            );
         }
         writeln!(buf, "{},{},{},{}", s.t, s.x[0], s.x[1], s.x[2])?;
     }
@@ -180,7 +184,8 @@ fn steady(common: &Common) -> Result<()> {
             let mut scene = scene_from(common, t_end, Output::Final)?;
             scene.metrics_from = Some(0.5 * t_end);
             let traj = solver.simulate(&model, &scene)?;
-            traj.metrics.ok_or_else(|| anyhow!("solver {other} returned no metrics"))?
+            traj.metrics
+                .ok_or_else(|| anyhow!("solver {other} returned no metrics"))?
         }
     };
     for (name, v) in st.values() {
@@ -206,7 +211,9 @@ fn main() -> ExitCode {
             csv,
         }) => simulate(common, *t_end, *dt, csv),
         Some(Command::Steady { common }) => steady(common),
-        None => Err(anyhow!("the main job (compare all fixtures) is not built yet")),
+        None => Err(anyhow!(
+            "the main job (compare all fixtures) is not built yet"
+        )),
     };
     match res {
         Ok(()) => ExitCode::SUCCESS,

@@ -205,11 +205,17 @@ impl Dop853 {
                 + k11 * A1211)
                 * h),
         );
-        let incr = k1 * B1 + k6 * B6 + k7 * B7 + k8 * B8 + k9 * B9 + k10 * B10 + k11 * B11
-            + k12 * B12;
+        let incr =
+            k1 * B1 + k6 * B6 + k7 * B7 + k8 * B8 + k9 * B9 + k10 * B10 + k11 * B11 + k12 * B12;
         let y1 = y + incr * h;
         let e3 = incr - k1 * BHH1 - k9 * BHH2 - k12 * BHH3;
-        let e5 = k1 * ER1 + k6 * ER6 + k7 * ER7 + k8 * ER8 + k9 * ER9 + k10 * ER10 + k11 * ER11
+        let e5 = k1 * ER1
+            + k6 * ER6
+            + k7 * ER7
+            + k8 * ER8
+            + k9 * ER9
+            + k10 * ER10
+            + k11 * ER11
             + k12 * ER12;
         let mut err2 = 0.0;
         let mut err = 0.0;
@@ -454,7 +460,9 @@ mod tests {
         params.step.h_ini = 1e-4;
         params.set_tolerances(1e-7, 1e-7, None).unwrap();
         let mut solver = OdeSolver::new(params, system).unwrap();
-        solver.solve(&mut y0, x0, x1, None, &mut args, None).unwrap();
+        solver
+            .solve(&mut y0, x0, x1, None, &mut args, None)
+            .unwrap();
         let st = solver.stats();
         let mut c = Dop853::new(1e-7, 1e-7);
         let (y, n) = integrate(&mut c, arenstorf, x0, arenstorf_y0(), x1, 1e-4);
@@ -467,7 +475,12 @@ mod tests {
             // in a different operation order, amplified by the orbit (measured 2.3e-10; the
             // integration error itself is ~1e-3 at this tolerance). 1e-8 still rejects any
             // different step or coefficient.
-            assert!((y[i] - yr[i]).abs() < 1e-8, "component {i}: {} vs {}", y[i], yr[i]);
+            assert!(
+                (y[i] - yr[i]).abs() < 1e-8,
+                "component {i}: {} vs {}",
+                y[i],
+                yr[i]
+            );
         }
     }
 
@@ -492,7 +505,10 @@ mod tests {
         for s in [0.1, 0.37, 0.5, 0.81] {
             let order = (err(0.8, s) / err(0.4, s)).log2();
             // Asymptotic local order 8; at h = 0.8/0.4 the measured value lies within ±0.6.
-            assert!((order - 8.0).abs() < 0.6, "s = {s}: observed local order {order}");
+            assert!(
+                (order - 8.0).abs() < 0.6,
+                "s = {s}: observed local order {order}"
+            );
         }
     }
 

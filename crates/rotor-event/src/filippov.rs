@@ -18,8 +18,7 @@
 //! Newton correction in time.
 
 use rotor_model::{
-    Disc, DiscMode, Event, EventKind, Mode, Model, OMEGA_L, SolveError, State, Stats,
-    check_finite,
+    Disc, DiscMode, Event, EventKind, Mode, Model, OMEGA_L, SolveError, State, Stats, check_finite,
 };
 
 use crate::dop853::{Dense, Dop853};
@@ -92,7 +91,10 @@ enum Guard {
 
 impl Guard {
     fn terminal(self) -> bool {
-        matches!(self, Guard::Velocity(_) | Guard::ExitHi(_) | Guard::ExitLo(_))
+        matches!(
+            self,
+            Guard::Velocity(_) | Guard::ExitHi(_) | Guard::ExitLo(_)
+        )
     }
 }
 
@@ -158,7 +160,11 @@ impl<'a> Integrator<'a> {
                     Disc::Upper => -k,
                     Disc::Lower => k,
                 };
-                if matches!(g, Guard::ExitHi(_)) { -dt } else { dt }
+                if matches!(g, Guard::ExitHi(_)) {
+                    -dt
+                } else {
+                    dt
+                }
             }
             Guard::Extremum(d, _) => {
                 let j = self.model.jacobian(x, self.u, mode);
@@ -255,7 +261,11 @@ impl<'a> Integrator<'a> {
                 if let Some((a, b, fa, kind)) = hit {
                     let f = |t: f64| self.guard(g, &d.eval(t), mode);
                     let fb = f(b);
-                    let root = if fb == 0.0 { b } else { illinois(&f, a, b, fa, fb) };
+                    let root = if fb == 0.0 {
+                        b
+                    } else {
+                        illinois(&f, a, b, fa, fb)
+                    };
                     if best.is_none_or(|(bt, _)| root < bt) {
                         best = Some((root, kind));
                     }
@@ -426,9 +436,7 @@ impl<'a> Integrator<'a> {
                         }
                         let dt = -gv / gr;
                         // Keep the correction inside the step and stop at rounding level.
-                        if dt.abs() <= 1e-15 * tev.abs().max(1.0)
-                            || tev + dt <= t
-                            || tev + dt > t1
+                        if dt.abs() <= 1e-15 * tev.abs().max(1.0) || tev + dt <= t || tev + dt > t1
                         {
                             break;
                         }
@@ -458,7 +466,11 @@ impl<'a> Integrator<'a> {
                         }
                         if sink.stop_after(&ev) {
                             self.stats.rhs_evals += rhs_evals;
-                            return Ok(RunEnd { t, x, mode: new_mode });
+                            return Ok(RunEnd {
+                                t,
+                                x,
+                                mode: new_mode,
+                            });
                         }
                     }
                     mode = new_mode;
@@ -488,7 +500,14 @@ impl<'a> Integrator<'a> {
                     (m, Some(EventKind::StickStart(d)))
                 } else if (s > 0.0 && t_ex < lo) || (s < 0.0 && t_ex > hi) || !fr.is_set_valued() {
                     // Both one-sided fields point the same way: crossing.
-                    m.set(d, if s > 0.0 { DiscMode::SlipNeg } else { DiscMode::SlipPos });
+                    m.set(
+                        d,
+                        if s > 0.0 {
+                            DiscMode::SlipNeg
+                        } else {
+                            DiscMode::SlipPos
+                        },
+                    );
                     (m, Some(EventKind::Reversal(d)))
                 } else {
                     // Grazing from the side the applied torque pushes back to: stay.
@@ -522,7 +541,13 @@ fn frozen_dense(t0: f64, h: f64, x: &State) -> Dense<3> {
 
 /// Illinois (modified regula falsi) root of `f` on `[a, b]` with `f(a)·f(b) ≤ 0`, to the
 /// last bits of the bracket.
-pub(crate) fn illinois(f: &impl Fn(f64) -> f64, mut a: f64, mut b: f64, mut fa: f64, mut fb: f64) -> f64 {
+pub(crate) fn illinois(
+    f: &impl Fn(f64) -> f64,
+    mut a: f64,
+    mut b: f64,
+    mut fa: f64,
+    mut fb: f64,
+) -> f64 {
     if fa == 0.0 {
         return a;
     }

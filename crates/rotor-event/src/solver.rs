@@ -58,7 +58,11 @@ impl Sink for SceneSink {
                     break;
                 }
                 // Grid times before this step's start were written by the previous step.
-                let x = if tg == t1 { *x1 } else { dense.eval(tg.max(t0)) };
+                let x = if tg == t1 {
+                    *x1
+                } else {
+                    dense.eval(tg.max(t0))
+                };
                 self.samples.push(Sample { t: tg, x });
                 g.advance();
             }

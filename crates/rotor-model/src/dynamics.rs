@@ -196,8 +196,16 @@ impl Model {
     /// is taken as exactly 0 (whatever is stored in `x`).
     #[inline]
     pub fn rhs(&self, x: &State, u: f64, mode: Mode) -> State {
-        let wu = if mode.upper == DiscMode::Stick { 0.0 } else { x[OMEGA_U] };
-        let wl = if mode.lower == DiscMode::Stick { 0.0 } else { x[OMEGA_L] };
+        let wu = if mode.upper == DiscMode::Stick {
+            0.0
+        } else {
+            x[OMEGA_U]
+        };
+        let wl = if mode.lower == DiscMode::Stick {
+            0.0
+        } else {
+            x[OMEGA_L]
+        };
         State::new(
             wu - wl,
             self.disc_accel(Disc::Upper, x, u, mode.upper),
@@ -257,7 +265,8 @@ impl Model {
     /// Mechanical energy `½J_u ω_u² + ½J_l ω_l² + ½k_θ α²`.
     pub fn energy(&self, x: &State) -> f64 {
         let p = &self.params;
-        0.5 * p.j_u * x[OMEGA_U].powi(2) + 0.5 * p.j_l * x[OMEGA_L].powi(2)
+        0.5 * p.j_u * x[OMEGA_U].powi(2)
+            + 0.5 * p.j_l * x[OMEGA_L].powi(2)
             + 0.5 * p.k_theta * x[ALPHA].powi(2)
     }
 
@@ -265,7 +274,8 @@ impl Model {
     pub fn power(&self, x: &State, u: f64, mode: Mode) -> f64 {
         let f = self.rhs(x, u, mode);
         let p = &self.params;
-        p.j_u * x[OMEGA_U] * f[OMEGA_U] + p.j_l * x[OMEGA_L] * f[OMEGA_L]
+        p.j_u * x[OMEGA_U] * f[OMEGA_U]
+            + p.j_l * x[OMEGA_L] * f[OMEGA_L]
             + p.k_theta * x[ALPHA] * f[ALPHA]
     }
 }
@@ -344,7 +354,10 @@ mod tests {
         // Stick persists while |k_θ α| ≤ T_sl = 0.1642: α = 1 gives 0.0727 (inside).
         assert!(m.can_stick(Disc::Lower, &x, 1.5));
         let x_out = State::new(3.0, 0.5, 0.0); // k_θ α = 0.218 > T_sl
-        assert_eq!(m.stick_exit(Disc::Lower, &x_out, 1.5), Some(DiscMode::SlipPos));
+        assert_eq!(
+            m.stick_exit(Disc::Lower, &x_out, 1.5),
+            Some(DiscMode::SlipPos)
+        );
     }
 
     #[test]

@@ -51,7 +51,12 @@ impl Friction {
         match *self {
             Friction::Upper(p) => p.t_s,
             Friction::Lower(LowerFriction::Exponential {
-                t_s, t_1, t_2, w_1, w_2, ..
+                t_s,
+                t_1,
+                t_2,
+                w_1,
+                w_2,
+                ..
             }) => t_s + t_1 * (0.5 * w_1 * x).tanh() + t_2 * (0.5 * w_2 * x).tanh(),
             Friction::Lower(LowerFriction::Stribeck {
                 t_s,
@@ -179,7 +184,12 @@ mod tests {
     fn exponential_matches_source_form() {
         // The tanh form against the source's 1 − 2/(1+e^x) form, evaluated literally.
         let LowerFriction::Exponential {
-            t_s, t_1, t_2, w_1, w_2, b,
+            t_s,
+            t_1,
+            t_2,
+            w_1,
+            w_2,
+            b,
         } = Params::table1().lower
         else {
             unreachable!()

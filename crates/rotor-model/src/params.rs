@@ -225,11 +225,7 @@ impl Params {
         let lower = match raw.lower.family.as_str() {
             "exponential" => {
                 let l = &raw.lower;
-                for (name, v) in [
-                    ("t_c", l.t_c),
-                    ("omega_s", l.omega_s),
-                    ("delta", l.delta),
-                ] {
+                for (name, v) in [("t_c", l.t_c), ("omega_s", l.omega_s), ("delta", l.delta)] {
                     if let Some(v) = v {
                         return Err(bad(
                             &format!("lower.{name}"),
@@ -420,7 +416,11 @@ impl Params {
                     return err("lower.t_c", t_c, "Coulomb level must be >= 0");
                 }
                 if omega_s <= 0.0 {
-                    return err("lower.omega_s", omega_s, "Stribeck velocity must be positive");
+                    return err(
+                        "lower.omega_s",
+                        omega_s,
+                        "Stribeck velocity must be positive",
+                    );
                 }
                 if delta <= 0.0 {
                     return err("lower.delta", delta, "Stribeck exponent must be positive");

@@ -168,10 +168,7 @@ impl Scenario {
             value,
             reason: reason.to_owned(),
         };
-        let params_path = path
-            .parent()
-            .unwrap_or(Path::new("."))
-            .join(&raw.params);
+        let params_path = path.parent().unwrap_or(Path::new(".")).join(&raw.params);
         let params = Params::from_file(&params_path).map_err(|source| ScenarioError::Params {
             path: path.to_owned(),
             source,
@@ -181,7 +178,11 @@ impl Scenario {
             return Err(bad("u", raw.u.to_string(), "must be finite"));
         }
         if !(raw.t_end > 0.0 && raw.t_end.is_finite()) {
-            return Err(bad("t_end", raw.t_end.to_string(), "must be positive and finite"));
+            return Err(bad(
+                "t_end",
+                raw.t_end.to_string(),
+                "must be positive and finite",
+            ));
         }
         if let Some(tol) = raw.tol
             && !(tol > 0.0 && tol < 1.0)
@@ -230,7 +231,11 @@ impl Scenario {
             }
         }
         if !(raw.compare.dt > 0.0 && raw.compare.dt.is_finite()) {
-            return Err(bad("compare.dt", raw.compare.dt.to_string(), "must be positive"));
+            return Err(bad(
+                "compare.dt",
+                raw.compare.dt.to_string(),
+                "must be positive",
+            ));
         }
         if let Some([a, b]) = raw.compare.transient
             && !(0.0 <= a && a < b && b <= raw.t_end)
@@ -244,7 +249,11 @@ impl Scenario {
         if let Some(t) = raw.compare.steady_from
             && !(t >= 0.0 && t < raw.t_end)
         {
-            return Err(bad("compare.steady_from", t.to_string(), "must lie in [0, t_end)"));
+            return Err(bad(
+                "compare.steady_from",
+                t.to_string(),
+                "must lie in [0, t_end)",
+            ));
         }
         for (pair, tol) in &raw.tolerance {
             for (name, v) in [

@@ -67,7 +67,10 @@ impl Scene {
         if !self.u.is_finite() {
             return bad("u", self.u, "must be finite");
         }
-        for (i, name) in ["x0[alpha]", "x0[omega_u]", "x0[omega_l]"].iter().enumerate() {
+        for (i, name) in ["x0[alpha]", "x0[omega_u]", "x0[omega_l]"]
+            .iter()
+            .enumerate()
+        {
             if !self.x0[i].is_finite() {
                 return bad(name, self.x0[i], "must be finite");
             }
@@ -141,7 +144,11 @@ impl OutputGrid {
         if self.k <= self.n {
             let t = self.k as f64 * self.dt;
             // The last grid point snaps to t_end when it is t_end up to rounding.
-            Some(if (t - self.t_end).abs() <= 1e-9 * self.dt { self.t_end } else { t.min(self.t_end) })
+            Some(if (t - self.t_end).abs() <= 1e-9 * self.dt {
+                self.t_end
+            } else {
+                t.min(self.t_end)
+            })
         } else {
             Some(self.t_end)
         }
@@ -336,6 +343,11 @@ mod tests {
             x0: State::new(0.0, f64::NAN, 0.0),
             ..Scene::default()
         };
-        assert!(s.validate().unwrap_err().to_string().contains("x0[omega_u] = NaN"));
+        assert!(
+            s.validate()
+                .unwrap_err()
+                .to_string()
+                .contains("x0[omega_u] = NaN")
+        );
     }
 }

@@ -1,0 +1,256 @@
+//! Tests of the event-driven solver against independent facts: an exact linear solution,
+//! the event conditions themselves, symmetry, and convergence in the tolerance.
+
+use std::path::Path;
+
+use nalgebra::{Matrix3, Vector3};
+use rotor_event::{EventOptions, EventSolver, SteadyOptions, steady_state};
+use rotor_model::{
+    Disc, EventKind, LowerFriction, Model, Output, Params, Scenario, Scene, Solver, State,
+    SteadyState,
+};
+
+fn fixtures() -> std::path::PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../../fixtures")
+}
+
+/// Without static/Stribeck levels the model is linear, ẋ = A x + B u, whose solution is
+/// `x(t) = e^{At}(x0 + A⁻¹Bu) − A⁻¹Bu`.
+#[test]
+fn frictionless_levels_match_matrix_exponential() {
+    let mut p = Params::table1();
+    p.lower = LowerFriction::Exponential {
+        t_s: 0.0,
+        t_1: 0.0,
+        t_2: 0.0,
+        w_1: 1.0,
+        w_2: 1.0,
+        b: 0.0109,
+    };
+    let m = Model::new(p);
+    let (ju, jl, k, km) = (p.j_u, p.j_l, p.k_theta, p.k_m);
+    let a = Matrix3::new(
+        0.0,
+        1.0,
+        -1.0,
+        -k / ju,
+        -p.upper.b / ju,
+        0.0,
+        k / jl,
+        0.0,
+        -0.0109 / jl,
+    );
+    let u = 1.5;
+    let bu = Vector3::new(0.0, km * u / ju, 0.0);
+    let x0 = State::new(0.3, -0.5, 1.0);
+    let ainv_b = a.try_inverse().unwrap() * bu;
+    for t_end in [1.0, 10.0, 50.0] {
+        let exact = (a * t_end).exp() * (x0 + ainv_b) - ainv_b;
+        let s = Scene {
+            u,
+            x0,
+            t_end,
+            tol: 1e-12,
+            output: Output::Final,
+            ..Scene::default()
+        };
+        let tr = EventSolver::default().simulate(&m, &s).unwrap();
+        let err = (tr.x_final - exact).amax();
+        // tol = 1e-12 per step, ~10² steps, lightly damped: global error ≲ 1e-10; the matrix
+        // exponential (Padé) is accurate to ~1e-14 here.
+        assert!(err < 1e-9, "t = {t_end}: error {err:e}");
+    }
+}
+
+fn t1_events(u: f64, t_end: f64) -> Vec<rotor_model::Event> {
+    let s = Scene {
+        u,
+        t_end,
+        tol: 1e-12,
+        output: Output::Events,
+        ..Scene::default()
+    };
+    EventSolver::default()
+        .simulate(&Model::table1(), &s)
+        .unwrap()
+        .events
+}
+
+#[test]
+fn stick_events_satisfy_their_conditions_exactly() {
+    let m = Model::table1();
+    let t_sl = m.friction(Disc::Lower).static_interval().1;
+    let evs = t1_events(1.5, 100.0);
+    let exits: Vec<_> = evs
+        .iter()
+        .filter(|e| e.kind == EventKind::StickEnd(Disc::Lower))
+        .collect();
+    assert!(
+        exits.len() > 10,
+        "a stick-slip cycle of period ≈ 4.6 s: {}",
+        exits.len()
+    );
+    for e in &exits {
+        // Refined exits: k_θ α = T_sl to rounding of the Newton-corrected RK step.
+        let r = m.params.k_theta * e.x[0] - t_sl;
+        assert!(r.abs() < 1e-13, "exit residual {r:e} at t = {}", e.t);
+        assert_eq!(e.x[2], 0.0);
+    }
+    for e in evs
+        .iter()
+        .filter(|e| e.kind == EventKind::StickStart(Disc::Lower))
+    {
+        assert_eq!(e.x[2], 0.0);
+        assert!(m.can_stick(Disc::Lower, &e.x, 1.5));
+    }
+}
+
+#[test]
+fn output_levels_keep_only_what_is_asked() {
+    let m = Model::table1();
+    let run = |output| {
+        let s = Scene {
+            u: 1.5,
+            t_end: 200.0,
+            output,
+            ..Scene::default()
+        };
+        EventSolver::default().simulate(&m, &s).unwrap()
+    };
+    let fin = run(Output::Final);
+    assert!(fin.samples.is_empty() && fin.events.is_empty() && fin.metrics.is_none());
+    let grid = run(Output::Grid { dt: 0.01 });
+    assert_eq!(grid.samples.len(), 20001);
+    assert_eq!(grid.samples[0].t, 0.0);
+    assert_eq!(grid.samples.last().unwrap().t, 200.0);
+    // Same final state whatever is kept: output does not perturb the integration.
+    assert_eq!(fin.x_final, grid.x_final);
+    assert_eq!(fin.stats.steps, grid.stats.steps);
+    let ev = run(Output::Events);
+    assert!(ev.samples.is_empty() && !ev.events.is_empty());
+}
+
+fn cycle(st: SteadyState) -> [f64; 3] {
+    match st {
+        SteadyState::LimitCycle {
+            period,
+            omega_l_max,
+            stick_time,
+            ..
+        } => [period, omega_l_max, stick_time],
+        e => panic!("expected a cycle, got {e:?}"),
+    }
+}
+
+/// The refined steady state (return-map fixed point) converges as the tolerance falls, and
+/// agrees with the metrics read off a long plain simulation.
+#[test]
+fn steady_state_converges_in_tolerance_and_matches_long_run() {
+    let m = Model::table1();
+    let ev = EventOptions::default();
+    let refined = |tol: f64| {
+        let o = SteadyOptions {
+            tol,
+            ..SteadyOptions::default()
+        };
+        cycle(steady_state(&m, 1.5, State::zeros(), &o, &ev).unwrap())
+    };
+    let r13 = refined(1e-13);
+    let mut prev = f64::INFINITY;
+    for tol in [1e-7, 1e-9, 1e-11] {
+        let r = refined(tol);
+        let err = (0..3)
+            .map(|i| ((r[i] - r13[i]) / r13[i]).abs())
+            .fold(0.0, f64::max);
+        // Error proportional to the tolerance (within a factor of 100 either way), and falling.
+        assert!(err < 1e2 * tol, "tol {tol:e}: relative error {err:e}");
+        assert!(err < prev || err < 1e-13, "not converging at tol {tol:e}");
+        prev = err;
+    }
+    let s = Scene {
+        u: 1.5,
+        t_end: 600.0,
+        tol: 1e-12,
+        output: Output::Final,
+        metrics_from: Some(300.0),
+        ..Scene::default()
+    };
+    let long = cycle(
+        EventSolver::default()
+            .simulate(&m, &s)
+            .unwrap()
+            .metrics
+            .unwrap(),
+    );
+    for i in 0..3 {
+        // The long run's last cycle has converged to the attractor (contraction per cycle
+        // ≈ 0.1, 60+ cycles), so it differs from the fixed point by the tolerance only.
+        assert!(
+            ((long[i] - r13[i]) / r13[i]).abs() < 1e-9,
+            "{i}: {} vs {}",
+            long[i],
+            r13[i]
+        );
+    }
+}
+
+/// Table 1's laws are odd in ω, so u → −u, x0 → −x0 mirrors the whole trajectory.
+#[test]
+fn mirror_symmetry_is_exact() {
+    let m = Model::table1();
+    let x0 = State::new(0.1, 0.2, -0.3);
+    let run = |u: f64, x0: State| {
+        let s = Scene {
+            u,
+            x0,
+            t_end: 50.0,
+            output: Output::Final,
+            ..Scene::default()
+        };
+        EventSolver::default().simulate(&m, &s).unwrap().x_final
+    };
+    let a = run(2.5, x0);
+    let b = run(-2.5, -x0);
+    // Every operation is odd-symmetric (tanh, sign, products), so the runs mirror to rounding.
+    assert!((a + b).amax() < 1e-12, "{a:?} vs {b:?}");
+}
+
+#[test]
+fn every_fixture_runs_to_its_horizon() {
+    for f in Scenario::list_dir(&fixtures().join("scenarios")).unwrap() {
+        let sc = Scenario::from_file(&f).unwrap();
+        let s = Scene {
+            u: sc.u,
+            x0: sc.x0,
+            t_end: sc.t_end,
+            output: Output::Final,
+            metrics_from: sc.compare.steady_from,
+            ..Scene::default()
+        };
+        let tr = EventSolver::default()
+            .simulate(&sc.model, &s)
+            .unwrap_or_else(|e| panic!("{}: {e}", sc.name));
+        assert_eq!(tr.t_final, sc.t_end, "{}", sc.name);
+        assert!(tr.x_final.iter().all(|v| v.is_finite()), "{}", sc.name);
+    }
+}
+
+/// The Stribeck set at u = 0.05 V: k_m u = 0.216 N m lies inside both stick intervals, so
+/// from rest nothing moves, exactly.
+#[test]
+fn stribeck_equilibrium_set_stays_stuck() {
+    let sc = Scenario::from_file(&fixtures().join("scenarios/st-u0.05-rest.toml")).unwrap();
+    let s = Scene {
+        u: sc.u,
+        t_end: sc.t_end,
+        output: Output::Steps,
+        ..Scene::default()
+    };
+    let tr = EventSolver::default().simulate(&sc.model, &s).unwrap();
+    assert_eq!(tr.x_final, State::zeros());
+    assert!(
+        tr.samples.len() <= 3,
+        "a frozen state needs no steps: {}",
+        tr.samples.len()
+    );
+}
