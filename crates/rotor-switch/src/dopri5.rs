@@ -176,7 +176,7 @@ fn err_norm<const N: usize>(
 
 impl<const N: usize> Dopri5<N> {
     /// Starts at `(t0, y0)` toward `t_end > t0`: evaluates `f(t0, y0)` and, unless `opts.h0`
-    /// is given, picks the first step with [`Dopri5::hinit`].
+    /// is given, picks the first step with Hairer's `HINIT` heuristic.
     pub fn new<F>(opts: Dopri5Options, t0: f64, y0: SVector<f64, N>, t_end: f64, f: &mut F) -> Self
     where
         F: FnMut(f64, &SVector<f64, N>) -> SVector<f64, N>,

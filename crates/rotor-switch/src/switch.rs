@@ -23,14 +23,14 @@ pub struct SwitchOptions {
     pub eta: f64,
     /// Largest number of step attempts.
     pub max_steps: u64,
-    /// Largest step [s]; also bounds the gap between guard samples (≤ h_max/`guard_samples`).
+    /// Largest step, in s; also bounds the gap between guard samples (≤ h_max/`guard_samples`).
     pub h_max: f64,
     /// Number of equal sub-intervals of each step on which guards are sampled (≥ 1), so that
     /// a guard that dips below 0 and back inside one step is still seen.
     pub guard_samples: usize,
     /// Zeno guard: this many switches within `zeno_window` seconds is an error.
     pub zeno_count: u32,
-    /// Zeno guard window [s].
+    /// Zeno guard window, in s.
     pub zeno_window: f64,
 }
 
