@@ -68,12 +68,31 @@
 //! (a failed check falls back to the enumeration). Counted in [`Stats::lcp_skipped`]
 //! (vs [`Stats::lcp_solves`]).
 //!
-//! # Orders measured (tests/convergence.rs)
+//! # Orders measured (`tests/integration/convergence.rs`)
 //!
-//! Self-convergence on Table 1, u = 1.5 V from rest, steady-state period and max ω_l over
-//! h = 1e-2 … 1e-4 (Richardson differences between successive h/2):
-//! see the table in `tests/convergence.rs` and the crate README-style notes in the final
-//! report. θ = 1/2 with the implicit level: second order; explicit level or θ = 1: first.
+//! Self-convergence on Table 1, u = 1.5 V from rest, 60 s, metrics over [30, 60] s: the
+//! Richardson differences `e(h) = |m(h) − m(h/10)|` for h = 1e-2, 1e-3, 1e-4 (runs down to
+//! 1e-5), fitted as `e ≈ C·h^p`:
+//!
+//! | scheme | period: p, C (s) | max ω_l: p, C (rad/s) | period e(1e-2), e(1e-3), e(1e-4) |
+//! |---|---|---|---|
+//! | θ = 1/2, implicit level (default) | 2.00, 0.59 | 2.02, 0.70 | 6.2e-5, 5.6e-7, 6.2e-9 |
+//! | θ = 1/2, explicit level | 1.00, 0.56 | 1.00, 0.59 | 5.6e-3, 5.5e-4, 5.5e-5 |
+//! | θ = 1, implicit level | 1.00, 3.0 | 1.00, 6.6 | 3.0e-2, 3.1e-3, 3.1e-4 |
+//!
+//! The default matches the second-order behaviour measured with Siconos 4.4's
+//! `MoreauJeanOSI` on this model (6e-5, 8e-7, 1e-8). Friction events keep the velocity
+//! continuous (no impacts), so the O(h²) local error of a step containing a stick onset or
+//! exit does not spoil the global order. Cost: about 0.4 µs per step (h = 1e-4, 60 s:
+//! 6e5 steps in 0.23 s on one core), ~2.1 Newton iterations per step, and about 80 % of the
+//! steps skip the enumeration.
+//!
+//! **Very large steps.** Up to h = 0.25 s every step problem of the fixtures is solved
+//! exactly. At h = 0.5 s a level falling faster than `M̂` can absorb (`θh|N'| > J_l`) makes
+//! the nonlinear step problem non-monotone (it may have no or several solutions); the step
+//! then falls back to a Picard iteration whose frozen problems are strictly convex, and if
+//! that does not converge takes its last (bounded) iterate ([`StepOutcome::exact`] =
+//! `false`): 29 of 6100 steps over all fixtures at h = 0.5. The state stays bounded at any h.
 //!
 //! # Output and events
 //!
@@ -292,7 +311,7 @@ impl Solver for MoreauSolver {
         // Number of steps: the last one is shortened to land on t_end (a remainder below
         // 1e-9·h is merged into the previous step).
         let n_f = (t_end / h - 1e-9).ceil().max(1.0);
-        if !(n_f <= o.max_steps as f64) {
+        if n_f.is_nan() || n_f > o.max_steps as f64 {
             return Err(SolveError::TooManySteps {
                 t: 0.0,
                 max_steps: o.max_steps,

@@ -137,7 +137,7 @@ impl OneStepProblem {
             (Some((_, bi)), None) | (None, Some((_, bi))) => {
                 let i = if slip[0].is_some() { 0 } else { 1 };
                 let diag = self.a[(i, i)] - bi.d;
-                if !(diag > 0.0) {
+                if diag.is_nan() || diag <= 0.0 {
                     return None;
                 }
                 v[i] = (self.b[i] + bi.c) / diag;
