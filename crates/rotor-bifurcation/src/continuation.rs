@@ -1,0 +1,322 @@
+//! Pseudo-arclength continuation of periodic orbits in `y = (u, α, ω_u)`.
+//!
+//! The periodic orbits at input u are the zeros of the section residual
+//!
+//! ```text
+//! F(y) = P_{c(u)}(α, ω_u; u) − (α, ω_u) = 0,     F : R³ → R²,
+//! ```
+//!
+//! a curve in R³. It is followed by pseudo-arclength: from a point `y_k` with unit tangent
+//! `t_k` (the null vector of `DF(y_k)`: the cross product of its two rows, oriented along
+//! the previous tangent), predict `y_p = y_k + h t_k` and correct with Newton (chord,
+//! Jacobian at the predictor) on
+//!
+//! ```text
+//! F(y) = 0,     t_k · (y − y_p) = 0.
+//! ```
+//!
+//! `DF` is a forward difference (step 1e-7). A fold in u is a sign change of the u-component
+//! of the tangent between two points; it is located by bisection on the step length h from
+//! the earlier point. A grazing point (the cycle starts or stops touching `ω_l = 0` with
+//! a stick phase) is a sign change of `g = ω_l,min` (slipping) / `−t_stick` (stick-slip),
+//! located the same way.
+
+use nalgebra::{Matrix3, Vector3};
+use rotor_model::{Output, Scene, Solver, State, SteadyState};
+
+use crate::BifError;
+use crate::periodic::{Shooter, eig2};
+
+/// What the diagram reports about one periodic orbit.
+#[derive(Debug, Clone, PartialEq)]
+pub struct CycleInfo {
+    pub period: f64,
+    pub omega_l_max: f64,
+    pub omega_l_min: f64,
+    /// Time per period with the lower disc stuck [s].
+    pub stick_time: f64,
+    /// Whether the lower disc sticks on the cycle.
+    pub stick_slip: bool,
+    /// Floquet multipliers: `[1, 0, λ]` (stick-slip) or `[1, λ1, λ2]` (slipping).
+    pub multipliers: Vec<nalgebra::Complex<f64>>,
+    pub stable: bool,
+}
+
+impl CycleInfo {
+    /// The grazing indicator: `ω_l,min > 0` for slipping cycles, `−t_stick ≤ 0` with stick.
+    pub fn grazing_indicator(&self) -> f64 {
+        if self.stick_slip {
+            -self.stick_time
+        } else {
+            self.omega_l_min
+        }
+    }
+}
+
+/// One point of the periodic branch.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Node {
+    /// `(u, α, ω_u)` on the section.
+    pub y: [f64; 3],
+    /// Section level `c(u)`.
+    pub c: f64,
+    /// Unit tangent of the branch.
+    pub tangent: [f64; 3],
+    /// Arclength step that produced this point from the previous one.
+    pub step: f64,
+    pub info: CycleInfo,
+}
+
+/// Continuation settings.
+#[derive(Debug, Clone, Copy)]
+pub struct ContOptions {
+    pub u_min: f64,
+    pub u_max: f64,
+    /// Largest arclength step.
+    pub h_max: f64,
+    /// Smallest arclength step before the branch is given up.
+    pub h_min: f64,
+    /// Newton tolerance on |F|∞ [rad, rad/s].
+    pub newton_tol: f64,
+    /// ω_l amplitude below which a branch stops (it is about to end at a Hopf point) [rad/s].
+    pub amp_stop: f64,
+    /// Largest number of points per direction.
+    pub max_nodes: usize,
+    /// FD step of the Floquet multipliers.
+    pub fd_step: f64,
+}
+
+pub struct Continuer<'a> {
+    pub sh: Shooter<'a>,
+    pub opts: ContOptions,
+}
+
+fn cross(a: &[f64; 3], b: &[f64; 3]) -> [f64; 3] {
+    [
+        a[1] * b[2] - a[2] * b[1],
+        a[2] * b[0] - a[0] * b[2],
+        a[0] * b[1] - a[1] * b[0],
+    ]
+}
+
+fn dot(a: &[f64; 3], b: &[f64; 3]) -> f64 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+
+impl Continuer<'_> {
+    /// `F(y)` and the section level used.
+    pub fn residual(&self, y: &[f64; 3]) -> Result<([f64; 2], f64), BifError> {
+        let c = self.sh.section_level(y[0])?;
+        let r = self.sh.section_map(y[0], c, [y[1], y[2]])?;
+        Ok(([r.x[0] - y[1], r.x[1] - y[2]], c))
+    }
+
+    /// `DF(y)` (2×3) by forward differences.
+    pub fn jacobian(&self, y: &[f64; 3], f0: &[f64; 2]) -> Result<[[f64; 3]; 2], BifError> {
+        let mut j = [[0.0; 3]; 2];
+        for k in 0..3 {
+            let d = 1e-7 * y[k].abs().max(1.0);
+            let mut yk = *y;
+            yk[k] += d;
+            let (fk, _) = self.residual(&yk)?;
+            for i in 0..2 {
+                j[i][k] = (fk[i] - f0[i]) / d;
+            }
+        }
+        Ok(j)
+    }
+
+    /// Unit tangent (null vector of `DF`), oriented along `along`.
+    pub fn tangent(j: &[[f64; 3]; 2], along: &[f64; 3]) -> [f64; 3] {
+        let t = cross(&j[0], &j[1]);
+        let n = dot(&t, &t).sqrt();
+        let s = if dot(&t, along) < 0.0 { -1.0 } else { 1.0 };
+        [s * t[0] / n, s * t[1] / n, s * t[2] / n]
+    }
+
+    /// Predictor–corrector step from `y` along `t` by `h`; returns the corrected point and
+    /// the Newton iteration count.
+    pub fn correct(
+        &self,
+        y: &[f64; 3],
+        t: &[f64; 3],
+        h: f64,
+    ) -> Result<([f64; 3], usize), BifError> {
+        let yp = [y[0] + h * t[0], y[1] + h * t[1], y[2] + h * t[2]];
+        let (f, _) = self.residual(&yp)?;
+        let j = self.jacobian(&yp, &f)?;
+        let a = Matrix3::new(
+            j[0][0], j[0][1], j[0][2], j[1][0], j[1][1], j[1][2], t[0], t[1], t[2],
+        );
+        let lu = a.lu();
+        let mut yc = yp;
+        let mut f = f;
+        for it in 0..12 {
+            let g = Vector3::new(
+                -f[0],
+                -f[1],
+                -(t[0] * (yc[0] - yp[0]) + t[1] * (yc[1] - yp[1]) + t[2] * (yc[2] - yp[2])),
+            );
+            let d = lu.solve(&g).ok_or(BifError::NoConvergence {
+                u: yc[0],
+                detail: "singular corrector matrix".into(),
+            })?;
+            for k in 0..3 {
+                yc[k] += d[k];
+            }
+            f = self.residual(&yc)?.0;
+            if f[0].abs().max(f[1].abs()) <= self.opts.newton_tol && d.amax() <= 1e-6 {
+                return Ok((yc, it + 1));
+            }
+        }
+        Err(BifError::NoConvergence {
+            u: yc[0],
+            detail: "corrector: 12 iterations".into(),
+        })
+    }
+
+    /// Builds the node at a converged `y`: tangent, metrics, multipliers.
+    pub fn node(&self, y: [f64; 3], along: &[f64; 3], step: f64) -> Result<Node, BifError> {
+        let (f, c) = self.residual(&y)?;
+        let j = self.jacobian(&y, &f)?;
+        let tangent = Self::tangent(&j, along);
+        let info = self.describe(y[0], c, [y[1], y[2]])?;
+        Ok(Node {
+            y,
+            c,
+            tangent,
+            step,
+            info,
+        })
+    }
+
+    /// Period, extrema of ω_l, stick time and Floquet multipliers of the cycle through
+    /// `[z0, z1, c]` on the section.
+    pub fn describe(&self, u: f64, c: f64, z: [f64; 2]) -> Result<CycleInfo, BifError> {
+        let ret = self.sh.section_map(u, c, z)?;
+        let x0 = State::new(z[0], z[1], c);
+        // Metrics over two periods: the accumulator needs two anchors (stick exits or ω_l
+        // maxima), and the first comes within one period.
+        let scene = Scene {
+            u,
+            x0,
+            t_end: 2.05 * ret.t,
+            tol: self.sh.tol,
+            output: Output::Final,
+            metrics_from: Some(0.0),
+            ..Scene::default()
+        };
+        let traj = rotor_event::EventSolver::default()
+            .simulate(self.sh.model, &scene)
+            .map_err(|e| BifError::Solve(e.to_string()))?;
+        let (wl_max, wl_min, stick_time) = match traj.metrics {
+            Some(SteadyState::LimitCycle {
+                omega_l_max,
+                omega_l_min,
+                stick_time,
+                ..
+            }) => (omega_l_max, omega_l_min, stick_time),
+            _ => (c, c, 0.0),
+        };
+        let one = nalgebra::Complex::new(1.0, 0.0);
+        let h = self.opts.fd_step;
+        let multipliers = if ret.stuck {
+            let exit = self.sh.next_exit(u, x0)?;
+            let lam = self.sh.stick_exit_multiplier(u, exit.x[1], h)?;
+            vec![
+                one,
+                nalgebra::Complex::new(0.0, 0.0),
+                nalgebra::Complex::new(lam, 0.0),
+            ]
+        } else {
+            let j = self.sh.section_jacobian(u, c, z, h)?;
+            let [a, b] = eig2(&j);
+            vec![one, a, b]
+        };
+        let stable = multipliers[1..].iter().all(|l| l.norm() < 1.0);
+        Ok(CycleInfo {
+            period: ret.t,
+            omega_l_max: wl_max,
+            omega_l_min: wl_min,
+            stick_time,
+            stick_slip: ret.stuck,
+            multipliers,
+            stable,
+        })
+    }
+
+    /// Follows the branch from `start` in the direction `dir` (its u-component sign) until it
+    /// leaves `[u_min, u_max]`, shrinks below `amp_stop`, or cannot be continued.
+    pub fn follow(&self, start: &Node, dir: f64) -> Vec<Node> {
+        let mut out = Vec::new();
+        let mut cur = start.clone();
+        if cur.tangent[0] * dir < 0.0 {
+            cur.tangent = cur.tangent.map(|v| -v);
+        }
+        let mut h = self.opts.h_max * 0.25;
+        while out.len() < self.opts.max_nodes {
+            let step = self.correct(&cur.y, &cur.tangent, h).and_then(|(y, its)| {
+                let n = self.node(y, &cur.tangent, h)?;
+                Ok((n, its))
+            });
+            match step {
+                Ok((n, its)) => {
+                    let turn = dot(&n.tangent, &cur.tangent);
+                    if turn < 0.8 && h > 4.0 * self.opts.h_min {
+                        h *= 0.5;
+                        continue;
+                    }
+                    if n.y[0] < self.opts.u_min
+                        || n.y[0] > self.opts.u_max
+                        || n.info.omega_l_max - n.info.omega_l_min < self.opts.amp_stop
+                    {
+                        break;
+                    }
+                    if its <= 3 {
+                        h = (h * 1.5).min(self.opts.h_max);
+                    }
+                    cur = n.clone();
+                    out.push(n);
+                }
+                Err(_) => {
+                    h *= 0.5;
+                    if h < self.opts.h_min {
+                        break;
+                    }
+                }
+            }
+        }
+        out
+    }
+
+    /// Bisection on the step length from `a` (toward its successor `b`, reached with step
+    /// `b.step`) for a sign change of `g`; returns the node at the located point.
+    pub fn bisect_between(
+        &self,
+        a: &Node,
+        b: &Node,
+        g: impl Fn(&Node) -> f64,
+        max_iter: usize,
+    ) -> Result<Node, BifError> {
+        let ga = g(a);
+        let mut lo = 0.0;
+        let mut hi = b.step;
+        let mut best = b.clone();
+        for _ in 0..max_iter {
+            let m = 0.5 * (lo + hi);
+            let (y, _) = self.correct(&a.y, &a.tangent, m)?;
+            let n = self.node(y, &a.tangent, m)?;
+            let gm = g(&n);
+            if gm * ga > 0.0 {
+                lo = m;
+            } else {
+                hi = m;
+                best = n;
+            }
+            if hi - lo < 1e-9 {
+                break;
+            }
+        }
+        Ok(best)
+    }
+}
