@@ -8,8 +8,6 @@ use anyhow::{Context, Result, anyhow, bail};
 use clap::{Parser, Subcommand};
 use rotor_model::{Model, Output, Params, Scene, Solver, State, SteadyState};
 
-mod atomic;
-
 /// Two-disc rotor with set-valued friction: three independent solvers, cross-validated.
 #[derive(Parser, Debug)]
 #[command(name = "rotor", version, about)]
@@ -38,6 +36,14 @@ enum Command {
     Steady {
         #[command(flatten)]
         common: Common,
+    },
+    /// Run scenarios through the three solvers, gate their agreement, write the report.
+    Compare {
+        /// Scenario files (default: every fixtures/scenarios/*.toml).
+        scenarios: Vec<PathBuf>,
+        /// Report directory.
+        #[arg(long, default_value = "reports")]
+        report: PathBuf,
     },
 }
 
@@ -68,9 +74,8 @@ const SOLVERS: [&str; 3] = ["switch", "event", "moreau"];
 fn solver_by_name(name: &str) -> Result<Box<dyn Solver>> {
     match name {
         "event" => Ok(Box::new(rotor_event::EventSolver::default())),
-        "switch" | "moreau" => bail!(
-            "--solver {name}: this solver is not built yet in this version of rotor (available: event)"
-        ),
+        "switch" => Ok(Box::new(rotor_switch::SwitchSolver::default())),
+        "moreau" => Ok(Box::new(rotor_moreau::MoreauSolver::default())),
         other => bail!(
             "--solver {other:?}: unknown solver (expected one of: {})",
             SOLVERS.join(", ")
@@ -154,7 +159,8 @@ fn simulate(common: &Common, t_end: f64, dt: f64, csv_path: &Path) -> Result<()>
         }
         writeln!(buf, "{},{},{},{}", s.t, s.x[0], s.x[1], s.x[2])?;
     }
-    atomic::write(csv_path, &buf)?;
+    rotor_compare::report::write_atomic(csv_path, &buf)
+        .with_context(|| format!("{}: cannot write", csv_path.display()))?;
     Ok(())
 }
 
@@ -197,6 +203,89 @@ fn steady(common: &Common) -> Result<()> {
     Ok(())
 }
 
+/// The fixtures directory: next to the workspace root when run through cargo, else ./fixtures.
+fn fixtures_dir() -> PathBuf {
+    let local = PathBuf::from("fixtures");
+    if local.is_dir() {
+        return local;
+    }
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../../fixtures")
+}
+
+fn compare(files: &[PathBuf], report: &Path) -> Result<()> {
+    use rayon::prelude::*;
+    let files = if files.is_empty() {
+        let dir = fixtures_dir().join("scenarios");
+        rotor_model::Scenario::list_dir(&dir)
+            .with_context(|| format!("{}: cannot list scenarios", dir.display()))?
+    } else {
+        files.to_vec()
+    };
+    let scenarios = files
+        .iter()
+        .map(|f| rotor_model::Scenario::from_file(f))
+        .collect::<Result<Vec<_>, _>>()?;
+    let t0 = std::time::Instant::now();
+    // In parallel across scenarios; collected in input order, so output is deterministic.
+    let results: Vec<_> = scenarios
+        .par_iter()
+        .map(rotor_compare::run_scenario)
+        .collect();
+    let wall = t0.elapsed().as_secs_f64();
+    let params = [
+        ("Table 1 (exponential)", Params::table1()),
+        (
+            "Stribeck set (unverified)",
+            Params::from_file(&fixtures_dir().join("params/stribeck.toml"))?,
+        ),
+    ];
+    let fails = rotor_compare::report::write_report(report, &results, &params)
+        .with_context(|| format!("{}: cannot write the report", report.display()))?;
+    println!(
+        "{:<18} {:<7} {:<12} {:>10} {:>12} {:>9}",
+        "scenario", "solver", "steady", "period", "omega_l_max", "ms"
+    );
+    for r in &results {
+        for run in &r.runs {
+            let (kind, period, wmax) = match run.result.as_ref().ok().and_then(|t| t.metrics) {
+                Some(SteadyState::LimitCycle {
+                    period,
+                    omega_l_max,
+                    ..
+                }) => ("cycle", format!("{period:.6}"), format!("{omega_l_max:.6}")),
+                Some(SteadyState::Equilibrium { omega_l, .. }) => {
+                    ("equilibrium", "-".into(), format!("{omega_l:.6}"))
+                }
+                None => ("error", "-".into(), "-".into()),
+            };
+            println!(
+                "{:<18} {:<7} {:<12} {:>10} {:>12} {:>9.1}",
+                r.scenario.name,
+                run.kind.name(),
+                kind,
+                period,
+                wmax,
+                run.seconds * 1e3
+            );
+        }
+    }
+    println!(
+        "{} scenarios, 3 solvers, {:.2} s wall; report in {}",
+        results.len(),
+        wall,
+        report.display()
+    );
+    if fails.is_empty() {
+        println!("all agreement gates pass");
+        Ok(())
+    } else {
+        for f in &fails {
+            eprintln!("GATE FAILED: {f}");
+        }
+        bail!("{} agreement gate(s) failed", fails.len())
+    }
+}
+
 fn steady_json(st: &SteadyState) -> String {
     serde_json::to_string(st).expect("plain floats and strings serialize")
 }
@@ -211,9 +300,8 @@ fn main() -> ExitCode {
             csv,
         }) => simulate(common, *t_end, *dt, csv),
         Some(Command::Steady { common }) => steady(common),
-        None => Err(anyhow!(
-            "the main job (compare all fixtures) is not built yet"
-        )),
+        Some(Command::Compare { scenarios, report }) => compare(scenarios, report),
+        None => compare(&[], Path::new("reports")),
     };
     match res {
         Ok(()) => ExitCode::SUCCESS,

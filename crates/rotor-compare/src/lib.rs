@@ -1,1 +1,10 @@
-//! placeholder
+//! Cross-validation: identical scenarios through the three independent solvers, agreement
+//! gates on θ̇_u and θ̇_l, and the report.
+
+pub mod gate;
+pub mod report;
+pub mod run;
+pub mod svg;
+
+pub use gate::{Failure, GateResult, Measured, check_pair};
+pub use run::{RunResult, ScenarioResult, SolverKind, run_scenario, solver_settings};

@@ -412,6 +412,7 @@ pub fn integrate<const N: usize>(
 }
 
 #[cfg(test)]
+#[allow(clippy::excessive_precision)]
 mod tests {
     use super::*;
     use nalgebra::{Vector2, Vector4};

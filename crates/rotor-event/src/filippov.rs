@@ -366,10 +366,7 @@ impl<'a> Integrator<'a> {
             // Earliest event in the step; non-terminal events before it are recorded.
             let mut t_lo = t;
             let mut stop_here = None;
-            loop {
-                let Some((te, g)) = self.detect(&dense, t_lo, t1, mode) else {
-                    break;
-                };
+            while let Some((te, g)) = self.detect(&dense, t_lo, t1, mode) {
                 if g.terminal() {
                     stop_here = Some((te, g));
                     break;

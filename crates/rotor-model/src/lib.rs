@@ -19,7 +19,7 @@ pub use equilibrium::{SlipEquilibrium, StuckSet};
 pub use friction::Friction;
 pub use lagrangian::{Coords, Lagrangian};
 pub use params::{LowerFriction, Params, ParamsError, UpperFriction};
-pub use scenario::{Scenario, ScenarioError};
+pub use scenario::{CompareSpec, PairTolerance, Scenario, ScenarioError};
 pub use scene::{
     Event, EventKind, Output, OutputGrid, Sample, Scene, SolveError, Solver, Stats, Trajectory,
     check_finite,

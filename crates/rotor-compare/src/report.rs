@@ -1,0 +1,306 @@
+//! Gating a scenario's results and writing the report (CSV, SVG, README.md), atomically.
+
+use std::fmt::Write as _;
+use std::io::Write as _;
+use std::path::Path;
+
+use rotor_model::{Disc, Friction, Model, Params, Scenario, SteadyState};
+
+use crate::gate::{Failure, GateResult, check_pair};
+use crate::run::{ScenarioResult, SolverKind, solver_settings};
+use crate::svg::{Panel, Series, render};
+
+/// The gated pairs: each solver against the event-driven reference.
+pub const PAIRS: [(SolverKind, SolverKind); 2] = [
+    (SolverKind::Event, SolverKind::Switch),
+    (SolverKind::Event, SolverKind::Moreau),
+];
+
+/// Gates every pair of one scenario. A solver error, or a pair without a tolerance in the
+/// scenario file, is a failure too.
+pub fn gate_scenario(r: &ScenarioResult) -> (Vec<GateResult>, Vec<Failure>) {
+    let sc = &r.scenario;
+    let mut gates = Vec::new();
+    let mut fails = Vec::new();
+    for run in &r.runs {
+        if let Err(e) = &run.result {
+            fails.push(Failure {
+                scenario: sc.name.clone(),
+                pair: run.kind.name().into(),
+                quantity: format!("run failed: {e}"),
+                diff: f64::INFINITY,
+                tol: 0.0,
+            });
+        }
+    }
+    for (a, b) in PAIRS {
+        let pair = format!("{}-{}", a.name(), b.name());
+        let Some(tol) = sc.tolerance.get(&pair) else {
+            fails.push(Failure {
+                scenario: sc.name.clone(),
+                pair: pair.clone(),
+                quantity: "no [tolerance] stated for this pair in the scenario file".into(),
+                diff: f64::INFINITY,
+                tol: 0.0,
+            });
+            continue;
+        };
+        let (Some(ta), Some(tb)) = (r.traj(a), r.traj(b)) else {
+            continue;
+        };
+        let g = check_pair(&pair, ta, tb, sc.compare.transient, tol);
+        fails.extend(g.failures(&sc.name));
+        gates.push(g);
+    }
+    (gates, fails)
+}
+
+/// Writes `bytes` to `path` through a temporary file and a rename, so an interrupted run
+/// leaves the previous file intact.
+pub fn write_atomic(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
+    let dir = match path.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d,
+        _ => Path::new("."),
+    };
+    let name = path.file_name().ok_or_else(|| {
+        std::io::Error::new(
+            std::io::ErrorKind::InvalidInput,
+            format!("{}: not a file path", path.display()),
+        )
+    })?;
+    let tmp = dir.join(format!(
+        ".{}.tmp{}",
+        name.to_string_lossy(),
+        std::process::id()
+    ));
+    let mut f = std::fs::File::create(&tmp)?;
+    f.write_all(bytes)?;
+    f.sync_all()?;
+    drop(f);
+    std::fs::rename(&tmp, path)
+}
+
+const COLORS: [(&str, Option<&str>, f64); 3] = [
+    ("#000000", None, 2.5),
+    ("#e66101", Some("6 3"), 1.5),
+    ("#5e3c99", Some("2 2"), 1.5),
+];
+
+fn label(kind: SolverKind, sc: &Scenario) -> String {
+    let (tol, h) = solver_settings(kind, sc);
+    match kind {
+        SolverKind::Event => format!("event-driven (tol {tol:.0e})"),
+        SolverKind::Switch => format!("switch model (tol {tol:.0e})"),
+        SolverKind::Moreau => format!("Moreau-Jean (h {h:.0e})"),
+    }
+}
+
+/// Per-scenario CSV: `t` and ω_u, ω_l of each solver on the comparison grid (12 significant
+/// digits: far below every gate's tolerance).
+pub fn scenario_csv(r: &ScenarioResult) -> String {
+    let mut s = String::from("t");
+    let kinds: Vec<SolverKind> = SolverKind::ALL
+        .into_iter()
+        .filter(|k| r.traj(*k).is_some())
+        .collect();
+    for k in &kinds {
+        let _ = write!(s, ",omega_u_{0},omega_l_{0}", k.name());
+    }
+    s.push('\n');
+    let n = kinds
+        .iter()
+        .map(|k| r.traj(*k).map_or(0, |t| t.samples.len()))
+        .min()
+        .unwrap_or(0);
+    for i in 0..n {
+        let t = r.traj(kinds[0]).map_or(0.0, |tr| tr.samples[i].t);
+        let _ = write!(s, "{t}");
+        for k in &kinds {
+            let x = r.traj(*k).map(|tr| tr.samples[i].x).unwrap_or_default();
+            let _ = write!(s, ",{:.12e},{:.12e}", x[1], x[2]);
+        }
+        s.push('\n');
+    }
+    s
+}
+
+/// Per-scenario SVG: ω_u and ω_l of the three solvers overlaid (the source's Figs. 4–7).
+pub fn scenario_svg(r: &ScenarioResult) -> String {
+    let sc = &r.scenario;
+    let t_max = sc
+        .compare
+        .transient
+        .map_or(sc.t_end, |w| w[1].max(sc.t_end.min(60.0)));
+    let mk = |idx: usize, name: &'static str| Panel {
+        title: format!("{}: {} (u = {} V)", sc.name, name, sc.u),
+        x_label: "t [s]",
+        y_label: if idx == 1 {
+            "omega_u [rad/s]"
+        } else {
+            "omega_l [rad/s]"
+        },
+        series: SolverKind::ALL
+            .iter()
+            .enumerate()
+            .filter_map(|(i, &k)| {
+                let tr = r.traj(k)?;
+                let (color, dash, width) = COLORS[i];
+                Some(Series {
+                    label: Box::leak(label(k, sc).into_boxed_str()),
+                    color,
+                    dash,
+                    width,
+                    points: tr
+                        .samples
+                        .iter()
+                        .filter(|s| s.t <= t_max)
+                        .map(|s| (s.t, s.x[idx]))
+                        .collect(),
+                })
+            })
+            .collect(),
+    };
+    render(&[mk(1, "upper disc"), mk(2, "lower disc")], 900.0, 320.0)
+}
+
+/// The friction curves of both parameter sets (the source's Fig. 2).
+pub fn friction_svg(sets: &[(&str, Params)]) -> String {
+    let mut panels = Vec::new();
+    for (disc, name) in [
+        (Disc::Upper, "upper disc T_fu"),
+        (Disc::Lower, "lower disc T_fl"),
+    ] {
+        let series = sets
+            .iter()
+            .enumerate()
+            .map(|(i, (set, p))| {
+                let m = Model::new(*p);
+                let f: Friction = *m.friction(disc);
+                let (lo, hi) = f.static_interval();
+                let mut pts: Vec<(f64, f64)> = (-400..=400)
+                    .map(|k| k as f64 * 0.025)
+                    .filter(|w| *w != 0.0)
+                    .map(|w| (w, f.curve(w)))
+                    .collect();
+                // The set-valued part at ω = 0: a vertical segment.
+                let mid = pts.iter().position(|p| p.0 > 0.0).unwrap_or(0);
+                pts.insert(mid, (0.0, hi));
+                pts.insert(mid, (0.0, lo));
+                let (color, dash, _) = COLORS[i];
+                Series {
+                    label: set,
+                    color,
+                    dash,
+                    width: 1.8,
+                    points: pts,
+                }
+            })
+            .collect();
+        panels.push(Panel {
+            title: format!("Friction: {name} (Fig. 2)"),
+            x_label: "omega [rad/s]",
+            y_label: "torque [N m]",
+            series,
+        });
+    }
+    render(&panels, 900.0, 340.0)
+}
+
+fn fmt_metrics(st: &Option<SteadyState>) -> String {
+    match st {
+        None => "—".into(),
+        Some(SteadyState::Equilibrium {
+            omega_u, omega_l, ..
+        }) => {
+            format!("equilibrium ω_u = {omega_u:.6}, ω_l = {omega_l:.6}")
+        }
+        Some(SteadyState::LimitCycle {
+            period,
+            omega_l_max,
+            omega_l_min,
+            stick_time,
+            ..
+        }) => format!(
+            "cycle T = {period:.6} s, ω_l ∈ [{omega_l_min:.4}, {omega_l_max:.6}], stick {stick_time:.5} s"
+        ),
+    }
+}
+
+/// Writes the whole report into `dir` and returns the failures.
+pub fn write_report(
+    dir: &Path,
+    results: &[ScenarioResult],
+    param_sets: &[(&str, Params)],
+) -> std::io::Result<Vec<Failure>> {
+    std::fs::create_dir_all(dir)?;
+    let mut md = String::new();
+    let mut all_fails = Vec::new();
+    md.push_str(include_str!("report_intro.md"));
+    md.push_str("\n## Agreement and run time per scenario\n\n");
+    md.push_str("| scenario | solver | steady state (second half of the run) | steps | rejected | RHS evals | events | LCP solves / skipped | time [ms] |\n|---|---|---|---|---|---|---|---|---|\n");
+    for r in results {
+        for run in &r.runs {
+            let (st, stats) = match &run.result {
+                Ok(t) => (fmt_metrics(&t.metrics), t.stats),
+                Err(e) => (format!("**error: {e}**"), Default::default()),
+            };
+            let _ = writeln!(
+                md,
+                "| [{}]({}.svg) | {} | {} | {} | {} | {} | {} | {} / {} | {:.1} |",
+                r.scenario.name,
+                r.scenario.name,
+                run.kind.name(),
+                st,
+                stats.steps,
+                stats.rejected,
+                stats.rhs_evals,
+                stats.events,
+                stats.lcp_solves,
+                stats.lcp_skipped,
+                run.seconds * 1e3
+            );
+        }
+    }
+    md.push_str("\n## Gates (measured difference / tolerance from the scenario file)\n\n| scenario | pair | quantity | difference | tolerance | |\n|---|---|---|---|---|---|\n");
+    for r in results {
+        let (gates, fails) = gate_scenario(r);
+        for g in &gates {
+            for m in &g.measured {
+                let _ = writeln!(
+                    md,
+                    "| {} | {} | {} | {:.2e} | {:.1e} | {} |",
+                    r.scenario.name,
+                    g.pair,
+                    m.quantity,
+                    m.diff,
+                    m.tol,
+                    if m.passes() { "ok" } else { "**FAIL**" }
+                );
+            }
+        }
+        for f in &fails {
+            if f.diff.is_infinite() {
+                let _ = writeln!(
+                    md,
+                    "| {} | {} | {} | — | — | **FAIL** |",
+                    f.scenario, f.pair, f.quantity
+                );
+            }
+        }
+        all_fails.extend(fails);
+        write_atomic(
+            &dir.join(format!("{}.csv", r.scenario.name)),
+            scenario_csv(r).as_bytes(),
+        )?;
+        write_atomic(
+            &dir.join(format!("{}.svg", r.scenario.name)),
+            scenario_svg(r).as_bytes(),
+        )?;
+    }
+    write_atomic(
+        &dir.join("friction.svg"),
+        friction_svg(param_sets).as_bytes(),
+    )?;
+    write_atomic(&dir.join("README.md"), md.as_bytes())?;
+    Ok(all_fails)
+}

@@ -1,0 +1,108 @@
+//! Running one scenario through every solver.
+
+use std::time::Instant;
+
+use rotor_model::{Model, Output, Scenario, Scene, SolveError, Solver, Trajectory};
+
+/// The three solvers, in report order.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash, serde::Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum SolverKind {
+    Event,
+    Switch,
+    Moreau,
+}
+
+impl SolverKind {
+    pub const ALL: [SolverKind; 3] = [SolverKind::Event, SolverKind::Switch, SolverKind::Moreau];
+
+    pub fn name(self) -> &'static str {
+        match self {
+            SolverKind::Event => "event",
+            SolverKind::Switch => "switch",
+            SolverKind::Moreau => "moreau",
+        }
+    }
+
+    fn solver(self) -> Box<dyn Solver> {
+        match self {
+            SolverKind::Event => Box::new(rotor_event::EventSolver::default()),
+            SolverKind::Switch => Box::new(rotor_switch::SwitchSolver::default()),
+            SolverKind::Moreau => Box::new(rotor_moreau::MoreauSolver::default()),
+        }
+    }
+}
+
+/// The accuracy setting of each solver in the comparison: the event-driven reference at
+/// tol 1e-12; the switch model at tol 1e-10 with its default band η = 1e-7; Moreau–Jean at
+/// h = 1e-3 (the step at which Siconos is benchmarked). A scenario file may override tol/h.
+pub fn solver_settings(kind: SolverKind, sc: &Scenario) -> (f64, f64) {
+    let d = Scene::default();
+    match kind {
+        SolverKind::Event => (1e-12, d.h),
+        SolverKind::Switch => (sc.tol.unwrap_or(1e-10), d.h),
+        SolverKind::Moreau => (d.tol, sc.h.unwrap_or(1e-3)),
+    }
+}
+
+/// One solver's run of one scenario.
+#[derive(Debug, Clone)]
+pub struct RunResult {
+    pub kind: SolverKind,
+    pub result: Result<Trajectory, SolveError>,
+    /// Wall-clock run time [s] (for the report; never asserted).
+    pub seconds: f64,
+}
+
+/// All solvers' runs of one scenario.
+#[derive(Debug, Clone)]
+pub struct ScenarioResult {
+    pub scenario: Scenario,
+    pub runs: Vec<RunResult>,
+}
+
+/// The scene of a scenario for one solver: the comparison grid, events, and metrics.
+pub fn scene_for(kind: SolverKind, sc: &Scenario) -> Scene {
+    let (tol, h) = solver_settings(kind, sc);
+    Scene {
+        u: sc.u,
+        x0: sc.x0,
+        t_end: sc.t_end,
+        tol,
+        h,
+        output: Output::Grid { dt: sc.compare.dt },
+        metrics_from: sc.compare.steady_from,
+    }
+}
+
+/// Runs a scenario through every solver.
+pub fn run_scenario(sc: &Scenario) -> ScenarioResult {
+    let runs = SolverKind::ALL
+        .iter()
+        .map(|&kind| run_one(kind, &sc.model, &scene_for(kind, sc)))
+        .collect();
+    ScenarioResult {
+        scenario: sc.clone(),
+        runs,
+    }
+}
+
+fn run_one(kind: SolverKind, model: &Model, scene: &Scene) -> RunResult {
+    let t0 = Instant::now();
+    let result = kind.solver().simulate(model, scene);
+    RunResult {
+        kind,
+        result,
+        seconds: t0.elapsed().as_secs_f64(),
+    }
+}
+
+impl ScenarioResult {
+    /// The trajectory of one solver, if it finished.
+    pub fn traj(&self, kind: SolverKind) -> Option<&Trajectory> {
+        self.runs
+            .iter()
+            .find(|r| r.kind == kind)
+            .and_then(|r| r.result.as_ref().ok())
+    }
+}
