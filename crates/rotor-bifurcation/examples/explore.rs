@@ -1,16 +1,16 @@
-//! Prints the diagram's special points for a parameter file (exploration aid).
+//! Prints the special points of the bifurcation diagram of a parameter file, and optionally
+//! writes the JSON and CSV: `cargo run --release -p rotor-bifurcation --example explore --
+//! fixtures/params/table1.toml [n] [out.json] [out.csv]`.
 use rotor_bifurcation::{DiagramOptions, diagram};
 use rotor_model::{Model, Params};
 
 fn main() {
-    let path = std::env::args()
-        .nth(1)
-        .unwrap_or("fixtures/params/table1.toml".into());
-    let n: usize = std::env::args()
-        .nth(2)
-        .map(|s| s.parse().unwrap())
-        .unwrap_or(200);
-    let model = Model::new(Params::from_file(std::path::Path::new(&path)).unwrap());
+    let args: Vec<String> = std::env::args().collect();
+    let path = args
+        .get(1)
+        .map_or("fixtures/params/table1.toml", |s| s.as_str());
+    let n: usize = args.get(2).map_or(200, |s| s.parse().expect("n"));
+    let model = Model::new(Params::from_file(std::path::Path::new(path)).expect("params"));
     let t = std::time::Instant::now();
     let d = diagram(
         &model,
@@ -19,21 +19,16 @@ fn main() {
             ..Default::default()
         },
     )
-    .unwrap();
-    eprintln!("time {:?}, {} periodic", t.elapsed(), d.periodic.len());
+    .expect("diagram");
+    eprintln!("{:?}, {} periodic orbits", t.elapsed(), d.periodic.len());
     for p in &d.points {
-        println!("{:?}", p);
+        println!("{:<17} u = {:.12}  {}", p.kind, p.u, p.detail);
     }
-    for p in d.periodic.iter().step_by(10) {
-        println!(
-            "u {:.5} T {:.4} max {:.4} min {:.4} st {} ss {} m {:?}",
-            p.u,
-            p.period,
-            p.omega_l_max,
-            p.omega_l_min,
-            p.stable,
-            p.stick_slip,
-            &p.multipliers[1..]
-        );
+    if let Some(j) = args.get(3) {
+        std::fs::write(j, d.to_json()).expect("write json");
+    }
+    if let Some(c) = args.get(4) {
+        let mut f = std::fs::File::create(c).expect("create csv");
+        d.write_csv(&mut f).expect("write csv");
     }
 }

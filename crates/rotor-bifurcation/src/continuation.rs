@@ -67,6 +67,19 @@ pub struct Node {
     pub info: CycleInfo,
 }
 
+/// Why a branch direction ended.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum End {
+    /// It left `[u_min, u_max]`.
+    Range,
+    /// Its amplitude fell below `amp_stop` (a Hopf point is near).
+    Small,
+    /// The step size collapsed (a non-smooth point: a grazing orbit where the branch turns).
+    Stuck,
+    /// The node limit.
+    MaxNodes,
+}
+
 /// Continuation settings.
 #[derive(Debug, Clone, Copy)]
 pub struct ContOptions {
@@ -247,12 +260,13 @@ impl Continuer<'_> {
 
     /// Follows the branch from `start` in the direction `dir` (its u-component sign) until it
     /// leaves `[u_min, u_max]`, shrinks below `amp_stop`, or cannot be continued.
-    pub fn follow(&self, start: &Node, dir: f64) -> Vec<Node> {
+    pub fn follow(&self, start: &Node, along: &[f64; 3]) -> (Vec<Node>, End) {
         let mut out = Vec::new();
         let mut cur = start.clone();
-        if cur.tangent[0] * dir < 0.0 {
+        if dot(&cur.tangent, along) < 0.0 {
             cur.tangent = cur.tangent.map(|v| -v);
         }
+        let mut end = End::MaxNodes;
         let mut h = self.opts.h_max * 0.25;
         while out.len() < self.opts.max_nodes {
             let step = self.correct(&cur.y, &cur.tangent, h).and_then(|(y, its)| {
@@ -266,10 +280,12 @@ impl Continuer<'_> {
                         h *= 0.5;
                         continue;
                     }
-                    if n.y[0] < self.opts.u_min
-                        || n.y[0] > self.opts.u_max
-                        || n.info.omega_l_max - n.info.omega_l_min < self.opts.amp_stop
-                    {
+                    if n.y[0] < self.opts.u_min || n.y[0] > self.opts.u_max {
+                        end = End::Range;
+                        break;
+                    }
+                    if n.info.omega_l_max - n.info.omega_l_min < self.opts.amp_stop {
+                        end = End::Small;
                         break;
                     }
                     if its <= 3 {
@@ -281,12 +297,96 @@ impl Continuer<'_> {
                 Err(_) => {
                     h *= 0.5;
                     if h < self.opts.h_min {
+                        end = End::Stuck;
                         break;
                     }
                 }
             }
         }
-        out
+        (out, end)
+    }
+
+    /// The cycle of amplitude ≈ `eps` (in ω_l) near a Hopf point at `omega_h`: the Hopf
+    /// eigenvector `v` (`J v = iβ v`, scaled so that `v_l = −i`) gives the upward crossing of
+    /// the section at `z ≈ z*(u) + ε (Re v_α, Re v_ωu)`; Newton on `F(y) = 0` with the
+    /// amplitude condition `d̂·(z − z*(u)) = ε|d|`, `d = (Re v_α, Re v_ωu)`, fixes the point.
+    pub fn hopf_cycle(&self, omega_h: f64, eps: f64) -> Result<[f64; 3], BifError> {
+        use nalgebra::Complex;
+        let m = self.sh.model;
+        let e = m.slip_equilibrium_at(omega_h);
+        let pair = crate::equilibria::complex_pair(m, omega_h).ok_or(BifError::NoConvergence {
+            u: e.u,
+            detail: "no complex pair at the Hopf point".into(),
+        })?;
+        let mode = rotor_model::Mode {
+            upper: rotor_model::DiscMode::SlipPos,
+            lower: rotor_model::DiscMode::SlipPos,
+        };
+        let j = m.jacobian(&e.state(), e.u, mode);
+        let lam = Complex::new(0.0, pair.im);
+        let row = |i: usize| -> [Complex<f64>; 3] {
+            [0, 1, 2].map(|k| {
+                Complex::new(j[(i, k)], 0.0) - if i == k { lam } else { Complex::new(0.0, 0.0) }
+            })
+        };
+        let cr = |a: [Complex<f64>; 3], b: [Complex<f64>; 3]| {
+            [
+                a[1] * b[2] - a[2] * b[1],
+                a[2] * b[0] - a[0] * b[2],
+                a[0] * b[1] - a[1] * b[0],
+            ]
+        };
+        let cands = [cr(row(0), row(1)), cr(row(0), row(2)), cr(row(1), row(2))];
+        let nrm = |v: &[Complex<f64>; 3]| v.iter().map(|c| c.norm_sqr()).sum::<f64>();
+        let v = cands
+            .into_iter()
+            .max_by(|a, b| nrm(a).total_cmp(&nrm(b)))
+            .expect("three candidates");
+        let scale = Complex::new(0.0, -1.0) / v[2];
+        let v = v.map(|c| c * scale);
+        let d = [v[0].re, v[1].re];
+        let dn = (d[0] * d[0] + d[1] * d[1]).sqrt();
+        let dh = [d[0] / dn, d[1] / dn];
+        let target = eps * dn;
+        let g = |y: &[f64; 3]| -> Result<[f64; 3], BifError> {
+            let (f, c) = self.residual(y)?;
+            let ze = m.slip_equilibrium_at(c);
+            Ok([
+                f[0],
+                f[1],
+                dh[0] * (y[1] - ze.alpha) + dh[1] * (y[2] - ze.omega) - target,
+            ])
+        };
+        let mut y = [e.u, e.alpha + eps * d[0], e.omega + eps * d[1]];
+        for _ in 0..30 {
+            let g0 = g(&y)?;
+            if g0[0].abs().max(g0[1].abs()).max(g0[2].abs()) <= self.opts.newton_tol {
+                return Ok(y);
+            }
+            let mut a = Matrix3::zeros();
+            for k in 0..3 {
+                let dk = 1e-7 * y[k].abs().max(1.0);
+                let mut yk = y;
+                yk[k] += dk;
+                let gk = g(&yk)?;
+                for i in 0..3 {
+                    a[(i, k)] = (gk[i] - g0[i]) / dk;
+                }
+            }
+            let dy = a.lu().solve(&Vector3::new(-g0[0], -g0[1], -g0[2])).ok_or(
+                BifError::NoConvergence {
+                    u: y[0],
+                    detail: "singular Hopf-start Jacobian".into(),
+                },
+            )?;
+            for k in 0..3 {
+                y[k] += dy[k];
+            }
+        }
+        Err(BifError::NoConvergence {
+            u: y[0],
+            detail: "Hopf start: 30 Newton iterations".into(),
+        })
     }
 
     /// Bisection on the step length from `a` (toward its successor `b`, reached with step
@@ -301,22 +401,37 @@ impl Continuer<'_> {
         let ga = g(a);
         let mut lo = 0.0;
         let mut hi = b.step;
-        let mut best = b.clone();
+        let mut lo_node = a.clone();
+        let mut hi_node: Option<(f64, Node)> = None;
         for _ in 0..max_iter {
             let m = 0.5 * (lo + hi);
-            let (y, _) = self.correct(&a.y, &a.tangent, m)?;
-            let n = self.node(y, &a.tangent, m)?;
-            let gm = g(&n);
-            if gm * ga > 0.0 {
-                lo = m;
-            } else {
-                hi = m;
-                best = n;
+            // A failed corrector means the curve does not reach this far along a's tangent
+            // (it turned back at a non-smooth point): treat it as past the sign change.
+            match self
+                .correct(&a.y, &a.tangent, m)
+                .and_then(|(y, _)| self.node(y, &a.tangent, m))
+            {
+                Ok(n) if g(&n) * ga > 0.0 => {
+                    lo = m;
+                    lo_node = n;
+                }
+                Ok(n) => {
+                    hi = m;
+                    hi_node = Some((m, n));
+                }
+                Err(_) => hi = m,
             }
-            if hi - lo < 1e-9 {
+            if hi - lo < 1e-10 {
                 break;
             }
         }
-        Ok(best)
+        match hi_node {
+            Some((m, n)) if m - lo < 1e-8 => Ok(n),
+            _ if lo > 0.0 => Ok(lo_node),
+            _ => Err(BifError::NoConvergence {
+                u: a.y[0],
+                detail: "bisection found no sign change".into(),
+            }),
+        }
     }
 }

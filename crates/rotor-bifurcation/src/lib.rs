@@ -24,7 +24,7 @@ use rotor_model::{Model, State};
 use serde::Serialize;
 use thiserror::Error;
 
-use continuation::{ContOptions, Continuer, Node};
+use continuation::{ContOptions, Continuer, End, Node};
 use periodic::Shooter;
 
 /// What can go wrong while computing the diagram.
@@ -89,6 +89,9 @@ pub struct EquilibriumRow {
 /// One periodic orbit of the branch (in branch order).
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct PeriodicRow {
+    /// Index of the branch (0: the one started from a steady orbit; then one per Hopf point
+    /// the first does not reach, started from the Hopf eigenvector).
+    pub branch: usize,
     pub u: f64,
     pub period: f64,
     pub omega_l_max: f64,
@@ -98,6 +101,8 @@ pub struct PeriodicRow {
     pub multipliers: Vec<[f64; 2]>,
     pub stick_slip: bool,
     pub stick_time: f64,
+    /// The orbit's state `[α, ω_u, ω_l]` on the section `ω_l = ω*(u)` (a restart point).
+    pub section_state: [f64; 3],
 }
 
 /// A special point.
@@ -129,8 +134,9 @@ pub struct Diagram {
 }
 
 impl PeriodicRow {
-    fn of(n: &Node) -> PeriodicRow {
+    fn of(n: &Node, branch: usize) -> PeriodicRow {
         PeriodicRow {
+            branch,
             u: n.y[0],
             period: n.info.period,
             omega_l_max: n.info.omega_l_max,
@@ -139,6 +145,7 @@ impl PeriodicRow {
             multipliers: n.info.multipliers.iter().map(|l| [l.re, l.im]).collect(),
             stick_slip: n.info.stick_slip,
             stick_time: n.info.stick_time,
+            section_state: [n.y[1], n.y[2], n.c],
         }
     }
 }
@@ -261,7 +268,7 @@ pub fn diagram(model: &Model, opts: &DiagramOptions) -> Result<Diagram, BifError
             u_min: opts.u_min,
             u_max: opts.u_max,
             h_max,
-            h_min: 1e-6,
+            h_min: 1e-9,
             newton_tol: 1e-9,
             amp_stop: opts.amp_stop,
             max_nodes: 20 * opts.n,
@@ -271,28 +278,168 @@ pub fn diagram(model: &Model, opts: &DiagramOptions) -> Result<Diagram, BifError
     let (z0, c) = start_point(&sh, opts.u_start)?;
     let z = sh.section_fixed_point(opts.u_start, c, z0, 1e-10)?;
     let start = cont.node([opts.u_start, z[0], z[1]], &[1.0, 0.0, 0.0], 0.0)?;
-    let down = cont.follow(&start, -1.0);
-    let up = cont.follow(&start, 1.0);
-    let mut branch: Vec<Node> = down.into_iter().rev().collect();
-    branch.push(start);
-    branch.extend(up);
-    // Orient every tangent along the branch order (increasing index).
-    for i in 1..branch.len() {
-        let prev = branch[i - 1].tangent;
-        let t = &mut branch[i].tangent;
-        if t[0] * prev[0] + t[1] * prev[1] + t[2] * prev[2] < 0.0 {
-            *t = t.map(|v| -v);
+    let (down, end_down) = cont.follow(&start, &[-1.0, 0.0, 0.0]);
+    let (up, end_up) = cont.follow(&start, &[1.0, 0.0, 0.0]);
+    let mut nodes: Vec<Node> = down.into_iter().rev().collect();
+    nodes.push(start);
+    nodes.extend(up);
+    let mut branches = vec![Branch {
+        nodes,
+        ends: [end_down, end_up],
+    }];
+    // Branches born at Hopf points that the first branch does not reach.
+    let hopfs = equilibria::omega_reaching(model, opts.u_max)
+        .map(|w| equilibria::hopf_points(model, w))
+        .unwrap_or_default();
+    let hopfs: Vec<_> = hopfs
+        .into_iter()
+        .filter(|h| (opts.u_min..=opts.u_max).contains(&h.equilibrium.u))
+        .collect();
+    for h in &hopfs {
+        if nearest_hopf_end(&branches, &hopfs, h).is_some() {
+            continue;
+        }
+        let eps = 2.0 * opts.amp_stop;
+        let (Ok(y1), Ok(y2)) = (
+            cont.hopf_cycle(h.equilibrium.omega, eps),
+            cont.hopf_cycle(h.equilibrium.omega, 1.5 * eps),
+        ) else {
+            continue;
+        };
+        let along = [y2[0] - y1[0], y2[1] - y1[1], y2[2] - y1[2]];
+        let Ok(first) = cont.node(y1, &along, 0.0) else {
+            continue;
+        };
+        let (rest, end) = cont.follow(&first, &along);
+        let mut nodes = vec![first];
+        nodes.extend(rest);
+        branches.push(Branch {
+            nodes,
+            ends: [End::Small, end],
+        });
+    }
+    for b in &mut branches {
+        orient(&mut b.nodes);
+        points.extend(special_points(&cont, &b.nodes));
+    }
+    // Criticality of each Hopf point: from the stability of the cycles at the branch end
+    // next to it.
+    for p in points.iter_mut().filter(|p| p.kind == "hopf") {
+        if let Some(h) = hopfs.iter().find(|h| h.equilibrium.u == p.u)
+            && let Some(n) = nearest_hopf_end(&branches, &hopfs, h)
+        {
+            p.detail = format!(
+                "{}; {} (cycles of amplitude {:.3} rad/s at u = {} are {})",
+                if n.info.stable {
+                    "supercritical"
+                } else {
+                    "subcritical"
+                },
+                p.detail,
+                n.info.omega_l_max - n.info.omega_l_min,
+                n.y[0],
+                if n.info.stable { "stable" } else { "unstable" }
+            );
         }
     }
-    if branch[0].tangent[0] * branch[1].tangent[0] < 0.0 && branch.len() > 1 {
-        // (keeps the first tangent consistent with its neighbour)
+    // Branch ends at a collapsed step: a non-smooth turning point at a grazing orbit. Two such
+    // ends at the same u form a discontinuous fold.
+    let stuck_ends: Vec<&Node> = branches
+        .iter()
+        .flat_map(|b| {
+            let first = (b.ends[0] == End::Stuck).then(|| b.nodes.first()).flatten();
+            let last = (b.ends[1] == End::Stuck).then(|| b.nodes.last()).flatten();
+            first.into_iter().chain(last)
+        })
+        .collect();
+    for (i, a) in stuck_ends.iter().enumerate() {
+        points.push(point_at(
+            "grazing",
+            a,
+            &format!(
+                "a branch ends at a grazing orbit (continuation step collapsed; stick time {:e} s, min omega_l {:e})",
+                a.info.stick_time, a.info.omega_l_min
+            ),
+        ));
+        for b in &stuck_ends[i + 1..] {
+            if (a.y[0] - b.y[0]).abs() < 1e-4 {
+                let mut p = point_at(
+                    "fold",
+                    a,
+                    &format!(
+                        "discontinuous fold: a {} and a {} branch meet at the grazing orbit (u = {} and {})",
+                        if a.info.stable { "stable" } else { "unstable" },
+                        if b.info.stable { "stable" } else { "unstable" },
+                        a.y[0],
+                        b.y[0]
+                    ),
+                );
+                p.u = 0.5 * (a.y[0] + b.y[0]);
+                points.push(p);
+            }
+        }
     }
-    points.extend(special_points(&cont, &branch));
-    let periodic = branch.iter().map(PeriodicRow::of).collect();
+    let periodic = branches
+        .iter()
+        .enumerate()
+        .flat_map(|(k, b)| b.nodes.iter().map(move |n| PeriodicRow::of(n, k)))
+        .collect();
     Ok(Diagram {
         equilibria,
         periodic,
         points,
+    })
+}
+
+/// A followed branch and why each of its ends ended.
+struct Branch {
+    nodes: Vec<Node>,
+    ends: [End; 2],
+}
+
+/// Orients every tangent along the branch order.
+fn orient(nodes: &mut [Node]) {
+    if nodes.len() >= 2 {
+        let (a, b) = (&nodes[0].y, &nodes[1].y);
+        let t = nodes[0].tangent;
+        if (0..3).map(|k| (b[k] - a[k]) * t[k]).sum::<f64>() < 0.0 {
+            nodes[0].tangent = t.map(|v| -v);
+        }
+    }
+    for i in 1..nodes.len() {
+        let prev = nodes[i - 1].tangent;
+        let t = &mut nodes[i].tangent;
+        if t[0] * prev[0] + t[1] * prev[1] + t[2] * prev[2] < 0.0 {
+            *t = t.map(|v| -v);
+        }
+    }
+}
+
+/// The branch end (stopped for small amplitude) whose nearest Hopf point is `h`, if any.
+fn nearest_hopf_end<'a>(
+    branches: &'a [Branch],
+    hopfs: &[equilibria::HopfPoint],
+    h: &equilibria::HopfPoint,
+) -> Option<&'a Node> {
+    let nearest = |u: f64| {
+        hopfs
+            .iter()
+            .min_by(|a, b| {
+                (a.equilibrium.u - u)
+                    .abs()
+                    .total_cmp(&(b.equilibrium.u - u).abs())
+            })
+            .map(|x| x.equilibrium.u)
+    };
+    branches.iter().find_map(|b| {
+        let cands = [
+            (b.ends[0] == End::Small).then(|| b.nodes.first()).flatten(),
+            (b.ends[1] == End::Small).then(|| b.nodes.last()).flatten(),
+        ];
+        cands
+            .into_iter()
+            .flatten()
+            .find(|n| nearest(n.y[0]) == Some(h.equilibrium.u))
     })
 }
 
