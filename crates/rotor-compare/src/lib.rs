@@ -4,7 +4,6 @@
 pub mod gate;
 pub mod report;
 pub mod run;
-pub mod svg;
 
 pub use gate::{Failure, GateResult, Measured, check_pair};
 pub use run::{RunResult, ScenarioResult, SolverKind, run_scenario, solver_settings};

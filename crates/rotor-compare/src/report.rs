@@ -8,7 +8,7 @@ use rotor_model::{Disc, Friction, Model, Params, Scenario, SteadyState};
 
 use crate::gate::{Failure, GateResult, check_pair};
 use crate::run::{ScenarioResult, SolverKind, solver_settings};
-use crate::svg::{Panel, Series, render};
+use rotor_plot::{Panel, Series, render};
 
 /// The gated pairs: each solver against the event-driven reference.
 pub const PAIRS: [(SolverKind, SolverKind); 2] = [
@@ -131,34 +131,38 @@ pub fn scenario_svg(r: &ScenarioResult) -> String {
         .compare
         .transient
         .map_or(sc.t_end, |w| w[1].max(sc.t_end.min(60.0)));
-    let mk = |idx: usize, name: &'static str| Panel {
-        title: format!("{}: {} (u = {} V)", sc.name, name, sc.u),
-        x_label: "t [s]",
-        y_label: if idx == 1 {
-            "omega_u [rad/s]"
-        } else {
-            "omega_l [rad/s]"
-        },
-        series: SolverKind::ALL
-            .iter()
-            .enumerate()
-            .filter_map(|(i, &k)| {
-                let tr = r.traj(k)?;
-                let (color, dash, width) = COLORS[i];
-                Some(Series {
-                    label: Box::leak(label(k, sc).into_boxed_str()),
-                    color,
-                    dash,
-                    width,
-                    points: tr
-                        .samples
-                        .iter()
-                        .filter(|s| s.t <= t_max)
-                        .map(|s| (s.t, s.x[idx]))
-                        .collect(),
+    let labels: Vec<String> = SolverKind::ALL.iter().map(|&k| label(k, sc)).collect();
+    let mk = |idx: usize, name: &'static str| {
+        Panel::new(
+            format!("{}: {} (u = {} V)", sc.name, name, sc.u),
+            "t [s]",
+            if idx == 1 {
+                "omega_u [rad/s]"
+            } else {
+                "omega_l [rad/s]"
+            },
+            SolverKind::ALL
+                .iter()
+                .enumerate()
+                .filter_map(|(i, &k)| {
+                    let tr = r.traj(k)?;
+                    let (color, dash, width) = COLORS[i];
+                    Some(Series {
+                        label: &labels[i],
+                        color,
+                        dash,
+                        width,
+                        marker: None,
+                        points: tr
+                            .samples
+                            .iter()
+                            .filter(|s| s.t <= t_max)
+                            .map(|s| (s.t, s.x[idx]))
+                            .collect(),
+                    })
                 })
-            })
-            .collect(),
+                .collect(),
+        )
     };
     render(&[mk(1, "upper disc"), mk(2, "lower disc")], 900.0, 320.0)
 }
@@ -192,16 +196,17 @@ pub fn friction_svg(sets: &[(&str, Params)]) -> String {
                     color,
                     dash,
                     width: 1.8,
+                    marker: None,
                     points: pts,
                 }
             })
             .collect();
-        panels.push(Panel {
-            title: format!("Friction: {name} (Fig. 2)"),
-            x_label: "omega [rad/s]",
-            y_label: "torque [N m]",
+        panels.push(Panel::new(
+            format!("Friction: {name} (Fig. 2)"),
+            "omega [rad/s]",
+            "torque [N m]",
             series,
-        });
+        ));
     }
     render(&panels, 900.0, 340.0)
 }

@@ -226,6 +226,10 @@ pub struct Stats {
     pub lcp_skipped: u64,
     /// Newton iterations (implicit steps, shooting).
     pub newton_iters: u64,
+    /// Implicit steps whose nonlinear step problem did not converge, so that the last
+    /// fixed-point iterate was taken (Moreau–Jean at very large h only). Zero in every
+    /// scenario the agreement gates cover; nonzero flags an answer to distrust.
+    pub inexact_steps: u64,
 }
 
 /// The result of a run.

@@ -366,6 +366,7 @@ impl Solver for MoreauSolver {
             stats.steps += 1;
             stats.newton_iters += u64::from(out.newton_iters);
             stats.rhs_evals += u64::from(out.evals);
+            stats.inexact_steps += u64::from(!out.exact);
             if out.used_enumeration {
                 stats.lcp_solves += 1;
             } else {

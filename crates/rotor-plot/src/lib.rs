@@ -1,0 +1,382 @@
+//! A small, dependency-free SVG line-plot writer (pure Rust, no fonts needed: text is left to
+//! the viewer's sans-serif).
+
+use std::fmt::Write;
+
+/// One polyline with a label and a style. A non-finite point lifts the pen (a gap).
+pub struct Series<'a> {
+    /// Legend text; an empty label keeps the series out of the legend.
+    pub label: &'a str,
+    pub color: &'a str,
+    /// SVG `stroke-dasharray`, e.g. `"6 4"`; `None` draws a solid line.
+    pub dash: Option<&'a str>,
+    /// Stroke width; `0.0` draws no line (markers only).
+    pub width: f64,
+    /// Draws a filled circle of this radius at every point.
+    pub marker: Option<f64>,
+    pub points: Vec<(f64, f64)>,
+}
+
+impl<'a> Series<'a> {
+    /// A solid line of width 1.5.
+    pub fn line(label: &'a str, color: &'a str, points: Vec<(f64, f64)>) -> Self {
+        Self {
+            label,
+            color,
+            dash: None,
+            width: 1.5,
+            marker: None,
+            points,
+        }
+    }
+}
+
+/// A text label placed at a data point, drawn with a small cross.
+pub struct Label {
+    pub x: f64,
+    pub y: f64,
+    pub text: String,
+}
+
+/// A panel: title, axis labels, series, and how each axis is scaled.
+pub struct Panel<'a> {
+    pub title: String,
+    pub x_label: &'a str,
+    pub y_label: &'a str,
+    pub series: Vec<Series<'a>>,
+    /// Labelled points (special points of a diagram, say).
+    pub labels: Vec<Label>,
+    /// Logarithmic axes: points with a non-positive coordinate are skipped.
+    pub x_log: bool,
+    pub y_log: bool,
+}
+
+impl<'a> Panel<'a> {
+    /// A linear panel without labels.
+    pub fn new(
+        title: impl Into<String>,
+        x_label: &'a str,
+        y_label: &'a str,
+        series: Vec<Series<'a>>,
+    ) -> Self {
+        Self {
+            title: title.into(),
+            x_label,
+            y_label,
+            series,
+            labels: Vec::new(),
+            x_log: false,
+            y_log: false,
+        }
+    }
+}
+
+/// Maps a data coordinate to the axis coordinate (log10 on a log axis; NaN if not drawable).
+fn axis(v: f64, log: bool) -> f64 {
+    if !log {
+        v
+    } else if v > 0.0 {
+        v.log10()
+    } else {
+        f64::NAN
+    }
+}
+
+/// Ticks on a log axis: every decade in `[lo, hi]` (given as log10 values).
+fn log_ticks(lo: f64, hi: f64) -> Vec<f64> {
+    let mut v = Vec::new();
+    let mut e = lo.ceil();
+    let step = ((hi - lo) / 8.0).ceil().max(1.0);
+    while e <= hi + 1e-9 {
+        v.push(e);
+        e += step;
+    }
+    v
+}
+
+fn nice_ticks(lo: f64, hi: f64, n: usize) -> Vec<f64> {
+    let span = (hi - lo).max(1e-12);
+    let raw = span / n as f64;
+    let mag = 10f64.powf(raw.log10().floor());
+    let step = [1.0, 2.0, 5.0, 10.0]
+        .iter()
+        .map(|m| m * mag)
+        .find(|s| *s >= raw)
+        .unwrap_or(10.0 * mag);
+    let mut v = Vec::new();
+    let mut t = (lo / step).ceil() * step;
+    while t <= hi + 1e-9 * span {
+        v.push(if t.abs() < 1e-12 * span { 0.0 } else { t });
+        t += step;
+    }
+    v
+}
+
+fn esc(s: &str) -> String {
+    s.replace('&', "&amp;")
+        .replace('<', "&lt;")
+        .replace('>', "&gt;")
+}
+
+/// Renders panels stacked vertically into one SVG document.
+pub fn render(panels: &[Panel], width: f64, panel_height: f64) -> String {
+    let height = panel_height * panels.len() as f64;
+    let mut s = String::new();
+    let _ = writeln!(
+        s,
+        r#"<svg xmlns="http://www.w3.org/2000/svg" width="{width}" height="{height}" viewBox="0 0 {width} {height}" font-family="sans-serif" font-size="12">"#
+    );
+    let _ = writeln!(s, r#"<rect width="100%" height="100%" fill="white"/>"#);
+    for (k, p) in panels.iter().enumerate() {
+        let oy = k as f64 * panel_height;
+        let (l, r, t, b) = (70.0, width - 20.0, oy + 30.0, oy + panel_height - 45.0);
+        let pts = p
+            .series
+            .iter()
+            .flat_map(|s| s.points.iter().copied())
+            .chain(p.labels.iter().map(|l| (l.x, l.y)))
+            .map(|(x, y)| (axis(x, p.x_log), axis(y, p.y_log)));
+        let (mut x0, mut x1, mut y0, mut y1) = (
+            f64::INFINITY,
+            f64::NEG_INFINITY,
+            f64::INFINITY,
+            f64::NEG_INFINITY,
+        );
+        for (x, y) in pts {
+            if x.is_finite() && y.is_finite() {
+                x0 = x0.min(x);
+                x1 = x1.max(x);
+                y0 = y0.min(y);
+                y1 = y1.max(y);
+            }
+        }
+        if !x0.is_finite() {
+            continue;
+        }
+        if y1 - y0 < 1e-9 {
+            y0 -= 0.5;
+            y1 += 0.5;
+        }
+        let pad = 0.05 * (y1 - y0);
+        let (y0, y1) = (y0 - pad, y1 + pad);
+        if x1 - x0 < 1e-12 {
+            x0 -= 0.5;
+            x1 += 0.5;
+        }
+        // Axis coordinate -> pixels.
+        let ax = |x: f64| l + (x - x0) / (x1 - x0) * (r - l);
+        let ay = |y: f64| b - (y - y0) / (y1 - y0) * (b - t);
+        // Data coordinate -> pixels.
+        let sx = |x: f64| ax(axis(x, p.x_log));
+        let sy = |y: f64| ay(axis(y, p.y_log));
+        let _ = writeln!(
+            s,
+            r#"<text x="{}" y="{}" text-anchor="middle" font-size="14">{}</text>"#,
+            (l + r) / 2.0,
+            oy + 20.0,
+            esc(&p.title)
+        );
+        let _ = writeln!(
+            s,
+            r#"<rect x="{l}" y="{t}" width="{}" height="{}" fill="none" stroke="black"/>"#,
+            r - l,
+            b - t
+        );
+        let x_ticks = if p.x_log {
+            log_ticks(x0, x1)
+        } else {
+            nice_ticks(x0, x1, 8)
+        };
+        for tx in x_ticks {
+            let x = ax(tx);
+            let _ = writeln!(
+                s,
+                r##"<line x1="{x:.1}" y1="{b}" x2="{x:.1}" y2="{t}" stroke="#ddd"/><text x="{x:.1}" y="{}" text-anchor="middle">{}</text>"##,
+                b + 15.0,
+                if p.x_log {
+                    fmt_decade(tx)
+                } else {
+                    fmt_tick(tx)
+                }
+            );
+        }
+        let y_ticks = if p.y_log {
+            log_ticks(y0, y1)
+        } else {
+            nice_ticks(y0, y1, 6)
+        };
+        for ty in y_ticks {
+            let y = ay(ty);
+            let _ = writeln!(
+                s,
+                r##"<line x1="{l}" y1="{y:.1}" x2="{r}" y2="{y:.1}" stroke="#ddd"/><text x="{}" y="{:.1}" text-anchor="end">{}</text>"##,
+                l - 5.0,
+                y + 4.0,
+                if p.y_log {
+                    fmt_decade(ty)
+                } else {
+                    fmt_tick(ty)
+                }
+            );
+        }
+        let _ = writeln!(
+            s,
+            r#"<text x="{}" y="{}" text-anchor="middle">{}</text>"#,
+            (l + r) / 2.0,
+            b + 35.0,
+            esc(p.x_label)
+        );
+        let _ = writeln!(
+            s,
+            r#"<text x="{}" y="{}" text-anchor="middle" transform="rotate(-90 {} {})">{}</text>"#,
+            l - 50.0,
+            (t + b) / 2.0,
+            l - 50.0,
+            (t + b) / 2.0,
+            esc(p.y_label)
+        );
+        let mut legend_row = 0usize;
+        for ser in &p.series {
+            let mut d = String::new();
+            let mut pen_up = true;
+            for &(x, y) in &ser.points {
+                let (px, py) = (sx(x), sy(y));
+                if !(px.is_finite() && py.is_finite()) {
+                    pen_up = true;
+                    continue;
+                }
+                let _ = write!(d, "{}{px:.2},{py:.2} ", if pen_up { "M" } else { "L" });
+                pen_up = false;
+                if let Some(radius) = ser.marker {
+                    let _ = writeln!(
+                        s,
+                        r#"<circle cx="{px:.2}" cy="{py:.2}" r="{radius}" fill="{}"/>"#,
+                        ser.color
+                    );
+                }
+            }
+            let dash = ser
+                .dash
+                .map(|d| format!(r#" stroke-dasharray="{d}""#))
+                .unwrap_or_default();
+            if ser.width > 0.0 && !d.is_empty() {
+                let _ = writeln!(
+                    s,
+                    r#"<path d="{d}" fill="none" stroke="{}" stroke-width="{}"{dash}/>"#,
+                    ser.color, ser.width
+                );
+            }
+            if ser.label.is_empty() {
+                continue;
+            }
+            let ly = t + 15.0 + 16.0 * legend_row as f64;
+            legend_row += 1;
+            let _ = writeln!(
+                s,
+                r#"<line x1="{}" y1="{ly}" x2="{}" y2="{ly}" stroke="{}" stroke-width="{}"{dash}/><text x="{}" y="{}">{}</text>"#,
+                r - 150.0,
+                r - 120.0,
+                ser.color,
+                ser.width.max(1.5),
+                r - 115.0,
+                ly + 4.0,
+                esc(ser.label)
+            );
+        }
+        for lab in &p.labels {
+            let (px, py) = (sx(lab.x), sy(lab.y));
+            if !(px.is_finite() && py.is_finite()) {
+                continue;
+            }
+            let _ = writeln!(
+                s,
+                r#"<path d="M{:.2},{:.2} L{:.2},{:.2} M{:.2},{:.2} L{:.2},{:.2}" stroke="black" stroke-width="1.5"/><text x="{:.2}" y="{:.2}" font-size="11">{}</text>"#,
+                px - 4.0,
+                py - 4.0,
+                px + 4.0,
+                py + 4.0,
+                px - 4.0,
+                py + 4.0,
+                px + 4.0,
+                py - 4.0,
+                px + 6.0,
+                py - 6.0,
+                esc(&lab.text)
+            );
+        }
+    }
+    s.push_str("</svg>\n");
+    s
+}
+
+fn fmt_tick(v: f64) -> String {
+    let s = format!("{v:.6}");
+    let s = s.trim_end_matches('0').trim_end_matches('.');
+    if s == "-0" { "0".into() } else { s.into() }
+}
+
+/// `1e-3` style label for a decade exponent.
+fn fmt_decade(e: f64) -> String {
+    format!("1e{}", e.round() as i64)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn ticks_cover_range_with_round_steps() {
+        assert_eq!(
+            nice_ticks(0.0, 10.0, 5),
+            vec![0.0, 2.0, 4.0, 6.0, 8.0, 10.0]
+        );
+        let t = nice_ticks(-0.3, 1.7, 4);
+        assert_eq!(t, vec![0.0, 0.5, 1.0, 1.5]);
+    }
+
+    #[test]
+    fn render_is_well_formed() {
+        let svg = render(
+            &[Panel::new(
+                "a < b",
+                "t [s]",
+                "w",
+                vec![Series::line(
+                    "x",
+                    "red",
+                    vec![(0.0, 1.0), (1.0, f64::NAN), (2.0, 3.0)],
+                )],
+            )],
+            600.0,
+            300.0,
+        );
+        assert!(svg.starts_with("<svg") && svg.ends_with("</svg>\n"));
+        assert!(svg.contains("a &lt; b"));
+        assert!(!svg.contains("NaN"));
+    }
+
+    #[test]
+    fn log_axes_skip_nonpositive_points_and_label_decades() {
+        let mut panel = Panel::new(
+            "wp",
+            "time",
+            "error",
+            vec![Series {
+                marker: Some(3.0),
+                ..Series::line("s", "blue", vec![(1e-3, 1e-2), (0.0, 1.0), (1e-1, 1e-8)])
+            }],
+        );
+        panel.x_log = true;
+        panel.y_log = true;
+        panel.labels.push(Label {
+            x: 1e-2,
+            y: 1e-4,
+            text: "A".into(),
+        });
+        let svg = render(&[panel], 600.0, 300.0);
+        assert!(svg.contains(">1e-8<") && svg.contains(">1e-3<"));
+        assert_eq!(svg.matches("<circle").count(), 2);
+        assert!(svg.contains(">A</text>"));
+        assert!(!svg.contains("NaN") && !svg.contains("inf"));
+    }
+}
