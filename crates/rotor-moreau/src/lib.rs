@@ -68,17 +68,17 @@
 //! (a failed check falls back to the enumeration). Counted in [`Stats::lcp_skipped`]
 //! (vs [`Stats::lcp_solves`]).
 //!
-//! # Orders measured (`tests/integration/convergence.rs`)
+//! # Orders measured (`rotor-compare/tests/moreau_order.rs`)
 //!
-//! Self-convergence on Table 1, u = 1.5 V from rest, 60 s, metrics over [30, 60] s: the
-//! Richardson differences `e(h) = |m(h) − m(h/10)|` for h = 1e-2, 1e-3, 1e-4 (runs down to
-//! 1e-5), fitted as `e ≈ C·h^p`:
+//! Against the event-driven solver (tol = 1e-13, its own error ≤ 1e-11) on Table 1,
+//! u = 1.5 V from rest, 60 s, metrics over [30, 60] s (period 4.5778 s, max ω_l 6.3361 rad/s):
+//! the errors `e(h) = |m(h) − m_event|` for h = 1e-2, 1e-3, 1e-4, 1e-5, fitted as `e ≈ C·h^p`:
 //!
-//! | scheme | period: p, C (s) | max ω_l: p, C (rad/s) | period e(1e-2), e(1e-3), e(1e-4) |
+//! | scheme | period: p, C (s) | max ω_l: p, C (rad/s) | period e(1e-2), e(1e-3), e(1e-4), e(1e-5) |
 //! |---|---|---|---|
-//! | θ = 1/2, implicit level (default) | 2.00, 0.59 | 2.02, 0.70 | 6.2e-5, 5.6e-7, 6.2e-9 |
-//! | θ = 1/2, explicit level | 1.00, 0.56 | 1.00, 0.59 | 5.6e-3, 5.5e-4, 5.5e-5 |
-//! | θ = 1, implicit level | 1.00, 3.0 | 1.00, 6.6 | 3.0e-2, 3.1e-3, 3.1e-4 |
+//! | θ = 1/2, implicit level (default) | 2.01, 0.62 | 2.02, 0.68 | 6.2e-5, 5.7e-7, 6.3e-9, 5.8e-11 |
+//! | θ = 1/2, explicit level | 1.00, 0.62 | 1.00, 0.65 | 6.2e-3, 6.1e-4, 6.1e-5, 6.1e-6 |
+//! | θ = 1, implicit level | 1.00, 3.4 | 1.00, 7.3 | 3.4e-2, 3.4e-3, 3.4e-4, 3.5e-5 |
 //!
 //! The default matches the second-order behaviour measured with Siconos 4.4's
 //! `MoreauJeanOSI` on this model (6e-5, 8e-7, 1e-8). Friction events keep the velocity

@@ -1,6 +1,5 @@
 //! Integration tests of the Moreau–Jean solver (one test binary).
 
-mod convergence;
 mod output;
 mod properties;
 mod scenarios;
