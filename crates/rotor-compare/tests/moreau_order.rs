@@ -22,7 +22,6 @@ fn scene(h: f64, tol: f64) -> Scene {
         h,
         output: Output::Final,
         metrics_from: Some(30.0),
-        ..Scene::default()
     }
 }
 
