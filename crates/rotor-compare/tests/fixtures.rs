@@ -3,19 +3,61 @@
 
 use std::path::Path;
 
+use std::sync::OnceLock;
+
 use rotor_compare::report::gate_scenario;
+use rotor_compare::snapshot::snapshot;
 use rotor_compare::{ScenarioResult, SolverKind, run_scenario};
 use rotor_model::Scenario;
 
+/// Every fixture through the three solvers, once per test binary (shared by the tests).
 fn all() -> Vec<ScenarioResult> {
-    use rayon::prelude::*;
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../fixtures/scenarios");
-    let files = Scenario::list_dir(&dir).unwrap();
-    assert!(files.len() >= 14);
-    files
-        .par_iter()
-        .map(|f| run_scenario(&Scenario::from_file(f).unwrap()))
-        .collect()
+    static RESULTS: OnceLock<Vec<ScenarioResult>> = OnceLock::new();
+    RESULTS
+        .get_or_init(|| {
+            use rayon::prelude::*;
+            let files = Scenario::list_dir(&scenario_dir()).unwrap();
+            assert!(files.len() >= 14);
+            files
+                .par_iter()
+                .map(|f| run_scenario(&Scenario::from_file(f).unwrap()))
+                .collect()
+        })
+        .clone()
+}
+
+fn scenario_dir() -> std::path::PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../../fixtures/scenarios")
+}
+
+/// Per scenario: each solver's steady-state metrics (rounded to the digits the scenario's
+/// tolerance justifies, see `rotor_compare::snapshot`) and its counters. A solver change that
+/// moves an answer by about the agreement tolerance, or changes how much work a solver does,
+/// shows up here for review.
+#[test]
+fn snapshots_of_metrics_and_counters() {
+    let results = all();
+    for r in &results {
+        insta::assert_yaml_snapshot!(r.scenario.name.clone(), snapshot(r));
+    }
+    // Every stored snapshot belongs to a fixture scenario: a renamed or deleted scenario
+    // must take its snapshot with it (CI also runs `cargo insta test --unreferenced=reject`).
+    let names: Vec<String> = results.iter().map(|r| r.scenario.name.clone()).collect();
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/snapshots");
+    for entry in std::fs::read_dir(&dir).unwrap() {
+        let file = entry.unwrap().file_name().into_string().unwrap();
+        assert!(
+            !file.ends_with(".snap.new"),
+            "pending snapshot {file}: review it"
+        );
+        let stem = file
+            .trim_start_matches("fixtures__")
+            .trim_end_matches(".snap");
+        assert!(
+            names.iter().any(|n| n == stem),
+            "unreferenced snapshot {file}"
+        );
+    }
 }
 
 #[test]
