@@ -226,11 +226,17 @@ fn compare(files: &[PathBuf], report: &Path) -> Result<()> {
         .map(|f| rotor_model::Scenario::from_file(f))
         .collect::<Result<Vec<_>, _>>()?;
     let t0 = std::time::Instant::now();
+    let bar = progress_bar(scenarios.len() as u64, "scenarios");
     // In parallel across scenarios; collected in input order, so output is deterministic.
     let results: Vec<_> = scenarios
         .par_iter()
-        .map(rotor_compare::run_scenario)
+        .map(|sc| {
+            let r = rotor_compare::run_scenario(sc);
+            bar.inc(1);
+            r
+        })
         .collect();
+    bar.finish_and_clear();
     let wall = t0.elapsed().as_secs_f64();
     let params = [
         ("Table 1 (exponential)", Params::table1()),
@@ -284,6 +290,24 @@ fn compare(files: &[PathBuf], report: &Path) -> Result<()> {
         }
         bail!("{} agreement gate(s) failed", fails.len())
     }
+}
+
+/// A progress bar on stderr when it is a terminal; hidden in CI and when piped, so logs and
+/// captured output stay clean.
+fn progress_bar(len: u64, what: &str) -> indicatif::ProgressBar {
+    use std::io::IsTerminal;
+    let quiet = std::env::var_os("CI").is_some() || !std::io::stderr().is_terminal();
+    if quiet {
+        return indicatif::ProgressBar::hidden();
+    }
+    let bar = indicatif::ProgressBar::new(len);
+    if let Ok(style) =
+        indicatif::ProgressStyle::with_template("{bar:30} {pos}/{len} {msg} [{elapsed_precise}]")
+    {
+        bar.set_style(style);
+    }
+    bar.set_message(what.to_owned());
+    bar
 }
 
 fn steady_json(st: &SteadyState) -> String {
