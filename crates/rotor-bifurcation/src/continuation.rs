@@ -15,17 +15,38 @@
 //! F(y) = 0,     t_k · (y − y_p) = 0.
 //! ```
 //!
-//! `DF` is a forward difference (step 1e-7). A fold in u is a sign change of the u-component
-//! of the tangent between two points; it is located by bisection on the step length h from
-//! the earlier point. A grazing point (the cycle starts or stops touching `ω_l = 0` with
-//! a stick phase) is a sign change of `g = ω_l,min` (slipping) / `−t_stick` (stick-slip),
-//! located the same way.
+//! `DF = [∂P/∂u, ∂P/∂z − I]` comes from the variational equations with saltation matrices
+//! ([`Shooter::section_derivatives`]); a forward difference (step 1e-7) is kept as a check
+//! ([`Continuer::jacobian_fd`]). The u-component of the tangent is, up to its norm,
+//! `det(∂P/∂z − I)`, so it vanishes exactly where a Floquet multiplier of the section map is
+//! 1: a fold in u is a sign change of it between two points, located by bisection on the
+//! step length h from the earlier point. A grazing point (the cycle starts or stops touching
+//! `ω_l = 0` with a stick phase) is a sign change of `g = ω_l,min` (slipping) / `−t_stick`
+//! (stick-slip); it is located by [`crate::grazing`].
+//!
+//! Floquet multipliers of each point are the eigenvalues of the monodromy matrix from the
+//! same variational integration ([`crate::monodromy`]); stability is read from the two
+//! eigenvalues of `∂P/∂z` (the nontrivial multipliers). [`Multipliers::FiniteDifference`]
+//! selects the earlier central differences of the return maps instead (a check).
 
-use nalgebra::{Matrix3, Vector3};
+use nalgebra::{Complex, Matrix3, Vector3};
 use rotor_model::{Output, Scene, Solver, State, SteadyState};
 
 use crate::BifError;
-use crate::periodic::{Shooter, eig2};
+use crate::monodromy::order_multipliers;
+use crate::periodic::{SectionDerivs, Shooter, eig2};
+
+/// How the Floquet multipliers of a cycle are computed.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Multipliers {
+    /// Eigenvalues of the monodromy matrix from the variational equations with saltation
+    /// matrices ([`crate::monodromy`]).
+    #[default]
+    Saltation,
+    /// Central differences of the return maps with step `ContOptions::fd_step`: the stick-exit
+    /// map (1-D) for stick-slip cycles, the section map (2-D) for slipping ones.
+    FiniteDifference,
+}
 
 /// What the diagram reports about one periodic orbit.
 #[derive(Debug, Clone, PartialEq)]
@@ -37,8 +58,12 @@ pub struct CycleInfo {
     pub stick_time: f64,
     /// Whether the lower disc sticks on the cycle.
     pub stick_slip: bool,
-    /// Floquet multipliers: `[1, 0, λ]` (stick-slip) or `[1, λ1, λ2]` (slipping).
-    pub multipliers: Vec<nalgebra::Complex<f64>>,
+    /// Floquet multipliers, the trivial one (nearest 1) first, then by decreasing modulus:
+    /// `[≈1, λ, 0]` (stick-slip) or `[≈1, λ1, λ2]` (slipping).
+    pub multipliers: Vec<Complex<f64>>,
+    /// The nontrivial multipliers: eigenvalues of the section map's `∂P/∂z`.
+    pub nontrivial: [Complex<f64>; 2],
+    /// All nontrivial multipliers inside the unit circle.
     pub stable: bool,
 }
 
@@ -95,8 +120,23 @@ pub struct ContOptions {
     pub amp_stop: f64,
     /// Largest number of points per direction.
     pub max_nodes: usize,
-    /// FD step of the Floquet multipliers.
+    /// FD step of the Floquet multipliers (with [`Multipliers::FiniteDifference`]).
     pub fd_step: f64,
+    /// How the multipliers are computed.
+    pub multipliers: Multipliers,
+}
+
+/// The residual of the continuation and its Jacobian at one point.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Linearized {
+    /// `F(y) = P_{c(u)}(z) − z`.
+    pub f: [f64; 2],
+    /// Section level `c(u)`.
+    pub c: f64,
+    /// `DF(y)`, rows `[∂F_i/∂u, ∂F_i/∂α, ∂F_i/∂ω_u]`.
+    pub j: [[f64; 3]; 2],
+    /// The section map's derivatives (and the monodromy matrix).
+    pub derivs: SectionDerivs,
 }
 
 pub struct Continuer<'a> {
@@ -124,8 +164,30 @@ impl Continuer<'_> {
         Ok(([r.x[0] - y[1], r.x[1] - y[2]], c))
     }
 
-    /// `DF(y)` (2×3) by forward differences.
-    pub fn jacobian(&self, y: &[f64; 3], f0: &[f64; 2]) -> Result<[[f64; 3]; 2], BifError> {
+    /// `F(y)` with the section level, `DF(y)` (2×3) from the variational equations, and the
+    /// section map's derivatives (monodromy included).
+    pub fn residual_jacobian(&self, y: &[f64; 3]) -> Result<Linearized, BifError> {
+        let c = self.sh.section_level(y[0])?;
+        let d = self.sh.section_derivatives(y[0], c, [y[1], y[2]])?;
+        let f = [d.ret.x[0] - y[1], d.ret.x[1] - y[2]];
+        let row = |i: usize| {
+            [
+                d.du[i],
+                d.dz[(i, 0)] - if i == 0 { 1.0 } else { 0.0 },
+                d.dz[(i, 1)] - if i == 1 { 1.0 } else { 0.0 },
+            ]
+        };
+        Ok(Linearized {
+            f,
+            c,
+            j: [row(0), row(1)],
+            derivs: d,
+        })
+    }
+
+    /// `DF(y)` (2×3) by forward differences (step `1e-7·max(1, |y_k|)`), a check on
+    /// [`Continuer::residual_jacobian`].
+    pub fn jacobian_fd(&self, y: &[f64; 3], f0: &[f64; 2]) -> Result<[[f64; 3]; 2], BifError> {
         let mut j = [[0.0; 3]; 2];
         for k in 0..3 {
             let d = 1e-7 * y[k].abs().max(1.0);
@@ -156,8 +218,7 @@ impl Continuer<'_> {
         h: f64,
     ) -> Result<([f64; 3], usize), BifError> {
         let yp = [y[0] + h * t[0], y[1] + h * t[1], y[2] + h * t[2]];
-        let (f, _) = self.residual(&yp)?;
-        let j = self.jacobian(&yp, &f)?;
+        let Linearized { f, j, .. } = self.residual_jacobian(&yp)?;
         let a = Matrix3::new(
             j[0][0], j[0][1], j[0][2], j[1][0], j[1][1], j[1][2], t[0], t[1], t[2],
         );
@@ -190,10 +251,14 @@ impl Continuer<'_> {
 
     /// Builds the node at a converged `y`: tangent, metrics, multipliers.
     pub fn node(&self, y: [f64; 3], along: &[f64; 3], step: f64) -> Result<Node, BifError> {
-        let (f, c) = self.residual(&y)?;
-        let j = self.jacobian(&y, &f)?;
+        let Linearized {
+            c, j, derivs: d, ..
+        } = self.residual_jacobian(&y)?;
         let tangent = Self::tangent(&j, along);
-        let info = self.describe(y[0], c, [y[1], y[2]])?;
+        let info = match self.opts.multipliers {
+            Multipliers::Saltation => self.describe_from(y[0], c, [y[1], y[2]], &d)?,
+            Multipliers::FiniteDifference => self.describe_fd(y[0], c, [y[1], y[2]])?,
+        };
         Ok(Node {
             y,
             c,
@@ -203,17 +268,52 @@ impl Continuer<'_> {
         })
     }
 
-    /// Period, extrema of ω_l, stick time and Floquet multipliers of the cycle through
-    /// `[z0, z1, c]` on the section.
+    /// Period, extrema of ω_l, stick time and Floquet multipliers (saltation monodromy) of
+    /// the cycle through `[z0, z1, c]` on the section.
     pub fn describe(&self, u: f64, c: f64, z: [f64; 2]) -> Result<CycleInfo, BifError> {
-        let ret = self.sh.section_map(u, c, z)?;
+        let d = self.sh.section_derivatives(u, c, z)?;
+        self.describe_from(u, c, z, &d)
+    }
+
+    /// [`Continuer::describe`] from already computed section derivatives.
+    pub fn describe_from(
+        &self,
+        u: f64,
+        c: f64,
+        z: [f64; 2],
+        d: &SectionDerivs,
+    ) -> Result<CycleInfo, BifError> {
+        let (wl_max, wl_min, stick_time) = self.metrics(u, c, z, d.ret.t)?;
+        let nontrivial = eig2(&d.dz);
+        let multipliers = order_multipliers(d.var.multipliers()).to_vec();
+        Ok(CycleInfo {
+            period: d.ret.t,
+            omega_l_max: wl_max,
+            omega_l_min: wl_min,
+            stick_time,
+            stick_slip: d.ret.stuck,
+            multipliers,
+            stable: nontrivial.iter().all(|l| l.norm() < 1.0),
+            nontrivial,
+        })
+    }
+
+    /// Extrema of ω_l and stick time per period of the cycle through `[z0, z1, c]`, whose
+    /// period is about `period`.
+    fn metrics(
+        &self,
+        u: f64,
+        c: f64,
+        z: [f64; 2],
+        period: f64,
+    ) -> Result<(f64, f64, f64), BifError> {
         let x0 = State::new(z[0], z[1], c);
         // Metrics over two periods: the accumulator needs two anchors (stick exits or ω_l
         // maxima), and the first comes within one period.
         let scene = Scene {
             u,
             x0,
-            t_end: 2.05 * ret.t,
+            t_end: 2.05 * period,
             tol: self.sh.tol,
             output: Output::Final,
             metrics_from: Some(0.0),
@@ -231,30 +331,39 @@ impl Continuer<'_> {
             }) => (omega_l_max, omega_l_min, stick_time),
             _ => (c, c, 0.0),
         };
-        let one = nalgebra::Complex::new(1.0, 0.0);
+        Ok((wl_max, wl_min, stick_time))
+    }
+
+    /// [`Continuer::describe`] with the multipliers from central differences of the return
+    /// maps (step `fd_step`): `[1, λ, 0]` from the stick-exit map for a stick-slip cycle (its
+    /// 0 and 1 are structural, not computed), `[1, λ1, λ2]` from the section map otherwise.
+    pub fn describe_fd(&self, u: f64, c: f64, z: [f64; 2]) -> Result<CycleInfo, BifError> {
+        let ret = self.sh.section_map(u, c, z)?;
+        let (wl_max, wl_min, stick_time) = self.metrics(u, c, z, ret.t)?;
+        let x0 = State::new(z[0], z[1], c);
+        let one = Complex::new(1.0, 0.0);
         let h = self.opts.fd_step;
-        let multipliers = if ret.stuck {
+        let nontrivial = if ret.stuck {
             let exit = self.sh.next_exit(u, x0)?;
             let lam = self.sh.stick_exit_multiplier(u, exit.x[1], h)?;
-            vec![
-                one,
-                nalgebra::Complex::new(0.0, 0.0),
-                nalgebra::Complex::new(lam, 0.0),
-            ]
+            [Complex::new(lam, 0.0), Complex::new(0.0, 0.0)]
         } else {
             let j = self.sh.section_jacobian(u, c, z, h)?;
-            let [a, b] = eig2(&j);
-            vec![one, a, b]
+            let mut e = eig2(&j);
+            if e[1].norm() > e[0].norm() {
+                e.swap(0, 1);
+            }
+            e
         };
-        let stable = multipliers[1..].iter().all(|l| l.norm() < 1.0);
         Ok(CycleInfo {
             period: ret.t,
             omega_l_max: wl_max,
             omega_l_min: wl_min,
             stick_time,
             stick_slip: ret.stuck,
-            multipliers,
-            stable,
+            multipliers: vec![one, nontrivial[0], nontrivial[1]],
+            stable: nontrivial.iter().all(|l| l.norm() < 1.0),
+            nontrivial,
         })
     }
 
@@ -390,7 +499,9 @@ impl Continuer<'_> {
     }
 
     /// Bisection on the step length from `a` (toward its successor `b`, reached with step
-    /// `b.step`) for a sign change of `g`; returns the node at the located point.
+    /// `b.step`) for a sign change of `g`, to a bracket of `1e-12·max(1, b.step)` in arclength;
+    /// returns the node at the located point (of the two bracketing nodes, the one with the
+    /// smaller |g|).
     pub fn bisect_between(
         &self,
         a: &Node,
@@ -421,12 +532,18 @@ impl Continuer<'_> {
                 }
                 Err(_) => hi = m,
             }
-            if hi - lo < 1e-10 {
+            if hi - lo < 1e-12 * b.step.abs().max(1.0) {
                 break;
             }
         }
         match hi_node {
-            Some((m, n)) if m - lo < 1e-8 => Ok(n),
+            Some((m, n)) if m - lo < 1e-8 => {
+                if lo > 0.0 && g(&lo_node).abs() < g(&n).abs() {
+                    Ok(lo_node)
+                } else {
+                    Ok(n)
+                }
+            }
             _ if lo > 0.0 => Ok(lo_node),
             _ => Err(BifError::NoConvergence {
                 u: a.y[0],

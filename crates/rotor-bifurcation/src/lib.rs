@@ -6,7 +6,11 @@
 //!   points as zeros of `Re λ(ω)` of the complex pair.
 //! * **Periodic orbits** ([`periodic`]): shooting on the Poincaré section `ω_l = ω*(u)`
 //!   (2-D map in (α, ω_u)) and on the lower disc's stick exit (1-D map in ω_u), with the
-//!   exact Filippov flow of `rotor_event::flow`; Floquet multipliers of the return maps.
+//!   exact Filippov flow of `rotor_event::flow`.
+//! * **Floquet multipliers** ([`monodromy`]): the monodromy matrix from the variational
+//!   equations with a saltation matrix at every switching event (one multiplier exactly 0
+//!   for a cycle with a stick phase); finite differences of the return maps remain as a check
+//!   ([`continuation::Multipliers::FiniteDifference`]).
 //! * **Continuation** ([`continuation`]): pseudo-arclength in (u, α, ω_u) with folds and
 //!   grazing points located by bisection.
 //!
@@ -15,6 +19,7 @@
 
 pub mod continuation;
 pub mod equilibria;
+pub mod monodromy;
 pub mod periodic;
 
 use std::io::Write;
@@ -40,6 +45,8 @@ pub enum BifError {
     NoConvergence { u: f64, detail: String },
     #[error("invalid options: {0}")]
     Options(String),
+    #[error("the trajectory meets a switching surface tangentially at u = {u}, state {state:?}")]
+    Grazing { u: f64, state: [f64; 3] },
 }
 
 /// What [`diagram`] computes.
@@ -97,7 +104,8 @@ pub struct PeriodicRow {
     pub omega_l_max: f64,
     pub omega_l_min: f64,
     pub stable: bool,
-    /// Floquet multipliers `[re, im]`: `[1, 0, λ]` (stick-slip) or `[1, λ1, λ2]` (slipping).
+    /// Floquet multipliers `[re, im]`, eigenvalues of the saltation monodromy matrix: the
+    /// trivial one (≈ 1) first, then by decreasing modulus (`[≈1, λ, 0]` with a stick phase).
     pub multipliers: Vec<[f64; 2]>,
     pub stick_slip: bool,
     pub stick_time: f64,
@@ -273,6 +281,7 @@ pub fn diagram(model: &Model, opts: &DiagramOptions) -> Result<Diagram, BifError
             amp_stop: opts.amp_stop,
             max_nodes: 20 * opts.n,
             fd_step: 1e-6,
+            multipliers: continuation::Multipliers::Saltation,
         },
     };
     let (z0, c) = start_point(&sh, opts.u_start)?;

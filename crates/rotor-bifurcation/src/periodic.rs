@@ -15,11 +15,25 @@
 //! `(P(w*+h) − P(w*−h)) / 2h`. For a slipping cycle the multipliers are `1` and the two
 //! eigenvalues of `DP_c(z*)`, also by central differences.
 
-use nalgebra::{Complex, Matrix2};
-use rotor_event::{StopAt, flow};
+use nalgebra::{Complex, Matrix2, Matrix3, Vector2, Vector3};
+use rotor_event::{FlowEnd, StopAt, flow};
 use rotor_model::{Disc, DiscMode, Mode, Model, OMEGA_L, SolveError, State};
 
 use crate::BifError;
+use crate::monodromy::{self, Variational};
+
+/// The section map at one point with its derivatives
+/// ([`Shooter::section_derivatives`]).
+#[derive(Debug, Clone, PartialEq)]
+pub struct SectionDerivs {
+    pub ret: Return,
+    /// Variational data over the return time (the monodromy matrix at a fixed point).
+    pub var: Variational,
+    /// `∂P/∂z` (2×2): at a fixed point its eigenvalues are the nontrivial Floquet multipliers.
+    pub dz: Matrix2<f64>,
+    /// `∂P/∂u`, the section level moving with u included.
+    pub du: Vector2<f64>,
+}
 
 /// Longest time a return may take [s] (periods here are a few seconds to a few tens).
 pub const T_RETURN: f64 = 2000.0;
@@ -33,7 +47,7 @@ pub struct Shooter<'a> {
 }
 
 /// One return to a section or stick exit.
-#[derive(Debug, Clone, Copy)]
+#[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Return {
     /// State at the return.
     pub x: State,
@@ -59,6 +73,17 @@ impl Shooter<'_> {
 
     /// `P_c(z)` at input `u`: the next upward crossing of `ω_l = c` from `[z0, z1, c]`.
     pub fn section_map(&self, u: f64, c: f64, z: [f64; 2]) -> Result<Return, BifError> {
+        Ok(self.section_flow(u, c, z)?.0)
+    }
+
+    /// The flow from `[z0, z1, c]` to the next upward crossing of `ω_l = c`, with its start
+    /// mode and its events.
+    fn section_flow(
+        &self,
+        u: f64,
+        c: f64,
+        z: [f64; 2],
+    ) -> Result<(Return, Mode, FlowEnd), BifError> {
         let x = State::new(z[0], z[1], c);
         let mode = self.model.mode_at(&x, u);
         let end = flow(
@@ -78,10 +103,55 @@ impl Shooter<'_> {
             .events
             .iter()
             .any(|e| e.kind == rotor_model::EventKind::StickStart(Disc::Lower));
-        Ok(Return {
-            x: end.x,
-            t: end.t,
-            stuck,
+        Ok((
+            Return {
+                x: end.x,
+                t: end.t,
+                stuck,
+            },
+            mode,
+            end,
+        ))
+    }
+
+    /// The section map with its derivatives from the variational equations and saltation
+    /// matrices ([`crate::monodromy`]), for the section level `c = c(u) = ω*(u)`.
+    ///
+    /// With `x₀ = (z₀, z₁, c(u))`, `X = ∂x(T)/∂x₀` and `p = ∂x(T)/∂u` over the return time T,
+    /// `f = f(x(T))` and the projection along the flow onto the section
+    /// `Π = I − f e₃ᵀ / f₃` (the return time moves by `δT = (c′δu − e₃ᵀδx(T))/f₃`):
+    ///
+    /// ```text
+    /// ∂P/∂z = [Π X E]₀..₁,     ∂P/∂u = [Π (X e₃ c′ + p) + f c′/f₃]₀..₁,
+    /// ```
+    ///
+    /// with `E = [e₁ e₂]` and `c′ = 1/(du/dω)` on the equilibrium branch at ω = c.
+    pub fn section_derivatives(
+        &self,
+        u: f64,
+        c: f64,
+        z: [f64; 2],
+    ) -> Result<SectionDerivs, BifError> {
+        let (ret, mode, end) = self.section_flow(u, c, z)?;
+        let x0 = State::new(z[0], z[1], c);
+        let var = monodromy::along(self.model, u, self.tol, x0, mode, &end.events, end.t)?;
+        let f = self.model.rhs(&end.x, u, end.mode);
+        if f[OMEGA_L] <= 0.0 {
+            return Err(BifError::Grazing {
+                u,
+                state: [end.x[0], end.x[1], end.x[2]],
+            });
+        }
+        let proj = Matrix3::identity() - f * Vector3::z().transpose() / f[OMEGA_L];
+        let dc = 1.0 / self.model.du_domega(c);
+        let x = &var.phi;
+        let dz = proj * x;
+        let du = proj * (x.column(2) * dc + var.p) + f * (dc / f[OMEGA_L]);
+        Ok(SectionDerivs {
+            ret,
+            dz: Matrix2::new(dz[(0, 0)], dz[(0, 1)], dz[(1, 0)], dz[(1, 1)]),
+            du: Vector2::new(du[0], du[1]),
+            var,
         })
     }
 

@@ -149,6 +149,7 @@ fn branch_period_matches_steady_state_refinement() {
             amp_stop: 0.02,
             max_nodes: 10,
             fd_step: 1e-6,
+            multipliers: Default::default(),
         },
     };
     let info = cont.describe(1.5, c, z).unwrap();
