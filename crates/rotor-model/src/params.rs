@@ -32,13 +32,13 @@ use thiserror::Error;
 #[derive(Debug, Error, Clone, PartialEq)]
 pub enum ParamsError {
     /// The file could not be read.
-    #[error("{path}: cannot read parameter file: {message}")]
+    #[error("{}: cannot read parameter file: {message}", shown(.path))]
     Io { path: PathBuf, message: String },
     /// The file is not valid TOML, or a key is unknown, missing or of the wrong type.
-    #[error("{path}: {message}")]
+    #[error("{}: {message}", shown(.path))]
     Parse { path: PathBuf, message: String },
     /// A value is out of its admissible range.
-    #[error("{path}: {field} = {value}: {reason}")]
+    #[error("{}: {field} = {value}: {reason}", shown(.path))]
     Invalid {
         path: PathBuf,
         field: String,
@@ -197,9 +197,9 @@ impl Params {
             path: path.to_owned(),
             message: e.to_string(),
         })?;
-        let text = String::from_utf8(bytes).map_err(|_| ParamsError::Parse {
+        let text = text_of(bytes).map_err(|message| ParamsError::Parse {
             path: path.to_owned(),
-            message: "not a UTF-8 text file".into(),
+            message,
         })?;
         Params::from_toml_str(&text, path)
     }
@@ -434,6 +434,63 @@ impl Params {
     }
 }
 
+/// A path as it appears in a one-line message: control characters (a newline is legal in a
+/// Unix file name) escaped.
+pub(crate) fn shown(path: &Path) -> String {
+    escape_controls(&path.to_string_lossy())
+}
+
+fn escape_controls(s: &str) -> String {
+    s.chars()
+        .flat_map(|c| {
+            if c.is_control() {
+                c.escape_default().collect::<Vec<_>>()
+            } else {
+                vec![c]
+            }
+        })
+        .collect()
+}
+
+/// The bytes of a file as text, or why it is not a text file: not UTF-8, or it holds a NUL
+/// byte (a binary file that happens to be valid UTF-8). Names the byte offset.
+pub(crate) fn text_of(bytes: Vec<u8>) -> Result<String, String> {
+    let text = String::from_utf8(bytes).map_err(|e| {
+        let at = e.utf8_error().valid_up_to();
+        let byte = e.as_bytes()[at];
+        format!("not a UTF-8 text file (byte 0x{byte:02x} at offset {at})")
+    })?;
+    if let Some(at) = text.find('\0') {
+        return Err(format!(
+            "not a text file (NUL byte at offset {at}: a binary file?)"
+        ));
+    }
+    Ok(text)
+}
+
+/// Drops a TOML comment from a source line (a `#` outside a string), and trims it.
+fn strip_comment(src: &str) -> &str {
+    let mut quote: Option<char> = None;
+    let mut escaped = false;
+    for (i, c) in src.char_indices() {
+        match quote {
+            Some(q) => {
+                if escaped {
+                    escaped = false;
+                } else if c == '\\' && q == '"' {
+                    escaped = true;
+                } else if c == q {
+                    quote = None;
+                }
+            }
+            None if c == '"' || c == '\'' => quote = Some(c),
+            None if c == '#' => return src[..i].trim(),
+            None => {}
+        }
+    }
+    src.trim()
+}
+
 /// Collapses a multi-line parser message into one line. toml prints a source excerpt
 /// (`6 | j_u = "heavy"` and a caret line); the excerpt's source line is kept, since it shows
 /// the offending key and value.
@@ -456,10 +513,14 @@ pub(crate) fn one_line(s: &str) -> String {
         head.push(t);
     }
     let mut out = head.join(": ");
-    if let Some(src) = at {
+    // The excerpt without its comment; a line that is only a comment (toml points at line 1
+    // for a key missing from the top level) tells nothing.
+    if let Some(src) = at.map(strip_comment).filter(|s| !s.is_empty()) {
         out.push_str(&format!(" (in `{src}`)"));
     }
-    out
+    // Control characters (a stray carriage return, bytes of a binary file) would break the
+    // one-line message or the terminal: escape them.
+    escape_controls(&out)
 }
 
 #[cfg(test)]

@@ -20,32 +20,35 @@ use serde::Deserialize;
 use thiserror::Error;
 
 use crate::dynamics::{Model, State};
-use crate::params::{Params, ParamsError, one_line};
+use crate::params::{Params, ParamsError, one_line, shown, text_of};
+use crate::scene::{MAX_GRID_ROWS, Scene};
+
+/// The solver pairs a `[tolerance.<pair>]` table may name: each solver against the
+/// event-driven reference (the pairs rotor-compare gates). Any other name is a typo that
+/// would leave a pair ungated, so it is rejected when the file is read.
+pub const TOLERANCE_PAIRS: [&str; 2] = ["event-switch", "event-moreau"];
 
 /// A scenario file could not be read or is not admissible.
 #[derive(Debug, Error, Clone, PartialEq)]
 pub enum ScenarioError {
     /// The file could not be read.
-    #[error("{path}: cannot read scenario file: {message}")]
+    #[error("{}: cannot read scenario file: {message}", shown(.path))]
     Io { path: PathBuf, message: String },
     /// Not valid TOML, or a key is unknown, missing or of the wrong type.
-    #[error("{path}: {message}")]
+    #[error("{}: {message}", shown(.path))]
     Parse { path: PathBuf, message: String },
     /// A value is out of range.
-    #[error("{path}: {field} = {value}: {reason}")]
+    #[error("{}: {field} = {value}: {reason}", shown(.path))]
     Invalid {
         path: PathBuf,
         field: String,
         value: String,
         reason: String,
     },
-    /// The parameter file it names is bad.
-    #[error("{path}: params: {source}")]
-    Params {
-        path: PathBuf,
-        #[source]
-        source: ParamsError,
-    },
+    /// The parameter file it names is bad. (Not a `#[source]`: the message already holds
+    /// it, and a reporter that prints the chain would print it twice.)
+    #[error("{}: params: {error}", shown(.path))]
+    Params { path: PathBuf, error: ParamsError },
 }
 
 /// What the comparison harness compares for this scene.
@@ -143,9 +146,9 @@ impl Scenario {
             path: path.to_owned(),
             message: e.to_string(),
         })?;
-        let text = String::from_utf8(bytes).map_err(|_| ScenarioError::Parse {
+        let text = text_of(bytes).map_err(|message| ScenarioError::Parse {
             path: path.to_owned(),
-            message: "not a UTF-8 text file".into(),
+            message,
         })?;
         Scenario::from_toml_str(&text, path)
     }
@@ -168,10 +171,26 @@ impl Scenario {
             value,
             reason: reason.to_owned(),
         };
+        // The name becomes the report's file names (`<name>.csv`, `<name>.svg`): a path
+        // separator or a leading dot would write outside the report or hide the file.
+        let name_ok = !raw.name.is_empty()
+            && raw.name.len() <= 100
+            && !raw.name.starts_with('.')
+            && raw
+                .name
+                .chars()
+                .all(|c| c.is_ascii_alphanumeric() || "._+-".contains(c));
+        if !name_ok {
+            return Err(bad(
+                "name",
+                format!("{:?}", raw.name),
+                "must be 1 to 100 characters from A-Z a-z 0-9 . _ + - (it names the report's files), not starting with '.'",
+            ));
+        }
         let params_path = path.parent().unwrap_or(Path::new(".")).join(&raw.params);
-        let params = Params::from_file(&params_path).map_err(|source| ScenarioError::Params {
+        let params = Params::from_file(&params_path).map_err(|error| ScenarioError::Params {
             path: path.to_owned(),
-            source,
+            error,
         })?;
         let model = Model::new(params);
         if !raw.u.is_finite() {
@@ -194,6 +213,16 @@ impl Scenario {
         {
             return Err(bad("h", h.to_string(), "must lie in (0, t_end]"));
         }
+        // Without `h`, the time-stepping solver takes the default step, which must fit in
+        // the horizon (Scene::validate), or every run of the scenario would fail.
+        let h_default = Scene::default().h;
+        if raw.h.is_none() && raw.t_end < h_default {
+            return Err(bad(
+                "t_end",
+                raw.t_end.to_string(),
+                &format!("is shorter than the default step h = {h_default}: set h"),
+            ));
+        }
         let x0 = match (raw.x0, raw.x0_from_equilibrium) {
             (Some(_), Some(_)) => {
                 return Err(bad(
@@ -204,6 +233,15 @@ impl Scenario {
             }
             (Some(x), None) => State::new(x[0], x[1], x[2]),
             (None, Some(d)) => {
+                for (i, v) in d.iter().enumerate() {
+                    if !v.is_finite() {
+                        return Err(bad(
+                            &format!("x0_from_equilibrium[{i}]"),
+                            v.to_string(),
+                            "must be finite",
+                        ));
+                    }
+                }
                 let eqs = model.slip_equilibria(raw.u);
                 match eqs.as_slice() {
                     [e] => e.state() + State::new(d[0], d[1], d[2]),
@@ -237,6 +275,13 @@ impl Scenario {
                 "must be positive",
             ));
         }
+        if raw.t_end / raw.compare.dt > MAX_GRID_ROWS {
+            return Err(bad(
+                "compare.dt",
+                raw.compare.dt.to_string(),
+                "asks more than 1e7 output rows (t_end/dt): choose a larger dt",
+            ));
+        }
         if let Some([a, b]) = raw.compare.transient
             && !(0.0 <= a && a < b && b <= raw.t_end)
         {
@@ -256,6 +301,13 @@ impl Scenario {
             ));
         }
         for (pair, tol) in &raw.tolerance {
+            if !TOLERANCE_PAIRS.contains(&pair.as_str()) {
+                return Err(bad(
+                    "tolerance",
+                    format!("{pair:?}"),
+                    "unknown solver pair (expected \"event-switch\" or \"event-moreau\")",
+                ));
+            }
             for (name, v) in [
                 ("transient_max", tol.transient_max),
                 ("transient_rms", tol.transient_rms),

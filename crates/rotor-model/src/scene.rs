@@ -20,6 +20,12 @@ pub enum Output {
     Steps,
 }
 
+/// Largest number of output rows `t_end/dt` a grid may ask for. A sample holds 32 bytes and a
+/// CSV row about 80, so 1e7 rows are ~0.3 GB per trajectory in memory and ~1 GB on disk: far
+/// above any report (the fixtures ask 2e4) and below what would abort the process on an
+/// allocation failure. A `dt` that asks more is a typo (a unit slip), not a request.
+pub const MAX_GRID_ROWS: f64 = 1e7;
+
 /// One simulation request: input, initial state, horizon, accuracy, and what to keep.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Scene {
@@ -84,10 +90,17 @@ impl Scene {
         if !(self.h > 0.0 && self.h <= self.t_end) {
             return bad("h", self.h, "must lie in (0, t_end]");
         }
-        if let Output::Grid { dt } = self.output
-            && !(dt > 0.0 && dt.is_finite())
-        {
-            return bad("dt", dt, "must be positive and finite");
+        if let Output::Grid { dt } = self.output {
+            if !(dt > 0.0 && dt.is_finite()) {
+                return bad("dt", dt, "must be positive and finite");
+            }
+            if self.t_end / dt > MAX_GRID_ROWS {
+                return bad(
+                    "dt",
+                    dt,
+                    "asks more than 1e7 output rows (t_end/dt): choose a larger dt",
+                );
+            }
         }
         if let Some(t) = self.metrics_from
             && !(t >= 0.0 && t < self.t_end)
