@@ -22,10 +22,16 @@ fn main() {
     .expect("diagram");
     eprintln!("{:?}, {} periodic orbits", t.elapsed(), d.periodic.len());
     for p in &d.points {
-        println!("{:<17} u = {:.12}  {}", p.kind, p.u, p.detail);
+        println!(
+            "{:<17} u = {:.12}  residual {:>9}  {}",
+            p.kind,
+            p.u,
+            p.residual.map(|r| format!("{r:.1e}")).unwrap_or_default(),
+            p.detail
+        );
     }
     if let Some(j) = args.get(3) {
-        std::fs::write(j, d.to_json()).expect("write json");
+        std::fs::write(j, d.to_json().expect("json")).expect("write json");
     }
     if let Some(c) = args.get(4) {
         let mut f = std::fs::File::create(c).expect("create csv");

@@ -11,19 +11,26 @@
 //!   equations with a saltation matrix at every switching event (one multiplier exactly 0
 //!   for a cycle with a stick phase); finite differences of the return maps remain as a check
 //!   ([`continuation::Multipliers::FiniteDifference`]).
-//! * **Continuation** ([`continuation`]): pseudo-arclength in (u, α, ω_u) with folds and
-//!   grazing points located by bisection.
+//! * **Continuation** ([`continuation`]): pseudo-arclength in (u, α, ω_u), with the exact
+//!   Jacobian of the section map from the same variational equations.
+//! * **Special points**, each with the residual of its defining condition:
+//!   Hopf points (`Re λ = 0`, bisection in ω to the last bit), smooth folds
+//!   (`du/ds = 0 ⇔ det(∂P/∂z − I) = 0`, a multiplier 1; bisection in arclength), grazing
+//!   orbits (`min ω_l = 0` of the slipping cycle, a 2×2 Newton solve, [`grazing`]) and
+//!   discontinuous folds (a grazing orbit where the branch turns back in u: point E).
 //!
-//! [`diagram`] assembles everything into a [`Diagram`] (serde-serializable, DESIGN.md §4),
-//! which also writes CSV.
+//! [`diagram`] assembles everything into a [`Diagram`], which writes JSON (the CLI contract,
+//! DESIGN.md §4) and CSV.
 
 pub mod continuation;
 pub mod equilibria;
+pub mod grazing;
 pub mod monodromy;
 pub mod periodic;
 
 use std::io::Write;
 
+use nalgebra::Complex;
 use rotor_event::{StopAt, flow};
 use rotor_model::{Model, State};
 use serde::Serialize;
@@ -43,24 +50,37 @@ pub enum BifError {
     NoReturn { u: f64 },
     #[error("no convergence at u = {u}: {detail}")]
     NoConvergence { u: f64, detail: String },
-    #[error("invalid options: {0}")]
-    Options(String),
+    #[error("invalid option {field} = {value}: {reason}")]
+    InvalidOption {
+        field: &'static str,
+        value: f64,
+        reason: &'static str,
+    },
     #[error("the trajectory meets a switching surface tangentially at u = {u}, state {state:?}")]
     Grazing { u: f64, state: [f64; 3] },
+    #[error("non-finite value in the diagram: {what} = {value}")]
+    NonFinite { what: String, value: f64 },
+    #[error("write failed: {0}")]
+    Io(String),
 }
 
 /// What [`diagram`] computes.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct DiagramOptions {
-    /// Range of the input voltage [V].
+    /// Lower end of the input range [V].
     pub u_min: f64,
+    /// Upper end of the input range [V].
     pub u_max: f64,
     /// Number of u values of the equilibrium table; the periodic branch gets at least this
     /// many points over the range it spans (arclength step ≤ (u_max − u_min)/n).
     pub n: usize,
-    /// Integration tolerance of the flow.
+    /// Integration tolerance of the flow along the branches.
     pub tol: f64,
-    /// Where the periodic branch is started (a steady orbit is reached from rest there).
+    /// Integration tolerance when a special point (grazing orbit) is located.
+    pub point_tol: f64,
+    /// Where the first periodic branch is started (the attractor reached from rest there);
+    /// outside `[u_min, u_max]` the middle of the range is used, and if no cycle is reached
+    /// from rest the branches start from the Hopf points only.
     pub u_start: f64,
     /// ω_l amplitude at which the branch is stopped near a Hopf point [rad/s].
     pub amp_stop: f64,
@@ -73,9 +93,49 @@ impl Default for DiagramOptions {
             u_max: 7.0,
             n: 200,
             tol: 1e-11,
+            point_tol: 1e-12,
             u_start: 1.5,
             amp_stop: 0.02,
         }
+    }
+}
+
+impl DiagramOptions {
+    /// Checks every field; the error names the first bad one and its value.
+    pub fn validate(&self) -> Result<(), BifError> {
+        let bad = |field, value, reason| {
+            Err(BifError::InvalidOption {
+                field,
+                value,
+                reason,
+            })
+        };
+        if !self.u_min.is_finite() {
+            return bad("u_min", self.u_min, "must be finite");
+        }
+        if !self.u_max.is_finite() {
+            return bad("u_max", self.u_max, "must be finite");
+        }
+        if self.u_max <= self.u_min {
+            return bad("u_max", self.u_max, "must be greater than u_min");
+        }
+        if self.n < 2 {
+            return bad("n", self.n as f64, "must be at least 2");
+        }
+        // DOP853 cannot resolve below ~1e-14 relative in double precision; above 1e-6 the
+        // located points would not reach the promised 1e-8 V.
+        for (field, v) in [("tol", self.tol), ("point_tol", self.point_tol)] {
+            if !(1e-14..=1e-6).contains(&v) {
+                return bad(field, v, "must lie in [1e-14, 1e-6]");
+            }
+        }
+        if !self.u_start.is_finite() {
+            return bad("u_start", self.u_start, "must be finite");
+        }
+        if !(self.amp_stop.is_finite() && self.amp_stop > 0.0) {
+            return bad("amp_stop", self.amp_stop, "must be positive and finite");
+        }
+        Ok(())
     }
 }
 
@@ -117,20 +177,52 @@ pub struct PeriodicRow {
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct SpecialPoint {
     /// `"hopf"`, `"fold"`, `"grazing"`, `"stick_limit"` (the slipping branch meets the stuck
-    /// set as ω → 0⁺), `"stability_change"` (between two branch points, not refined).
+    /// set as ω → 0⁺), `"stability_change"` (a multiplier leaves the unit circle other than
+    /// at a fold or grazing point), `"branch_end"` (a branch stopped without a located cause).
     pub kind: &'static str,
     pub u: f64,
+    /// Folds only: `true` for a discontinuous fold (the branch turns at a grazing orbit,
+    /// where a stable and an unstable branch meet), `false` for a smooth one.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub discontinuous: Option<bool>,
+    /// Hopf: the equilibrium velocity [rad/s].
     #[serde(skip_serializing_if = "Option::is_none")]
     pub omega: Option<f64>,
     /// Hopf: crossing frequency |Im λ| [rad/s].
     #[serde(skip_serializing_if = "Option::is_none")]
     pub frequency: Option<f64>,
-    /// Period of the orbit at a fold or grazing point [s].
+    /// Period of the orbit (Hopf: 2π/frequency) [s].
     #[serde(skip_serializing_if = "Option::is_none")]
     pub period: Option<f64>,
     #[serde(skip_serializing_if = "Option::is_none")]
     pub omega_l_max: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub omega_l_min: Option<f64>,
+    /// The value of the defining condition at the located point (see `condition`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub residual: Option<f64>,
+    /// What `residual` is.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub condition: Option<&'static str>,
     pub detail: String,
+}
+
+impl SpecialPoint {
+    fn new(kind: &'static str, u: f64, detail: String) -> SpecialPoint {
+        SpecialPoint {
+            kind,
+            u,
+            discontinuous: None,
+            omega: None,
+            frequency: None,
+            period: None,
+            omega_l_max: None,
+            omega_l_min: None,
+            residual: None,
+            condition: None,
+            detail,
+        }
+    }
 }
 
 /// The bifurcation diagram (DESIGN.md §4).
@@ -157,6 +249,15 @@ impl PeriodicRow {
         }
     }
 }
+
+/// Condition of a Hopf point.
+const HOPF_CONDITION: &str = "Re lambda of the critical pair of the Jacobian [1/s]";
+/// Condition of a grazing orbit.
+const GRAZING_CONDITION: &str =
+    "max(|min omega_l|, |omega_u(t_min) - omega_u(0)|) of the touching orbit [rad/s]";
+/// Condition of a smooth fold.
+const FOLD_CONDITION: &str =
+    "u-component of the unit branch tangent (du/ds, proportional to det(dP/dz - I))";
 
 /// The equilibrium table at `n` values of u, and the Hopf and stick-limit points.
 pub fn equilibrium_part(
@@ -194,34 +295,33 @@ pub fn equilibrium_part(
     let mut points = Vec::new();
     let u0 = model.slip_equilibrium_at(f64::MIN_POSITIVE).u;
     if (opts.u_min..=opts.u_max).contains(&u0) {
-        points.push(SpecialPoint {
-            kind: "stick_limit",
-            u: u0,
-            omega: Some(0.0),
-            frequency: None,
-            period: None,
-            omega_l_max: None,
-            detail: "slipping branch meets the stuck set (omega -> 0+)".into(),
-        });
+        let mut p = SpecialPoint::new(
+            "stick_limit",
+            u0,
+            "slipping branch meets the stuck set (omega -> 0+)".into(),
+        );
+        p.omega = Some(0.0);
+        points.push(p);
     }
     if let Some(wmax) = equilibria::omega_reaching(model, opts.u_max) {
         for h in equilibria::hopf_points(model, wmax) {
             if !(opts.u_min..=opts.u_max).contains(&h.equilibrium.u) {
                 continue;
             }
-            points.push(SpecialPoint {
-                kind: "hopf",
-                u: h.equilibrium.u,
-                omega: Some(h.equilibrium.omega),
-                frequency: Some(h.frequency),
-                period: Some(2.0 * std::f64::consts::PI / h.frequency),
-                omega_l_max: None,
-                detail: format!(
-                    "equilibrium {} stability with increasing u; Re lambda = {:e}",
+            let mut p = SpecialPoint::new(
+                "hopf",
+                h.equilibrium.u,
+                format!(
+                    "equilibrium {} stability with increasing u",
                     if h.stabilizing { "gains" } else { "loses" },
-                    h.re
                 ),
-            });
+            );
+            p.omega = Some(h.equilibrium.omega);
+            p.frequency = Some(h.frequency);
+            p.period = Some(2.0 * std::f64::consts::PI / h.frequency);
+            p.residual = Some(h.re);
+            p.condition = Some(HOPF_CONDITION);
+            points.push(p);
         }
     }
     (rows, points)
@@ -260,10 +360,16 @@ pub fn start_point(sh: &Shooter, u: f64) -> Result<([f64; 2], f64), BifError> {
 }
 
 /// The bifurcation diagram over `[u_min, u_max]` (see the crate docs).
+///
+/// ```no_run
+/// use rotor_bifurcation::{DiagramOptions, diagram};
+/// let model = rotor_model::Model::table1();
+/// let d = diagram(&model, &DiagramOptions { u_min: 0.0, u_max: 7.0, ..Default::default() })?;
+/// std::fs::write("diagram.json", d.to_json()?).unwrap();
+/// # Ok::<(), rotor_bifurcation::BifError>(())
+/// ```
 pub fn diagram(model: &Model, opts: &DiagramOptions) -> Result<Diagram, BifError> {
-    if !(opts.u_max > opts.u_min && opts.n >= 2 && opts.tol > 0.0) {
-        return Err(BifError::Options(format!("{opts:?}")));
-    }
+    opts.validate()?;
     let (equilibria, mut points) = equilibrium_part(model, opts);
     let sh = Shooter {
         model,
@@ -284,18 +390,28 @@ pub fn diagram(model: &Model, opts: &DiagramOptions) -> Result<Diagram, BifError
             multipliers: continuation::Multipliers::Saltation,
         },
     };
-    let (z0, c) = start_point(&sh, opts.u_start)?;
-    let z = sh.section_fixed_point(opts.u_start, c, z0, 1e-10)?;
-    let start = cont.node([opts.u_start, z[0], z[1]], &[1.0, 0.0, 0.0], 0.0)?;
-    let (down, end_down) = cont.follow(&start, &[-1.0, 0.0, 0.0]);
-    let (up, end_up) = cont.follow(&start, &[1.0, 0.0, 0.0]);
-    let mut nodes: Vec<Node> = down.into_iter().rev().collect();
-    nodes.push(start);
-    nodes.extend(up);
-    let mut branches = vec![Branch {
-        nodes,
-        ends: [end_down, end_up],
-    }];
+    let mut branches = Vec::new();
+    let u_start = if (opts.u_min..=opts.u_max).contains(&opts.u_start) {
+        opts.u_start
+    } else {
+        0.5 * (opts.u_min + opts.u_max)
+    };
+    // The branch through the attractor reached from rest, if that is a cycle.
+    let started = start_point(&sh, u_start).and_then(|(z0, c)| {
+        let z = sh.section_fixed_point(u_start, c, z0, 1e-10)?;
+        cont.node([u_start, z[0], z[1]], &[1.0, 0.0, 0.0], 0.0)
+    });
+    if let Ok(start) = started {
+        let (down, end_down) = cont.follow(&start, &[-1.0, 0.0, 0.0]);
+        let (up, end_up) = cont.follow(&start, &[1.0, 0.0, 0.0]);
+        let mut nodes: Vec<Node> = down.into_iter().rev().collect();
+        nodes.push(start);
+        nodes.extend(up);
+        branches.push(Branch {
+            nodes,
+            ends: [end_down, end_up],
+        });
+    }
     // Branches born at Hopf points that the first branch does not reach.
     let hopfs = equilibria::omega_reaching(model, opts.u_max)
         .map(|w| equilibria::hopf_points(model, w))
@@ -329,7 +445,7 @@ pub fn diagram(model: &Model, opts: &DiagramOptions) -> Result<Diagram, BifError
     }
     for b in &mut branches {
         orient(&mut b.nodes);
-        points.extend(special_points(&cont, &b.nodes));
+        points.extend(special_points(&cont, &b.nodes, opts.point_tol));
     }
     // Criticality of each Hopf point: from the stability of the cycles at the branch end
     // next to it.
@@ -351,43 +467,7 @@ pub fn diagram(model: &Model, opts: &DiagramOptions) -> Result<Diagram, BifError
             );
         }
     }
-    // Branch ends at a collapsed step: a non-smooth turning point at a grazing orbit. Two such
-    // ends at the same u form a discontinuous fold.
-    let stuck_ends: Vec<&Node> = branches
-        .iter()
-        .flat_map(|b| {
-            let first = (b.ends[0] == End::Stuck).then(|| b.nodes.first()).flatten();
-            let last = (b.ends[1] == End::Stuck).then(|| b.nodes.last()).flatten();
-            first.into_iter().chain(last)
-        })
-        .collect();
-    for (i, a) in stuck_ends.iter().enumerate() {
-        points.push(point_at(
-            "grazing",
-            a,
-            &format!(
-                "a branch ends at a grazing orbit (continuation step collapsed; stick time {:e} s, min omega_l {:e})",
-                a.info.stick_time, a.info.omega_l_min
-            ),
-        ));
-        for b in &stuck_ends[i + 1..] {
-            if (a.y[0] - b.y[0]).abs() < 1e-4 {
-                let mut p = point_at(
-                    "fold",
-                    a,
-                    &format!(
-                        "discontinuous fold: a {} and a {} branch meet at the grazing orbit (u = {} and {})",
-                        if a.info.stable { "stable" } else { "unstable" },
-                        if b.info.stable { "stable" } else { "unstable" },
-                        a.y[0],
-                        b.y[0]
-                    ),
-                );
-                p.u = 0.5 * (a.y[0] + b.y[0]);
-                points.push(p);
-            }
-        }
-    }
+    points.extend(stuck_end_points(model, &branches, opts.point_tol));
     let periodic = branches
         .iter()
         .enumerate()
@@ -452,8 +532,54 @@ fn nearest_hopf_end<'a>(
     })
 }
 
-/// Folds, grazing points and stability changes along an ordered branch.
-fn special_points(cont: &Continuer, branch: &[Node]) -> Vec<SpecialPoint> {
+/// The grazing orbit near a branch node (its u, and its ω_u on the section as the guess of
+/// ω_u at the touch point: ω_u varies by a few per cent along these cycles).
+pub fn grazing_near(model: &Model, n: &Node, tol: f64) -> Result<grazing::GrazingOrbit, BifError> {
+    // Newton stops at |G|∞ ≤ 1e-13 rad/s (rounding of ω_l ~ 1e-15·|ω|max for |ω| ≤ 20) or
+    // when its steps stop shrinking at rounding level.
+    grazing::locate(model, n.y[0], n.y[2], tol, 1e-13)
+}
+
+fn grazing_point(g: &grazing::GrazingOrbit, detail: String) -> SpecialPoint {
+    let mut p = SpecialPoint::new("grazing", g.u, detail);
+    p.period = Some(g.period);
+    p.omega_l_max = Some(g.omega_l_max);
+    p.omega_l_min = Some(0.0);
+    p.residual = Some(g.residual[0].abs().max(g.residual[1].abs()));
+    p.condition = Some(GRAZING_CONDITION);
+    p
+}
+
+fn discontinuous_fold(g: &grazing::GrazingOrbit, a: &Node, b: &Node) -> SpecialPoint {
+    let side = |n: &Node| {
+        format!(
+            "{} {}",
+            if n.info.stable { "stable" } else { "unstable" },
+            if n.info.stick_slip {
+                "stick-slip"
+            } else {
+                "slipping"
+            }
+        )
+    };
+    let mut p = grazing_point(
+        g,
+        format!(
+            "discontinuous fold: a {} branch and a {} branch meet at the grazing orbit and both lie {} u = {}",
+            side(a),
+            side(b),
+            if a.y[0] > g.u { "above" } else { "below" },
+            g.u
+        ),
+    );
+    p.kind = "fold";
+    p.discontinuous = Some(true);
+    p
+}
+
+/// Folds, grazing points and other stability changes along an ordered branch.
+fn special_points(cont: &Continuer, branch: &[Node], point_tol: f64) -> Vec<SpecialPoint> {
+    let model = cont.sh.model;
     let mut out = Vec::new();
     for w in branch.windows(2) {
         let (a, b) = (&w[0], &w[1]);
@@ -463,59 +589,247 @@ fn special_points(cont: &Continuer, branch: &[Node]) -> Vec<SpecialPoint> {
             .sum::<f64>();
         let mut b2 = b.clone();
         b2.step = step;
-        if a.tangent[0] * b.tangent[0] < 0.0
-            && let Ok(n) = cont.bisect_between(a, &b2, |n| n.tangent[0], 40)
-        {
-            out.push(point_at(
-                "fold",
-                &n,
-                "extremum of u along the periodic branch",
-            ));
-        }
         let (ga, gb) = (a.info.grazing_indicator(), b.info.grazing_indicator());
-        if ga * gb < 0.0 || (ga == 0.0) != (gb == 0.0) {
-            let g = |n: &Node| {
-                let v = n.info.grazing_indicator();
-                if v == 0.0 { -1e-300 } else { v }
-            };
-            if let Ok(n) = cont.bisect_between(a, &b2, g, 40) {
-                out.push(point_at("grazing", &n, "the cycle touches omega_l = 0"));
+        let grazes = ga * gb < 0.0 || (ga == 0.0) != (gb == 0.0);
+        let mut explained = false;
+        if grazes {
+            // Start from the slipping node of the pair.
+            let from = if a.info.stick_slip { b } else { a };
+            match grazing_near(model, from, point_tol) {
+                Ok(g) => {
+                    explained = true;
+                    out.push(grazing_point(
+                        &g,
+                        format!(
+                            "the cycle touches omega_l = 0 (between branch points at u = {} and {})",
+                            a.y[0], b.y[0]
+                        ),
+                    ));
+                    if (a.y[0] - g.u) * (b.y[0] - g.u) > 0.0 {
+                        out.push(discontinuous_fold(&g, a, b));
+                    }
+                }
+                Err(e) => {
+                    let mut p = SpecialPoint::new(
+                        "grazing",
+                        0.5 * (a.y[0] + b.y[0]),
+                        format!("between u = {} and {}; not located: {e}", a.y[0], b.y[0]),
+                    );
+                    p.omega_l_min = Some(0.0);
+                    out.push(p);
+                }
             }
         }
-        if a.info.stable != b.info.stable {
+        if !grazes
+            && a.tangent[0] * b.tangent[0] < 0.0
+            && let Ok(n) = cont.bisect_between(a, &b2, |n| n.tangent[0], 60)
+        {
+            explained = true;
+            let crit = n
+                .info
+                .nontrivial
+                .iter()
+                .min_by(|x, y| {
+                    (*x - Complex::new(1.0, 0.0))
+                        .norm()
+                        .total_cmp(&(*y - Complex::new(1.0, 0.0)).norm())
+                })
+                .copied()
+                .unwrap_or_default();
             let mut p = point_at(
-                "stability_change",
-                b,
-                &format!("between u = {} and u = {} (not refined)", a.y[0], b.y[0]),
+                "fold",
+                &n,
+                format!(
+                    "smooth fold: extremum of u along the branch; critical multiplier {:.12} {:+.1e}i",
+                    crit.re, crit.im
+                ),
             );
-            p.u = 0.5 * (a.y[0] + b.y[0]);
+            p.discontinuous = Some(false);
+            p.residual = Some(n.tangent[0]);
+            p.condition = Some(FOLD_CONDITION);
+            out.push(p);
+        }
+        if a.info.stable != b.info.stable && !explained {
+            let g = |n: &Node| {
+                n.info
+                    .nontrivial
+                    .iter()
+                    .map(|l| l.norm())
+                    .fold(0.0, f64::max)
+                    - 1.0
+            };
+            let p = match cont.bisect_between(a, &b2, g, 60) {
+                Ok(n) => {
+                    let crit = n
+                        .info
+                        .nontrivial
+                        .iter()
+                        .max_by(|x, y| x.norm().total_cmp(&y.norm()))
+                        .copied()
+                        .unwrap_or_default();
+                    let what = if crit.im.abs() > 1e-8 {
+                        "a complex pair of multipliers crosses the unit circle (Neimark-Sacker)"
+                    } else if crit.re < 0.0 {
+                        "a multiplier crosses -1 (period doubling)"
+                    } else {
+                        "a multiplier crosses +1"
+                    };
+                    let mut p = point_at("stability_change", &n, what.to_string());
+                    p.residual = Some(g(&n));
+                    p.condition = Some("largest nontrivial |multiplier| - 1");
+                    p
+                }
+                Err(_) => point_at(
+                    "stability_change",
+                    b,
+                    format!("between u = {} and u = {} (not refined)", a.y[0], b.y[0]),
+                ),
+            };
             out.push(p);
         }
     }
     out
 }
 
-fn point_at(kind: &'static str, n: &Node, detail: &str) -> SpecialPoint {
-    SpecialPoint {
-        kind,
-        u: n.y[0],
-        omega: None,
-        frequency: None,
-        period: Some(n.info.period),
-        omega_l_max: Some(n.info.omega_l_max),
-        detail: detail.to_string(),
+/// Branch ends at a collapsed step: a non-smooth turning point at a grazing orbit. Each is
+/// located as a grazing orbit; two ends at the same grazing orbit form a discontinuous fold.
+fn stuck_end_points(model: &Model, branches: &[Branch], point_tol: f64) -> Vec<SpecialPoint> {
+    let ends: Vec<&Node> = branches
+        .iter()
+        .flat_map(|b| {
+            let first = (b.ends[0] == End::Stuck).then(|| b.nodes.first()).flatten();
+            let last = (b.ends[1] == End::Stuck).then(|| b.nodes.last()).flatten();
+            first.into_iter().chain(last)
+        })
+        .collect();
+    let located: Vec<Option<grazing::GrazingOrbit>> = ends
+        .iter()
+        .map(|n| grazing_near(model, n, point_tol).ok())
+        .collect();
+    let mut out = Vec::new();
+    let mut paired = vec![false; ends.len()];
+    for i in 0..ends.len() {
+        if paired[i] {
+            continue;
+        }
+        let a = ends[i];
+        let Some(ga) = located[i] else {
+            out.push(point_at(
+                "branch_end",
+                a,
+                "the continuation step collapsed here; no grazing orbit found nearby".into(),
+            ));
+            continue;
+        };
+        // The same grazing orbit from another end: located from different starts, the two
+        // agree to the Newton solve's accuracy (|G| ≤ 1e-13 with |∂G/∂(u, w)| ~ 1: 1e-12);
+        // 1e-9 V leaves room for the integration error at point_tol ≤ 1e-10.
+        let partner = (i + 1..ends.len()).find(|&j| {
+            !paired[j]
+                && located[j].is_some_and(|gb| {
+                    (gb.u - ga.u).abs() < 1e-9 * ga.u.abs().max(1.0)
+                        && (gb.w - ga.w).abs() < 1e-6 * ga.w.abs().max(1.0)
+                })
+        });
+        out.push(grazing_point(
+            &ga,
+            format!(
+                "a branch ends at this grazing orbit (continuation step collapsed at u = {}, stick time {:e} s, min omega_l {:e})",
+                a.y[0], a.info.stick_time, a.info.omega_l_min
+            ),
+        ));
+        if let Some(j) = partner {
+            paired[j] = true;
+            let b = ends[j];
+            out.push(discontinuous_fold(&ga, a, b));
+        }
     }
+    out
+}
+
+fn point_at(kind: &'static str, n: &Node, detail: String) -> SpecialPoint {
+    let mut p = SpecialPoint::new(kind, n.y[0], detail);
+    p.period = Some(n.info.period);
+    p.omega_l_max = Some(n.info.omega_l_max);
+    p.omega_l_min = Some(n.info.omega_l_min);
+    p
+}
+
+/// Every number of the diagram, named, for the finiteness check.
+fn numbers(d: &Diagram) -> impl Iterator<Item = (String, f64)> + '_ {
+    let eq = d.equilibria.iter().enumerate().flat_map(|(i, e)| {
+        [
+            (format!("equilibria[{i}].u"), e.u),
+            (format!("equilibria[{i}].omega"), e.omega),
+            (format!("equilibria[{i}].alpha"), e.alpha),
+            (
+                format!("equilibria[{i}].alpha_max"),
+                e.alpha_max.unwrap_or(0.0),
+            ),
+        ]
+    });
+    let per = d.periodic.iter().enumerate().flat_map(|(i, p)| {
+        let mut v = vec![
+            (format!("periodic[{i}].u"), p.u),
+            (format!("periodic[{i}].period"), p.period),
+            (format!("periodic[{i}].omega_l_max"), p.omega_l_max),
+            (format!("periodic[{i}].omega_l_min"), p.omega_l_min),
+            (format!("periodic[{i}].stick_time"), p.stick_time),
+        ];
+        for (k, m) in p.multipliers.iter().enumerate() {
+            v.push((format!("periodic[{i}].multipliers[{k}].re"), m[0]));
+            v.push((format!("periodic[{i}].multipliers[{k}].im"), m[1]));
+        }
+        for (k, s) in p.section_state.iter().enumerate() {
+            v.push((format!("periodic[{i}].section_state[{k}]"), *s));
+        }
+        v
+    });
+    let pts = d.points.iter().enumerate().flat_map(|(i, p)| {
+        let opt = [
+            ("omega", p.omega),
+            ("frequency", p.frequency),
+            ("period", p.period),
+            ("omega_l_max", p.omega_l_max),
+            ("omega_l_min", p.omega_l_min),
+            ("residual", p.residual),
+        ];
+        std::iter::once((format!("points[{i}].u"), p.u)).chain(
+            opt.into_iter()
+                .filter_map(move |(k, v)| v.map(|v| (format!("points[{i}].{k}"), v))),
+        )
+    });
+    eq.chain(per).chain(pts)
 }
 
 impl Diagram {
-    /// The diagram as pretty JSON.
-    pub fn to_json(&self) -> String {
-        serde_json::to_string_pretty(self).expect("plain data serializes")
+    /// The first non-finite number of the diagram, as an error naming it.
+    pub fn check_finite(&self) -> Result<(), BifError> {
+        match numbers(self).find(|(_, v)| !v.is_finite()) {
+            Some((what, value)) => Err(BifError::NonFinite { what, value }),
+            None => Ok(()),
+        }
+    }
+
+    /// The diagram as pretty JSON (DESIGN.md §4): `{"equilibria": [{"u", "omega", "alpha",
+    /// "stable", ...}], "periodic": [{"u", "period", "omega_l_max", "omega_l_min", "stable",
+    /// "multipliers": [[re, im]...], ...}], "points": [{"kind", "u", ...}]}`. A non-finite
+    /// number is an error (JSON has none; serde would write `null`).
+    pub fn to_json(&self) -> Result<String, BifError> {
+        self.check_finite()?;
+        serde_json::to_string_pretty(self).map_err(|e| BifError::Io(e.to_string()))
     }
 
     /// Writes the three tables as CSV, one after another, each with a header line; the first
-    /// column names the table (`equilibrium`, `periodic`, `point`).
-    pub fn write_csv(&self, w: &mut impl Write) -> std::io::Result<()> {
+    /// column names the table (`equilibrium`, `periodic`, `point`). A non-finite number is
+    /// an error, and nothing is written then.
+    pub fn write_csv(&self, w: &mut impl Write) -> Result<(), BifError> {
+        self.check_finite()?;
+        self.write_csv_io(w)
+            .map_err(|e| BifError::Io(e.to_string()))
+    }
+
+    fn write_csv_io(&self, w: &mut impl Write) -> std::io::Result<()> {
         writeln!(w, "table,u,omega,alpha,stable,kind")?;
         for e in &self.equilibria {
             writeln!(
@@ -539,17 +853,22 @@ impl Diagram {
             }
             writeln!(w)?;
         }
-        writeln!(w, "table,kind,u,omega,frequency,period,detail")?;
+        writeln!(
+            w,
+            "table,kind,u,discontinuous,omega,frequency,period,residual,detail"
+        )?;
         let opt = |v: Option<f64>| v.map(|x| x.to_string()).unwrap_or_default();
         for p in &self.points {
             writeln!(
                 w,
-                "point,{},{},{},{},{},\"{}\"",
+                "point,{},{},{},{},{},{},{},\"{}\"",
                 p.kind,
                 p.u,
+                p.discontinuous.map(|b| b.to_string()).unwrap_or_default(),
                 opt(p.omega),
                 opt(p.frequency),
                 opt(p.period),
+                opt(p.residual),
                 p.detail.replace('"', "'")
             )?;
         }

@@ -280,6 +280,40 @@ impl Shooter<'_> {
         Ok(j)
     }
 
+    /// Fixed point of the section map at `u` (with `c = c(u)`, the section level) by Newton's
+    /// method with the Jacobian `∂P/∂z − I` from the variational equations
+    /// ([`Shooter::section_derivatives`]): exact for the mode sequence of the current
+    /// iterate, so it stays on a cycle family right up to its grazing orbit.
+    pub fn section_fixed_point_exact(
+        &self,
+        u: f64,
+        c: f64,
+        z0: [f64; 2],
+        tol: f64,
+    ) -> Result<[f64; 2], BifError> {
+        let mut z = z0;
+        for _ in 0..30 {
+            let d = self.section_derivatives(u, c, z)?;
+            let r = Vector2::new(d.ret.x[0] - z[0], d.ret.x[1] - z[1]);
+            if r.amax() <= tol {
+                return Ok(z);
+            }
+            let step =
+                (d.dz - Matrix2::identity())
+                    .lu()
+                    .solve(&(-r))
+                    .ok_or(BifError::NoConvergence {
+                        u,
+                        detail: "singular section Jacobian".into(),
+                    })?;
+            z = [z[0] + step[0], z[1] + step[1]];
+        }
+        Err(BifError::NoConvergence {
+            u,
+            detail: "section Newton (variational Jacobian): 30 iterations".into(),
+        })
+    }
+
     /// Fixed point of the section map at fixed u by Newton with a forward-difference Jacobian.
     pub fn section_fixed_point(
         &self,

@@ -212,7 +212,7 @@ fn table1_diagram_structure() {
         let inside = hopf[0].u < e.u && e.u < hopf[1].u;
         assert_eq!(e.stable, !inside, "{e:?}");
     }
-    let json = d.to_json();
+    let json = d.to_json().unwrap();
     assert!(json.contains("\"equilibria\"") && json.contains("\"multipliers\""));
     let mut csv = Vec::new();
     d.write_csv(&mut csv).unwrap();
@@ -234,13 +234,15 @@ fn stribeck_diagram_structure() {
         "{hopf:?}"
     );
     let folds = points(d, "fold");
-    // E: the stable stick-slip branch meets the unstable slipping branch of Hopf C at a
-    // grazing orbit (a discontinuous fold): above Hopf C, with 2.5 V inside the window and
-    // 4.5 V above it (the source's narrative: coexistence at 2.5, equilibrium only at 4.5).
-    let e = folds
-        .iter()
-        .find(|f| f.detail.starts_with("discontinuous"))
-        .expect("fold E");
+    // Two discontinuous folds and no smooth one. D: just below Hopf point 1, the unstable
+    // slipping cycles born there graze and turn into the stable stick-slip branch. E: the
+    // stable stick-slip branch meets the unstable slipping branch of Hopf C at a grazing orbit:
+    // above Hopf C, with 2.5 V inside the window and 4.5 V above it (the source's narrative:
+    // coexistence at 2.5, equilibrium only at 4.5).
+    assert_eq!(folds.len(), 2, "{folds:?}");
+    assert!(folds.iter().all(|f| f.discontinuous == Some(true)));
+    let (dl, e) = (folds[0], folds[1]);
+    assert!(dl.u < hopf[0].u && hopf[0].u - dl.u < 1e-3, "{dl:?}");
     assert!(hopf[1].u < 2.5 && 2.5 < e.u && e.u < 4.5);
     let st = d
         .periodic
