@@ -1,6 +1,6 @@
 //! Prints the special points of the bifurcation diagram of a parameter file, and optionally
 //! writes the JSON and CSV: `cargo run --release -p rotor-bifurcation --example explore --
-//! fixtures/params/table1.toml [n] [out.json] [out.csv]`.
+//! fixtures/params/table1.toml [n] [out.json] [out.csv] [out.svg]`.
 use rotor_bifurcation::{DiagramOptions, diagram};
 use rotor_model::{Model, Params};
 
@@ -32,6 +32,9 @@ fn main() {
     }
     if let Some(j) = args.get(3) {
         std::fs::write(j, d.to_json().expect("json")).expect("write json");
+    }
+    if let Some(s) = args.get(5) {
+        std::fs::write(s, d.to_svg(path)).expect("write svg");
     }
     if let Some(c) = args.get(4) {
         let mut f = std::fs::File::create(c).expect("create csv");

@@ -20,13 +20,14 @@
 //!   discontinuous folds (a grazing orbit where the branch turns back in u: point E).
 //!
 //! [`diagram`] assembles everything into a [`Diagram`], which writes JSON (the CLI contract,
-//! DESIGN.md §4) and CSV.
+//! DESIGN.md §4), CSV and an SVG figure ([`Diagram::to_svg`]).
 
 pub mod continuation;
 pub mod equilibria;
 pub mod grazing;
 pub mod monodromy;
 pub mod periodic;
+mod svg;
 
 use std::io::Write;
 
@@ -366,6 +367,7 @@ pub fn start_point(sh: &Shooter, u: f64) -> Result<([f64; 2], f64), BifError> {
 /// let model = rotor_model::Model::table1();
 /// let d = diagram(&model, &DiagramOptions { u_min: 0.0, u_max: 7.0, ..Default::default() })?;
 /// std::fs::write("diagram.json", d.to_json()?).unwrap();
+/// std::fs::write("diagram.svg", d.to_svg("Table 1")).unwrap();
 /// # Ok::<(), rotor_bifurcation::BifError>(())
 /// ```
 pub fn diagram(model: &Model, opts: &DiagramOptions) -> Result<Diagram, BifError> {
@@ -396,12 +398,16 @@ pub fn diagram(model: &Model, opts: &DiagramOptions) -> Result<Diagram, BifError
     } else {
         0.5 * (opts.u_min + opts.u_max)
     };
-    // The branch through the attractor reached from rest, if that is a cycle.
+    // The branch through the attractor reached from rest, if that is a cycle (a damped
+    // approach to a stable equilibrium also crosses the section: its "fixed point" is the
+    // equilibrium, of zero amplitude).
     let started = start_point(&sh, u_start).and_then(|(z0, c)| {
         let z = sh.section_fixed_point(u_start, c, z0, 1e-10)?;
         cont.node([u_start, z[0], z[1]], &[1.0, 0.0, 0.0], 0.0)
     });
-    if let Ok(start) = started {
+    if let Ok(start) = started
+        && start.info.omega_l_max - start.info.omega_l_min >= opts.amp_stop
+    {
         let (down, end_down) = cont.follow(&start, &[-1.0, 0.0, 0.0]);
         let (up, end_up) = cont.follow(&start, &[1.0, 0.0, 0.0]);
         let mut nodes: Vec<Node> = down.into_iter().rev().collect();
@@ -873,5 +879,14 @@ impl Diagram {
             )?;
         }
         Ok(())
+    }
+
+    /// The diagram as an SVG figure like the source's Figure 3: ω of each equilibrium and the
+    /// max and min of ω_l over each cycle against u, stable solid, unstable dashed (the dash
+    /// switches where the stability changes), special points marked and labelled
+    /// (`H1 Hopf 0.3835`, `G1 grazing 0.6031`, `F1 fold 4.8430`, `E fold (discontinuous)
+    /// 3.8659`). Non-finite numbers are left out (the pen lifts), never written.
+    pub fn to_svg(&self, title: &str) -> String {
+        svg::render(self, title)
     }
 }
