@@ -1,0 +1,198 @@
+//! What the benchmark runs: scenes, accuracy ladders, repetitions, peers.
+
+use std::path::{Path, PathBuf};
+
+use serde::Serialize;
+
+/// One solver of the workspace.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash, Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum SolverKind {
+    /// `rotor-event`: event-driven Filippov (DOP853), the accuracy reference.
+    Event,
+    /// `rotor-switch`: Leine's switch model (DOPRI5).
+    Switch,
+    /// `rotor-moreau`: Moreau–Jean time-stepping.
+    Moreau,
+}
+
+impl SolverKind {
+    /// All solvers, in report order.
+    pub const ALL: [SolverKind; 3] = [SolverKind::Event, SolverKind::Switch, SolverKind::Moreau];
+
+    /// Short name (as the CLI's `--solver`).
+    pub fn name(self) -> &'static str {
+        match self {
+            SolverKind::Event => "event",
+            SolverKind::Switch => "switch",
+            SolverKind::Moreau => "moreau",
+        }
+    }
+
+    /// Name of the accuracy setting: `tol` for the adaptive solvers, `h` for Moreau–Jean.
+    pub fn setting_name(self) -> &'static str {
+        match self {
+            SolverKind::Moreau => "h",
+            _ => "tol",
+        }
+    }
+}
+
+/// One benchmark scene: a scenario file, a horizon, and the windows the errors are read on.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SceneSpec {
+    /// Scenario file (`fixtures/scenarios/*.toml`): parameters, u, x0.
+    pub scenario: PathBuf,
+    /// Horizon (s) (overrides the file's `t_end`).
+    pub t_end: f64,
+    /// Steady-state metrics (period, max ω_l) over `[metrics_from, t_end]` (s).
+    pub metrics_from: f64,
+    /// Window `[t0, t1]` (s) on which max |Δω_l| is read, on the grid `k·dt`.
+    pub transient: [f64; 2],
+    /// Grid step of the full trace (s).
+    pub dt: f64,
+}
+
+impl SceneSpec {
+    /// Table 1 at u = 1.5 V from rest over `t_end` seconds: a stick-slip cycle. Metrics over
+    /// the second half, the transient over the first `min(20, t_end/5)` seconds.
+    pub fn table1_u15(root: &Path, t_end: f64) -> SceneSpec {
+        SceneSpec {
+            scenario: root.join("fixtures/scenarios/t1-u1.5-rest.toml"),
+            t_end,
+            metrics_from: 0.5 * t_end,
+            transient: [0.0, (0.2 * t_end).min(20.0)],
+            dt: 0.01,
+        }
+    }
+}
+
+/// Which peers to run next to the Rust solvers, and how.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PeerOptions {
+    /// Run `bench/peers/scipy_rotor.py` if `python -c "import scipy"` works.
+    pub scipy: bool,
+    /// Interpreter for the scipy peer.
+    pub python: String,
+    /// rtol = atol ladder of the scipy peer (`solve_ivp`, DOP853).
+    pub scipy_tols: Vec<f64>,
+    /// Run `bench/peers/siconos_rotor.py` if `siconos_python -c "import siconos"` works.
+    pub siconos: bool,
+    /// Interpreter for the Siconos peer (Debian's python3-siconos lives in /usr/bin/python3).
+    pub siconos_python: String,
+    /// Step sizes at which Siconos and rotor-moreau are compared per step.
+    pub siconos_hs: Vec<f64>,
+    /// Directory holding the peer scripts.
+    pub dir: PathBuf,
+}
+
+/// Everything [`crate::run`] does.
+#[derive(Debug, Clone, PartialEq)]
+pub struct BenchOptions {
+    /// Scenes; the first one is also used for the output-level ratios and the peers.
+    pub scenes: Vec<SceneSpec>,
+    /// Tolerance ladder of the event-driven solver.
+    pub event_tols: Vec<f64>,
+    /// Tolerance ladder of the switch-model solver.
+    pub switch_tols: Vec<f64>,
+    /// Step ladder of Moreau–Jean (s).
+    pub moreau_hs: Vec<f64>,
+    /// Tolerance of the reference run (event-driven solver).
+    pub reference_tol: f64,
+    /// A tighter tolerance run once to estimate the reference's own error
+    /// (`|ref(reference_tol) − ref(reference_check_tol)|`).
+    pub reference_check_tol: f64,
+    /// Timed repetitions per point (the median is reported).
+    pub repeats: usize,
+    /// Seconds of timing per point: a point whose single run takes longer is timed fewer
+    /// times (down to its untimed-warm-up-free single run).
+    pub time_budget: f64,
+    /// Measure metrics-only vs full-trace run time for each solver at its default setting.
+    pub output_levels: bool,
+    /// Settings for the output-level ratio: event/switch tolerance and Moreau step.
+    pub output_level_tol: f64,
+    pub output_level_h: f64,
+    /// Peers.
+    pub peers: PeerOptions,
+}
+
+/// The workspace root: the current directory if it holds `fixtures/`, else the checkout
+/// this crate was built from.
+pub fn workspace_root() -> PathBuf {
+    let here = PathBuf::from(".");
+    if here.join("fixtures/scenarios").is_dir() {
+        return here;
+    }
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
+}
+
+fn decades(from: i32, to: i32) -> Vec<f64> {
+    (from..=to).map(|e| 10f64.powi(-e)).collect()
+}
+
+impl Default for BenchOptions {
+    /// The full benchmark: Table 1 at 1.5 V over 100 s; event and switch at tol 1e-4 … 1e-12,
+    /// Moreau–Jean at h = 1e-2 … 1e-5 (half decades to 1e-4, then 1e-5), reference = event
+    /// at tol 1e-13, median of 5, peers on.
+    fn default() -> Self {
+        let root = workspace_root();
+        BenchOptions {
+            scenes: vec![SceneSpec::table1_u15(&root, 100.0)],
+            event_tols: decades(4, 12),
+            switch_tols: decades(4, 12),
+            moreau_hs: vec![1e-2, 3e-3, 1e-3, 3e-4, 1e-4, 1e-5],
+            reference_tol: 1e-13,
+            reference_check_tol: 1e-14,
+            repeats: 15,
+            time_budget: 3.0,
+            output_levels: true,
+            output_level_tol: 1e-10,
+            output_level_h: 1e-3,
+            peers: PeerOptions {
+                scipy: true,
+                python: "python3".into(),
+                scipy_tols: decades(4, 12),
+                siconos: true,
+                siconos_python: "/usr/bin/python3".into(),
+                siconos_hs: vec![1e-2, 1e-3],
+                dir: root.join("bench/peers"),
+            },
+        }
+    }
+}
+
+impl BenchOptions {
+    /// A few-second variant for tests: 30 s horizon, three points per ladder, reference at
+    /// tol 1e-12, median of 3, no peers.
+    pub fn quick() -> Self {
+        let root = workspace_root();
+        let full = BenchOptions::default();
+        BenchOptions {
+            scenes: vec![SceneSpec::table1_u15(&root, 30.0)],
+            event_tols: vec![1e-4, 1e-6, 1e-8],
+            switch_tols: vec![1e-4, 1e-6, 1e-8],
+            moreau_hs: vec![1e-2, 3e-3, 1e-3],
+            reference_tol: 1e-12,
+            reference_check_tol: 1e-13,
+            repeats: 3,
+            time_budget: 0.5,
+            output_levels: true,
+            peers: PeerOptions {
+                scipy: false,
+                siconos: false,
+                scipy_tols: vec![1e-4, 1e-6, 1e-8],
+                ..full.peers
+            },
+            ..full
+        }
+    }
+
+    /// The ladder of one solver.
+    pub fn ladder(&self, kind: SolverKind) -> &[f64] {
+        match kind {
+            SolverKind::Event => &self.event_tols,
+            SolverKind::Switch => &self.switch_tols,
+            SolverKind::Moreau => &self.moreau_hs,
+        }
+    }
+}

@@ -1,0 +1,488 @@
+//! The report as a text table, JSON, CSV and a work-precision SVG.
+
+use std::fmt::Write;
+
+use rotor_plot::{Panel, Series, render};
+
+use crate::measure::Errors;
+use crate::options::SolverKind;
+use crate::{BenchReport, PeerReport};
+
+fn e(v: Option<f64>) -> String {
+    v.map_or("-".into(), |x| format!("{x:.1e}"))
+}
+
+fn ms(s: f64) -> String {
+    format!("{:.3}", 1e3 * s)
+}
+
+fn csv_num(v: Option<f64>) -> String {
+    v.map_or(String::new(), |x| format!("{x:e}"))
+}
+
+fn csv_int(v: Option<u64>) -> String {
+    v.map_or(String::new(), |x| x.to_string())
+}
+
+/// A CSV field: quoted when it holds a comma, a quote or a line break.
+fn csv_text(s: &str) -> String {
+    if s.contains([',', '"', '\n']) {
+        format!("\"{}\"", s.replace('"', "\"\""))
+    } else {
+        s.to_string()
+    }
+}
+
+fn color(name: &str) -> &'static str {
+    match name {
+        "event" => "#1f77b4",
+        "switch" => "#ff7f0e",
+        "moreau" => "#2ca02c",
+        "scipy" => "#d62728",
+        _ => "#9467bd",
+    }
+}
+
+impl BenchReport {
+    /// A readable text table: per scene the reference and the ladders, then the output-level
+    /// ratios and the peers.
+    pub fn table(&self) -> String {
+        let mut s = String::new();
+        for sc in &self.scenes {
+            let r = &sc.reference;
+            let _ = writeln!(
+                s,
+                "scene {}: u = {} V, x0 = {:?}, {} s; metrics over [{}, {}] s, transient \
+                 [{}, {}] s on a {} s grid",
+                sc.name,
+                sc.u,
+                sc.x0,
+                sc.t_end,
+                sc.metrics_from,
+                sc.t_end,
+                sc.transient[0],
+                sc.transient[1],
+                sc.dt
+            );
+            let _ = writeln!(
+                s,
+                "reference: event tol {:e}: period {:.12} s, max omega_l {:.12} rad/s ({} \
+                 steps, {} ms)",
+                r.tol,
+                r.period,
+                r.omega_l_max,
+                r.stats.steps,
+                ms(r.seconds)
+            );
+            match (&r.check, &r.check_failure) {
+                (Some(c), _) => {
+                    let _ = writeln!(
+                        s,
+                        "reference error estimate (vs tol {:e}): steady {} rel, transient {} \
+                         rad/s",
+                        r.check_tol,
+                        e(c.steady_rel),
+                        e(c.transient_max)
+                    );
+                }
+                (None, f) => {
+                    let _ = writeln!(
+                        s,
+                        "reference check at tol {:e} failed: {}",
+                        r.check_tol,
+                        f.as_deref().unwrap_or("?")
+                    );
+                }
+            }
+            let _ = writeln!(
+                s,
+                "\n{:<7} {:>11} {:>11} {:>4} {:>10} {:>10} {:>10} {:>10} {:>8} {:>8} {:>9} {:>7}",
+                "solver",
+                "setting",
+                "time [ms]",
+                "runs",
+                "steady rel",
+                "period [s]",
+                "wl max",
+                "transient",
+                "steps",
+                "rejected",
+                "rhs",
+                "events"
+            );
+            for p in &sc.points {
+                let setting = format!("{} {:.0e}", p.setting_name, p.setting);
+                match (&p.timing, &p.failure) {
+                    (Some(t), _) => {
+                        let _ = writeln!(
+                            s,
+                            "{:<7} {:>11} {:>11} {:>4} {:>10} {:>10} {:>10} {:>10} {:>8} {:>8} \
+                             {:>9} {:>7}",
+                            p.solver.name(),
+                            setting,
+                            ms(t.median_s),
+                            t.repeats,
+                            e(p.errors.steady_rel),
+                            e(p.errors.period),
+                            e(p.errors.omega_l_max),
+                            e(p.errors.transient_max),
+                            p.stats.steps,
+                            p.stats.rejected,
+                            p.stats.rhs_evals,
+                            p.stats.events
+                        );
+                    }
+                    (None, f) => {
+                        let _ = writeln!(
+                            s,
+                            "{:<7} {:>11} failed: {}",
+                            p.solver.name(),
+                            setting,
+                            f.as_deref().unwrap_or("?")
+                        );
+                    }
+                }
+            }
+            let _ = writeln!(
+                s,
+                "(errors vs the reference: steady rel = max(|dT|/T, |d max wl|/max wl); \
+                 transient = max |d omega_l| [rad/s]; time = median wall clock)\n"
+            );
+        }
+        if !self.output_levels.is_empty() {
+            let _ = writeln!(
+                s,
+                "output levels (first scene, metrics on): metrics-only = Output::Final, full \
+                 trace = Output::Grid"
+            );
+            let _ = writeln!(
+                s,
+                "{:<7} {:>11} {:>16} {:>16} {:>7} {:>16} {:>8} {:>6}",
+                "solver",
+                "setting",
+                "metrics-only ms",
+                "full trace ms",
+                "ratio",
+                "kept (final)",
+                "kept",
+                "same"
+            );
+            for o in &self.output_levels {
+                let _ = writeln!(
+                    s,
+                    "{:<7} {:>11} {:>16} {:>16} {:>7.2} {:>16} {:>8} {:>6}",
+                    o.solver.name(),
+                    format!("{} {:.0e}", o.setting_name, o.setting),
+                    ms(o.metrics_only.median_s),
+                    ms(o.full_trace.median_s),
+                    o.ratio,
+                    format!("{}/{}", o.metrics_only_samples, o.metrics_only_events),
+                    o.full_trace_samples,
+                    if o.same_answer { "yes" } else { "NO" }
+                );
+            }
+            let _ = writeln!(
+                s,
+                "(kept (final) = samples/events of the metrics-only run; same = same metrics \
+                 and final state)\n"
+            );
+        }
+        for p in &self.peers {
+            peer_table(&mut s, p);
+        }
+        let env = &self.environment;
+        let load =
+            |l: Option<[f64; 3]>| l.map_or("?".into(), |[a, b, c]| format!("{a:.2} {b:.2} {c:.2}"));
+        let _ = writeln!(
+            s,
+            "measured on {} core(s){}, median of up to {} runs per point within {} s; load \
+             average {} at the start, {} at the end",
+            env.cores,
+            if env.debug_build {
+                ", DEBUG BUILD (times not meaningful)"
+            } else {
+                ""
+            },
+            env.repeats,
+            env.time_budget_s,
+            load(env.load_start),
+            load(env.load_end)
+        );
+        s
+    }
+
+    /// The report as pretty JSON (absent values are `null`, never NaN).
+    pub fn to_json(&self) -> String {
+        serde_json::to_string_pretty(self).unwrap_or_else(|e| format!("{{\"error\": \"{e}\"}}"))
+    }
+
+    /// Every point (ladders and peers) as CSV rows.
+    pub fn to_csv(&self) -> String {
+        let mut s = String::from(
+            "scene,source,setting_name,setting,median_s,min_s,repeats,err_period_s,\
+             err_omega_l_max,err_steady_rel,err_transient_max,steps,rejected,rhs_evals,events,\
+             lcp_solves,newton_iters,failure\n",
+        );
+        let row = |s: &mut String,
+                   scene: &str,
+                   source: &str,
+                   setting_name: &str,
+                   setting: f64,
+                   t: Option<crate::Timing>,
+                   er: &Errors,
+                   counts: [Option<u64>; 6],
+                   failure: Option<&str>| {
+            let _ = writeln!(
+                s,
+                "{},{},{},{:e},{},{},{},{},{},{},{},{},{},{},{},{},{},{}",
+                csv_text(scene),
+                source,
+                setting_name,
+                setting,
+                csv_num(t.map(|t| t.median_s)),
+                csv_num(t.map(|t| t.min_s)),
+                t.map_or(String::new(), |t| t.repeats.to_string()),
+                csv_num(er.period),
+                csv_num(er.omega_l_max),
+                csv_num(er.steady_rel),
+                csv_num(er.transient_max),
+                csv_int(counts[0]),
+                csv_int(counts[1]),
+                csv_int(counts[2]),
+                csv_int(counts[3]),
+                csv_int(counts[4]),
+                csv_int(counts[5]),
+                csv_text(failure.unwrap_or(""))
+            );
+        };
+        for sc in &self.scenes {
+            for p in &sc.points {
+                let st = &p.stats;
+                let counts = if p.timing.is_some() {
+                    [
+                        Some(st.steps),
+                        Some(st.rejected),
+                        Some(st.rhs_evals),
+                        Some(st.events),
+                        Some(st.lcp_solves),
+                        Some(st.newton_iters),
+                    ]
+                } else {
+                    [None; 6]
+                };
+                row(
+                    &mut s,
+                    &sc.name,
+                    p.solver.name(),
+                    p.setting_name,
+                    p.setting,
+                    p.timing,
+                    &p.errors,
+                    counts,
+                    p.failure.as_deref(),
+                );
+            }
+        }
+        if let Some(sc) = self.scenes.first() {
+            for peer in &self.peers {
+                for p in &peer.points {
+                    row(
+                        &mut s,
+                        &sc.name,
+                        &peer.name,
+                        peer.setting_name,
+                        p.setting,
+                        p.timing,
+                        &p.errors,
+                        [p.steps, None, p.rhs_evals, None, None, None],
+                        p.failure.as_deref(),
+                    );
+                }
+            }
+        }
+        s
+    }
+
+    /// Work-precision plot: per scene, steady-state error and transient error against run
+    /// time, log–log, one line per solver and peer, markers at the points.
+    pub fn to_svg(&self) -> String {
+        let mut panels = Vec::new();
+        type Pick = fn(&Errors) -> Option<f64>;
+        let kinds: [(&str, &str, Pick); 2] = [
+            (
+                "steady-state error",
+                "max(|dT|/T, |d max wl|/max wl)",
+                |e| e.steady_rel,
+            ),
+            ("transient error", "max |d omega_l| [rad/s]", |e| {
+                e.transient_max
+            }),
+        ];
+        for (k, sc) in self.scenes.iter().enumerate() {
+            for (what, y_label, pick) in kinds {
+                let mut series = Vec::new();
+                for kind in SolverKind::ALL {
+                    let pts: Vec<(f64, f64)> = sc
+                        .points
+                        .iter()
+                        .filter(|p| p.solver == kind)
+                        .filter_map(|p| Some((p.timing?.median_s, pick(&p.errors)?)))
+                        .collect();
+                    series.push(Series {
+                        marker: Some(3.0),
+                        ..Series::line(kind.name(), color(kind.name()), pts)
+                    });
+                }
+                if k == 0 {
+                    for peer in self.peers.iter().filter(|p| !p.points.is_empty()) {
+                        let pts: Vec<(f64, f64)> = peer
+                            .points
+                            .iter()
+                            .filter_map(|p| Some((p.timing?.median_s, pick(&p.errors)?)))
+                            .collect();
+                        series.push(Series {
+                            label: &peer.name,
+                            color: color(&peer.name),
+                            dash: Some("6 4"),
+                            width: 1.5,
+                            marker: Some(3.0),
+                            points: pts,
+                        });
+                    }
+                }
+                let mut panel = Panel::new(
+                    format!("{} ({}, {} s): {what} vs run time", sc.name, sc.u, sc.t_end),
+                    "run time [s] (median)",
+                    y_label,
+                    series,
+                );
+                panel.x_log = true;
+                panel.y_log = true;
+                panels.push(panel);
+            }
+        }
+        render(&panels, 760.0, 420.0)
+    }
+}
+
+fn peer_table(s: &mut String, p: &PeerReport) {
+    let _ = write!(s, "peer {}: {}", p.name, p.status);
+    if let Some(r) = &p.reason {
+        let _ = write!(s, " ({r})");
+    }
+    if let (Some(v), Some(m)) = (&p.version, &p.method) {
+        let _ = write!(s, ", version {v}, {m}");
+    }
+    let _ = writeln!(s);
+    if p.points.is_empty() {
+        let _ = writeln!(s);
+        return;
+    }
+    if let Some(a) = &p.agreement {
+        let _ = writeln!(
+            s,
+            "agreement at {} {:e}: steady {} (gate {:.0e}), transient {} (gate {:.0e}) from \
+             {}: {}",
+            p.setting_name,
+            a.setting,
+            e(a.steady_rel),
+            a.gate_steady_rel,
+            e(a.transient_max),
+            a.gate_transient_max,
+            a.gate_origin,
+            if a.agrees {
+                "agrees"
+            } else {
+                "DOES NOT AGREE (no ratio)"
+            }
+        );
+    }
+    let _ = writeln!(
+        s,
+        "{:>11} {:>11} {:>4} {:>10} {:>10} {:>9} {:>9}",
+        "setting", "time [ms]", "runs", "steady rel", "transient", "steps", "rhs"
+    );
+    for q in &p.points {
+        match q.timing {
+            Some(t) => {
+                let _ = writeln!(
+                    s,
+                    "{:>11} {:>11} {:>4} {:>10} {:>10} {:>9} {:>9}",
+                    format!("{} {:.0e}", p.setting_name, q.setting),
+                    ms(t.median_s),
+                    t.repeats,
+                    e(q.errors.steady_rel),
+                    e(q.errors.transient_max),
+                    q.steps.map_or("-".into(), |v| v.to_string()),
+                    q.rhs_evals.map_or("-".into(), |v| v.to_string())
+                );
+            }
+            None => {
+                let _ = writeln!(
+                    s,
+                    "{:>11} failed: {}",
+                    format!("{} {:.0e}", p.setting_name, q.setting),
+                    q.failure.as_deref().unwrap_or("?")
+                );
+            }
+        }
+    }
+    if !p.ratios.is_empty() {
+        let _ = writeln!(
+            s,
+            "time ratio {} / {} at equal error (Rust time interpolated on its work-precision \
+             front; '>=' where the Rust solver's fastest point is already more accurate):",
+            p.name,
+            p.ratios[0].against.name()
+        );
+        let _ = writeln!(
+            s,
+            "{:>14} {:>11} {:>9} {:>11} {:>11} {:>9} {:>9}",
+            "error kind", "peer", "error", "peer ms", "rust ms", "ratio", "of minima"
+        );
+        for r in &p.ratios {
+            let _ = writeln!(
+                s,
+                "{:>14} {:>11} {:>9} {:>11} {:>11} {:>9} {:>9}",
+                r.error_kind,
+                format!("{} {:.0e}", p.setting_name, r.peer_setting),
+                format!("{:.1e}", r.error),
+                ms(r.peer_seconds),
+                ms(r.rust_seconds),
+                format!("{}{:.0}", if r.rust_is_bound { ">=" } else { "" }, r.ratio),
+                r.ratio_of_minima.map_or("-".into(), |m| format!(
+                    "{}{m:.0}",
+                    if r.rust_is_bound { ">=" } else { "" }
+                ))
+            );
+        }
+    }
+    if !p.per_step.is_empty() {
+        let _ = writeln!(s, "time per step {} / moreau at equal h:", p.name);
+        let _ = writeln!(
+            s,
+            "{:>9} {:>13} {:>15} {:>8} {:>10} {:>12} {:>14}",
+            "h",
+            "peer us/step",
+            "moreau us/step",
+            "ratio",
+            "of minima",
+            "peer steady",
+            "moreau steady"
+        );
+        for q in &p.per_step {
+            let _ = writeln!(
+                s,
+                "{:>9} {:>13.3} {:>15.4} {:>8.0} {:>10.0} {:>12} {:>14}",
+                format!("{:.0e}", q.h),
+                1e6 * q.peer_s_per_step,
+                1e6 * q.moreau_s_per_step,
+                q.ratio,
+                q.ratio_of_minima,
+                e(q.peer_errors.steady_rel),
+                e(q.moreau_errors.steady_rel)
+            );
+        }
+    }
+    let _ = writeln!(s);
+}

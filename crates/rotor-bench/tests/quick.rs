@@ -1,0 +1,166 @@
+//! The quick benchmark: errors fall as the setting tightens, the reference is tight enough,
+//! output levels are honoured, and the report's JSON/CSV/SVG are complete and NaN-free.
+//! No assertion here is about speed.
+
+use rotor_bench::{BenchOptions, BenchReport, SolverKind, run};
+
+fn quick() -> BenchReport {
+    let mut lines = Vec::new();
+    let r = run(&BenchOptions::quick(), |m| lines.push(m.to_string())).unwrap();
+    assert!(
+        lines.iter().any(|l| l.contains("reference")),
+        "progress names the steps: {lines:?}"
+    );
+    r
+}
+
+/// Each solver's errors (steady-state and transient) fall monotonically along the quick
+/// ladder, and by at least 30× from its loosest to its tightest setting.
+///
+/// Origin of 30: event and switch go from tol 1e-4 to 1e-8, four decades (measured: ≥ 200×
+/// on both errors); Moreau–Jean from h = 1e-2 to 1e-3 is second order (θ = 1/2, implicit
+/// friction level), so 100× is expected and measured (110×, 100×), while a first-order
+/// scheme would give 10×: 30 tells the two apart.
+#[test]
+fn errors_fall_as_the_setting_tightens() {
+    let r = quick();
+    let sc = &r.scenes[0];
+    for kind in SolverKind::ALL {
+        let pts: Vec<_> = sc.points.iter().filter(|p| p.solver == kind).collect();
+        assert_eq!(pts.len(), 3, "{kind:?}");
+        for p in &pts {
+            assert!(
+                p.failure.is_none(),
+                "{kind:?} at {}: {:?}",
+                p.setting,
+                p.failure
+            );
+            assert!(p.timing.unwrap().median_s > 0.0);
+            assert!(p.stats.steps > 0);
+        }
+        let steady: Vec<f64> = pts.iter().map(|p| p.errors.steady_rel.unwrap()).collect();
+        let transient: Vec<f64> = pts
+            .iter()
+            .map(|p| p.errors.transient_max.unwrap())
+            .collect();
+        for (name, err) in [("steady", steady), ("transient", transient)] {
+            for w in err.windows(2) {
+                assert!(w[1] < w[0], "{kind:?} {name}: {err:?} not decreasing");
+            }
+            assert!(
+                err[0] > 30.0 * err[2],
+                "{kind:?} {name}: {err:?} falls less than 30x"
+            );
+        }
+    }
+}
+
+/// The reference's own error (vs a tenfold tighter run) is far below every error it is used
+/// to measure: the smallest quick-ladder error is ≥ 1e-9 (steady) and ≥ 1e-7 rad/s
+/// (transient), the reference estimate ~1e-12 and ~4e-11 (measured); 10× margin asked.
+#[test]
+fn the_reference_is_tight_enough() {
+    let r = quick();
+    let sc = &r.scenes[0];
+    let check = sc.reference.check.expect("the check run succeeds");
+    let min = |f: fn(&rotor_bench::Errors) -> Option<f64>| {
+        sc.points
+            .iter()
+            .filter_map(|p| f(&p.errors))
+            .fold(f64::INFINITY, f64::min)
+    };
+    assert!(check.steady_rel.unwrap() * 10.0 < min(|e| e.steady_rel));
+    assert!(check.transient_max.unwrap() * 10.0 < min(|e| e.transient_max));
+    // A stick-slip cycle of Table 1 at 1.5 V: period ≈ 4.58 s, max ω_l ≈ 6.34 rad/s
+    // (the comparison report's values).
+    assert!((sc.reference.period - 4.578).abs() < 1e-3);
+    assert!((sc.reference.omega_l_max - 6.336).abs() < 1e-3);
+}
+
+/// `Output::Final` keeps nothing but gives the same answer as the full trace.
+#[test]
+fn metrics_only_runs_keep_no_samples() {
+    let r = quick();
+    assert_eq!(r.output_levels.len(), 3);
+    for o in &r.output_levels {
+        assert_eq!(
+            (o.metrics_only_samples, o.metrics_only_events),
+            (0, 0),
+            "{:?}",
+            o.solver
+        );
+        assert_eq!(o.full_trace_samples, 3001, "{:?}: 30 s at 0.01 s", o.solver);
+        assert!(o.same_answer, "{:?}", o.solver);
+        assert!(o.ratio.is_finite() && o.ratio > 0.0);
+    }
+}
+
+#[test]
+fn json_csv_and_svg_are_complete_and_nan_free() {
+    let r = quick();
+    let json = r.to_json();
+    for bad in ["NaN", "nan", "inf"] {
+        assert!(!json.contains(bad), "JSON holds {bad}");
+    }
+    let v: serde_json::Value = serde_json::from_str(&json).unwrap();
+    assert_eq!(v["scenes"][0]["points"].as_array().unwrap().len(), 9);
+    assert_eq!(v["peers"][0]["status"], "skipped");
+
+    let svg = r.to_svg();
+    assert!(svg.starts_with("<svg") && svg.trim_end().ends_with("</svg>"));
+    for bad in ["NaN", "inf"] {
+        assert!(!svg.contains(bad), "SVG holds {bad}");
+    }
+    // Two panels, each with three solver lines and a marker per point.
+    assert_eq!(svg.matches("<circle").count(), 2 * 9);
+    for name in ["event", "switch", "moreau"] {
+        assert!(svg.contains(&format!(">{name}</text>")), "legend {name}");
+    }
+
+    let csv = r.to_csv();
+    let rows: Vec<&str> = csv.lines().collect();
+    assert_eq!(rows.len(), 1 + 9);
+    let cols = rows[0].split(',').count();
+    assert!(rows.iter().all(|l| l.split(',').count() == cols));
+    assert!(!csv.contains("NaN"));
+
+    let table = r.table();
+    assert!(table.contains("reference") && table.contains("moreau"));
+}
+
+/// A peer whose interpreter is missing is skipped with the reason, and the run goes on.
+#[test]
+fn a_missing_peer_is_skipped_with_its_reason() {
+    let mut o = BenchOptions::quick();
+    o.event_tols = vec![1e-6];
+    o.switch_tols = vec![1e-6];
+    o.moreau_hs = vec![1e-2];
+    o.output_levels = false;
+    o.peers.scipy = true;
+    o.peers.python = "/nonexistent/python3".into();
+    o.peers.siconos = true;
+    o.peers.siconos_python = "/nonexistent/python3".into();
+    let r = run(&o, |_| {}).unwrap();
+    for p in &r.peers {
+        assert_eq!(p.status, "skipped");
+        assert!(
+            p.reason
+                .as_deref()
+                .unwrap()
+                .contains("/nonexistent/python3")
+        );
+        assert!(p.ratios.is_empty() && p.per_step.is_empty());
+    }
+}
+
+#[test]
+fn bad_options_are_refused_with_the_field() {
+    let mut o = BenchOptions::quick();
+    o.moreau_hs = vec![1e-2, -1.0];
+    let e = run(&o, |_| {}).unwrap_err().to_string();
+    assert!(e.contains("moreau_hs") && e.contains("-1"), "{e}");
+    let mut o = BenchOptions::quick();
+    o.scenes[0].transient = [0.0, 1e3];
+    let e = run(&o, |_| {}).unwrap_err().to_string();
+    assert!(e.contains("transient"), "{e}");
+}
