@@ -1,0 +1,93 @@
+//! The peers, when installed (CI has neither scipy nor Siconos: these tests then return after
+//! saying so). A peer that runs must compute the reference's answer, else its ratio is
+//! meaningless.
+
+use rotor_bench::{BenchOptions, peer_available, run};
+
+fn options() -> BenchOptions {
+    let mut o = BenchOptions::quick();
+    o.event_tols = vec![1e-6, 1e-8, 1e-10];
+    o.switch_tols = vec![1e-6];
+    o.moreau_hs = vec![1e-2];
+    o.output_levels = false;
+    o.repeats = 1;
+    o.time_budget = 0.0;
+    o.peers.scipy = false;
+    o.peers.siconos = false;
+    o
+}
+
+/// scipy's `solve_ivp` (DOP853, rtol = atol = 1e-10) agrees with the event-driven reference
+/// within the scenario's event-switch gate, and gets ratios at equal error.
+#[test]
+fn scipy_peer_agrees_with_the_reference() {
+    let o = options();
+    if let Err(why) = peer_available(&o.peers.python, "scipy") {
+        eprintln!("scipy peer not tested: {why}");
+        return;
+    }
+    let o = BenchOptions {
+        peers: rotor_bench::PeerOptions {
+            scipy: true,
+            scipy_tols: vec![1e-6, 1e-10],
+            ..o.peers.clone()
+        },
+        ..o
+    };
+    let r = run(&o, |m| eprintln!("{m}")).unwrap();
+    let p = &r.peers[0];
+    assert_eq!(p.name, "scipy");
+    assert_eq!(p.status, "ran", "{:?}", p.reason);
+    assert_eq!(p.points.len(), 2);
+    let a = p.agreement.as_ref().expect("the scenario has gates");
+    assert!(a.agrees, "{a:?}");
+    // The tighter tolerance is more accurate.
+    let e: Vec<f64> = p
+        .points
+        .iter()
+        .map(|q| q.errors.transient_max.unwrap())
+        .collect();
+    assert!(e[1] < e[0], "{e:?}");
+    assert!(!p.ratios.is_empty());
+    assert!(
+        p.ratios
+            .iter()
+            .all(|q| q.ratio.is_finite() && q.ratio > 0.0)
+    );
+}
+
+/// Siconos' MoreauJeanOSI at h = 1e-3 agrees with the reference within the scenario's
+/// event-moreau gate (the gate's setting), and gets a per-step comparison with rotor-moreau
+/// at the same h, whose answer is the same scheme's.
+#[test]
+fn siconos_peer_agrees_with_the_reference() {
+    let o = options();
+    if let Err(why) = peer_available(&o.peers.siconos_python, "siconos.kernel") {
+        eprintln!("siconos peer not tested: {why}");
+        return;
+    }
+    let o = BenchOptions {
+        peers: rotor_bench::PeerOptions {
+            siconos: true,
+            siconos_hs: vec![1e-3],
+            ..o.peers.clone()
+        },
+        ..o
+    };
+    let r = run(&o, |m| eprintln!("{m}")).unwrap();
+    let p = &r.peers[1];
+    assert_eq!(p.name, "siconos");
+    assert_eq!(p.status, "ran", "{:?}", p.reason);
+    let a = p.agreement.as_ref().expect("the scenario has gates");
+    assert!(a.agrees, "{a:?}");
+    assert_eq!(p.per_step.len(), 1);
+    let s = &p.per_step[0];
+    assert!(s.ratio.is_finite() && s.ratio > 0.0);
+    // Same scheme (θ = 1/2, implicit level, exact one-step problem) at the same h: the
+    // steady errors agree to within 10% (measured: equal to two digits).
+    let (pe, me) = (
+        s.peer_errors.steady_rel.unwrap(),
+        s.moreau_errors.steady_rel.unwrap(),
+    );
+    assert!((pe - me).abs() < 0.1 * me, "siconos {pe} vs moreau {me}");
+}
