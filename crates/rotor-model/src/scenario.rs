@@ -21,7 +21,7 @@ use thiserror::Error;
 
 use crate::dynamics::{Model, State};
 use crate::params::{Params, ParamsError, one_line, shown, text_of};
-use crate::scene::{MAX_GRID_ROWS, Scene};
+use crate::scene::{MAX_GRID_ROWS, MIN_TOL, Scene};
 
 /// The solver pairs a `[tolerance.<pair>]` table may name: each solver against the
 /// event-driven reference (the pairs rotor-compare gates). Any other name is a typo that
@@ -207,6 +207,15 @@ impl Scenario {
             && !(tol > 0.0 && tol < 1.0)
         {
             return Err(bad("tol", tol.to_string(), "must lie in (0, 1)"));
+        }
+        if let Some(tol) = raw.tol
+            && tol < MIN_TOL
+        {
+            return Err(bad(
+                "tol",
+                tol.to_string(),
+                "is below 1.1e-15 (10 unit roundoffs): double precision cannot deliver it",
+            ));
         }
         if let Some(h) = raw.h
             && !(h > 0.0 && h <= raw.t_end)

@@ -26,6 +26,12 @@ pub enum Output {
 /// allocation failure. A `dt` that asks more is a typo (a unit slip), not a request.
 pub const MAX_GRID_ROWS: f64 = 1e7;
 
+/// Smallest admissible tolerance: 10 × the unit roundoff of f64 (1.1e-15), the bound below
+/// which Hairer's DOP853 refuses to run ("tolerances are too small"): a relative error per
+/// step smaller than a few roundoffs cannot be met, and a solver asked for it either
+/// underflows its step or silently delivers less than it was asked.
+pub const MIN_TOL: f64 = 10.0 * (f64::EPSILON / 2.0);
+
 /// One simulation request: input, initial state, horizon, accuracy, and what to keep.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Scene {
@@ -86,6 +92,13 @@ impl Scene {
         }
         if !(self.tol > 0.0 && self.tol < 1.0) {
             return bad("tol", self.tol, "must lie in (0, 1)");
+        }
+        if self.tol < MIN_TOL {
+            return bad(
+                "tol",
+                self.tol,
+                "is below 1.1e-15 (10 unit roundoffs): double precision cannot deliver it",
+            );
         }
         if !(self.h > 0.0 && self.h <= self.t_end) {
             return bad("h", self.h, "must lie in (0, t_end]");

@@ -306,6 +306,10 @@ fn scenario_horizon_step_and_tolerance_out_of_range() {
         ("t_end = 200.0\ntol = 1.0", vec!["tol = 1", "(0, 1)"]),
         ("t_end = 200.0\ntol = 2.0", vec!["tol = 2", "(0, 1)"]),
         ("t_end = 200.0\ntol = nan", vec!["tol = NaN"]),
+        (
+            "t_end = 200.0\ntol = 1e-16",
+            vec!["tol = 0.0000000000000001", "roundoff"],
+        ),
     ] {
         scenario_err(edit(&s, "t_end = 200.0", to).as_bytes(), &needles);
     }
@@ -495,6 +499,25 @@ fn scenario_unreadable_empty_and_binary_files() {
         &["not a UTF-8", "0x89", "offset 0"],
     );
     scenario_err(b"name = \"a\"\n\x00", &["NUL byte", "offset 11"]);
+}
+
+#[test]
+fn scene_tolerance_below_roundoff_is_refused() {
+    use rotor_model::scene::MIN_TOL;
+    let at = |tol| {
+        Scene {
+            tol,
+            ..Scene::default()
+        }
+        .validate()
+    };
+    assert!(at(1e-13).is_ok());
+    assert!(at(MIN_TOL).is_ok());
+    let e = at(1e-20).unwrap_err().to_string();
+    assert!(
+        e.contains("tol = 0.00000000000000000001") && e.contains("roundoff"),
+        "{e}"
+    );
 }
 
 #[test]
