@@ -54,7 +54,7 @@ pub struct CycleInfo {
     pub period: f64,
     pub omega_l_max: f64,
     pub omega_l_min: f64,
-    /// Time per period with the lower disc stuck [s].
+    /// Time per period with the lower disc stuck \[s\].
     pub stick_time: f64,
     /// Whether the lower disc sticks on the cycle.
     pub stick_slip: bool,
@@ -114,9 +114,9 @@ pub struct ContOptions {
     pub h_max: f64,
     /// Smallest arclength step before the branch is given up.
     pub h_min: f64,
-    /// Newton tolerance on |F|∞ [rad, rad/s].
+    /// Newton tolerance on |F|∞ \[rad, rad/s\].
     pub newton_tol: f64,
-    /// ω_l amplitude below which a branch stops (it is about to end at a Hopf point) [rad/s].
+    /// ω_l amplitude below which a branch stops (it is about to end at a Hopf point) \[rad/s\].
     pub amp_stop: f64,
     /// Largest number of points per direction.
     pub max_nodes: usize,

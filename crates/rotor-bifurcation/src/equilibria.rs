@@ -29,7 +29,7 @@ pub fn complex_pair(model: &Model, omega: f64) -> Option<Complex<f64>> {
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct HopfPoint {
     pub equilibrium: SlipEquilibrium,
-    /// Crossing frequency `|Im λ|` [rad/s]; the cycles born here have period ≈ 2π/frequency.
+    /// Crossing frequency `|Im λ|` \[rad/s\]; the cycles born here have period ≈ 2π/frequency.
     pub frequency: f64,
     /// `Re λ` at the located point (the residual).
     pub re: f64,

@@ -31,15 +31,15 @@ use crate::BifError;
 /// The located grazing orbit.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct GrazingOrbit {
-    /// Input [V].
+    /// Input \[V\].
     pub u: f64,
-    /// ω_u at the touch point [rad/s].
+    /// ω_u at the touch point \[rad/s\].
     pub w: f64,
-    /// Period [s] (time from the touch to the next minimum of ω_l).
+    /// Period \[s\] (time from the touch to the next minimum of ω_l).
     pub period: f64,
-    /// Largest ω_l on the orbit [rad/s].
+    /// Largest ω_l on the orbit \[rad/s\].
     pub omega_l_max: f64,
-    /// `G(u, w)` at the located point: `[min ω_l, ω_u(t_m) − w]` [rad/s].
+    /// `G(u, w)` at the located point: `[min ω_l, ω_u(t_m) − w]` \[rad/s\].
     pub residual: [f64; 2],
     /// Newton iterations taken.
     pub iterations: usize,

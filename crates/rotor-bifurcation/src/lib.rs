@@ -21,6 +21,14 @@
 //!
 //! [`diagram`] assembles everything into a [`Diagram`], which writes JSON (the CLI contract,
 //! DESIGN.md §4), CSV and an SVG figure ([`Diagram::to_svg`]).
+//!
+//! # Cost
+//!
+//! The whole diagram over 0–7 V with the default options (200 equilibria; each periodic
+//! branch at arclength steps ≤ 7/200, about 500 orbits with their monodromy matrices; every
+//! special point located) takes 1.1 s for the Table 1 set and 1.6 s for the Stribeck set
+//! (criterion medians, `cargo bench -p rotor-bifurcation`, benches/diagram.rs; release build,
+//! one thread, on a 2-core machine shared with other jobs while measured).
 
 pub mod continuation;
 pub mod equilibria;
@@ -68,9 +76,9 @@ pub enum BifError {
 /// What [`diagram`] computes.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct DiagramOptions {
-    /// Lower end of the input range [V].
+    /// Lower end of the input range \[V\].
     pub u_min: f64,
-    /// Upper end of the input range [V].
+    /// Upper end of the input range \[V\].
     pub u_max: f64,
     /// Number of u values of the equilibrium table; the periodic branch gets at least this
     /// many points over the range it spans (arclength step ≤ (u_max − u_min)/n).
@@ -83,7 +91,7 @@ pub struct DiagramOptions {
     /// outside `[u_min, u_max]` the middle of the range is used, and if no cycle is reached
     /// from rest the branches start from the Hopf points only.
     pub u_start: f64,
-    /// ω_l amplitude at which the branch is stopped near a Hopf point [rad/s].
+    /// ω_l amplitude at which the branch is stopped near a Hopf point \[rad/s\].
     pub amp_stop: f64,
 }
 
@@ -186,13 +194,13 @@ pub struct SpecialPoint {
     /// where a stable and an unstable branch meet), `false` for a smooth one.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub discontinuous: Option<bool>,
-    /// Hopf: the equilibrium velocity [rad/s].
+    /// Hopf: the equilibrium velocity \[rad/s\].
     #[serde(skip_serializing_if = "Option::is_none")]
     pub omega: Option<f64>,
-    /// Hopf: crossing frequency |Im λ| [rad/s].
+    /// Hopf: crossing frequency |Im λ| \[rad/s\].
     #[serde(skip_serializing_if = "Option::is_none")]
     pub frequency: Option<f64>,
-    /// Period of the orbit (Hopf: 2π/frequency) [s].
+    /// Period of the orbit (Hopf: 2π/frequency) \[s\].
     #[serde(skip_serializing_if = "Option::is_none")]
     pub period: Option<f64>,
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -556,25 +564,30 @@ fn grazing_point(g: &grazing::GrazingOrbit, detail: String) -> SpecialPoint {
     p
 }
 
-fn discontinuous_fold(g: &grazing::GrazingOrbit, a: &Node, b: &Node) -> SpecialPoint {
+/// The discontinuous fold at grazing orbit `g` where the branches of nodes `a` and `b` meet;
+/// `side_u` is the u of a branch point far enough from `g` (several steps) to tell on which
+/// side of `g.u` the branches lie.
+fn discontinuous_fold(g: &grazing::GrazingOrbit, a: &Node, b: &Node, side_u: f64) -> SpecialPoint {
     let side = |n: &Node| {
-        format!(
-            "{} {}",
-            if n.info.stable { "stable" } else { "unstable" },
+        if n.info.stable {
             if n.info.stick_slip {
-                "stick-slip"
+                "a stable stick-slip"
             } else {
-                "slipping"
+                "a stable slipping"
             }
-        )
+        } else if n.info.stick_slip {
+            "an unstable stick-slip"
+        } else {
+            "an unstable slipping"
+        }
     };
     let mut p = grazing_point(
         g,
         format!(
-            "discontinuous fold: a {} branch and a {} branch meet at the grazing orbit and both lie {} u = {}",
+            "discontinuous fold: {} branch and {} branch meet at the grazing orbit and both lie {} u = {}",
             side(a),
             side(b),
-            if a.y[0] > g.u { "above" } else { "below" },
+            if side_u > g.u { "above" } else { "below" },
             g.u
         ),
     );
@@ -612,7 +625,7 @@ fn special_points(cont: &Continuer, branch: &[Node], point_tol: f64) -> Vec<Spec
                         ),
                     ));
                     if (a.y[0] - g.u) * (b.y[0] - g.u) > 0.0 {
-                        out.push(discontinuous_fold(&g, a, b));
+                        out.push(discontinuous_fold(&g, a, b, a.y[0]));
                     }
                 }
                 Err(e) => {
@@ -700,17 +713,21 @@ fn special_points(cont: &Continuer, branch: &[Node], point_tol: f64) -> Vec<Spec
 /// Branch ends at a collapsed step: a non-smooth turning point at a grazing orbit. Each is
 /// located as a grazing orbit; two ends at the same grazing orbit form a discontinuous fold.
 fn stuck_end_points(model: &Model, branches: &[Branch], point_tol: f64) -> Vec<SpecialPoint> {
-    let ends: Vec<&Node> = branches
+    // Each stuck end with the node 10 steps back (its side of the end in u).
+    let ends: Vec<(&Node, &Node)> = branches
         .iter()
         .flat_map(|b| {
-            let first = (b.ends[0] == End::Stuck).then(|| b.nodes.first()).flatten();
-            let last = (b.ends[1] == End::Stuck).then(|| b.nodes.last()).flatten();
+            let n = b.nodes.len();
+            let back = 10.min(n.saturating_sub(1));
+            let first = (b.ends[0] == End::Stuck && n > 0).then(|| (&b.nodes[0], &b.nodes[back]));
+            let last = (b.ends[1] == End::Stuck && n > 0)
+                .then(|| (&b.nodes[n - 1], &b.nodes[n - 1 - back]));
             first.into_iter().chain(last)
         })
         .collect();
     let located: Vec<Option<grazing::GrazingOrbit>> = ends
         .iter()
-        .map(|n| grazing_near(model, n, point_tol).ok())
+        .map(|(n, _)| grazing_near(model, n, point_tol).ok())
         .collect();
     let mut out = Vec::new();
     let mut paired = vec![false; ends.len()];
@@ -718,7 +735,7 @@ fn stuck_end_points(model: &Model, branches: &[Branch], point_tol: f64) -> Vec<S
         if paired[i] {
             continue;
         }
-        let a = ends[i];
+        let (a, a_back) = ends[i];
         let Some(ga) = located[i] else {
             out.push(point_at(
                 "branch_end",
@@ -746,8 +763,8 @@ fn stuck_end_points(model: &Model, branches: &[Branch], point_tol: f64) -> Vec<S
         ));
         if let Some(j) = partner {
             paired[j] = true;
-            let b = ends[j];
-            out.push(discontinuous_fold(&ga, a, b));
+            let (b, _) = ends[j];
+            out.push(discontinuous_fold(&ga, a, b, a_back.y[0]));
         }
     }
     out

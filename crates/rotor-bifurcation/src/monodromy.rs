@@ -66,7 +66,7 @@ pub struct Switch {
 /// Sensitivities of a trajectory piece of duration `t` from `x₀` (see the module docs).
 #[derive(Debug, Clone, PartialEq)]
 pub struct Variational {
-    /// Duration [s].
+    /// Duration \[s\].
     pub t: f64,
     /// State at the end, as integrated with the variational equations.
     pub x_end: State,

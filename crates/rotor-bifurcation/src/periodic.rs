@@ -35,7 +35,7 @@ pub struct SectionDerivs {
     pub du: Vector2<f64>,
 }
 
-/// Longest time a return may take [s] (periods here are a few seconds to a few tens).
+/// Longest time a return may take \[s\] (periods here are a few seconds to a few tens).
 pub const T_RETURN: f64 = 2000.0;
 
 /// The shooting setup at one input u.
@@ -51,7 +51,7 @@ pub struct Shooter<'a> {
 pub struct Return {
     /// State at the return.
     pub x: State,
-    /// Return time [s].
+    /// Return time \[s\].
     pub t: f64,
     /// Whether the lower disc stuck on the way.
     pub stuck: bool,

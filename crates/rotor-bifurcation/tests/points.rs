@@ -198,6 +198,14 @@ fn discontinuous_folds_are_grazing_orbits_where_two_branches_turn() {
         // Each is a grazing orbit of the diagram.
         assert!(graz.iter().any(|g| g.u == f.u));
     }
+    // D: the unstable slipping branch and the stable stick-slip branch both lie above it; E:
+    // the stable stick-slip branch and the unstable slipping branch both lie below it.
+    for (f, side) in [(folds[0], "above"), (folds[1], "below")] {
+        assert!(f.detail.contains(&format!("both lie {side}")), "{f:?}");
+        assert!(
+            f.detail.contains("a stable stick-slip") && f.detail.contains("an unstable slipping")
+        );
+    }
     let e = folds[1];
     // E located at two tolerances: agrees to < 1e-9 V (as for the grazing points).
     let w0 = m.slip_equilibria(e.u)[0].omega;
