@@ -137,9 +137,9 @@ pub fn scenario_svg(r: &ScenarioResult) -> String {
             format!("{}: {} (u = {} V)", sc.name, name, sc.u),
             "t [s]",
             if idx == 1 {
-                "omega_u [rad/s]"
+                "ω_u [rad/s]"
             } else {
-                "omega_l [rad/s]"
+                "ω_l [rad/s]"
             },
             SolverKind::ALL
                 .iter()
@@ -203,7 +203,7 @@ pub fn friction_svg(sets: &[(&str, Params)]) -> String {
             .collect();
         panels.push(Panel::new(
             format!("Friction: {name} (Fig. 2)"),
-            "omega [rad/s]",
+            "ω [rad/s]",
             "torque [N m]",
             series,
         ));

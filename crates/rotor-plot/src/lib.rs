@@ -129,7 +129,9 @@ pub fn render(panels: &[Panel], width: f64, panel_height: f64) -> String {
     let _ = writeln!(s, r#"<rect width="100%" height="100%" fill="white"/>"#);
     for (k, p) in panels.iter().enumerate() {
         let oy = k as f64 * panel_height;
-        let (l, r, t, b) = (70.0, width - 20.0, oy + 30.0, oy + panel_height - 45.0);
+        let has_legend = p.series.iter().any(|s| !s.label.is_empty());
+        let top = if has_legend { 50.0 } else { 30.0 };
+        let (l, r, t, b) = (70.0, width - 20.0, oy + top, oy + panel_height - 45.0);
         let pts = p
             .series
             .iter()
@@ -235,7 +237,7 @@ pub fn render(panels: &[Panel], width: f64, panel_height: f64) -> String {
             (t + b) / 2.0,
             esc(p.y_label)
         );
-        let mut legend_row = 0usize;
+        let mut legend: Vec<(&Series, String)> = Vec::new();
         for ser in &p.series {
             let mut d = String::new();
             let mut pen_up = true;
@@ -266,22 +268,34 @@ pub fn render(panels: &[Panel], width: f64, panel_height: f64) -> String {
                     ser.color, ser.width
                 );
             }
-            if ser.label.is_empty() {
-                continue;
+            if !ser.label.is_empty() {
+                legend.push((ser, dash));
             }
-            let ly = t + 15.0 + 16.0 * legend_row as f64;
-            legend_row += 1;
+        }
+        // The legend: one row between the title and the plot box, so it never hides data.
+        let ly = oy + 36.0;
+        let mut lx = l;
+        for (ser, dash) in &legend {
             let _ = writeln!(
                 s,
-                r#"<line x1="{}" y1="{ly}" x2="{}" y2="{ly}" stroke="{}" stroke-width="{}"{dash}/><text x="{}" y="{}">{}</text>"#,
-                r - 150.0,
-                r - 120.0,
+                r#"<line x1="{lx}" y1="{ly}" x2="{}" y2="{ly}" stroke="{}" stroke-width="{}"{dash}/><text x="{}" y="{}">{}</text>"#,
+                lx + 30.0,
                 ser.color,
                 ser.width.max(1.5),
-                r - 115.0,
+                lx + 35.0,
                 ly + 4.0,
                 esc(ser.label)
             );
+            if let Some(radius) = ser.marker {
+                let _ = writeln!(
+                    s,
+                    r#"<circle cx="{}" cy="{ly}" r="{radius}" fill="{}"/>"#,
+                    lx + 15.0,
+                    ser.color
+                );
+            }
+            // ~6.7 px per character of the 12 px sans-serif, plus a gap.
+            lx += 35.0 + 6.7 * ser.label.chars().count() as f64 + 18.0;
         }
         for lab in &p.labels {
             let (px, py) = (sx(lab.x), sy(lab.y));
@@ -375,7 +389,8 @@ mod tests {
         });
         let svg = render(&[panel], 600.0, 300.0);
         assert!(svg.contains(">1e-8<") && svg.contains(">1e-3<"));
-        assert_eq!(svg.matches("<circle").count(), 2);
+        // Two drawable points (the one at x = 0 is skipped) and the legend's marker.
+        assert_eq!(svg.matches("<circle").count(), 3);
         assert!(svg.contains(">A</text>"));
         assert!(!svg.contains("NaN") && !svg.contains("inf"));
     }
