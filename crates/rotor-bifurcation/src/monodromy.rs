@@ -237,7 +237,8 @@ fn segment(
 
 /// Integrates the variational equations along a trajectory of the Filippov system from
 /// `(x0, mode0)` for `t_end` seconds, whose switching events (as reported by
-/// `rotor_event::flow`) are `events`. Each smooth piece restarts from the event state of the
+/// `rotor_event::flow`) are `events`. A disc stuck in `mode0` starts at velocity 0 whatever
+/// `x0` says, so `X(0)` has its column zeroed. Each smooth piece restarts from the event state of the
 /// flow (where the event condition holds to rounding), and each event applies its saltation
 /// matrix.
 pub fn along(
@@ -251,12 +252,15 @@ pub fn along(
 ) -> Result<Variational, BifError> {
     let mut mode = mode0;
     let mut x = x0;
+    // A disc stuck at the start has its velocity set to 0 (as the flow does): the initial
+    // sensitivity is that map's derivative, I with the stuck discs' columns zeroed.
+    let mut phi = Matrix3::identity();
     for d in Disc::BOTH {
         if mode.of(d) == DiscMode::Stick {
             x[d.index()] = 0.0;
+            phi[(d.index(), d.index())] = 0.0;
         }
     }
-    let mut phi = Matrix3::identity();
     let mut p = Vector3::zeros();
     let mut t = 0.0;
     let mut switches = Vec::new();
