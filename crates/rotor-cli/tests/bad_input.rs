@@ -1,0 +1,577 @@
+//! Bad input through the `rotor` binary (issue #8): bad parameter files, bad scenario files
+//! and bad flags each give an error on stderr that names the file or flag, the field and the
+//! value, with a non-zero exit code that is not a panic's (101) nor a signal's (an abort on a
+//! failed allocation); `rotor compare --report DIR` with a bad scenario writes nothing into
+//! DIR; and a report interrupted by SIGKILL leaves every file whole (old or new, never cut).
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+use std::sync::atomic::{AtomicUsize, Ordering};
+
+const TABLE1: &str = include_str!("../../../fixtures/params/table1.toml");
+const STRIBECK: &str = include_str!("../../../fixtures/params/stribeck.toml");
+const SCENARIO: &str = include_str!("../../../fixtures/scenarios/t1-u1.5-rest.toml");
+
+fn fixtures() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../../fixtures")
+}
+
+fn rotor(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_rotor"))
+        .args(args)
+        .output()
+        .unwrap()
+}
+
+/// A fresh directory per call (tests run in parallel).
+fn tmp_dir() -> PathBuf {
+    static N: AtomicUsize = AtomicUsize::new(0);
+    let d = std::env::temp_dir().join(format!(
+        "rotor-cli-bad-input-{}-{}",
+        std::process::id(),
+        N.fetch_add(1, Ordering::Relaxed)
+    ));
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+/// Replaces `from` on the first line that starts with it (else its first occurrence outside
+/// a comment) by `to`; insists that it occurs, so a fixture edit cannot make a case vacuous.
+fn edit(text: &str, from: &str, to: &str) -> String {
+    let mut starts = None;
+    let mut inside = None;
+    let mut at = 0;
+    for line in text.split_inclusive('\n') {
+        if starts.is_none() && line.starts_with(from) {
+            starts = Some(at);
+        }
+        let code = line.split('#').next().unwrap();
+        if inside.is_none()
+            && let Some(i) = code.find(from)
+        {
+            inside = Some(at + i);
+        }
+        at += line.len();
+    }
+    let i = starts
+        .or(inside)
+        .unwrap_or_else(|| panic!("fixture no longer contains {from:?}"));
+    format!("{}{}{}", &text[..i], to, &text[i + from.len()..])
+}
+
+/// An error exit: a code that is neither success, nor a panic (101), nor a signal; stderr's
+/// first line starts with `error:` and contains every needle; no panic message anywhere.
+fn assert_clean_error(o: &Output, what: &str, needles: &[&str]) {
+    let err = String::from_utf8_lossy(&o.stderr);
+    let code = o.status.code();
+    assert!(
+        matches!(code, Some(c) if c != 0 && c != 101),
+        "{what}: exit {:?} (want non-zero, not 101, not a signal): {err}",
+        o.status
+    );
+    assert!(!err.contains("panicked"), "{what}: {err}");
+    let first = err.lines().next().unwrap_or("");
+    assert!(first.starts_with("error:"), "{what}: {err}");
+    for n in needles {
+        assert!(first.contains(n), "{what}: first line lacks {n:?}: {err}");
+    }
+}
+
+#[test]
+fn bad_parameter_files_are_named_with_field_and_value() {
+    let dir = tmp_dir();
+    let cases: Vec<(&str, String, Vec<&str>)> = vec![
+        (
+            "unknown key",
+            edit(TABLE1, "j_u = 0.4765", "j_uu = 0.4765"),
+            vec!["j_uu", "unknown field"],
+        ),
+        (
+            "missing key",
+            edit(TABLE1, "k_m = 3.9950", ""),
+            vec!["k_m", "missing field"],
+        ),
+        (
+            "wrong type",
+            edit(TABLE1, "j_u = 0.4765", "j_u = \"heavy\""),
+            vec!["j_u = \"heavy\"", "invalid type"],
+        ),
+        (
+            "non-finite",
+            edit(TABLE1, "k_theta = 0.0727", "k_theta = nan"),
+            vec!["k_theta = NaN"],
+        ),
+        (
+            "non-positive inertia",
+            edit(TABLE1, "j_l = 0.0326", "j_l = -0.5"),
+            vec!["j_l = -0.5"],
+        ),
+        (
+            "zero stiffness",
+            edit(TABLE1, "k_theta = 0.0727", "k_theta = 0.0"),
+            vec!["k_theta = 0"],
+        ),
+        (
+            "negative static level",
+            edit(TABLE1, "t_s = 0.1642", "t_s = -0.1"),
+            vec!["lower.t_s = -0.1"],
+        ),
+        (
+            "Stribeck exponent <= 0",
+            edit(STRIBECK, "delta = 2.0575", "delta = 0.0"),
+            vec!["lower.delta = 0"],
+        ),
+        (
+            "unknown family",
+            edit(TABLE1, "\"exponential\"", "\"dahl\""),
+            vec!["lower.family", "\"dahl\""],
+        ),
+        ("empty", String::new(), vec!["empty"]),
+    ];
+    for (i, (what, text, needles)) in cases.into_iter().enumerate() {
+        let f = dir.join(format!("p{i}.toml"));
+        std::fs::write(&f, text).unwrap();
+        let fs = f.to_str().unwrap();
+        let mut needles = needles;
+        needles.push(fs);
+        let o = rotor(&["steady", "--solver", "event", "--u", "1", "--params", fs]);
+        assert_clean_error(&o, what, &needles);
+        let csv = dir.join(format!("p{i}.csv"));
+        let o = rotor(&[
+            "simulate",
+            "--solver",
+            "moreau",
+            "--u",
+            "1",
+            "--t-end",
+            "1",
+            "--params",
+            fs,
+            "--csv",
+            csv.to_str().unwrap(),
+        ]);
+        assert_clean_error(&o, what, &needles);
+        assert!(!csv.exists(), "{what}: no CSV on error");
+    }
+    // Binary, and a path that does not exist.
+    let bin = dir.join("bin.toml");
+    std::fs::write(&bin, b"\x7fELF\x02\x01\x01\x00\xff\xfe").unwrap();
+    let o = rotor(&[
+        "steady",
+        "--solver",
+        "event",
+        "--u",
+        "1",
+        "--params",
+        bin.to_str().unwrap(),
+    ]);
+    assert_clean_error(
+        &o,
+        "binary",
+        &[bin.to_str().unwrap(), "not a UTF-8", "offset"],
+    );
+    let none = dir.join("nothere.toml");
+    let o = rotor(&[
+        "steady",
+        "--solver",
+        "event",
+        "--u",
+        "1",
+        "--params",
+        none.to_str().unwrap(),
+    ]);
+    assert_clean_error(&o, "missing file", &[none.to_str().unwrap(), "cannot read"]);
+}
+
+#[test]
+fn bad_flags_name_the_flag_and_value() {
+    let dir = tmp_dir();
+    let csv = dir.join("out.csv");
+    let csv_s = csv.to_str().unwrap();
+    let cases: [(&[&str], &[&str]); 14] = [
+        (&["--solver", "nope", "--u", "1"], &["--solver", "\"nope\""]),
+        (&["--solver", "event", "--u", "nan"], &["--u", "NaN"]),
+        (&["--solver", "event", "--u", "inf"], &["--u", "inf"]),
+        // clap's own message for what is not a number at all.
+        (&["--solver", "event", "--u", "fast"], &["'fast'", "--u"]),
+        (&["--solver", "moreau", "--u", "1", "--h", "0"], &["--h 0"]),
+        (
+            &["--solver", "moreau", "--u", "1", "--h", "-1e-3"],
+            &["--h -0.001"],
+        ),
+        (
+            &["--solver", "moreau", "--u", "1", "--h", "5"],
+            &["--h 5", "t_end"],
+        ),
+        (
+            &["--solver", "event", "--u", "1", "--tol", "2"],
+            &["--tol 2"],
+        ),
+        (
+            &["--solver", "event", "--u", "1", "--tol", "0"],
+            &["--tol 0"],
+        ),
+        (
+            &["--solver", "event", "--u", "1", "--tol", "-1e-9"],
+            &["--tol -0.000000001"],
+        ),
+        (
+            &["--solver", "event", "--u", "1", "--x0", "1,2"],
+            &["--x0", "\"1,2\""],
+        ),
+        (
+            &["--solver", "event", "--u", "1", "--x0", "1,a,2"],
+            &["--x0", "\"a\""],
+        ),
+        (
+            &["--solver", "event", "--u", "1", "--x0", "0,nan,0"],
+            &["--x0", "\"nan\""],
+        ),
+        (
+            &["--solver", "event", "--u", "1", "--t-end", "-1"],
+            &["--t-end -1"],
+        ),
+    ];
+    for (args, needles) in cases {
+        let mut a = vec!["simulate"];
+        a.extend_from_slice(args);
+        if !args.contains(&"--t-end") {
+            a.extend(["--t-end", "1"]);
+        }
+        a.extend(["--csv", csv_s]);
+        let o = rotor(&a);
+        assert_clean_error(&o, &format!("{a:?}"), needles);
+        assert!(!csv.exists(), "{a:?}: no CSV on error");
+        // The same flags through `steady` (which has no --t-end).
+        if !args.contains(&"--t-end") && !args.contains(&"5") {
+            let mut a = vec!["steady"];
+            a.extend_from_slice(args);
+            assert_clean_error(&rotor(&a), &format!("{a:?}"), needles);
+        }
+    }
+    // A grid of 1e14 rows used to abort the process on the failed allocation (signal 6).
+    for dt in ["0", "1e-12"] {
+        let o = rotor(&[
+            "simulate", "--solver", "event", "--u", "1", "--t-end", "100", "--dt", dt, "--csv",
+            csv_s,
+        ]);
+        assert_clean_error(&o, &format!("--dt {dt}"), &["dt"]);
+    }
+    // A horizon shorter than the default step is not an error when --h is not given.
+    let o = rotor(&[
+        "simulate", "--solver", "moreau", "--u", "1", "--t-end", "5e-4", "--csv", csv_s,
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+}
+
+/// A directory holding a good Table 1 parameter file and a scenario file of `text`.
+fn scenario_dir(text: &str) -> (PathBuf, PathBuf) {
+    let dir = tmp_dir();
+    std::fs::write(dir.join("table1.toml"), TABLE1).unwrap();
+    let f = dir.join("s.toml");
+    std::fs::write(&f, text).unwrap();
+    (dir, f)
+}
+
+fn good_scenario() -> String {
+    edit(SCENARIO, "\"../params/table1.toml\"", "\"table1.toml\"")
+}
+
+/// Every non-hidden file of a directory with its bytes, sorted by name.
+fn files_of(dir: &Path) -> Vec<(String, Vec<u8>)> {
+    let Ok(rd) = std::fs::read_dir(dir) else {
+        return Vec::new();
+    };
+    let mut v: Vec<(String, Vec<u8>)> = rd
+        .map(|e| e.unwrap().path())
+        .filter(|p| !p.file_name().unwrap().to_string_lossy().starts_with('.'))
+        .map(|p| {
+            let b = std::fs::read(&p).unwrap();
+            (p.file_name().unwrap().to_string_lossy().into_owned(), b)
+        })
+        .collect();
+    v.sort();
+    v
+}
+
+#[test]
+fn compare_with_a_bad_scenario_writes_no_report() {
+    let s = good_scenario();
+    let cases: Vec<(&str, Vec<u8>, Vec<&str>)> = vec![
+        (
+            "t_end <= 0",
+            edit(&s, "t_end = 200.0", "t_end = 0.0").into(),
+            vec!["t_end = 0"],
+        ),
+        (
+            "h <= 0",
+            edit(&s, "t_end = 200.0", "t_end = 200.0\nh = 0.0").into(),
+            vec!["h = 0"],
+        ),
+        (
+            "h > t_end",
+            edit(&s, "t_end = 200.0", "t_end = 200.0\nh = 250.0").into(),
+            vec!["h = 250"],
+        ),
+        (
+            "tol <= 0",
+            edit(&s, "t_end = 200.0", "t_end = 200.0\ntol = -1e-9").into(),
+            vec!["tol = -0.000000001"],
+        ),
+        (
+            "tol >= 1",
+            edit(&s, "t_end = 200.0", "t_end = 200.0\ntol = 1.0").into(),
+            vec!["tol = 1"],
+        ),
+        (
+            "unknown solver key",
+            edit(&s, "t_end = 200.0", "t_end = 200.0\nsolver = \"rk4\"").into(),
+            vec!["solver = \"rk4\"", "unknown field"],
+        ),
+        (
+            "missing key",
+            edit(&s, "u = 1.5", "").into(),
+            vec!["missing field", "`u`"],
+        ),
+        (
+            "wrong type",
+            edit(&s, "u = 1.5", "u = \"fast\"").into(),
+            vec!["u = \"fast\""],
+        ),
+        (
+            "non-finite",
+            edit(&s, "u = 1.5", "u = nan").into(),
+            vec!["u = NaN"],
+        ),
+        (
+            "params path does not exist",
+            edit(&s, "\"table1.toml\"", "\"nothere.toml\"").into(),
+            vec!["params", "nothere.toml", "cannot read"],
+        ),
+        (
+            "report name escapes the directory",
+            edit(&s, "name = \"t1-u1.5-rest\"", "name = \"../escape\"").into(),
+            vec!["name = \"../escape\""],
+        ),
+        ("empty", Vec::new(), vec!["empty"]),
+        (
+            "binary",
+            b"\x89PNG\r\n\x1a\n\x00\x00\x00\rIHDR".to_vec(),
+            vec!["not a UTF-8"],
+        ),
+    ];
+    for (what, text, needles) in cases {
+        let (dir, f) = scenario_dir("");
+        std::fs::write(&f, &text).unwrap();
+        // A good scenario first: it must not be reported either when a later one is bad.
+        let good = dir.join("good.toml");
+        std::fs::write(&good, good_scenario()).unwrap();
+        let report = dir.join("report");
+        let mut needles = needles;
+        let fs = f.to_str().unwrap();
+        needles.push(fs);
+        let o = rotor(&[
+            "compare",
+            good.to_str().unwrap(),
+            fs,
+            "--report",
+            report.to_str().unwrap(),
+        ]);
+        assert_clean_error(&o, what, &needles);
+        assert!(files_of(&report).is_empty(), "{what}: report written");
+    }
+    // A bad parameter file named by a scenario: both files named.
+    let (dir, f) = scenario_dir(&edit(&s, "\"table1.toml\"", "\"bad.toml\""));
+    std::fs::write(
+        dir.join("bad.toml"),
+        edit(TABLE1, "j_u = 0.4765", "j_u = 0.0"),
+    )
+    .unwrap();
+    let report = dir.join("report");
+    // An existing report stays as it was.
+    std::fs::create_dir_all(&report).unwrap();
+    std::fs::write(report.join("README.md"), "old report\n").unwrap();
+    let o = rotor(&[
+        "compare",
+        f.to_str().unwrap(),
+        "--report",
+        report.to_str().unwrap(),
+    ]);
+    assert_clean_error(
+        &o,
+        "bad params",
+        &[f.to_str().unwrap(), "bad.toml", "j_u = 0"],
+    );
+    assert_eq!(
+        files_of(&report),
+        vec![("README.md".to_string(), b"old report\n".to_vec())]
+    );
+    // Two scenarios of one name would overwrite each other's report files.
+    let (dir, f) = scenario_dir(&s);
+    let twin = dir.join("twin.toml");
+    std::fs::write(&twin, &s).unwrap();
+    let report = dir.join("report");
+    let o = rotor(&[
+        "compare",
+        f.to_str().unwrap(),
+        twin.to_str().unwrap(),
+        "--report",
+        report.to_str().unwrap(),
+    ]);
+    assert_clean_error(&o, "duplicate name", &["twin.toml", "t1-u1.5-rest"]);
+    assert!(files_of(&report).is_empty());
+}
+
+/// Name, length and modification time of every entry of a directory (hidden ones too).
+#[cfg(unix)]
+fn listing(dir: &Path) -> Vec<(String, u64, std::time::SystemTime)> {
+    let mut v: Vec<_> = std::fs::read_dir(dir)
+        .map(|rd| {
+            rd.filter_map(|e| {
+                let e = e.ok()?;
+                let m = e.metadata().ok()?;
+                Some((
+                    e.file_name().to_string_lossy().into_owned(),
+                    m.len(),
+                    m.modified().ok()?,
+                ))
+            })
+            .collect()
+        })
+        .unwrap_or_default();
+    v.sort();
+    v
+}
+
+/// SIGKILL during `rotor compare --report DIR` over an existing report leaves every report
+/// file whole. Most attempts watch DIR and kill the moment anything in it changes (a temporary
+/// file appears, or a file's length or time changes: a write is under way); the others kill
+/// at spread-out moments of a run. The solvers are deterministic, so a whole CSV or SVG equals
+/// the first run's bytes; README.md holds run times, so it must be whole by structure (same
+/// number of lines, ends with a newline).
+#[cfg(unix)]
+#[test]
+fn a_killed_compare_leaves_every_report_file_whole() {
+    use std::os::unix::process::ExitStatusExt;
+    use std::time::Instant;
+
+    let dir = tmp_dir();
+    let params = fixtures().join("params/table1.toml");
+    // Large files (1e5 CSV rows, ~11 MB) so that writing them takes a while.
+    let big = edit(
+        &edit(SCENARIO, "name = \"t1-u1.5-rest\"", "name = \"kill-big\""),
+        "\"../params/table1.toml\"",
+        &format!("{:?}", params.to_str().unwrap()),
+    );
+    let big = edit(
+        &big,
+        "steady_from = 100.0",
+        "steady_from = 100.0\ndt = 2e-3",
+    );
+    std::fs::write(dir.join("big.toml"), big).unwrap();
+    let small = fixtures().join("scenarios/t1-u0.5-rest.toml");
+    let report = dir.join("report");
+    let args = [
+        "compare".to_string(),
+        dir.join("big.toml").to_string_lossy().into_owned(),
+        small.to_string_lossy().into_owned(),
+        "--report".to_string(),
+        report.to_string_lossy().into_owned(),
+    ];
+    let spawn = || {
+        Command::new(env!("CARGO_BIN_EXE_rotor"))
+            .args(&args)
+            .stdout(std::process::Stdio::null())
+            .stderr(std::process::Stdio::null())
+            .spawn()
+            .unwrap()
+    };
+    let t0 = Instant::now();
+    let status = spawn().wait().unwrap();
+    // Used only to spread the timed kills over a run; never asserted.
+    let run = t0.elapsed();
+    assert!(status.success());
+    let first = files_of(&report);
+    let names: Vec<&str> = first.iter().map(|(n, _)| n.as_str()).collect();
+    assert_eq!(
+        names,
+        [
+            "README.md",
+            "friction.svg",
+            "kill-big.csv",
+            "kill-big.svg",
+            "t1-u0.5-rest.csv",
+            "t1-u0.5-rest.svg"
+        ]
+    );
+    // The first run's files are whole.
+    for (n, b) in &first {
+        if n.ends_with(".svg") {
+            assert!(b.ends_with(b"</svg>\n"), "{n}");
+        }
+    }
+    let csv_rows = first
+        .iter()
+        .find(|(n, _)| n == "kill-big.csv")
+        .map(|(_, b)| b.iter().filter(|&&c| c == b'\n').count())
+        .unwrap();
+    assert_eq!(csv_rows, 1 + 100_001, "header + 200 s / 2e-3 s + 1 rows");
+    let readme_lines = |b: &[u8]| String::from_utf8_lossy(b).lines().count();
+    let check_whole = |k: usize| {
+        let now = files_of(&report);
+        let names_now: Vec<&str> = now.iter().map(|(n, _)| n.as_str()).collect();
+        assert_eq!(
+            names_now, names,
+            "attempt {k}: the set of report files changed"
+        );
+        for ((n, b), (_, b0)) in now.iter().zip(&first) {
+            if n == "README.md" {
+                assert_eq!(
+                    readme_lines(b),
+                    readme_lines(b0),
+                    "attempt {k}: README.md cut"
+                );
+                assert!(b.ends_with(b"\n"), "attempt {k}: README.md cut");
+            } else {
+                assert!(
+                    b == b0,
+                    "attempt {k}: {n} has {} bytes, whole: {}",
+                    b.len(),
+                    b0.len()
+                );
+            }
+        }
+    };
+
+    // Kills at the moment a write is seen under way.
+    let mut caught_writing = 0;
+    for k in 0..6 {
+        let before = listing(&report);
+        let mut child = spawn();
+        loop {
+            if child.try_wait().unwrap().is_some() {
+                break;
+            }
+            if listing(&report) != before {
+                let _ = child.kill();
+                if child.wait().unwrap().signal() == Some(9) {
+                    caught_writing += 1;
+                }
+                break;
+            }
+            std::thread::sleep(std::time::Duration::from_micros(100));
+        }
+        let _ = child.wait();
+        check_whole(k);
+    }
+    // Kills at spread-out moments of a run (most land while the solvers compute).
+    for k in 0..4 {
+        let mut child = spawn();
+        std::thread::sleep(run.mul_f64(0.2 + 0.2 * k as f64));
+        let _ = child.kill();
+        let _ = child.wait();
+        check_whole(6 + k);
+    }
+    // Else no kill landed inside a write, and the test would have shown nothing.
+    assert!(caught_writing >= 1, "no attempt was killed while writing");
+}
