@@ -23,10 +23,10 @@ enum Command {
         #[command(flatten)]
         common: Common,
         /// Horizon [s].
-        #[arg(long, default_value_t = 100.0)]
+        #[arg(long, default_value_t = 100.0, allow_hyphen_values = true)]
         t_end: f64,
         /// Output interval [s] (rows at 0, dt, 2dt, ..., t_end).
-        #[arg(long, default_value_t = 0.01)]
+        #[arg(long, default_value_t = 0.01, allow_hyphen_values = true)]
         dt: f64,
         /// Output CSV file.
         #[arg(long)]
@@ -36,6 +36,28 @@ enum Command {
     Steady {
         #[command(flatten)]
         common: Common,
+    },
+    /// Bifurcation diagram over u: equilibria, periodic branches with Floquet multipliers,
+    /// special points (Hopf, grazing, folds), as JSON, and optionally CSV and an SVG figure.
+    Bifurcation {
+        /// Parameter file (default: the source's Table 1).
+        #[arg(long)]
+        params: Option<PathBuf>,
+        /// Lower end of the input range [V].
+        #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
+        u_min: f64,
+        /// Upper end of the input range [V].
+        #[arg(long, default_value_t = 7.0, allow_hyphen_values = true)]
+        u_max: f64,
+        /// Output JSON file (equilibria, periodic, points).
+        #[arg(long)]
+        json: PathBuf,
+        /// Output SVG figure (max/min of omega_l against u, like the source's Figure 3).
+        #[arg(long)]
+        svg: Option<PathBuf>,
+        /// Output CSV of every branch point.
+        #[arg(long)]
+        csv: Option<PathBuf>,
     },
     /// Run scenarios through the three solvers, gate their agreement, write the report.
     Compare {
@@ -62,10 +84,10 @@ struct Common {
     #[arg(long, allow_hyphen_values = true)]
     x0: Option<String>,
     /// Integration tolerance (switch, event).
-    #[arg(long)]
+    #[arg(long, allow_hyphen_values = true)]
     tol: Option<f64>,
     /// Step size (moreau) [s].
-    #[arg(long)]
+    #[arg(long, allow_hyphen_values = true)]
     h: Option<f64>,
 }
 
@@ -125,7 +147,8 @@ fn scene_from(common: &Common, t_end: f64, output: Output) -> Result<Scene> {
     let d = Scene::default();
     let tol = common.tol.unwrap_or(d.tol);
     check("tol", tol, tol > 0.0 && tol < 1.0, "must lie in (0, 1)")?;
-    let h = common.h.unwrap_or(d.h);
+    // The default step shrinks to a horizon shorter than itself; an explicit --h does not.
+    let h = common.h.unwrap_or(d.h.min(t_end));
     check("h", h, h > 0.0 && h <= t_end, "must lie in (0, t_end]")?;
     Ok(Scene {
         u: common.u,
@@ -203,6 +226,58 @@ fn steady(common: &Common) -> Result<()> {
     Ok(())
 }
 
+fn bifurcation(
+    params: Option<&Path>,
+    u_min: f64,
+    u_max: f64,
+    json: &Path,
+    svg: Option<&Path>,
+    csv: Option<&Path>,
+) -> Result<()> {
+    use rotor_compare::report::write_atomic;
+    let model = load_model(params)?;
+    let opts = rotor_bifurcation::DiagramOptions {
+        u_min,
+        u_max,
+        ..Default::default()
+    };
+    // The library names the field: "u_min = ...", which is the flag --u-min.
+    opts.validate().map_err(|e| {
+        anyhow!(
+            "{}",
+            e.to_string()
+                .replace("u_min", "--u-min")
+                .replace("u_max", "--u-max")
+        )
+    })?;
+    let d = rotor_bifurcation::diagram(&model, &opts)?;
+    write_atomic(json, d.to_json()?.as_bytes())
+        .with_context(|| format!("{}: cannot write", json.display()))?;
+    if let Some(path) = csv {
+        let mut buf = Vec::new();
+        d.write_csv(&mut buf)?;
+        write_atomic(path, &buf).with_context(|| format!("{}: cannot write", path.display()))?;
+    }
+    if let Some(path) = svg {
+        let name = params.map_or("Table 1".to_owned(), |p| p.display().to_string());
+        write_atomic(
+            path,
+            d.to_svg(&format!("Bifurcation diagram: {name}")).as_bytes(),
+        )
+        .with_context(|| format!("{}: cannot write", path.display()))?;
+    }
+    println!(
+        "{} equilibria, {} periodic orbits, {} special points",
+        d.equilibria.len(),
+        d.periodic.len(),
+        d.points.len()
+    );
+    for p in &d.points {
+        println!("  {}", serde_json::to_string(p)?);
+    }
+    Ok(())
+}
+
 /// The fixtures directory: next to the workspace root when run through cargo, else ./fixtures.
 fn fixtures_dir() -> PathBuf {
     let local = PathBuf::from("fixtures");
@@ -212,7 +287,70 @@ fn fixtures_dir() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../../fixtures")
 }
 
-fn compare(files: &[PathBuf], report: &Path) -> Result<()> {
+/// The report section with the bifurcation diagrams of both parameter sets (the source's
+/// Figure 3): SVG, JSON and CSV per set, and a table of the special points.
+fn bifurcation_section(sets: &[(&str, &str, Params)]) -> Result<rotor_compare::report::Section> {
+    use rayon::prelude::*;
+    use std::fmt::Write as _;
+    let diagrams = sets
+        .par_iter()
+        .map(|(_, _, p)| {
+            let t0 = std::time::Instant::now();
+            let d = rotor_bifurcation::diagram(&Model::new(*p), &Default::default());
+            (d, t0.elapsed().as_secs_f64())
+        })
+        .collect::<Vec<_>>();
+    let mut sec = rotor_compare::report::Section::default();
+    let md = &mut sec.markdown;
+    md.push_str("## Bifurcation diagrams (the source's Figure 3)\n\n");
+    md.push_str(
+        "Computed by `rotor bifurcation` (crate `rotor-bifurcation`): the equilibrium branch with \
+         its eigenvalues, periodic orbits by shooting with the exact Filippov flow, Floquet \
+         multipliers from the monodromy matrix with saltation matrices, pseudo-arclength \
+         continuation started at each Hopf point. Stable: solid; unstable: dashed. Each special \
+         point is listed with the residual of its defining condition.\n",
+    );
+    for ((name, slug, _), (d, secs)) in sets.iter().zip(diagrams) {
+        let d = d.with_context(|| format!("bifurcation diagram of the {name} set"))?;
+        let _ = write!(
+            md,
+            "\n### {name}\n\n![bifurcation diagram, {name}](bifurcation-{slug}.svg)\n\n\
+             {} equilibria, {} periodic orbits, computed in {secs:.1} s \
+             ([JSON](bifurcation-{slug}.json), [CSV](bifurcation-{slug}.csv)).\n\n\
+             | point | u [V] | residual | detail |\n|---|---|---|---|\n",
+            d.equilibria.len(),
+            d.periodic.len()
+        );
+        for p in &d.points {
+            let v = serde_json::to_value(p)?;
+            let get = |k: &str| v.get(k).and_then(|x| x.as_f64());
+            let _ = writeln!(
+                md,
+                "| {} | {:.10} | {} | {} |",
+                v.get("kind").and_then(|x| x.as_str()).unwrap_or("?"),
+                get("u").unwrap_or(f64::NAN),
+                get("residual").map_or("—".into(), |r| format!("{r:.1e}")),
+                v.get("detail").and_then(|x| x.as_str()).unwrap_or("")
+            );
+        }
+        let mut csv = Vec::new();
+        d.write_csv(&mut csv)?;
+        sec.files.push((
+            format!("bifurcation-{slug}.svg"),
+            d.to_svg(&format!("Bifurcation diagram: {name}"))
+                .into_bytes(),
+        ));
+        sec.files.push((
+            format!("bifurcation-{slug}.json"),
+            d.to_json()?.into_bytes(),
+        ));
+        sec.files.push((format!("bifurcation-{slug}.csv"), csv));
+    }
+    Ok(sec)
+}
+
+/// `rotor compare`; with `main_job`, the report also gets the bifurcation diagrams.
+fn compare(files: &[PathBuf], report: &Path, main_job: bool) -> Result<()> {
     use rayon::prelude::*;
     let files = if files.is_empty() {
         let dir = fixtures_dir().join("scenarios");
@@ -225,27 +363,53 @@ fn compare(files: &[PathBuf], report: &Path) -> Result<()> {
         .iter()
         .map(|f| rotor_model::Scenario::from_file(f))
         .collect::<Result<Vec<_>, _>>()?;
+    // Report files are named after the scenarios: two of one name would overwrite each other.
+    for (i, a) in scenarios.iter().enumerate() {
+        if let Some(b) = scenarios[..i].iter().find(|b| b.name == a.name) {
+            bail!(
+                "{}: name = {:?}: also the name of {}",
+                a.path.display(),
+                a.name,
+                b.path.display()
+            );
+        }
+    }
+    let stribeck = Params::from_file(&fixtures_dir().join("params/stribeck.toml"))?;
     let t0 = std::time::Instant::now();
     let bar = progress_bar(scenarios.len() as u64, "scenarios");
-    // In parallel across scenarios; collected in input order, so output is deterministic.
-    let results: Vec<_> = scenarios
-        .par_iter()
-        .map(|sc| {
-            let r = rotor_compare::run_scenario(sc);
-            bar.inc(1);
-            r
-        })
-        .collect();
+    let sets = [
+        ("Table 1", "table1", Params::table1()),
+        ("Stribeck set", "stribeck", stribeck),
+    ];
+    // In parallel across scenarios (and with the diagrams); collected in input order, so the
+    // output is deterministic.
+    let (results, sections) = rayon::join(
+        || {
+            scenarios
+                .par_iter()
+                .map(|sc| {
+                    let r = rotor_compare::run_scenario(sc);
+                    bar.inc(1);
+                    r
+                })
+                .collect::<Vec<_>>()
+        },
+        || -> Result<Vec<rotor_compare::report::Section>> {
+            if main_job {
+                Ok(vec![bifurcation_section(&sets)?])
+            } else {
+                Ok(Vec::new())
+            }
+        },
+    );
+    let sections = sections?;
     bar.finish_and_clear();
     let wall = t0.elapsed().as_secs_f64();
     let params = [
         ("Table 1 (exponential)", Params::table1()),
-        (
-            "Stribeck set (unverified)",
-            Params::from_file(&fixtures_dir().join("params/stribeck.toml"))?,
-        ),
+        ("Stribeck set (unverified)", stribeck),
     ];
-    let fails = rotor_compare::report::write_report(report, &results, &params)
+    let fails = rotor_compare::report::write_report(report, &results, &params, &sections)
         .with_context(|| format!("{}: cannot write the report", report.display()))?;
     println!(
         "{:<18} {:<7} {:<12} {:>10} {:>12} {:>9}",
@@ -324,8 +488,23 @@ fn main() -> ExitCode {
             csv,
         }) => simulate(common, *t_end, *dt, csv),
         Some(Command::Steady { common }) => steady(common),
-        Some(Command::Compare { scenarios, report }) => compare(scenarios, report),
-        None => compare(&[], Path::new("reports")),
+        Some(Command::Bifurcation {
+            params,
+            u_min,
+            u_max,
+            json,
+            svg,
+            csv,
+        }) => bifurcation(
+            params.as_deref(),
+            *u_min,
+            *u_max,
+            json,
+            svg.as_deref(),
+            csv.as_deref(),
+        ),
+        Some(Command::Compare { scenarios, report }) => compare(scenarios, report, false),
+        None => compare(&[], Path::new("reports"), true),
     };
     match res {
         Ok(()) => ExitCode::SUCCESS,

@@ -80,3 +80,74 @@ fn bad_input_is_a_clear_error_not_a_panic() {
         assert!(err.contains(needle), "{args:?}: {err}");
     }
 }
+
+#[test]
+fn bifurcation_writes_the_contract_json_and_a_figure() {
+    let dir = std::env::temp_dir().join(format!("rotor-cli-bif-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let (json, svg) = (dir.join("d.json"), dir.join("d.svg"));
+    let o = rotor(&[
+        "bifurcation",
+        "--u-min",
+        "0",
+        "--u-max",
+        "1",
+        "--json",
+        json.to_str().unwrap(),
+        "--svg",
+        svg.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let v: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    for (key, fields) in [
+        ("equilibria", &["u", "omega", "alpha", "stable"][..]),
+        (
+            "periodic",
+            &[
+                "u",
+                "period",
+                "omega_l_max",
+                "omega_l_min",
+                "stable",
+                "multipliers",
+            ][..],
+        ),
+        ("points", &["kind", "u"][..]),
+    ] {
+        let rows = v[key].as_array().unwrap_or_else(|| panic!("{key}"));
+        assert!(!rows.is_empty(), "{key}");
+        for f in fields {
+            assert!(rows.iter().all(|r| r.get(f).is_some()), "{key}.{f}");
+        }
+    }
+    // Table 1 between 0 and 1 V: the supercritical Hopf point (0.3835 V) and the grazing
+    // point (0.6031 V) lie in the window; their values are tested in rotor-bifurcation.
+    let kinds: Vec<&str> = v["points"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|p| p["kind"].as_str().unwrap())
+        .collect();
+    assert!(
+        kinds.contains(&"hopf") && kinds.contains(&"grazing"),
+        "{kinds:?}"
+    );
+    let figure = std::fs::read_to_string(&svg).unwrap();
+    assert!(figure.starts_with("<svg") && figure.trim_end().ends_with("</svg>"));
+
+    // A bad range names the flag and the value, and exits non-zero without a panic.
+    let o = rotor(&[
+        "bifurcation",
+        "--u-min",
+        "3",
+        "--u-max",
+        "1",
+        "--json",
+        dir.join("bad.json").to_str().unwrap(),
+    ]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "{err}");
+    assert!(err.contains("--u-max") && err.contains('1'), "{err}");
+    assert!(!dir.join("bad.json").exists());
+}

@@ -231,11 +231,22 @@ fn fmt_metrics(st: &Option<SteadyState>) -> String {
     }
 }
 
+/// A further section of the report (the bifurcation diagrams, the stress table, ...): its
+/// markdown, appended to `README.md`, and the files it links, written atomically beside it.
+#[derive(Debug, Clone, Default)]
+pub struct Section {
+    /// Markdown, starting with its own `## ` heading.
+    pub markdown: String,
+    /// File name (relative to the report directory) and contents.
+    pub files: Vec<(String, Vec<u8>)>,
+}
+
 /// Writes the whole report into `dir` and returns the failures.
 pub fn write_report(
     dir: &Path,
     results: &[ScenarioResult],
     param_sets: &[(&str, Params)],
+    sections: &[Section],
 ) -> std::io::Result<Vec<Failure>> {
     std::fs::create_dir_all(dir)?;
     let mut md = String::new();
@@ -306,6 +317,13 @@ pub fn write_report(
         &dir.join("friction.svg"),
         friction_svg(param_sets).as_bytes(),
     )?;
+    for sec in sections {
+        md.push('\n');
+        md.push_str(&sec.markdown);
+        for (name, bytes) in &sec.files {
+            write_atomic(&dir.join(name), bytes)?;
+        }
+    }
     write_atomic(&dir.join("README.md"), md.as_bytes())?;
     Ok(all_fails)
 }
