@@ -351,7 +351,10 @@ impl BenchReport {
                     }
                 }
                 let mut panel = Panel::new(
-                    format!("{} ({}, {} s): {what} vs run time", sc.name, sc.u, sc.t_end),
+                    format!(
+                        "{} (u = {} V, {} s): {what} vs run time",
+                        sc.name, sc.u, sc.t_end
+                    ),
                     "run time [s] (median)",
                     y_label,
                     series,
