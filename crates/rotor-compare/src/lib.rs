@@ -5,6 +5,7 @@ pub mod gate;
 pub mod report;
 pub mod run;
 pub mod snapshot;
+pub mod stress;
 
 pub use gate::{Failure, GateResult, Measured, check_pair};
 pub use run::{RunResult, ScenarioResult, SolverKind, run_scenario, solver_settings};
