@@ -8,3 +8,7 @@ ci:
 lint:
     cargo fmt --all -- --check
     cargo clippy --workspace --all-targets --release -- -D warnings
+# Numerical stress, full form (1e5 s horizon, whole tolerance and step ladders; minutes).
+# CI runs the fast form as part of `cargo test`.
+stress:
+    ROTOR_STRESS=full cargo test --release -p rotor-compare stress -- --nocapture
