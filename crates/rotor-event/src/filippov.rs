@@ -35,7 +35,7 @@ pub struct EventOptions {
     /// an error.
     pub zeno_count: u32,
     pub zeno_window: f64,
-    /// Interior sample points per step for guard detection.
+    /// Sample intervals per step for guard detection (at most 64).
     pub guard_samples: usize,
 }
 
@@ -50,6 +50,9 @@ impl Default for EventOptions {
         }
     }
 }
+
+/// Largest number of guard samples per step (the sample buffers live on the stack).
+const MAX_GUARD_SAMPLES: usize = 64;
 
 /// What to do with a run as it goes.
 pub(crate) trait Sink {
@@ -224,31 +227,48 @@ impl<'a> Integrator<'a> {
     fn detect(&self, d: &Dense<3>, t0: f64, t1: f64, mode: Mode) -> Option<(f64, Guard)> {
         let mut gs = [Guard::Section; 8];
         let n = self.guards(mode, &mut gs);
-        let m = self.opts.guard_samples.max(1);
+        let m = self.opts.guard_samples.clamp(1, MAX_GUARD_SAMPLES);
+        // The sample states and the vector field there, computed once and shared by every
+        // guard: the field gives the extremum guards' values and the velocity guards' rates
+        // (one friction evaluation per sample instead of one per guard and sample).
+        let mut ts = [0.0; MAX_GUARD_SAMPLES + 1];
+        let mut xs = [State::zeros(); MAX_GUARD_SAMPLES + 1];
+        let mut fs = [State::zeros(); MAX_GUARD_SAMPLES + 1];
+        for k in 0..=m {
+            ts[k] = if k == m {
+                t1
+            } else {
+                t0 + (t1 - t0) * k as f64 / m as f64
+            };
+            xs[k] = d.eval(ts[k]);
+            fs[k] = self.field(&xs[k], mode);
+        }
+        let value = |g: Guard, k: usize| match g {
+            Guard::Extremum(disc, _) => fs[k][disc.index()],
+            _ => self.guard(g, &xs[k], mode),
+        };
         let mut best: Option<(f64, Guard)> = None;
         for &g in &gs[..n] {
-            let mut ta = t0;
-            let mut xa = d.eval(ta);
-            let mut ga = self.guard(g, &xa, mode);
+            let mut ga = value(g, 0);
             for i in 1..=m {
-                let tb = if i == m {
-                    t1
-                } else {
-                    t0 + (t1 - t0) * i as f64 / m as f64
-                };
+                let (ta, tb) = (ts[i - 1], ts[i]);
                 if let Some((bt, _)) = best
                     && ta >= bt
                 {
                     break;
                 }
-                let xb = d.eval(tb);
-                let gb = self.guard(g, &xb, mode);
+                let gb = value(g, i);
                 let mut hit = Self::fires(g, ga, gb).map(|kind| (ta, tb, ga, kind));
                 // A shallow dip of a velocity guard between two positive samples: look for
                 // the minimum (root of the guard's rate) and test its value.
-                if hit.is_none() && matches!(g, Guard::Velocity(_)) && ga > 0.0 && gb > 0.0 {
-                    let ra = self.guard_rate(g, &xa, mode);
-                    let rb = self.guard_rate(g, &xb, mode);
+                if hit.is_none()
+                    && let Guard::Velocity(disc) = g
+                    && ga > 0.0
+                    && gb > 0.0
+                {
+                    let s = mode.of(disc).branch().unwrap_or(1.0);
+                    let ra = s * fs[i - 1][disc.index()];
+                    let rb = s * fs[i][disc.index()];
                     if ra < 0.0 && rb > 0.0 {
                         let rate = |t: f64| self.guard_rate(g, &d.eval(t), mode);
                         let tm = illinois(&rate, ta, tb, ra, rb);
@@ -271,8 +291,6 @@ impl<'a> Integrator<'a> {
                     }
                     break;
                 }
-                ta = tb;
-                xa = xb;
                 ga = gb;
             }
         }
