@@ -83,7 +83,13 @@
 //! The default matches the second-order behaviour measured with Siconos 4.4's
 //! `MoreauJeanOSI` on this model (6e-5, 8e-7, 1e-8). Friction events keep the velocity
 //! continuous (no impacts), so the O(h²) local error of a step containing a stick onset or
-//! exit does not spoil the global order. Cost: about 0.4 µs per step (h = 1e-4, 60 s:
+//! exit does not spoil the global order. **Not across a velocity reversal:** a disc whose
+//! velocity passes through zero without sticking is held at rest for the one step that
+//! contains the reversal (reported as a StickStart/StickEnd pair, not a Reversal), a local
+//! error O(h) that makes the global error first order (measured by rotor-compare's stress
+//! case "far from rest": 2.2e-4, 1.9e-5, 3.8e-6 rad/s at h = 1e-3, 1e-4, 1e-5). No fixture
+//! scenario has a reversal; the second order above holds on stick-slip and slipping cycles.
+//! Cost: about 0.4 µs per step (h = 1e-4, 60 s:
 //! 6e5 steps in 0.23 s on one core), ~2.1 Newton iterations per step, and about 80 % of the
 //! steps skip the enumeration.
 //!
@@ -130,7 +136,7 @@ pub use stepper::{StepOutcome, Stepper};
 pub enum FrictionLevel {
     /// θ-weighted between the start and the end of the step, solved together with the
     /// one-step problem by Newton (as Siconos does with `F_int` in its Newton loop).
-    /// Second order with θ = 1/2.
+    /// Second order with θ = 1/2 (first order across a velocity reversal; see the crate docs).
     #[default]
     Implicit,
     /// Taken at the start of the step: first order, one linear pass per step.
