@@ -12,3 +12,6 @@ lint:
 # CI runs the fast form as part of `cargo test`.
 stress:
     ROTOR_STRESS=full cargo test --release -p rotor-compare stress -- --nocapture
+# Work-precision benchmark with peers (scipy, Siconos when installed), into reports/bench/.
+bench:
+    cargo run --release -- bench --json reports/bench/bench.json --svg reports/bench/bench.svg --csv reports/bench/bench.csv

@@ -59,6 +59,26 @@ enum Command {
         #[arg(long)]
         csv: Option<PathBuf>,
     },
+    /// Work-precision benchmark: each solver over a ladder of tolerances / steps, error
+    /// against a tight reference, median run time, counters; peers (scipy, Siconos) side by
+    /// side when installed. Prints a table.
+    Bench {
+        /// Output JSON file.
+        #[arg(long)]
+        json: Option<PathBuf>,
+        /// Output SVG work-precision plot (error against run time, log-log).
+        #[arg(long)]
+        svg: Option<PathBuf>,
+        /// Output CSV file.
+        #[arg(long)]
+        csv: Option<PathBuf>,
+        /// A short ladder over a 30 s horizon without peers (seconds instead of a minute).
+        #[arg(long)]
+        quick: bool,
+        /// Skip the peers even when python3 with scipy / Siconos is installed.
+        #[arg(long)]
+        no_peers: bool,
+    },
     /// Run scenarios through the three solvers, gate their agreement, write the report.
     Compare {
         /// Scenario files (default: every fixtures/scenarios/*.toml).
@@ -134,6 +154,17 @@ fn parse_x0(s: Option<&str>) -> Result<State> {
     Ok(x)
 }
 
+/// Moreau–Jean steps whose step problem did not converge are answers to distrust: say so.
+fn warn_inexact(stats: &rotor_model::Stats) {
+    if stats.inexact_steps > 0 {
+        eprintln!(
+            "warning: {} of {} steps fell back to an inexact iteration (the step is too large \
+             for the friction law's slope); reduce --h",
+            stats.inexact_steps, stats.steps
+        );
+    }
+}
+
 /// Checks a numeric option: finite and in range, naming the flag and the value.
 fn check(flag: &str, v: f64, ok: bool, what: &str) -> Result<()> {
     if !v.is_finite() || !ok {
@@ -170,6 +201,7 @@ fn simulate(common: &Common, t_end: f64, dt: f64, csv_path: &Path) -> Result<()>
     let traj = solver
         .simulate(&model, &scene)
         .with_context(|| format!("solver {}", solver.name()))?;
+    warn_inexact(&traj.stats);
     let mut buf = Vec::with_capacity(traj.samples.len() * 64);
     writeln!(buf, "t,alpha,omega_u,omega_l")?;
     for s in &traj.samples {
@@ -213,6 +245,7 @@ fn steady(common: &Common) -> Result<()> {
             let mut scene = scene_from(common, t_end, Output::Final)?;
             scene.metrics_from = Some(0.5 * t_end);
             let traj = solver.simulate(&model, &scene)?;
+            warn_inexact(&traj.stats);
             traj.metrics
                 .ok_or_else(|| anyhow!("solver {other} returned no metrics"))?
         }
@@ -274,6 +307,38 @@ fn bifurcation(
     );
     for p in &d.points {
         println!("  {}", serde_json::to_string(p)?);
+    }
+    Ok(())
+}
+
+fn bench(
+    json: Option<&Path>,
+    svg: Option<&Path>,
+    csv: Option<&Path>,
+    quick: bool,
+    no_peers: bool,
+) -> Result<()> {
+    use rotor_compare::report::write_atomic;
+    let mut opts = if quick {
+        rotor_bench::BenchOptions::quick()
+    } else {
+        rotor_bench::BenchOptions::default()
+    };
+    if no_peers {
+        opts.peers.scipy = false;
+        opts.peers.siconos = false;
+    }
+    let report = rotor_bench::run(&opts, |m| eprintln!("{m}"))?;
+    print!("{}", report.table());
+    for (path, text) in [
+        (json, report.to_json()),
+        (svg, report.to_svg()),
+        (csv, report.to_csv()),
+    ] {
+        if let Some(path) = path {
+            write_atomic(path, text.as_bytes())
+                .with_context(|| format!("{}: cannot write", path.display()))?;
+        }
     }
     Ok(())
 }
@@ -349,6 +414,32 @@ fn bifurcation_section(sets: &[(&str, &str, Params)]) -> Result<rotor_compare::r
     Ok(sec)
 }
 
+/// The report section with the numerical stress cases in their fast form (the full form:
+/// `just stress`).
+fn stress_section() -> rotor_compare::report::Section {
+    use rayon::prelude::*;
+    use rotor_compare::stress;
+    let rows: Vec<_> = stress::cases(false)
+        .par_iter()
+        .flat_map(stress::run_case)
+        .collect();
+    let failed = rows.iter().filter(|r| !r.passes()).count();
+    rotor_compare::report::Section {
+        markdown: format!(
+            "## Numerical stress (fast form)\n\n\
+             Each case pushes one thing to an extreme (crate `rotor-compare`, module `stress`; \
+             the full form with long horizons and the widest ladders runs with `just stress`). \
+             Every solver must finish with a finite state or a typed error that says why, and \
+             where it finishes agree with the event-driven solver or an exact solution within \
+             the stated gate. {} rows, {} outside their gate.\n\n{}",
+            rows.len(),
+            failed,
+            stress::stress_table_markdown(&rows)
+        ),
+        files: Vec::new(),
+    }
+}
+
 /// `rotor compare`; with `main_job`, the report also gets the bifurcation diagrams.
 fn compare(files: &[PathBuf], report: &Path, main_job: bool) -> Result<()> {
     use rayon::prelude::*;
@@ -396,7 +487,8 @@ fn compare(files: &[PathBuf], report: &Path, main_job: bool) -> Result<()> {
         },
         || -> Result<Vec<rotor_compare::report::Section>> {
             if main_job {
-                Ok(vec![bifurcation_section(&sets)?])
+                let (bif, stress) = rayon::join(|| bifurcation_section(&sets), stress_section);
+                Ok(vec![bif?, stress])
             } else {
                 Ok(Vec::new())
             }
@@ -502,6 +594,19 @@ fn main() -> ExitCode {
             json,
             svg.as_deref(),
             csv.as_deref(),
+        ),
+        Some(Command::Bench {
+            json,
+            svg,
+            csv,
+            quick,
+            no_peers,
+        }) => bench(
+            json.as_deref(),
+            svg.as_deref(),
+            csv.as_deref(),
+            *quick,
+            *no_peers,
         ),
         Some(Command::Compare { scenarios, report }) => compare(scenarios, report, false),
         None => compare(&[], Path::new("reports"), true),

@@ -231,6 +231,20 @@ fn fmt_metrics(st: &Option<SteadyState>) -> String {
     }
 }
 
+/// Removes the hidden temporaries (`.NAME.tmpPID`, see [`write_atomic`]) that a killed run
+/// left behind. The report files themselves are never touched: they are whole, old or new.
+fn remove_stale_temporaries(dir: &Path) -> std::io::Result<()> {
+    for entry in std::fs::read_dir(dir)? {
+        let entry = entry?;
+        let name = entry.file_name();
+        let name = name.to_string_lossy();
+        if name.starts_with('.') && name.contains(".tmp") && entry.file_type()?.is_file() {
+            std::fs::remove_file(entry.path())?;
+        }
+    }
+    Ok(())
+}
+
 /// A further section of the report (the bifurcation diagrams, the stress table, ...): its
 /// markdown, appended to `README.md`, and the files it links, written atomically beside it.
 #[derive(Debug, Clone, Default)]
@@ -249,6 +263,7 @@ pub fn write_report(
     sections: &[Section],
 ) -> std::io::Result<Vec<Failure>> {
     std::fs::create_dir_all(dir)?;
+    remove_stale_temporaries(dir)?;
     let mut md = String::new();
     let mut all_fails = Vec::new();
     md.push_str(include_str!("report_intro.md"));
@@ -326,4 +341,32 @@ pub fn write_report(
     }
     write_atomic(&dir.join("README.md"), md.as_bytes())?;
     Ok(all_fails)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn atomic_writes_replace_whole_files_and_stale_temporaries_go() {
+        let dir = std::env::temp_dir().join(format!("rotor-report-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let file = dir.join("a.csv");
+        write_atomic(&file, b"old\n").unwrap();
+        write_atomic(&file, b"new\n").unwrap();
+        assert_eq!(std::fs::read(&file).unwrap(), b"new\n");
+        // What a killed run leaves: a hidden temporary. The next report removes it and
+        // leaves the report files alone.
+        let stale = dir.join(".a.csv.tmp12345");
+        std::fs::write(&stale, b"partial").unwrap();
+        remove_stale_temporaries(&dir).unwrap();
+        assert!(!stale.exists());
+        assert_eq!(std::fs::read(&file).unwrap(), b"new\n");
+        let names: Vec<_> = std::fs::read_dir(&dir)
+            .unwrap()
+            .map(|e| e.unwrap().file_name())
+            .collect();
+        assert_eq!(names, vec![std::ffi::OsString::from("a.csv")]);
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
 }
