@@ -151,3 +151,28 @@ fn bifurcation_writes_the_contract_json_and_a_figure() {
     assert!(err.contains("--u-max") && err.contains('1'), "{err}");
     assert!(!dir.join("bad.json").exists());
 }
+
+#[test]
+fn bench_quick_prints_the_table_and_writes_the_plot() {
+    let dir = std::env::temp_dir().join(format!("rotor-cli-bench-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let (json, svg) = (dir.join("b.json"), dir.join("b.svg"));
+    let o = rotor(&[
+        "bench",
+        "--quick",
+        "--json",
+        json.to_str().unwrap(),
+        "--svg",
+        svg.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let table = String::from_utf8_lossy(&o.stdout);
+    for solver in ["event", "switch", "moreau"] {
+        assert!(table.contains(solver), "{table}");
+    }
+    let v: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    assert!(v.is_object());
+    let figure = std::fs::read_to_string(&svg).unwrap();
+    assert!(figure.starts_with("<svg") && !figure.contains("NaN"));
+}
