@@ -2,10 +2,7 @@
 
 use std::time::Instant;
 
-use rotor_event::EventSolver;
 use rotor_model::{OMEGA_L, Output, Scene, SolveError, Solver, SteadyState, Trajectory};
-use rotor_moreau::MoreauSolver;
-use rotor_switch::SwitchSolver;
 use serde::Serialize;
 
 use crate::options::SolverKind;
@@ -65,11 +62,7 @@ pub fn timed<T, E>(
 
 /// The solver of a kind, with its default options.
 pub fn solver(kind: SolverKind) -> Box<dyn Solver> {
-    match kind {
-        SolverKind::Event => Box::new(EventSolver::default()),
-        SolverKind::Switch => Box::new(SwitchSolver::default()),
-        SolverKind::Moreau => Box::new(MoreauSolver::default()),
-    }
+    kind.solver()
 }
 
 /// The scene for one solver at one accuracy setting (tol, or h for Moreau–Jean).

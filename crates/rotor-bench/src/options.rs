@@ -2,41 +2,7 @@
 
 use std::path::{Path, PathBuf};
 
-use serde::Serialize;
-
-/// One solver of the workspace.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash, Serialize)]
-#[serde(rename_all = "lowercase")]
-pub enum SolverKind {
-    /// `rotor-event`: event-driven Filippov (DOP853), the accuracy reference.
-    Event,
-    /// `rotor-switch`: Leine's switch model (DOPRI5).
-    Switch,
-    /// `rotor-moreau`: Moreau–Jean time-stepping.
-    Moreau,
-}
-
-impl SolverKind {
-    /// All solvers, in report order.
-    pub const ALL: [SolverKind; 3] = [SolverKind::Event, SolverKind::Switch, SolverKind::Moreau];
-
-    /// Short name (as the CLI's `--solver`).
-    pub fn name(self) -> &'static str {
-        match self {
-            SolverKind::Event => "event",
-            SolverKind::Switch => "switch",
-            SolverKind::Moreau => "moreau",
-        }
-    }
-
-    /// Name of the accuracy setting: `tol` for the adaptive solvers, `h` for Moreau–Jean.
-    pub fn setting_name(self) -> &'static str {
-        match self {
-            SolverKind::Moreau => "h",
-            _ => "tol",
-        }
-    }
-}
+pub use rotor_compare::SolverKind;
 
 /// One benchmark scene: a scenario file, a horizon, and the windows the errors are read on.
 #[derive(Debug, Clone, PartialEq)]

@@ -8,14 +8,27 @@ use rotor_model::{Model, Output, Scenario, Scene, SolveError, Solver, Trajectory
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash, serde::Serialize)]
 #[serde(rename_all = "lowercase")]
 pub enum SolverKind {
+    /// `rotor-event`: event-driven Filippov (DOP853), the accuracy reference.
     Event,
+    /// `rotor-switch`: Leine's switch model (DOPRI5).
     Switch,
+    /// `rotor-moreau`: Moreau–Jean time-stepping.
     Moreau,
 }
 
 impl SolverKind {
+    /// All solvers, in report order.
     pub const ALL: [SolverKind; 3] = [SolverKind::Event, SolverKind::Switch, SolverKind::Moreau];
 
+    /// Name of the accuracy setting: `tol` for the adaptive solvers, `h` for Moreau–Jean.
+    pub fn setting_name(self) -> &'static str {
+        match self {
+            SolverKind::Moreau => "h",
+            _ => "tol",
+        }
+    }
+
+    /// Short name (as the CLI's `--solver`).
     pub fn name(self) -> &'static str {
         match self {
             SolverKind::Event => "event",
@@ -24,7 +37,8 @@ impl SolverKind {
         }
     }
 
-    fn solver(self) -> Box<dyn Solver> {
+    /// The solver of this kind, with its default options.
+    pub fn solver(self) -> Box<dyn Solver> {
         match self {
             SolverKind::Event => Box::new(rotor_event::EventSolver::default()),
             SolverKind::Switch => Box::new(rotor_switch::SwitchSolver::default()),
