@@ -29,7 +29,23 @@ pub enum Friction {
 #[inline]
 fn tanh_fast(y: f64) -> f64 {
     let e = (2.0 * y.abs()).exp();
-    (1.0 - 2.0 / (e + 1.0)).copysign(y)
+    // 2·(1/(e + 1)) rounds exactly as 2/(e + 1) (scaling by 2 commutes with rounding):
+    // the same bits as tanh_sech2's tanh, from one division there.
+    (1.0 - 2.0 * (1.0 / (e + 1.0))).copysign(y)
+}
+
+/// `(tanh y, sech² y)` from one `exp`: with `e = e^{2|y|}`, `tanh y` as in [`tanh_fast`] and
+/// `sech² y = 4/(e^y + e^{−y})² = 4e/(e + 1)²` (0 once `e` overflows, where sech² < 1e-300).
+#[inline]
+fn tanh_sech2(y: f64) -> (f64, f64) {
+    let e = (2.0 * y.abs()).exp();
+    let inv = 1.0 / (e + 1.0);
+    let sech2 = if e.is_finite() {
+        4.0 * e * inv * inv
+    } else {
+        0.0
+    };
+    ((1.0 - 2.0 * inv).copysign(y), sech2)
 }
 
 impl Friction {
@@ -79,14 +95,31 @@ impl Friction {
 
     /// `d level_ext / dx`.
     pub fn dlevel_ext(&self, x: f64) -> f64 {
+        self.level_ext_with_slope(x).1
+    }
+
+    /// `(level_ext(x), d level_ext/dx)` together, sharing the exponentials: one `exp` per
+    /// tanh term of the exponential family, whose slope is `(w/2)·T·sech²(wx/2)` with
+    /// `sech² y = 4e/(e + 1)²`, `e = e^{2|y|}` (the `e` of [`tanh_fast`]); one `exp` and one
+    /// `powf` for the Stribeck family. The level equals [`Friction::level_ext`] bit for bit.
+    #[inline]
+    pub fn level_ext_with_slope(&self, x: f64) -> (f64, f64) {
         match *self {
-            Friction::Upper(_) => 0.0,
+            Friction::Upper(p) => (p.t_s, 0.0),
             Friction::Lower(LowerFriction::Exponential {
-                t_1, t_2, w_1, w_2, ..
+                t_s,
+                t_1,
+                t_2,
+                w_1,
+                w_2,
+                ..
             }) => {
-                let s1 = 1.0 / (0.5 * w_1 * x).cosh();
-                let s2 = 1.0 / (0.5 * w_2 * x).cosh();
-                0.5 * t_1 * w_1 * s1 * s1 + 0.5 * t_2 * w_2 * s2 * s2
+                let (th1, sech1) = tanh_sech2(0.5 * w_1 * x);
+                let (th2, sech2) = tanh_sech2(0.5 * w_2 * x);
+                (
+                    t_s + t_1 * th1 + t_2 * th2,
+                    0.5 * t_1 * w_1 * sech1 + 0.5 * t_2 * w_2 * sech2,
+                )
             }
             Friction::Lower(LowerFriction::Stribeck {
                 t_s,
@@ -96,18 +129,25 @@ impl Friction {
                 ..
             }) => {
                 let a = x.abs();
+                let r = (a / omega_s).powf(delta);
+                let decay = (-r).exp();
+                let level = t_c + (t_s - t_c) * decay;
                 if a == 0.0 {
                     // d/da e^{-(a/ω_s)^δ} at 0: 0 for δ > 1, −1/ω_s for δ = 1, −∞ for δ < 1.
-                    return if delta > 1.0 {
+                    let slope = if delta > 1.0 {
                         0.0
                     } else if delta == 1.0 {
                         -(t_s - t_c) / omega_s
                     } else {
                         f64::NEG_INFINITY * (t_s - t_c).signum()
                     };
+                    return (level, slope);
                 }
-                let r = (a / omega_s).powf(delta);
-                -(t_s - t_c) * (-r).exp() * delta * r / a * x.signum()
+                if decay == 0.0 {
+                    // r overflowed (or e^{−r} underflowed): the slope is 0, not 0·∞.
+                    return (level, 0.0);
+                }
+                (level, -(t_s - t_c) * decay * delta * r / a * x.signum())
             }
         }
     }
@@ -258,6 +298,31 @@ mod tests {
                     let fd = (f.torque(w + d, s) - f.torque(w - d, s)) / (2.0 * d);
                     // Central difference: truncation O(d²·T''') ~ 1e-10, rounding ~1e-16/d ~ 1e-10.
                     assert_relative_eq!(f.dtorque(w, s), fd, epsilon = 1e-8, max_relative = 1e-7);
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn level_with_slope_matches_the_separate_forms() {
+        for f in laws() {
+            for x in [
+                -1e300, -40.0, -3.0, -0.2, 0.0, 1e-9, 0.2, 3.0, 40.0, 700.0, 1e300,
+            ] {
+                let (n, dn) = f.level_ext_with_slope(x);
+                // The level is the same expression: bit for bit.
+                assert_eq!(n.to_bits(), f.level_ext(x).to_bits(), "{f:?} x={x}");
+                assert!(dn.is_finite(), "{f:?} x={x}: slope {dn}");
+                // The exponential family's slope against the textbook form (w/2)·T/cosh²:
+                // both are a few roundings of the same quantity, 1e-14 relative.
+                if let Friction::Lower(LowerFriction::Exponential {
+                    t_1, t_2, w_1, w_2, ..
+                }) = f
+                {
+                    let c1 = (0.5 * w_1 * x).cosh();
+                    let c2 = (0.5 * w_2 * x).cosh();
+                    let text = 0.5 * t_1 * w_1 / (c1 * c1) + 0.5 * t_2 * w_2 / (c2 * c2);
+                    assert_relative_eq!(dn, text, epsilon = 1e-300, max_relative = 1e-14);
                 }
             }
         }
