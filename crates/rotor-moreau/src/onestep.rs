@@ -108,6 +108,7 @@ impl OneStepProblem {
     /// The linear solve of one mode: slipping discs' velocities and stuck discs' impulses.
     /// `None` if the mode's matrix is singular or not positive on its diagonal (no solution
     /// of that mode then exists in the sense of a well-posed branch).
+    #[inline]
     pub fn solve_mode(&self, mode: [DiscMode; 2]) -> Option<OneStepSolution> {
         let mut v = Vector2::zeros();
         let mut r = Vector2::zeros();
@@ -131,8 +132,9 @@ impl OneStepProblem {
                 }
                 let y0 = self.b[0] + b0.c;
                 let y1 = self.b[1] + b1.c;
-                v[0] = (m[(1, 1)] * y0 - m[(0, 1)] * y1) / det;
-                v[1] = (m[(0, 0)] * y1 - m[(1, 0)] * y0) / det;
+                let inv_det = 1.0 / det;
+                v[0] = (m[(1, 1)] * y0 - m[(0, 1)] * y1) * inv_det;
+                v[1] = (m[(0, 0)] * y1 - m[(1, 0)] * y0) * inv_det;
             }
             (Some((_, bi)), None) | (None, Some((_, bi))) => {
                 let i = if slip[0].is_some() { 0 } else { 1 };

@@ -58,14 +58,81 @@ struct BranchEval {
     d_level: f64,
 }
 
+#[inline(always)]
 fn eval_branch(f: &Friction, db: f64, w: f64, s: f64) -> BranchEval {
-    let x = s * w;
+    let (level, slope) = f.level_ext_with_slope(s * w);
     BranchEval {
         off: -f.offset(w, s),
         d_off: -s * db,
-        level: f.level_ext(x),
-        d_level: s * f.dlevel_ext(x),
+        level,
+        d_level: s * slope,
     }
+}
+
+/// What the slip branches of one step are built from: the step's constants and the
+/// friction evaluations at the start velocity.
+struct BranchCtx<'a> {
+    stepper: &'a Stepper,
+    /// `hθ`.
+    ht: f64,
+    implicit: bool,
+    p_start: [f64; 2],
+    v: Vector2<f64>,
+    /// Branch sign and evaluation at the start velocity, per disc.
+    start: [(f64, Option<BranchEval>); 2],
+}
+
+impl BranchCtx<'_> {
+    /// The affine slip branch of disc i, sign s, linearised at w, from the friction
+    /// evaluation `e` of that branch at w.
+    #[inline(always)]
+    fn affine(&self, i: usize, s: f64, w: f64, e: BranchEval) -> Branch {
+        let ht = self.ht;
+        // Total friction impulse φ(ω) = hθ·smooth(ω) − s·P(ω).
+        let (mut phi, mut dphi) = (ht * e.off, ht * e.d_off);
+        let (mut p, mut dp) = (self.p_start[i], 0.0);
+        if self.implicit {
+            if e.level > 0.0 {
+                p += ht * e.level;
+                dp = ht * e.d_level;
+            } else {
+                phi += -s * ht * e.level;
+                dphi += -s * ht * e.d_level;
+            }
+        }
+        phi -= s * p;
+        dphi -= s * dp;
+        Branch {
+            c: phi - dphi * w,
+            d: dphi,
+            pc: p - dp * w,
+            pd: dp,
+        }
+    }
+
+    /// The branch of disc i, sign s, at w; `evals` counts fresh evaluations only. The
+    /// start evaluation serves at w = v, and at any w when the law is affine (its
+    /// linearisation at v is the branch itself).
+    #[inline(always)]
+    fn branch(&self, i: usize, s: f64, w: f64, evals: &mut u32) -> Branch {
+        let st = self.stepper;
+        if let (s0, Some(e0)) = self.start[i]
+            && s0 == s
+            && (st.affine_law[i] || w.to_bits() == self.v[i].to_bits())
+        {
+            return self.affine(i, s, self.v[i], e0);
+        }
+        *evals += 1;
+        self.affine(i, s, w, eval_branch(&st.law[i], st.db[i], w, s))
+    }
+}
+
+/// The data of one step size: `h`, the iteration matrix `M̂` and `W = M̂⁻¹`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct StepSize {
+    pub h: f64,
+    pub a: Matrix2<f64>,
+    pub w_inv: Matrix2<f64>,
 }
 
 /// Precomputed data of one run: the Lagrangian matrices' entries and the friction laws.
@@ -75,12 +142,20 @@ pub struct Stepper {
     level: FrictionLevel,
     max_newton: u32,
     skip_free: bool,
+    estimate_stop: bool,
+    /// Whether disc i's slip branches are affine in ω (the upper disc's law, eq. (4): a
+    /// constant level and the offset `ΔT_su + Δb_u|ω|`): its linearisation is then exact.
+    affine_law: [bool; 2],
     j: [f64; 2],
     c: [f64; 2],
     k: f64,
     f_ext: f64,
     law: [Friction; 2],
     db: [f64; 2],
+    /// `max(N_i(0), 0)`: the half-width of disc i's stick interval.
+    n_zero: [f64; 2],
+    /// `−a_i(0)`: the smooth friction force on a stuck disc.
+    off_zero: [f64; 2],
 }
 
 impl Stepper {
@@ -97,12 +172,17 @@ impl Stepper {
             level: options.friction_level,
             max_newton: options.max_newton,
             skip_free: options.skip_free_steps,
+            estimate_stop: options.newton_estimate_stop,
+            affine_law: [Disc::Upper, Disc::Lower]
+                .map(|d| matches!(model.friction(d), Friction::Upper(_))),
             j: [l.m[(0, 0)], l.m[(1, 1)]],
             c: [l.c[(0, 0)], l.c[(1, 1)]],
             k: l.k[(0, 0)],
             f_ext: l.f_ext(u)[0],
             law: [*model.friction(Disc::Upper), *model.friction(Disc::Lower)],
             db: [db_u, 0.0],
+            n_zero: [Disc::Upper, Disc::Lower].map(|d| model.friction(d).level(0.0).max(0.0)),
+            off_zero: [Disc::Upper, Disc::Lower].map(|d| -model.friction(d).offset(0.0, 1.0)),
         }
     }
 
@@ -118,12 +198,28 @@ impl Stepper {
         )
     }
 
+    /// The step-size dependent data: `M̂` and its inverse (`t` only names the time in the
+    /// error). Computed once per run for the constant step.
+    pub fn step_size(&self, t: f64, h: f64) -> Result<StepSize, SolveError> {
+        let a = self.iteration_matrix(h);
+        let w_inv = a.try_inverse().ok_or_else(|| SolveError::Complementarity {
+            t,
+            detail: format!("singular iteration matrix at h = {h:e}"),
+        })?;
+        Ok(StepSize { h, a, w_inv })
+    }
+
     /// One step of size `h` from `x` (at time `t`, for error reports).
     pub fn step(&self, t: f64, x: &State, h: f64) -> Result<StepOutcome, SolveError> {
+        self.step_with(t, x, &self.step_size(t, h)?)
+    }
+
+    /// One step from `x` with the precomputed [`StepSize`].
+    pub fn step_with(&self, t: f64, x: &State, size: &StepSize) -> Result<StepOutcome, SolveError> {
         let th = self.theta;
         let implicit = self.level == FrictionLevel::Implicit;
         let v = Vector2::new(x[1], x[2]);
-        let a = self.iteration_matrix(h);
+        let StepSize { h, a, w_inv } = *size;
         let mut evals = 0u32;
 
         // Start-of-step terms.
@@ -135,18 +231,22 @@ impl Stepper {
             (self.j[1] - (1.0 - th) * h * self.c[1]) * v[1] + th * (1.0 - th) * h * h * kv + h * kq,
         );
         // Start-of-step contact bound part and stick data.
+        // The friction of branch s0 = sign(v_i) at the start velocity is evaluated once here
+        // and reused by the skip test and by the first Newton iteration (which linearise at
+        // w = v on the same branch): one evaluation per disc instead of three.
         let mut p_start = [0.0; 2];
         let mut stick = [StickData::default(); 2];
+        let mut start = [(1.0, None::<BranchEval>); 2];
         for i in 0..2 {
             let s0 = if v[i] < 0.0 { -1.0 } else { 1.0 };
             let e0 = eval_branch(&self.law[i], self.db[i], v[i], s0);
+            start[i] = (s0, Some(e0));
             evals += 1;
             // Negative part of the level, as a smooth force −sign(ω)·min(N, 0).
             let neg0 = -s0 * e0.level.min(0.0);
             let npos0 = e0.level.max(0.0);
             // The level at ω = 0 (stick): N(0) ≥ 0 is the half-width of the interval.
-            let n_zero = self.law[i].level(0.0).max(0.0);
-            let off_zero = -self.law[i].offset(0.0, 1.0);
+            let (n_zero, off_zero) = (self.n_zero[i], self.off_zero[i]);
             if implicit {
                 b[i] += h * (1.0 - th) * (e0.off + neg0);
                 p_start[i] = h * (1.0 - th) * npos0;
@@ -164,37 +264,18 @@ impl Stepper {
             }
         }
 
-        // The affine slip branch of disc i, sign s, linearised at w.
-        let branch = |i: usize, s: f64, w: f64| -> Branch {
-            let e = eval_branch(&self.law[i], self.db[i], w, s);
-            // Total friction impulse φ(ω) = hθ·smooth(ω) − s·P(ω).
-            let (mut phi, mut dphi) = (h * th * e.off, h * th * e.d_off);
-            let (mut p, mut dp) = (p_start[i], 0.0);
-            if implicit {
-                if e.level > 0.0 {
-                    p += h * th * e.level;
-                    dp = h * th * e.d_level;
-                } else {
-                    phi += -s * h * th * e.level;
-                    dphi += -s * h * th * e.d_level;
-                }
-            }
-            phi -= s * p;
-            dphi -= s * dp;
-            Branch {
-                c: phi - dphi * w,
-                d: dphi,
-                pc: p - dp * w,
-                pd: dp,
-            }
+        let ctx = BranchCtx {
+            stepper: self,
+            ht: h * th,
+            implicit,
+            p_start,
+            v,
+            start,
         };
+        let branch = |i: usize, s: f64, w: f64, evals: &mut u32| ctx.branch(i, s, w, evals);
 
         // Skip test (the spec's criterion): the frozen-bound free velocity of each disc is
         // more than twice as far from 0 as any admissible impulse can move it.
-        let w_inv = a.try_inverse().ok_or_else(|| SolveError::Complementarity {
-            t,
-            detail: "singular iteration matrix".into(),
-        })?;
         let mut skip = self.skip_free;
         {
             let mut rhs = b;
@@ -205,8 +286,7 @@ impl Stepper {
                     break;
                 }
                 let s = v[i].signum();
-                let br = branch(i, s, v[i]);
-                evals += 1;
+                let br = branch(i, s, v[i], &mut evals);
                 rhs[i] += br.c + br.d * v[i] + s * (br.pc + br.pd * v[i]);
                 pmax[i] = (br.pc + br.pd * v[i]).abs();
             }
@@ -231,25 +311,27 @@ impl Stepper {
             let s = [v[0].signum(), v[1].signum()];
             let mode = [DiscMode::slip_of(v[0]), DiscMode::slip_of(v[1])];
             let mut w = v;
+            let mut dv_prev = f64::INFINITY;
+            let mut prob = OneStepProblem {
+                a,
+                b,
+                slip: [[Branch::default(); 2]; 2],
+                stick,
+            };
             for _ in 0..self.max_newton {
                 newton_iters += 1;
-                let mut prob = OneStepProblem {
-                    a,
-                    b,
-                    slip: [[Branch::default(); 2]; 2],
-                    stick,
-                };
                 for i in 0..2 {
                     let bi = if s[i] > 0.0 { 0 } else { 1 };
-                    prob.slip[i][bi] = branch(i, s[i], w[i]);
-                    evals += 1;
+                    prob.slip[i][bi] = branch(i, s[i], w[i], &mut evals);
                 }
                 let Some(sol) = prob.solve_mode(mode) else {
                     break;
                 };
                 let dv = (sol.v - w).amax();
                 w = sol.v;
-                if !implicit || dv <= 1e-12 * (1.0 + w.amax()) {
+                let done = self.converged(mode, dv, dv_prev, w.amax());
+                dv_prev = dv;
+                if done {
                     if OneStepProblem::is_admissible(&sol, 0.0, 0.0) {
                         result = Some(sol);
                     }
@@ -264,18 +346,21 @@ impl Stepper {
             // Semi-smooth Newton: linearise, solve the piecewise-linear problem exactly.
             let mut w = v;
             let mut prev: Option<[DiscMode; 2]> = None;
+            let mut dv_prev = f64::INFINITY;
             let mut newton_failed = false;
+            let mut prob = OneStepProblem {
+                a,
+                b,
+                slip: [[Branch::default(); 2]; 2],
+                stick,
+            };
             for _ in 0..self.max_newton {
                 newton_iters += 1;
-                let mut prob = OneStepProblem {
-                    a,
-                    b,
-                    slip: [[Branch::default(); 2]; 2],
-                    stick,
-                };
                 for i in 0..2 {
-                    prob.slip[i] = [branch(i, 1.0, w[i]), branch(i, -1.0, w[i])];
-                    evals += 2;
+                    prob.slip[i] = [
+                        branch(i, 1.0, w[i], &mut evals),
+                        branch(i, -1.0, w[i], &mut evals),
+                    ];
                 }
                 let Ok(sol) = prob.solve() else {
                     newton_failed = true;
@@ -285,7 +370,15 @@ impl Stepper {
                 let same = prev == Some(sol.mode);
                 w = sol.v;
                 prev = Some(sol.mode);
-                if !implicit || (same && dv <= 1e-12 * (1.0 + w.amax())) {
+                // A mode change makes the previous update no Newton step of this mode.
+                let done = self.converged(
+                    sol.mode,
+                    dv,
+                    if same { dv_prev } else { f64::INFINITY },
+                    w.amax(),
+                );
+                dv_prev = dv;
+                if (same || self.exact_linearisation(sol.mode)) && done {
                     result = Some(sol);
                     break;
                 }
@@ -366,6 +459,34 @@ impl Stepper {
             newton_iters,
             evals,
         })
+    }
+
+    /// Whether the linearised step problem of `mode` is the step problem itself: explicit
+    /// level, or every slipping disc has an affine law (a stuck disc's data are constants).
+    fn exact_linearisation(&self, mode: [DiscMode; 2]) -> bool {
+        self.level == FrictionLevel::Explicit
+            || (0..2).all(|i| mode[i] == DiscMode::Stick || self.affine_law[i])
+    }
+
+    /// Newton's stopping rule on the iterate `w` reached by the update `dv` (after the
+    /// update `dv_prev` in the same mode, ∞ if none), tolerance `1e-12·(1 + |w|)`: the
+    /// update is below it, or (with [`MoreauOptions::newton_estimate_stop`]) the
+    /// linearisation is exact, or the quadratic-convergence estimate of the *next* update,
+    /// `dv³/dv_prev²` (κ ≈ dv/dv_prev², next ≈ κ·dv²), is below a tenth of it with a
+    /// contraction dv/dv_prev ≤ 0.1 that shows the quadratic regime.
+    fn converged(&self, mode: [DiscMode; 2], dv: f64, dv_prev: f64, w_max: f64) -> bool {
+        let tol = 1e-12 * (1.0 + w_max);
+        if dv <= tol {
+            return true;
+        }
+        if !self.estimate_stop {
+            return self.level == FrictionLevel::Explicit;
+        }
+        if self.exact_linearisation(mode) {
+            return true;
+        }
+        // ρ = dv/dv_prev ≤ 0.1 and dv·ρ² ≤ 0.1·tol, multiplied out (no division).
+        dv_prev.is_finite() && dv <= 0.1 * dv_prev && dv * dv * dv <= 0.1 * tol * dv_prev * dv_prev
     }
 
     /// Checks a converged solution against the exact (not linearised) Coulomb conditions:

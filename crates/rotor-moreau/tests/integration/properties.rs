@@ -117,3 +117,46 @@ fn friction_never_injects_energy_along_a_run() {
         );
     }
 }
+
+/// The early Newton stop (error estimate, exact linearisation) against iterating until the
+/// update itself is below the tolerance `1e-12·(1 + |v|)`: from every state of a stick-slip
+/// run, both steps agree to that tolerance (the estimate claims a tenth of it), in the same
+/// mode, and the early stop saves iterations (else this test checks nothing).
+#[test]
+fn estimate_stop_agrees_with_the_strict_stop() {
+    for model in [Model::table1(), crate::stribeck()] {
+        for h in [1e-2, 1e-3] {
+            let est = Stepper::new(&model, 1.5, &MoreauOptions::default());
+            let strict = Stepper::new(
+                &model,
+                1.5,
+                &MoreauOptions {
+                    newton_estimate_stop: false,
+                    ..MoreauOptions::default()
+                },
+            );
+            let mut x = State::zeros();
+            let (mut it_est, mut it_strict) = (0u64, 0u64);
+            for k in 0..(30.0 / h) as usize {
+                let t = k as f64 * h;
+                let a = est.step(t, &x, h).unwrap();
+                let b = strict.step(t, &x, h).unwrap();
+                assert_eq!(a.mode, b.mode, "t = {t}, h = {h}");
+                let tol = 1e-12 * (1.0 + b.x.amax());
+                assert!(
+                    (a.x - b.x).amax() <= tol,
+                    "t = {t}, h = {h}: {:?} vs {:?}",
+                    a.x,
+                    b.x
+                );
+                it_est += u64::from(a.newton_iters);
+                it_strict += u64::from(b.newton_iters);
+                x = b.x;
+            }
+            assert!(
+                (it_est as f64) < 0.8 * it_strict as f64,
+                "h = {h}: {it_est} vs {it_strict} iterations"
+            );
+        }
+    }
+}
