@@ -20,6 +20,7 @@
 use rotor_model::{
     Disc, DiscMode, Event, EventKind, Mode, Model, OMEGA_L, SolveError, State, Stats, check_finite,
 };
+use std::cell::Cell;
 
 use crate::dop853::{Dense, Dop853};
 
@@ -110,6 +111,9 @@ pub(crate) struct Integrator<'a> {
     pub stats: Stats,
     pub extrema: bool,
     pub section: Option<f64>,
+    /// Vector-field evaluations outside the integrator's stages (guard samples, guard
+    /// rates, extremum guards), added to `stats.rhs_evals` when a run returns.
+    extra_evals: Cell<u64>,
 }
 
 impl<'a> Integrator<'a> {
@@ -124,11 +128,13 @@ impl<'a> Integrator<'a> {
             stats: Stats::default(),
             extrema: false,
             section: None,
+            extra_evals: Cell::new(0),
         }
     }
 
     #[inline]
     fn field(&self, x: &State, mode: Mode) -> State {
+        self.extra_evals.set(self.extra_evals.get() + 1);
         self.model.rhs(x, self.u, mode)
     }
 
@@ -147,7 +153,10 @@ impl<'a> Integrator<'a> {
                 let (lo, _) = self.model.friction(d).static_interval();
                 self.model.applied_torque(d, x, self.u) - lo
             }
-            Guard::Extremum(d, _) => self.model.disc_accel(d, x, self.u, mode.of(d)),
+            Guard::Extremum(d, _) => {
+                self.extra_evals.set(self.extra_evals.get() + 1);
+                self.model.disc_accel(d, x, self.u, mode.of(d))
+            }
             Guard::Section => x[OMEGA_L] - self.section.unwrap_or(0.0),
         }
     }
@@ -223,8 +232,20 @@ impl<'a> Integrator<'a> {
         }
     }
 
-    /// Finds the earliest guard event in the step `[t0, t1]` of dense output `d`.
-    fn detect(&self, d: &Dense<3>, t0: f64, t1: f64, mode: Mode) -> Option<(f64, Guard)> {
+    /// Finds the earliest guard event in `[t0, t1]` of the step with dense output `d`. The
+    /// step's end state and field `end = (y1, f1)` are known (the field was evaluated for
+    /// the dense output), and so is the start's when `t0` is the step's start: those samples
+    /// cost nothing, and the end sample is the state the next step starts from, so a guard
+    /// sign at a step boundary is the same for both steps.
+    fn detect(
+        &self,
+        d: &Dense<3>,
+        t0: f64,
+        t1: f64,
+        mode: Mode,
+        start: Option<(&State, &State)>,
+        end: (&State, &State),
+    ) -> Option<(f64, Guard)> {
         let mut gs = [Guard::Section; 8];
         let n = self.guards(mode, &mut gs);
         let m = self.opts.guard_samples.clamp(1, MAX_GUARD_SAMPLES);
@@ -240,8 +261,14 @@ impl<'a> Integrator<'a> {
             } else {
                 t0 + (t1 - t0) * k as f64 / m as f64
             };
-            xs[k] = d.eval(ts[k]);
-            fs[k] = self.field(&xs[k], mode);
+            match (k, start) {
+                (0, Some((x0, f0))) => (xs[k], fs[k]) = (*x0, *f0),
+                _ if k == m => (xs[k], fs[k]) = (*end.0, *end.1),
+                _ => {
+                    xs[k] = d.eval(ts[k]);
+                    fs[k] = self.field(&xs[k], mode);
+                }
+            }
         }
         let value = |g: Guard, k: usize| match g {
             Guard::Extremum(disc, _) => fs[k][disc.index()],
@@ -384,7 +411,14 @@ impl<'a> Integrator<'a> {
             // Earliest event in the step; non-terminal events before it are recorded.
             let mut t_lo = t;
             let mut stop_here = None;
-            while let Some((te, g)) = self.detect(&dense, t_lo, t1, mode) {
+            while let Some((te, g)) = self.detect(
+                &dense,
+                t_lo,
+                t1,
+                mode,
+                (t_lo == t).then_some((&x, &f0)),
+                (&tr.y1, &f1),
+            ) {
                 if g.terminal() {
                     stop_here = Some((te, g));
                     break;
@@ -406,7 +440,7 @@ impl<'a> Integrator<'a> {
                 if g == Guard::Section {
                     if sink.section(te, &xe) {
                         sink.step(&dense, t, te, &xe, mode);
-                        self.stats.rhs_evals += rhs_evals;
+                        self.stats.rhs_evals += rhs_evals + self.extra_evals.take();
                         return Ok(RunEnd { t: te, x: xe, mode });
                     }
                 } else {
@@ -414,7 +448,7 @@ impl<'a> Integrator<'a> {
                     sink.event(&ev);
                     if sink.stop_after(&ev) {
                         sink.step(&dense, t, te, &xe, mode);
-                        self.stats.rhs_evals += rhs_evals;
+                        self.stats.rhs_evals += rhs_evals + self.extra_evals.take();
                         return Ok(RunEnd { t: te, x: xe, mode });
                     }
                 }
@@ -480,7 +514,7 @@ impl<'a> Integrator<'a> {
                             }
                         }
                         if sink.stop_after(&ev) {
-                            self.stats.rhs_evals += rhs_evals;
+                            self.stats.rhs_evals += rhs_evals + self.extra_evals.take();
                             return Ok(RunEnd {
                                 t,
                                 x,
@@ -496,7 +530,7 @@ impl<'a> Integrator<'a> {
                 }
             }
         }
-        self.stats.rhs_evals += rhs_evals;
+        self.stats.rhs_evals += rhs_evals + self.extra_evals.take();
         Ok(RunEnd { t, x, mode })
     }
 
