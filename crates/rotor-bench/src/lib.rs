@@ -610,6 +610,73 @@ fn skipped(name: &str, setting_name: &'static str, status: &str, reason: String)
     }
 }
 
+/// One peer script to launch: whether it is on, its interpreter and the module that must
+/// import, its script and ladder flag, and the scenario's tolerance pair it must agree within.
+struct PeerLaunch<'a> {
+    name: &'static str,
+    setting_name: &'static str,
+    enabled: bool,
+    python: &'a str,
+    module: &'static str,
+    script: &'static str,
+    flag: &'static str,
+    settings: &'a [f64],
+    pair: &'static str,
+}
+
+/// What a peer that ran gave: its output, the points measured against the reference, and
+/// its agreement with the reference within the scenario's gate.
+struct Launched {
+    out: PeerOutput,
+    points: Vec<PeerPoint>,
+    agreement: Option<Agreement>,
+}
+
+/// Runs a peer script if it is turned on and its interpreter has the module; `Err` is the
+/// report of a peer that was skipped or failed.
+fn launch_peer(
+    pl: &PeerLaunch,
+    opts: &BenchOptions,
+    l: &Loaded,
+    progress: &mut impl FnMut(&str),
+) -> Result<Launched, Box<PeerReport>> {
+    let (name, setting) = (pl.name, pl.setting_name);
+    if !pl.enabled {
+        return Err(Box::new(skipped(
+            name,
+            setting,
+            "skipped",
+            "turned off in the options".into(),
+        )));
+    }
+    if let Err(why) = peers::available(pl.python, pl.module) {
+        progress(&format!("{name} peer skipped: {why}"));
+        return Err(Box::new(skipped(name, setting, "skipped", why)));
+    }
+    let list = peers::list(pl.settings);
+    progress(&format!(
+        "{}: {name} peer, {setting} = {list}",
+        l.scenario.name
+    ));
+    let mut args = peer_args(l, opts.repeats, opts.time_budget);
+    args.extend([pl.flag.to_string(), list]);
+    let out = peers::run_script(pl.python, &opts.peers.dir.join(pl.script), &args)
+        .map_err(|e| Box::new(skipped(name, setting, "failed", e.to_string())))?;
+    let points = peer_points(l, &out);
+    let origin = format!("scenario [tolerance.{}]", pl.pair);
+    let gate = l
+        .scenario
+        .tolerance
+        .get(pl.pair)
+        .map(|t| (origin.as_str(), *t));
+    let agreement = agreement(&points, gate);
+    Ok(Launched {
+        out,
+        points,
+        agreement,
+    })
+}
+
 fn scipy_peer(
     opts: &BenchOptions,
     l: &Loaded,
@@ -617,36 +684,25 @@ fn scipy_peer(
     progress: &mut impl FnMut(&str),
 ) -> PeerReport {
     let p = &opts.peers;
-    if !p.scipy {
-        return skipped(
-            "scipy",
-            "tol",
-            "skipped",
-            "turned off in the options".into(),
-        );
-    }
-    if let Err(why) = peers::available(&p.python, "scipy") {
-        progress(&format!("scipy peer skipped: {why}"));
-        return skipped("scipy", "tol", "skipped", why);
-    }
-    progress(&format!(
-        "{}: scipy peer, rtol = atol = {}",
-        l.scenario.name,
-        peers::list(&p.scipy_tols)
-    ));
-    let mut args = peer_args(l, opts.repeats, opts.time_budget);
-    args.extend(["--tol".into(), peers::list(&p.scipy_tols)]);
-    let out = match peers::run_script(&p.python, &p.dir.join("scipy_rotor.py"), &args) {
-        Ok(o) => o,
-        Err(e) => return skipped("scipy", "tol", "failed", e.to_string()),
+    let launch = PeerLaunch {
+        name: "scipy",
+        setting_name: "tol",
+        enabled: p.scipy,
+        python: &p.python,
+        module: "scipy",
+        script: "scipy_rotor.py",
+        flag: "--tol",
+        settings: &p.scipy_tols,
+        pair: "event-switch",
     };
-    let pts = peer_points(l, &out);
-    let gate = l
-        .scenario
-        .tolerance
-        .get("event-switch")
-        .map(|t| ("scenario [tolerance.event-switch]", *t));
-    let agreement = agreement(&pts, gate);
+    let Launched {
+        out,
+        points: pts,
+        agreement,
+    } = match launch_peer(&launch, opts, l, progress) {
+        Ok(x) => x,
+        Err(report) => return *report,
+    };
     let mut ratios = Vec::new();
     if agreement.as_ref().is_some_and(|a| a.agrees) {
         for (kind_name, pick) in [
@@ -703,36 +759,25 @@ fn scipy_peer(
 
 fn siconos_peer(opts: &BenchOptions, l: &Loaded, progress: &mut impl FnMut(&str)) -> PeerReport {
     let p = &opts.peers;
-    if !p.siconos {
-        return skipped(
-            "siconos",
-            "h",
-            "skipped",
-            "turned off in the options".into(),
-        );
-    }
-    if let Err(why) = peers::available(&p.siconos_python, "siconos.kernel") {
-        progress(&format!("siconos peer skipped: {why}"));
-        return skipped("siconos", "h", "skipped", why);
-    }
-    progress(&format!(
-        "{}: siconos peer, h = {}",
-        l.scenario.name,
-        peers::list(&p.siconos_hs)
-    ));
-    let mut args = peer_args(l, opts.repeats, opts.time_budget);
-    args.extend(["--h".into(), peers::list(&p.siconos_hs)]);
-    let out = match peers::run_script(&p.siconos_python, &p.dir.join("siconos_rotor.py"), &args) {
-        Ok(o) => o,
-        Err(e) => return skipped("siconos", "h", "failed", e.to_string()),
+    let launch = PeerLaunch {
+        name: "siconos",
+        setting_name: "h",
+        enabled: p.siconos,
+        python: &p.siconos_python,
+        module: "siconos.kernel",
+        script: "siconos_rotor.py",
+        flag: "--h",
+        settings: &p.siconos_hs,
+        pair: "event-moreau",
     };
-    let pts = peer_points(l, &out);
-    let gate = l
-        .scenario
-        .tolerance
-        .get("event-moreau")
-        .map(|t| ("scenario [tolerance.event-moreau]", *t));
-    let agreement = agreement(&pts, gate);
+    let Launched {
+        out,
+        points: pts,
+        agreement,
+    } = match launch_peer(&launch, opts, l, progress) {
+        Ok(x) => x,
+        Err(report) => return *report,
+    };
     let mut per_step = Vec::new();
     for pp in &pts {
         let (Some(t), Some(steps)) = (pp.timing, pp.steps) else {
