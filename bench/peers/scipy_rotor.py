@@ -39,16 +39,16 @@ metrics), after one untimed warm-up run; interpreter start-up and imports are ex
         --t-end 100 --metrics-from 50 --transient 0,20 --dt 0.01 --tol 1e-6,1e-9 --repeat 3
 """
 
-import argparse
-import json
 import math
+import os
 import sys
-import time
-import tomllib
 
 import numpy as np
 import scipy
 from scipy.integrate import solve_ivp
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import peer_common as common  # noqa: E402  (shared set-up, next to this script)
 
 
 class Rotor:
@@ -153,17 +153,6 @@ def stick_events(rotor):
     return [exit_hi, exit_lo]
 
 
-def grid_times(dt, t_end):
-    """0, dt, 2dt, ... and t_end (as rotor-model's OutputGrid)."""
-    n = math.floor((t_end / dt) * (1.0 + 1e-12) + 1e-9)
-    g = np.arange(n + 1) * dt
-    if abs(g[-1] - t_end) <= 1e-9 * dt:
-        g[-1] = t_end
-    else:
-        g = np.append(g, t_end)
-    return g
-
-
 def simulate(rotor, x0, t_end, grid, tol, method):
     """One run: returns (grid samples of omega_l, exit times, maxima, rhs evaluations)."""
     t = 0.0
@@ -227,103 +216,31 @@ def simulate(rotor, x0, t_end, grid, tol, method):
     return omega_l, exits, maxima, nfev
 
 
-def cycle_metrics(exits, maxima, t_from):
-    """Period and max omega_l of the last complete cycle with both anchors >= t_from."""
-    anchors = [t for t in exits if t >= t_from]
-    if len(anchors) < 2:
-        anchors = [t for t, _ in maxima if t >= t_from]
-    if len(anchors) < 2:
-        return None
-    a, b = anchors[-2], anchors[-1]
-    # The anchors' own omega_l (0 at a stick exit, the maximum itself otherwise) bound it.
-    peaks = [w for t, w in maxima if a <= t <= b]
-    peak = max(peaks + ([0.0] if len(exits) >= 2 else []))
-    return {"period": b - a, "omega_l_max": peak}
-
-
 def run_setting(rotor, args, grid, window, tol):
-    def once():
-        return simulate(rotor, args.x0, args.t_end, grid, tol, args.method)
-
+    """Time one tolerance and return its entry of "runs" (a failed run's reason if it raised)."""
     try:
-        start = time.perf_counter()
-        result = once()
-        first = time.perf_counter() - start
-        seconds = []
-        if first >= args.time_budget:
-            seconds.append(first)
-        else:
-            n = max(1, min(args.repeat, int(args.time_budget / max(first, 1e-9))))
-            for _ in range(n):
-                start = time.perf_counter()
-                once()
-                seconds.append(time.perf_counter() - start)
+        (omega_l, exits, maxima, nfev), seconds = common.time_runs(
+            lambda: simulate(rotor, args.x0, args.t_end, grid, tol, args.method),
+            args.repeat,
+            args.time_budget,
+        )
     except (RuntimeError, ValueError, FloatingPointError) as e:
-        return {
-            "setting": tol,
-            "seconds": [],
-            "metrics": None,
-            "steps": None,
-            "rhs_evals": None,
-            "t": [],
-            "omega_l": [],
-            "failure": str(e),
-        }
-    omega_l, exits, maxima, nfev = result
-    return {
-        "setting": tol,
-        "seconds": seconds,
-        "metrics": cycle_metrics(exits, maxima, args.metrics_from),
-        "steps": None,
-        "rhs_evals": int(nfev),
-        "t": [float(grid[k]) for k in window],
-        "omega_l": [float(omega_l[k]) for k in window],
-        "failure": None,
-    }
-
-
-def floats(text):
-    return [float(v) for v in text.split(",")]
+        return common.failed_record(tol, str(e))
+    metrics = common.cycle_metrics(exits, maxima, args.metrics_from, maxima_fallback=True)
+    return common.run_record(tol, seconds, metrics, grid, omega_l, window, rhs_evals=int(nfev))
 
 
 def main():
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--params", required=True, help="parameter TOML file (fixtures/params)")
-    ap.add_argument("--u", type=float, required=True, help="motor input [V]")
-    ap.add_argument("--x0", type=floats, default=[0.0, 0.0, 0.0], help="alpha,omega_u,omega_l")
-    ap.add_argument("--t-end", type=float, required=True, help="horizon [s]")
-    ap.add_argument("--metrics-from", type=float, required=True, help="metrics window start [s]")
-    ap.add_argument("--transient", type=floats, required=True, help="t0,t1 of the printed trace")
-    ap.add_argument("--dt", type=float, default=0.01, help="trace grid step [s]")
-    ap.add_argument("--tol", type=floats, required=True, help="rtol = atol ladder, comma-separated")
-    ap.add_argument("--repeat", type=int, default=5, help="timed runs per setting (median)")
-    ap.add_argument("--time-budget", type=float, default=3.0, help="seconds of timing per setting")
-    ap.add_argument("--method", default="DOP853", help="solve_ivp method")
-    args = ap.parse_args()
-    if len(args.x0) != 3 or len(args.transient) != 2:
-        ap.error("--x0 needs 3 values and --transient 2")
-    with open(args.params, "rb") as f:
-        params = tomllib.load(f)
-    try:
-        rotor = Rotor(params, args.u)
-    except (KeyError, ValueError) as e:
-        print(f"{args.params}: {e}", file=sys.stderr)
-        sys.exit(2)
-    grid = grid_times(args.dt, args.t_end)
-    t0, t1 = args.transient
-    eps = 1e-9 * args.dt
-    window = [k for k, t in enumerate(grid) if t0 - eps <= t <= t1 + eps]
-    runs = [run_setting(rotor, args, grid, window, tol) for tol in args.tol]
-    json.dump(
-        {
-            "peer": "scipy",
-            "version": scipy.__version__,
-            "method": f"solve_ivp {args.method}",
-            "runs": runs,
-        },
-        sys.stdout,
+    ap = common.make_parser(
+        __doc__.splitlines()[0], "--tol", "rtol = atol ladder, comma-separated", repeat_default=5
     )
-    print()
+    ap.add_argument("--method", default="DOP853", help="solve_ivp method")
+    args = common.parse_args(ap)
+    rotor = common.load_model(args, Rotor)
+    grid = common.grid_times(args.dt, args.t_end)
+    window = common.trace_window(grid, args.transient, args.dt)
+    runs = [run_setting(rotor, args, grid, window, tol) for tol in args.tol]
+    common.emit("scipy", scipy.__version__, f"solve_ivp {args.method}", runs)
 
 
 if __name__ == "__main__":

@@ -37,21 +37,19 @@ and interpreter start-up excluded) and its number of steps.
         --x0 0,0,0 --t-end 100 --metrics-from 50 --transient 0,20 --dt 0.01 --h 1e-2,1e-3
 """
 
-import argparse
-import json
-import math
 import os
 import shutil
 import subprocess
 import sys
 import tempfile
-import time
-import tomllib
 from importlib import metadata
 
 import numpy as np
 import siconos.kernel as sk
 import siconos.numerics as sn
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import peer_common as common  # noqa: E402  (shared set-up, next to this script)
 
 # A stuck step's tangential velocity: Lemke solves the 2x2 problem exactly, and stuck
 # velocities came out at |theta_l'| <= 2e-18 rad/s in trial runs; the first slipping step
@@ -190,97 +188,29 @@ def simulate(p, plugin, x0, t_end, h, grid):
     return omega_l, exits, maxima, steps
 
 
-def cycle_metrics(exits, maxima, t_from):
-    anchors = [t for t in exits if t >= t_from]
-    if len(anchors) < 2:
-        return None
-    a, b = anchors[-2], anchors[-1]
-    peaks = [w for t, w in maxima if a <= t <= b]
-    return {"period": b - a, "omega_l_max": max(peaks + [0.0])}
-
-
-def grid_times(dt, t_end):
-    n = math.floor((t_end / dt) * (1.0 + 1e-12) + 1e-9)
-    g = np.arange(n + 1) * dt
-    if abs(g[-1] - t_end) <= 1e-9 * dt:
-        g[-1] = t_end
-    else:
-        g = np.append(g, t_end)
-    return g
-
-
 def run_setting(p, plugin, args, grid, window, h):
-    def once():
-        return simulate(p, plugin, args.x0, args.t_end, h, grid)
-
+    """Time one step size and return its entry of "runs" (a failed run's reason if it raised)."""
     try:
-        start = time.perf_counter()
-        result = once()
-        first = time.perf_counter() - start
-        seconds = []
-        if first >= args.time_budget:
-            seconds.append(first)
-        else:
-            n = max(1, min(args.repeat, int(args.time_budget / max(first, 1e-9))))
-            for _ in range(n):
-                start = time.perf_counter()
-                once()
-                seconds.append(time.perf_counter() - start)
+        (omega_l, exits, maxima, steps), seconds = common.time_runs(
+            lambda: simulate(p, plugin, args.x0, args.t_end, h, grid),
+            args.repeat,
+            args.time_budget,
+        )
     except Exception as e:  # Siconos raises its own exception types through SWIG
-        return {
-            "setting": h,
-            "seconds": [],
-            "metrics": None,
-            "steps": None,
-            "rhs_evals": None,
-            "t": [],
-            "omega_l": [],
-            "failure": f"{type(e).__name__}: {e}",
-        }
-    omega_l, exits, maxima, steps = result
-    return {
-        "setting": h,
-        "seconds": seconds,
-        "metrics": cycle_metrics(exits, maxima, args.metrics_from),
-        "steps": steps,
-        "rhs_evals": None,
-        "t": [float(grid[k]) for k in window],
-        "omega_l": [float(omega_l[k]) for k in window],
-        "failure": None,
-    }
-
-
-def floats(text):
-    return [float(v) for v in text.split(",")]
+        return common.failed_record(h, f"{type(e).__name__}: {e}")
+    metrics = common.cycle_metrics(exits, maxima, args.metrics_from)
+    return common.run_record(h, seconds, metrics, grid, omega_l, window, steps=steps)
 
 
 def main():
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--params", required=True, help="parameter TOML file (fixtures/params)")
-    ap.add_argument("--u", type=float, required=True, help="motor input [V]")
-    ap.add_argument("--x0", type=floats, default=[0.0, 0.0, 0.0], help="alpha,omega_u,omega_l")
-    ap.add_argument("--t-end", type=float, required=True, help="horizon [s]")
-    ap.add_argument("--metrics-from", type=float, required=True, help="metrics window start [s]")
-    ap.add_argument("--transient", type=floats, required=True, help="t0,t1 of the printed trace")
-    ap.add_argument("--dt", type=float, default=0.01, help="trace grid step [s]")
-    ap.add_argument("--h", type=floats, required=True, help="step sizes, comma-separated")
-    ap.add_argument("--repeat", type=int, default=3, help="timed runs per setting (median)")
-    ap.add_argument("--time-budget", type=float, default=3.0, help="seconds of timing per setting")
-    args = ap.parse_args()
-    if len(args.x0) != 3 or len(args.transient) != 2:
-        ap.error("--x0 needs 3 values and --transient 2")
-    with open(args.params, "rb") as f:
-        params = tomllib.load(f)
-    try:
-        p = Params(params, args.u)
-    except (KeyError, ValueError) as e:
-        print(f"{args.params}: {e}", file=sys.stderr)
-        sys.exit(2)
+    ap = common.make_parser(
+        __doc__.splitlines()[0], "--h", "step sizes, comma-separated", repeat_default=3
+    )
+    args = common.parse_args(ap)
+    p = common.load_model(args, Params)
     sn.numerics_set_verbose(0)
-    grid = grid_times(args.dt, args.t_end)
-    t0, t1 = args.transient
-    eps = 1e-9 * args.dt
-    window = [k for k, t in enumerate(grid) if t0 - eps <= t <= t1 + eps]
+    grid = common.grid_times(args.dt, args.t_end)
+    window = common.trace_window(grid, args.transient, args.dt)
     with tempfile.TemporaryDirectory() as workdir:
         plugin = build_plugin(workdir)
         runs = [run_setting(p, plugin, args, grid, window, h) for h in args.h]
@@ -288,16 +218,7 @@ def main():
         version = metadata.version("siconos")
     except metadata.PackageNotFoundError:
         version = "unknown"
-    json.dump(
-        {
-            "peer": "siconos",
-            "version": version,
-            "method": "MoreauJeanOSI theta=1/2, FrictionContact(2) Lemke",
-            "runs": runs,
-        },
-        sys.stdout,
-    )
-    print()
+    common.emit("siconos", version, "MoreauJeanOSI theta=1/2, FrictionContact(2) Lemke", runs)
 
 
 if __name__ == "__main__":
