@@ -59,6 +59,13 @@ def parse_args(ap):
     args = ap.parse_args()
     if len(args.x0) != 3 or len(args.transient) != 2:
         ap.error("--x0 needs 3 values and --transient 2")
+    # The ladder (--tol or --h) and the horizon must be positive and finite: a negative
+    # step would make a time-stepping peer loop forever.
+    for name, values in (("--tol", getattr(args, "tol", None)), ("--h", getattr(args, "h", None)),
+                         ("--t-end", [args.t_end]), ("--dt", [args.dt])):
+        for v in values or []:
+            if not (math.isfinite(v) and v > 0.0):
+                ap.error(f"{name} must be positive and finite, got {v}")
     return args
 
 
