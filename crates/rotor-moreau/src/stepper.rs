@@ -15,8 +15,10 @@
 //! (`Kq = k_θ[α, −α]`, so only α is needed.) Newton on the step: at the iterate `w`, every
 //! velocity-dependent term of a slip branch is linearised in the disc's own velocity, the
 //! resulting piecewise-linear problem is solved exactly by [`OneStepProblem::solve`], and the
-//! iteration stops when the mode repeats and the velocity update is below
-//! `1e-12·(1 + |w|)` — a semi-smooth Newton method, quadratic once the mode is settled.
+//! iteration stops when the mode repeats and the iterate's error is below `1e-12·(1 + |w|)`:
+//! the update itself is, or the quadratic-convergence estimate of the next update is, or the
+//! linearisation is exact (`Stepper::converged`) — a semi-smooth Newton method,
+//! quadratic once the mode is settled.
 
 use nalgebra::{Matrix2, Vector2};
 use rotor_model::{Disc, DiscMode, Friction, Model, SolveError, State};
