@@ -112,8 +112,9 @@ fn orders(options: MoreauOptions, label: &str) -> [(f64, f64); 2] {
     );
     // The smallest error measured must stand well above the reference's own error, or the
     // fit would measure the reference. A factor 5 perturbs ln e at the smallest h by at most
-    // ln 1.2 = 0.18; that point's weight in the least-squares slope over four decade-spaced
-    // points is |x − x̄|/Sxx = 1.5/(5 ln 10) = 0.13, so the slope moves by < 0.03.
+    // ln 1.2 = 0.18; that point's weight in the least-squares slope over the five points
+    // (log10 h = −2, −2.52, −3, −3.52, −4) is |x − x̄|/Sxx = ln 10/(2(1 + 0.48²)(ln 10)²)
+    // = 0.18, so the slope moves by < 0.04.
     // The same argument covers the scheme's rounding noise, largest at the smallest h.
     let smallest = ep.iter().chain(&ew).cloned().fold(f64::INFINITY, f64::min);
     assert!(
