@@ -3,14 +3,17 @@
 //! value, with a non-zero exit code that is not a panic's (101) nor a signal's (an abort on a
 //! failed allocation); `rotor compare --report DIR` with a bad scenario writes nothing into
 //! DIR; and a report interrupted by SIGKILL leaves every file whole (old or new, never cut).
+//!
+//! The bad parameter and scenario files are `rotor-testkit`'s ([`bad_params_cases`],
+//! [`bad_scenario_cases`]), the same ones the library's own bad-input test loads; the flags,
+//! the report and the kill cases are the binary's own.
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
-use std::sync::atomic::{AtomicUsize, Ordering};
 
-const TABLE1: &str = include_str!("../../../fixtures/params/table1.toml");
-const STRIBECK: &str = include_str!("../../../fixtures/params/stribeck.toml");
-const SCENARIO: &str = include_str!("../../../fixtures/scenarios/t1-u1.5-rest.toml");
+use rotor_testkit::{
+    SCENARIO, TABLE1, bad_params_cases, bad_scenario_cases, edit, local_scenario, write_scenario,
+};
 
 fn fixtures() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../../fixtures")
@@ -25,38 +28,7 @@ fn rotor(args: &[&str]) -> Output {
 
 /// A fresh directory per call (tests run in parallel).
 fn tmp_dir() -> PathBuf {
-    static N: AtomicUsize = AtomicUsize::new(0);
-    let d = std::env::temp_dir().join(format!(
-        "rotor-cli-bad-input-{}-{}",
-        std::process::id(),
-        N.fetch_add(1, Ordering::Relaxed)
-    ));
-    std::fs::create_dir_all(&d).unwrap();
-    d
-}
-
-/// Replaces `from` on the first line that starts with it (else its first occurrence outside
-/// a comment) by `to`; insists that it occurs, so a fixture edit cannot make a case vacuous.
-fn edit(text: &str, from: &str, to: &str) -> String {
-    let mut starts = None;
-    let mut inside = None;
-    let mut at = 0;
-    for line in text.split_inclusive('\n') {
-        if starts.is_none() && line.starts_with(from) {
-            starts = Some(at);
-        }
-        let code = line.split('#').next().unwrap();
-        if inside.is_none()
-            && let Some(i) = code.find(from)
-        {
-            inside = Some(at + i);
-        }
-        at += line.len();
-    }
-    let i = starts
-        .or(inside)
-        .unwrap_or_else(|| panic!("fixture no longer contains {from:?}"));
-    format!("{}{}{}", &text[..i], to, &text[i + from.len()..])
+    rotor_testkit::tmp_dir("rotor-cli-bad-input")
 }
 
 /// An error exit: a code that is neither success, nor a panic (101), nor a signal; stderr's
@@ -80,59 +52,14 @@ fn assert_clean_error(o: &Output, what: &str, needles: &[&str]) {
 #[test]
 fn bad_parameter_files_are_named_with_field_and_value() {
     let dir = tmp_dir();
-    let cases: Vec<(&str, String, Vec<&str>)> = vec![
-        (
-            "unknown key",
-            edit(TABLE1, "j_u = 0.4765", "j_uu = 0.4765"),
-            vec!["j_uu", "unknown field"],
-        ),
-        (
-            "missing key",
-            edit(TABLE1, "k_m = 3.9950", ""),
-            vec!["k_m", "missing field"],
-        ),
-        (
-            "wrong type",
-            edit(TABLE1, "j_u = 0.4765", "j_u = \"heavy\""),
-            vec!["j_u = \"heavy\"", "invalid type"],
-        ),
-        (
-            "non-finite",
-            edit(TABLE1, "k_theta = 0.0727", "k_theta = nan"),
-            vec!["k_theta = NaN"],
-        ),
-        (
-            "non-positive inertia",
-            edit(TABLE1, "j_l = 0.0326", "j_l = -0.5"),
-            vec!["j_l = -0.5"],
-        ),
-        (
-            "zero stiffness",
-            edit(TABLE1, "k_theta = 0.0727", "k_theta = 0.0"),
-            vec!["k_theta = 0"],
-        ),
-        (
-            "negative static level",
-            edit(TABLE1, "t_s = 0.1642", "t_s = -0.1"),
-            vec!["lower.t_s = -0.1"],
-        ),
-        (
-            "Stribeck exponent <= 0",
-            edit(STRIBECK, "delta = 2.0575", "delta = 0.0"),
-            vec!["lower.delta = 0"],
-        ),
-        (
-            "unknown family",
-            edit(TABLE1, "\"exponential\"", "\"dahl\""),
-            vec!["lower.family", "\"dahl\""],
-        ),
-        ("empty", String::new(), vec!["empty"]),
-    ];
-    for (i, (what, text, needles)) in cases.into_iter().enumerate() {
+    let cases = bad_params_cases();
+    assert!(!cases.is_empty());
+    for (i, c) in cases.iter().enumerate() {
+        let what = c.name.as_str();
         let f = dir.join(format!("p{i}.toml"));
-        std::fs::write(&f, text).unwrap();
+        std::fs::write(&f, &c.contents).unwrap();
         let fs = f.to_str().unwrap();
-        let mut needles = needles;
+        let mut needles = c.needles.clone();
         needles.push(fs);
         let o = rotor(&["steady", "--solver", "event", "--u", "1", "--params", fs]);
         assert_clean_error(&o, what, &needles);
@@ -153,23 +80,7 @@ fn bad_parameter_files_are_named_with_field_and_value() {
         assert_clean_error(&o, what, &needles);
         assert!(!csv.exists(), "{what}: no CSV on error");
     }
-    // Binary, and a path that does not exist.
-    let bin = dir.join("bin.toml");
-    std::fs::write(&bin, b"\x7fELF\x02\x01\x01\x00\xff\xfe").unwrap();
-    let o = rotor(&[
-        "steady",
-        "--solver",
-        "event",
-        "--u",
-        "1",
-        "--params",
-        bin.to_str().unwrap(),
-    ]);
-    assert_clean_error(
-        &o,
-        "binary",
-        &[bin.to_str().unwrap(), "not a UTF-8", "offset"],
-    );
+    // A path that does not exist.
     let none = dir.join("nothere.toml");
     let o = rotor(&[
         "steady",
@@ -264,19 +175,6 @@ fn bad_flags_name_the_flag_and_value() {
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
 }
 
-/// A directory holding a good Table 1 parameter file and a scenario file of `text`.
-fn scenario_dir(text: &str) -> (PathBuf, PathBuf) {
-    let dir = tmp_dir();
-    std::fs::write(dir.join("table1.toml"), TABLE1).unwrap();
-    let f = dir.join("s.toml");
-    std::fs::write(&f, text).unwrap();
-    (dir, f)
-}
-
-fn good_scenario() -> String {
-    edit(SCENARIO, "\"../params/table1.toml\"", "\"table1.toml\"")
-}
-
 /// Every non-hidden file of a directory with its bytes, sorted by name.
 fn files_of(dir: &Path) -> Vec<(String, Vec<u8>)> {
     let Ok(rd) = std::fs::read_dir(dir) else {
@@ -296,78 +194,18 @@ fn files_of(dir: &Path) -> Vec<(String, Vec<u8>)> {
 
 #[test]
 fn compare_with_a_bad_scenario_writes_no_report() {
-    let s = good_scenario();
-    let cases: Vec<(&str, Vec<u8>, Vec<&str>)> = vec![
-        (
-            "t_end <= 0",
-            edit(&s, "t_end = 200.0", "t_end = 0.0").into(),
-            vec!["t_end = 0"],
-        ),
-        (
-            "h <= 0",
-            edit(&s, "t_end = 200.0", "t_end = 200.0\nh = 0.0").into(),
-            vec!["h = 0"],
-        ),
-        (
-            "h > t_end",
-            edit(&s, "t_end = 200.0", "t_end = 200.0\nh = 250.0").into(),
-            vec!["h = 250"],
-        ),
-        (
-            "tol <= 0",
-            edit(&s, "t_end = 200.0", "t_end = 200.0\ntol = -1e-9").into(),
-            vec!["tol = -0.000000001"],
-        ),
-        (
-            "tol >= 1",
-            edit(&s, "t_end = 200.0", "t_end = 200.0\ntol = 1.0").into(),
-            vec!["tol = 1"],
-        ),
-        (
-            "unknown solver key",
-            edit(&s, "t_end = 200.0", "t_end = 200.0\nsolver = \"rk4\"").into(),
-            vec!["solver = \"rk4\"", "unknown field"],
-        ),
-        (
-            "missing key",
-            edit(&s, "u = 1.5", "").into(),
-            vec!["missing field", "`u`"],
-        ),
-        (
-            "wrong type",
-            edit(&s, "u = 1.5", "u = \"fast\"").into(),
-            vec!["u = \"fast\""],
-        ),
-        (
-            "non-finite",
-            edit(&s, "u = 1.5", "u = nan").into(),
-            vec!["u = NaN"],
-        ),
-        (
-            "params path does not exist",
-            edit(&s, "\"table1.toml\"", "\"nothere.toml\"").into(),
-            vec!["params", "nothere.toml", "cannot read"],
-        ),
-        (
-            "report name escapes the directory",
-            edit(&s, "name = \"t1-u1.5-rest\"", "name = \"../escape\"").into(),
-            vec!["name = \"../escape\""],
-        ),
-        ("empty", Vec::new(), vec!["empty"]),
-        (
-            "binary",
-            b"\x89PNG\r\n\x1a\n\x00\x00\x00\rIHDR".to_vec(),
-            vec!["not a UTF-8"],
-        ),
-    ];
-    for (what, text, needles) in cases {
-        let (dir, f) = scenario_dir("");
-        std::fs::write(&f, &text).unwrap();
+    let s = local_scenario();
+    let cases = bad_scenario_cases();
+    assert!(!cases.is_empty());
+    for c in &cases {
+        let what = c.name.as_str();
+        let dir = tmp_dir();
+        let f = write_scenario(&dir, &c.contents);
         // A good scenario first: it must not be reported either when a later one is bad.
         let good = dir.join("good.toml");
-        std::fs::write(&good, good_scenario()).unwrap();
+        std::fs::write(&good, &s).unwrap();
         let report = dir.join("report");
-        let mut needles = needles;
+        let mut needles = c.needles.clone();
         let fs = f.to_str().unwrap();
         needles.push(fs);
         let o = rotor(&[
@@ -381,7 +219,8 @@ fn compare_with_a_bad_scenario_writes_no_report() {
         assert!(files_of(&report).is_empty(), "{what}: report written");
     }
     // A bad parameter file named by a scenario: both files named.
-    let (dir, f) = scenario_dir(&edit(&s, "\"table1.toml\"", "\"bad.toml\""));
+    let dir = tmp_dir();
+    let f = write_scenario(&dir, edit(&s, "\"table1.toml\"", "\"bad.toml\"").as_bytes());
     std::fs::write(
         dir.join("bad.toml"),
         edit(TABLE1, "j_u = 0.4765", "j_u = 0.0"),
@@ -407,7 +246,8 @@ fn compare_with_a_bad_scenario_writes_no_report() {
         vec![("README.md".to_string(), b"old report\n".to_vec())]
     );
     // Two scenarios of one name would overwrite each other's report files.
-    let (dir, f) = scenario_dir(&s);
+    let dir = tmp_dir();
+    let f = write_scenario(&dir, s.as_bytes());
     let twin = dir.join("twin.toml");
     std::fs::write(&twin, &s).unwrap();
     let report = dir.join("report");
