@@ -8,15 +8,11 @@
 use nalgebra::{Matrix3, Vector3};
 use rotor_bifurcation::monodromy::{Variational, along};
 use rotor_event::{StopAt, flow};
-use rotor_model::{Disc, EventKind, Mode, Model, Params, State};
+use rotor_model::{Disc, EventKind, Mode, Model, State};
+
+use crate::common::model;
 
 const TOL: f64 = 1e-12;
-
-fn model(name: &str) -> Model {
-    let p = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join(format!("../../fixtures/params/{name}.toml"));
-    Model::new(Params::from_file(&p).unwrap())
-}
 
 fn end(m: &Model, u: f64, x0: State, mode: Mode, t: f64, tol: f64) -> State {
     flow(m, u, tol, x0, mode, t, StopAt::Time).unwrap().x

@@ -1,41 +1,13 @@
 //! The diagram for both parameter sets, checked against independent facts.
 
-use std::sync::OnceLock;
-
 use rotor_bifurcation::continuation::{ContOptions, Continuer};
 use rotor_bifurcation::equilibria::{complex_pair, hopf_points, omega_reaching};
 use rotor_bifurcation::periodic::{Shooter, eig2};
-use rotor_bifurcation::{Diagram, DiagramOptions, SpecialPoint, diagram, start_point};
+use rotor_bifurcation::start_point;
 use rotor_event::{EventOptions, SteadyOptions, steady_state};
-use rotor_model::{Model, Params, State, SteadyState};
+use rotor_model::{Model, State, SteadyState};
 
-fn stribeck() -> Model {
-    let p = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../../fixtures/params/stribeck.toml");
-    Model::new(Params::from_file(&p).unwrap())
-}
-
-fn table1() -> Model {
-    let p =
-        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../fixtures/params/table1.toml");
-    Model::new(Params::from_file(&p).unwrap())
-}
-
-fn t1_diagram() -> &'static Diagram {
-    static D: OnceLock<Diagram> = OnceLock::new();
-    D.get_or_init(|| diagram(&table1(), &DiagramOptions::default()).unwrap())
-}
-
-fn st_diagram() -> &'static Diagram {
-    static D: OnceLock<Diagram> = OnceLock::new();
-    D.get_or_init(|| diagram(&stribeck(), &DiagramOptions::default()).unwrap())
-}
-
-fn points<'a>(d: &'a Diagram, kind: &str) -> Vec<&'a SpecialPoint> {
-    let mut v: Vec<_> = d.points.iter().filter(|p| p.kind == kind).collect();
-    v.sort_by(|a, b| a.u.total_cmp(&b.u));
-    v
-}
+use crate::common::{model, points, st_diagram, t1_diagram};
 
 fn shooter(m: &Model) -> Shooter<'_> {
     Shooter {
@@ -46,7 +18,7 @@ fn shooter(m: &Model) -> Shooter<'_> {
 
 #[test]
 fn hopf_points_are_roots_and_bracketed_by_simulation() {
-    let m = table1();
+    let m = model("table1");
     let hs = hopf_points(&m, omega_reaching(&m, 7.0).unwrap());
     assert_eq!(hs.len(), 2);
     for h in &hs {
@@ -71,7 +43,7 @@ fn hopf_points_are_roots_and_bracketed_by_simulation() {
 
 #[test]
 fn stick_slip_multipliers_agree_at_two_steps_and_with_the_section_map() {
-    let m = table1();
+    let m = model("table1");
     let sh = shooter(&m);
     let u = 1.5;
     let (z0, c) = start_point(&sh, u).unwrap();
@@ -96,7 +68,7 @@ fn stick_slip_multipliers_agree_at_two_steps_and_with_the_section_map() {
 
 #[test]
 fn slipping_cycle_multipliers_agree_at_two_steps() {
-    let m = table1();
+    let m = model("table1");
     let sh = shooter(&m);
     let u = 0.5; // small slipping cycle (simulated fact)
     let (z0, c) = start_point(&sh, u).unwrap();
@@ -118,7 +90,7 @@ fn slipping_cycle_multipliers_agree_at_two_steps() {
 fn branch_period_matches_steady_state_refinement() {
     // rotor_event::steady_state reaches the 1.5 V cycle by a settling run and a secant on the
     // stick-exit map: an independent path to the same orbit.
-    let m = table1();
+    let m = model("table1");
     let st = steady_state(
         &m,
         1.5,
@@ -261,7 +233,7 @@ fn hysteresis_of_a_brute_force_sweep_matches_the_bistable_window() {
     let d = t1_diagram();
     let hopf = points(d, "hopf")[1].u;
     let fold = points(d, "fold")[0].u;
-    let m = table1();
+    let m = model("table1");
     let solver = rotor_event::EventSolver::default();
     // Two successive runs of 300 s (≈70 periods each), amplitude of ω_l over the last 100 s
     // of each (a1, a2). The state is on (or leaving toward) a cycle if a2 > 1 rad/s (the

@@ -3,37 +3,14 @@
 //! independent route (sign changes of the condition on either side, the Filippov flow's own
 //! stick detection).
 
-use std::sync::OnceLock;
-
 use rotor_bifurcation::continuation::{ContOptions, Continuer, Node};
 use rotor_bifurcation::equilibria::complex_pair;
 use rotor_bifurcation::grazing;
 use rotor_bifurcation::periodic::Shooter;
-use rotor_bifurcation::{Diagram, DiagramOptions, SpecialPoint, diagram};
 use rotor_event::{StopAt, flow};
-use rotor_model::{Model, Params};
+use rotor_model::Model;
 
-fn model(name: &str) -> Model {
-    let p = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join(format!("../../fixtures/params/{name}.toml"));
-    Model::new(Params::from_file(&p).unwrap())
-}
-
-fn t1_diagram() -> &'static Diagram {
-    static D: OnceLock<Diagram> = OnceLock::new();
-    D.get_or_init(|| diagram(&model("table1"), &DiagramOptions::default()).unwrap())
-}
-
-fn st_diagram() -> &'static Diagram {
-    static D: OnceLock<Diagram> = OnceLock::new();
-    D.get_or_init(|| diagram(&model("stribeck"), &DiagramOptions::default()).unwrap())
-}
-
-fn points<'a>(d: &'a Diagram, kind: &str) -> Vec<&'a SpecialPoint> {
-    let mut v: Vec<_> = d.points.iter().filter(|p| p.kind == kind).collect();
-    v.sort_by(|a, b| a.u.total_cmp(&b.u));
-    v
-}
+use crate::common::{model, points, st_diagram, t1_diagram};
 
 /// The goal of the issue: every special point to 1e-8 V.
 const GOAL: f64 = 1e-8;

@@ -7,13 +7,9 @@ use rotor_bifurcation::continuation::{ContOptions, Continuer, End};
 use rotor_bifurcation::equilibria::{hopf_points, omega_reaching};
 use rotor_bifurcation::periodic::{SectionDerivs, Shooter, eig2};
 use rotor_bifurcation::start_point;
-use rotor_model::{Disc, EventKind, Model, Params, State};
+use rotor_model::{Disc, EventKind, State};
 
-fn model(name: &str) -> Model {
-    let p = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join(format!("../../fixtures/params/{name}.toml"));
-    Model::new(Params::from_file(&p).unwrap())
-}
+use crate::common::model;
 
 /// Flow tolerance of these checks.
 const TOL: f64 = 1e-12;

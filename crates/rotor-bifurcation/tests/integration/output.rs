@@ -1,27 +1,11 @@
 //! What the CLI writes: the JSON contract (DESIGN.md §4), the CSV, the SVG figure, and the
 //! option checks.
 
-use std::sync::OnceLock;
-
 use rotor_bifurcation::{BifError, Diagram, DiagramOptions, diagram};
-use rotor_model::{Model, Params};
+use rotor_model::Model;
+
+use crate::common::{model, st_diagram, t1_diagram};
 use serde_json::Value;
-
-fn model(name: &str) -> Model {
-    let p = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join(format!("../../fixtures/params/{name}.toml"));
-    Model::new(Params::from_file(&p).unwrap())
-}
-
-fn t1_diagram() -> &'static Diagram {
-    static D: OnceLock<Diagram> = OnceLock::new();
-    D.get_or_init(|| diagram(&model("table1"), &DiagramOptions::default()).unwrap())
-}
-
-fn st_diagram() -> &'static Diagram {
-    static D: OnceLock<Diagram> = OnceLock::new();
-    D.get_or_init(|| diagram(&model("stribeck"), &DiagramOptions::default()).unwrap())
-}
 
 fn num(v: &Value, key: &str) -> f64 {
     v[key]
