@@ -50,7 +50,7 @@ pub struct StepOutcome {
 }
 
 /// The smooth friction of one disc along branch s, its level, and their ω-derivatives.
-#[derive(Debug, Clone, Copy)]
+#[derive(Debug, Clone, Copy, Default)]
 struct BranchEval {
     /// Smooth offset force `−a^s(ω)` (enters the right-hand side).
     off: f64,
@@ -81,7 +81,7 @@ struct BranchCtx<'a> {
     p_start: [f64; 2],
     v: Vector2<f64>,
     /// Branch sign and evaluation at the start velocity, per disc.
-    start: [(f64, Option<BranchEval>); 2],
+    start: [(f64, BranchEval); 2],
 }
 
 impl BranchCtx<'_> {
@@ -118,10 +118,8 @@ impl BranchCtx<'_> {
     #[inline(always)]
     fn branch(&self, i: usize, s: f64, w: f64, evals: &mut u32) -> Branch {
         let st = self.stepper;
-        if let (s0, Some(e0)) = self.start[i]
-            && s0 == s
-            && (st.affine_law[i] || w.to_bits() == self.v[i].to_bits())
-        {
+        let (s0, e0) = self.start[i];
+        if s0 == s && (st.affine_law[i] || w.to_bits() == self.v[i].to_bits()) {
             return self.affine(i, s, self.v[i], e0);
         }
         *evals += 1;
@@ -238,11 +236,11 @@ impl Stepper {
         // w = v on the same branch): one evaluation per disc instead of three.
         let mut p_start = [0.0; 2];
         let mut stick = [StickData::default(); 2];
-        let mut start = [(1.0, None::<BranchEval>); 2];
+        let mut start = [(1.0, BranchEval::default()); 2];
         for i in 0..2 {
             let s0 = if v[i] < 0.0 { -1.0 } else { 1.0 };
             let e0 = eval_branch(&self.law[i], self.db[i], v[i], s0);
-            start[i] = (s0, Some(e0));
+            start[i] = (s0, e0);
             evals += 1;
             // Negative part of the level, as a smooth force −sign(ω)·min(N, 0).
             let neg0 = -s0 * e0.level.min(0.0);
@@ -304,6 +302,13 @@ impl Stepper {
             }
         }
 
+        // The step problem before any slip branch is linearised into it.
+        let base = OneStepProblem {
+            a,
+            b,
+            slip: [[Branch::default(); 2]; 2],
+            stick,
+        };
         let mut newton_iters = 0u32;
         let mut used_enum = false;
         let mut result: Option<OneStepSolution> = None;
@@ -314,12 +319,7 @@ impl Stepper {
             let mode = [DiscMode::slip_of(v[0]), DiscMode::slip_of(v[1])];
             let mut w = v;
             let mut dv_prev = f64::INFINITY;
-            let mut prob = OneStepProblem {
-                a,
-                b,
-                slip: [[Branch::default(); 2]; 2],
-                stick,
-            };
+            let mut prob = base;
             for _ in 0..self.max_newton {
                 newton_iters += 1;
                 for i in 0..2 {
@@ -350,12 +350,7 @@ impl Stepper {
             let mut prev: Option<[DiscMode; 2]> = None;
             let mut dv_prev = f64::INFINITY;
             let mut newton_failed = false;
-            let mut prob = OneStepProblem {
-                a,
-                b,
-                slip: [[Branch::default(); 2]; 2],
-                stick,
-            };
+            let mut prob = base;
             for _ in 0..self.max_newton {
                 newton_iters += 1;
                 for i in 0..2 {
@@ -399,12 +394,7 @@ impl Stepper {
                 exact = false;
                 for _ in 0..self.max_newton {
                     newton_iters += 1;
-                    let mut prob = OneStepProblem {
-                        a,
-                        b,
-                        slip: [[Branch::default(); 2]; 2],
-                        stick,
-                    };
+                    let mut prob = base;
                     for i in 0..2 {
                         let s = if w[i] < 0.0 { -1.0 } else { 1.0 };
                         let e = eval_branch(&self.law[i], self.db[i], w[i], s);
