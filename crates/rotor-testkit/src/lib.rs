@@ -496,3 +496,53 @@ pub fn bad_scenario_cases() -> Vec<BadFile> {
     ]);
     v
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn edit_prefers_a_line_start_and_skips_comments() {
+        let text = "# a = 1 in a comment\nb = 2 # a = 1 here too\na = 1\n";
+        // The line that starts with the key wins over earlier occurrences.
+        assert_eq!(
+            edit(text, "a = 1", "a = 7"),
+            "# a = 1 in a comment\nb = 2 # a = 1 here too\na = 7\n"
+        );
+        // Otherwise the first occurrence outside a comment.
+        assert_eq!(edit("x = [a, b] # a\n", "b", "c"), "x = [a, c] # a\n");
+    }
+
+    #[test]
+    #[should_panic(expected = "no longer contains")]
+    fn edit_refuses_a_string_found_only_in_a_comment() {
+        edit("# k = 1\n", "k = 1", "k = 2");
+    }
+
+    /// Every case is a real change of its fixture (a case equal to a good file would test
+    /// nothing), has a name unique in its list (failures say which case) and a needle.
+    #[test]
+    fn every_case_changes_its_file_and_names_what_to_find() {
+        let good: Vec<Vec<u8>> = [TABLE1, STRIBECK, SCENARIO, &local_scenario()]
+            .iter()
+            .map(|t| t.as_bytes().to_vec())
+            .collect();
+        for list in [bad_params_cases(), bad_scenario_cases()] {
+            let mut names = std::collections::HashSet::new();
+            for c in &list {
+                assert!(!good.contains(&c.contents), "{}: unchanged fixture", c.name);
+                assert!(!c.needles.is_empty(), "{}: no needle", c.name);
+                assert!(names.insert(c.name.clone()), "{}: name used twice", c.name);
+            }
+            assert!(names.len() >= 40, "{} cases", names.len());
+        }
+    }
+
+    #[test]
+    fn tmp_dirs_are_fresh() {
+        let (a, b) = (tmp_dir("rotor-testkit"), tmp_dir("rotor-testkit"));
+        assert!(a != b && a.is_dir() && b.is_dir());
+        let f = write_scenario(&a, local_scenario().as_bytes());
+        assert!(f.is_file() && a.join("table1.toml").is_file());
+    }
+}
