@@ -79,13 +79,9 @@ pub struct ScenarioResult {
 pub fn scene_for(kind: SolverKind, sc: &Scenario) -> Scene {
     let (tol, h) = solver_settings(kind, sc);
     Scene {
-        u: sc.u,
-        x0: sc.x0,
-        t_end: sc.t_end,
         tol,
         h,
-        output: Output::Grid { dt: sc.compare.dt },
-        metrics_from: sc.compare.steady_from,
+        ..sc.scene(Output::Grid { dt: sc.compare.dt })
     }
 }
 

@@ -219,14 +219,7 @@ fn mirror_symmetry_is_exact() {
 fn every_fixture_runs_to_its_horizon() {
     for f in Scenario::list_dir(&fixtures().join("scenarios")).unwrap() {
         let sc = Scenario::from_file(&f).unwrap();
-        let s = Scene {
-            u: sc.u,
-            x0: sc.x0,
-            t_end: sc.t_end,
-            output: Output::Final,
-            metrics_from: sc.compare.steady_from,
-            ..Scene::default()
-        };
+        let s = sc.scene(Output::Final);
         let tr = EventSolver::default()
             .simulate(&sc.model, &s)
             .unwrap_or_else(|e| panic!("{}: {e}", sc.name));

@@ -21,7 +21,7 @@ use thiserror::Error;
 
 use crate::dynamics::{Model, State};
 use crate::params::{Params, ParamsError, one_line, shown, text_of};
-use crate::scene::{MAX_GRID_ROWS, MIN_TOL, Scene};
+use crate::scene::{MAX_GRID_ROWS, MIN_TOL, Output, Scene};
 
 /// The solver pairs a `[tolerance.<pair>]` table may name: each solver against the
 /// event-driven reference (the pairs rotor-compare gates). Any other name is a typo that
@@ -140,6 +140,19 @@ pub struct Scenario {
 }
 
 impl Scenario {
+    /// The scene of this scenario keeping `output`: its input, initial state, horizon and
+    /// steady-state window, at [`Scene::default`]'s accuracy (callers set `tol` or `h`).
+    pub fn scene(&self, output: Output) -> Scene {
+        Scene {
+            u: self.u,
+            x0: self.x0,
+            t_end: self.t_end,
+            output,
+            metrics_from: self.compare.steady_from,
+            ..Scene::default()
+        }
+    }
+
     /// Reads and validates a scenario file and the parameter file it names.
     pub fn from_file(path: &Path) -> Result<Scenario, ScenarioError> {
         let bytes = std::fs::read(path).map_err(|e| ScenarioError::Io {

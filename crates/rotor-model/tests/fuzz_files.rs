@@ -215,13 +215,9 @@ fn check(which: usize, muts: &[Mutation]) -> Result<(), TestCaseError> {
                     (d.tol, sc.h.unwrap_or(1e-3)),
                 ] {
                     let scene = Scene {
-                        u: sc.u,
-                        x0: sc.x0,
-                        t_end: sc.t_end,
                         tol,
                         h,
-                        output: Output::Grid { dt: sc.compare.dt },
-                        metrics_from: sc.compare.steady_from,
+                        ..sc.scene(Output::Grid { dt: sc.compare.dt })
                     };
                     prop_assert!(
                         scene.validate().is_ok(),

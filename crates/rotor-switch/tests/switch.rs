@@ -134,13 +134,8 @@ fn fixtures() -> Vec<PathBuf> {
 
 fn scene_of(sc: &Scenario, output: Output) -> Scene {
     Scene {
-        u: sc.u,
-        x0: sc.x0,
-        t_end: sc.t_end,
         tol: sc.tol.unwrap_or(1e-10),
-        output,
-        metrics_from: sc.compare.steady_from,
-        ..Scene::default()
+        ..sc.scene(output)
     }
 }
 

@@ -7,13 +7,8 @@ use crate::scenarios;
 
 fn scene(sc: &rotor_model::Scenario, h: f64, output: Output) -> Scene {
     Scene {
-        u: sc.u,
-        x0: sc.x0,
-        t_end: sc.t_end,
         h,
-        output,
-        metrics_from: sc.compare.steady_from,
-        ..Scene::default()
+        ..sc.scene(output)
     }
 }
 
