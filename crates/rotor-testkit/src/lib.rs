@@ -534,6 +534,8 @@ mod tests {
                 assert!(!c.needles.is_empty(), "{}: no needle", c.name);
                 assert!(names.insert(c.name.clone()), "{}: name used twice", c.name);
             }
+            // 46 parameter and 51 scenario cases today: a list that shrinks below 40 has lost
+            // cases by accident (an edit that drops entries), not by design.
             assert!(names.len() >= 40, "{} cases", names.len());
         }
     }
