@@ -153,9 +153,8 @@ fn estimate_stop_agrees_with_the_strict_stop() {
                 it_strict += u64::from(b.newton_iters);
                 x = b.x;
             }
-            // Measured ≈ 0.65 at h = 1e-3 (1.8 vs 2.8 iterations per step); 0.8 asks for a
-            // saving well outside run-to-run variation (there is none: the runs are
-            // deterministic) yet not tied to the exact count.
+            // Measured ≈ 0.65 at h = 1e-3 (1.8 vs 2.8 iterations per step); 0.8 demands a
+            // clear saving without pinning the exact count.
             assert!(
                 (it_est as f64) < 0.8 * it_strict as f64,
                 "h = {h}: {it_est} vs {it_strict} iterations"
