@@ -14,8 +14,12 @@
 //!
 //! Guards are sampled at interior points of the dense output and, for the velocity guards,
 //! their derivative too, so that a shallow dip below zero inside one step is not missed.
-//! A located root is refined by re-taking the RK step exactly to it (8th-order state) plus a
-//! Newton correction in time.
+//! Guards are functions of the state along the dense output, so at interior samples their
+//! rates come from the dense output's own derivative (no field evaluation); at the step's
+//! ends that derivative is the field (the interpolant is Hermite). A located terminal root
+//! is refined by re-taking the RK step exactly to it (8th-order state) plus a Newton
+//! correction in time; an extremum, bracketed on the dense output's derivative, is moved by
+//! Newton's method to the root of the field's acceleration along the dense output.
 
 use rotor_model::{
     Disc, DiscMode, Event, EventKind, Mode, Model, OMEGA_L, SolveError, State, Stats, check_finite,
@@ -102,6 +106,16 @@ impl Guard {
     }
 }
 
+/// A guard event found in a step.
+#[derive(Debug, Clone, Copy)]
+struct Detected {
+    /// Its time.
+    t: f64,
+    guard: Guard,
+    /// Where a search for later events in the same step starts (at or after `t`).
+    resume: f64,
+}
+
 /// One integration run of the Filippov system.
 pub(crate) struct Integrator<'a> {
     pub model: &'a Model,
@@ -111,8 +125,8 @@ pub(crate) struct Integrator<'a> {
     pub stats: Stats,
     pub extrema: bool,
     pub section: Option<f64>,
-    /// Vector-field evaluations outside the integrator's stages (guard samples, guard
-    /// rates, extremum guards), added to `stats.rhs_evals` when a run returns.
+    /// Vector-field evaluations outside the integrator's stages (guard rates at event
+    /// refinement, extremum polishing), added to `stats.rhs_evals` when a run returns.
     extra_evals: Cell<u64>,
 }
 
@@ -245,83 +259,157 @@ impl<'a> Integrator<'a> {
         mode: Mode,
         start: Option<(&State, &State)>,
         end: (&State, &State),
-    ) -> Option<(f64, Guard)> {
+    ) -> Option<Detected> {
         let mut gs = [Guard::Section; 8];
         let n = self.guards(mode, &mut gs);
         let m = self.opts.guard_samples.clamp(1, MAX_GUARD_SAMPLES);
-        // The sample states and the vector field there, computed once and shared by every
-        // guard: the field gives the extremum guards' values and the velocity guards' rates
-        // (one friction evaluation per sample instead of one per guard and sample).
-        let mut ts = [0.0; MAX_GUARD_SAMPLES + 1];
-        let mut xs = [State::zeros(); MAX_GUARD_SAMPLES + 1];
-        let mut fs = [State::zeros(); MAX_GUARD_SAMPLES + 1];
-        for k in 0..=m {
-            ts[k] = if k == m {
-                t1
-            } else {
-                t0 + (t1 - t0) * k as f64 / m as f64
-            };
+        // The samples' states and rates, shared by every guard. Guards are functions of the
+        // state along the dense output (that is where their roots are located), so at an
+        // interior sample the rate is the dense output's own derivative: no field evaluation.
+        // At the step's ends it is the field, which the derivative equals there (Hermite).
+        // The rates give the extremum guards' values and the velocity guards' dip test.
+        let sample = |k: usize| -> (f64, State, State) {
             match (k, start) {
-                (0, Some((x0, f0))) => (xs[k], fs[k]) = (*x0, *f0),
-                _ if k == m => (xs[k], fs[k]) = (*end.0, *end.1),
+                (0, Some((x0, f0))) => (t0, *x0, *f0),
+                _ if k == m => (t1, *end.0, *end.1),
                 _ => {
-                    xs[k] = d.eval(ts[k]);
-                    fs[k] = self.field(&xs[k], mode);
+                    let t = t0 + (t1 - t0) * k as f64 / m as f64;
+                    let (x, r) = d.eval_with_rate(t);
+                    (t, x, r)
                 }
             }
-        }
-        let value = |g: Guard, k: usize| match g {
-            Guard::Extremum(disc, _) => fs[k][disc.index()],
-            _ => self.guard(g, &xs[k], mode),
         };
-        let mut best: Option<(f64, Guard)> = None;
-        for &g in &gs[..n] {
-            let mut ga = value(g, 0);
-            for i in 1..=m {
-                let (ta, tb) = (ts[i - 1], ts[i]);
-                if let Some((bt, _)) = best
-                    && ta >= bt
-                {
-                    break;
-                }
-                let gb = value(g, i);
-                let mut hit = Self::fires(g, ga, gb).map(|kind| (ta, tb, ga, kind));
+        let value = |g: Guard, x: &State, f: &State| match g {
+            Guard::Extremum(disc, _) => f[disc.index()],
+            _ => self.guard(g, x, mode),
+        };
+        // Sample intervals in time order; the first one where any guard fires holds the
+        // earliest event (the earliest root among the guards firing there).
+        let (mut ta, x0, mut fa_rate) = sample(0);
+        let mut ga = [0.0; 8];
+        for (j, &g) in gs[..n].iter().enumerate() {
+            ga[j] = value(g, &x0, &fa_rate);
+        }
+        for i in 1..=m {
+            let (tb, xb, fb_rate) = sample(i);
+            let mut best: Option<Detected> = None;
+            for (j, &g) in gs[..n].iter().enumerate() {
+                let gb = value(g, &xb, &fb_rate);
+                let mut hit = Self::fires(g, ga[j], gb).map(|kind| (ta, tb, ga[j], kind));
                 // A shallow dip of a velocity guard between two positive samples: look for
                 // the minimum (root of the guard's rate) and test its value.
                 if hit.is_none()
                     && let Guard::Velocity(disc) = g
-                    && ga > 0.0
+                    && ga[j] > 0.0
                     && gb > 0.0
                 {
                     let s = mode.of(disc).branch().unwrap_or(1.0);
-                    let ra = s * fs[i - 1][disc.index()];
-                    let rb = s * fs[i][disc.index()];
+                    let ra = s * fa_rate[disc.index()];
+                    let rb = s * fb_rate[disc.index()];
                     if ra < 0.0 && rb > 0.0 {
-                        let rate = |t: f64| self.guard_rate(g, &d.eval(t), mode);
+                        let rate = |t: f64| s * d.eval_with_rate(t).1[disc.index()];
                         let tm = illinois(&rate, ta, tb, ra, rb);
                         let gm = self.guard(g, &d.eval(tm), mode);
                         if gm <= 0.0 {
-                            hit = Some((ta, tm, ga, g));
+                            hit = Some((ta, tm, ga[j], g));
                         }
                     }
                 }
-                if let Some((a, b, fa, kind)) = hit {
-                    let f = |t: f64| self.guard(g, &d.eval(t), mode);
-                    let fb = f(b);
-                    let root = if fb == 0.0 {
-                        b
-                    } else {
-                        illinois(&f, a, b, fa, fb)
-                    };
-                    if best.is_none_or(|(bt, _)| root < bt) {
-                        best = Some((root, kind));
+                ga[j] = gb;
+                let Some((a, b, fa, kind)) = hit else {
+                    continue;
+                };
+                let found = match g {
+                    Guard::Extremum(disc, _) => {
+                        let f = |t: f64| d.eval_with_rate(t).1[disc.index()];
+                        let fb = f(b);
+                        let r = if fb == 0.0 {
+                            b
+                        } else {
+                            illinois(&f, a, b, fa, fb)
+                        };
+                        let is_max = matches!(kind, Guard::Extremum(_, true));
+                        let te = self.polish_extremum(disc, is_max, d, r, (t0, t1), mode);
+                        // The interpolant's root may lie after the polished one: a search
+                        // resumed before it would find this extremum again.
+                        Detected {
+                            t: te,
+                            guard: kind,
+                            resume: te.max(r),
+                        }
                     }
-                    break;
+                    _ => {
+                        let f = |t: f64| self.guard(g, &d.eval(t), mode);
+                        let fb = f(b);
+                        let t = if fb == 0.0 {
+                            b
+                        } else {
+                            illinois(&f, a, b, fa, fb)
+                        };
+                        Detected {
+                            t,
+                            guard: kind,
+                            resume: t,
+                        }
+                    }
+                };
+                if best.is_none_or(|b| found.t < b.t) {
+                    best = Some(found);
                 }
-                ga = gb;
+            }
+            if best.is_some() {
+                return best;
+            }
+            (ta, fa_rate) = (tb, fb_rate);
+        }
+        None
+    }
+
+    /// An extremum of a disc's velocity located as a root of the dense output's derivative
+    /// (exact for the interpolant, whose derivative is of one order less than its state)
+    /// moved to the root of the field's acceleration along the dense output, a(t) =
+    /// ω̇(x(t)), by Newton's method with a'(t) = (J f)_d: from a start within the rate's
+    /// interpolation error, two or three iterations reach rounding level. A step that would
+    /// leave the searched interval `span`, or a vanishing a', keeps the current time.
+    fn polish_extremum(
+        &self,
+        disc: Disc,
+        is_max: bool,
+        d: &Dense<3>,
+        mut t: f64,
+        span: (f64, f64),
+        mode: Mode,
+    ) -> f64 {
+        let (lo, hi) = (span.0.min(span.1), span.0.max(span.1));
+        for _ in 0..4 {
+            let x = d.eval(t);
+            let a = self.guard(Guard::Extremum(disc, true), &x, mode);
+            let ar = self.guard_rate(Guard::Extremum(disc, true), &x, mode);
+            if ar == 0.0 || !ar.is_finite() {
+                break;
+            }
+            let dt = -a / ar;
+            if !(lo..=hi).contains(&(t + dt)) {
+                break;
+            }
+            t += dt;
+            if dt.abs() <= 4.0 * f64::EPSILON * t.abs().max(1.0) {
+                break;
             }
         }
-        best
+        // Return a time where the guard has fired (a ≤ 0 after a maximum, a ≥ 0 after a
+        // minimum), as a bracketing root finder does: a run restarted from this event must
+        // not see it again. Newton ends within rounding of the root, so a few ulps suffice.
+        let fired = |t: f64| {
+            let a = self.guard(Guard::Extremum(disc, is_max), &d.eval(t), mode);
+            if is_max { a <= 0.0 } else { a >= 0.0 }
+        };
+        let mut nudge = 2.0 * f64::EPSILON * t.abs().max(1.0);
+        while !fired(t) && t + nudge <= hi {
+            t += nudge;
+            nudge *= 2.0;
+        }
+        t
     }
 
     /// Integrates from `(t, x, mode)` to `t_end`, or until the sink asks to stop.
@@ -411,7 +499,11 @@ impl<'a> Integrator<'a> {
             // Earliest event in the step; non-terminal events before it are recorded.
             let mut t_lo = t;
             let mut stop_here = None;
-            while let Some((te, g)) = self.detect(
+            while let Some(Detected {
+                t: te,
+                guard: g,
+                resume,
+            }) = self.detect(
                 &dense,
                 t_lo,
                 t1,
@@ -424,7 +516,7 @@ impl<'a> Integrator<'a> {
                     break;
                 }
                 if matches!(g, Guard::Extremum(..)) && te - t_switch <= 1e-9 * te.abs().max(1.0) {
-                    t_lo = te + 1e-12 * (t1 - t).abs().max(1e-300);
+                    t_lo = resume + 1e-12 * (t1 - t).abs().max(1e-300);
                     if t_lo >= t1 {
                         break;
                     }
@@ -453,7 +545,7 @@ impl<'a> Integrator<'a> {
                     }
                 }
                 // Continue the search just past this root.
-                t_lo = te + 1e-12 * (t1 - t).abs().max(1e-300);
+                t_lo = resume + 1e-12 * (t1 - t).abs().max(1e-300);
                 if t_lo >= t1 {
                     break;
                 }
