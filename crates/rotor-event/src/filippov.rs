@@ -128,6 +128,9 @@ pub(crate) struct Integrator<'a> {
     /// Vector-field evaluations outside the integrator's stages (guard rates at event
     /// refinement, extremum polishing), added to `stats.rhs_evals` when a run returns.
     extra_evals: Cell<u64>,
+    /// Stick intervals `[T_f(0⁻), T_f(0⁺)]` of the upper and lower disc (constant; the
+    /// exit guards use them at every sample).
+    stick_intervals: [(f64, f64); 2],
 }
 
 impl<'a> Integrator<'a> {
@@ -143,6 +146,7 @@ impl<'a> Integrator<'a> {
             extrema: false,
             section: None,
             extra_evals: Cell::new(0),
+            stick_intervals: Disc::BOTH.map(|d| model.friction(d).static_interval()),
         }
     }
 
@@ -150,6 +154,13 @@ impl<'a> Integrator<'a> {
     fn field(&self, x: &State, mode: Mode) -> State {
         self.extra_evals.set(self.extra_evals.get() + 1);
         self.model.rhs(x, self.u, mode)
+    }
+
+    fn stick_interval(&self, d: Disc) -> (f64, f64) {
+        match d {
+            Disc::Upper => self.stick_intervals[0],
+            Disc::Lower => self.stick_intervals[1],
+        }
     }
 
     /// Value of a guard at state x (in the current mode).
@@ -160,11 +171,11 @@ impl<'a> Integrator<'a> {
                 s * x[d.index()]
             }
             Guard::ExitHi(d) => {
-                let (_, hi) = self.model.friction(d).static_interval();
+                let (_, hi) = self.stick_interval(d);
                 hi - self.model.applied_torque(d, x, self.u)
             }
             Guard::ExitLo(d) => {
-                let (lo, _) = self.model.friction(d).static_interval();
+                let (lo, _) = self.stick_interval(d);
                 self.model.applied_torque(d, x, self.u) - lo
             }
             Guard::Extremum(d, _) => {
@@ -381,18 +392,26 @@ impl<'a> Integrator<'a> {
         mode: Mode,
     ) -> f64 {
         let (lo, hi) = (span.0.min(span.1), span.0.max(span.1));
+        let i = disc.index();
+        // The acceleration at t (one field evaluation), kept for the fired-side test below.
+        let mut at = (t, f64::NAN);
+        let mut dt_prev = f64::INFINITY;
         for _ in 0..4 {
             let x = d.eval(t);
-            let a = self.guard(Guard::Extremum(disc, true), &x, mode);
-            let ar = self.guard_rate(Guard::Extremum(disc, true), &x, mode);
+            let f = self.field(&x, mode);
+            at = (t, f[i]);
+            let ar = (self.model.jacobian(&x, self.u, mode) * f)[i];
             if ar == 0.0 || !ar.is_finite() {
                 break;
             }
-            let dt = -a / ar;
-            if !(lo..=hi).contains(&(t + dt)) {
+            let dt = -f[i] / ar;
+            // Outside the searched interval, or no contraction (a at rounding level, as on
+            // the decaying oscillation into an equilibrium): keep the current time.
+            if !(lo..=hi).contains(&(t + dt)) || dt.abs() >= 0.5 * dt_prev {
                 break;
             }
             t += dt;
+            dt_prev = dt.abs();
             if dt.abs() <= 4.0 * f64::EPSILON * t.abs().max(1.0) {
                 break;
             }
@@ -401,7 +420,11 @@ impl<'a> Integrator<'a> {
         // minimum), as a bracketing root finder does: a run restarted from this event must
         // not see it again. Newton ends within rounding of the root, so a few ulps suffice.
         let fired = |t: f64| {
-            let a = self.guard(Guard::Extremum(disc, is_max), &d.eval(t), mode);
+            let a = if t == at.0 && !at.1.is_nan() {
+                at.1
+            } else {
+                self.guard(Guard::Extremum(disc, is_max), &d.eval(t), mode)
+            };
             if is_max { a <= 0.0 } else { a >= 0.0 }
         };
         let mut nudge = 2.0 * f64::EPSILON * t.abs().max(1.0);
