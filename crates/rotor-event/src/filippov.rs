@@ -56,7 +56,7 @@ impl Default for EventOptions {
     }
 }
 
-/// Largest number of guard samples per step (the sample buffers live on the stack).
+/// Largest number of guard samples per step.
 const MAX_GUARD_SAMPLES: usize = 64;
 
 /// What to do with a run as it goes.
