@@ -164,6 +164,10 @@ impl OutputGrid {
 
     /// The next output time, if any.
     pub fn peek(&self) -> Option<f64> {
+        if self.k < self.n {
+            // Before the last point k·dt ≤ t_end − dt (up to 1e-12 relative): no snapping.
+            return Some(self.k as f64 * self.dt);
+        }
         if self.done {
             return None;
         }
@@ -182,6 +186,10 @@ impl OutputGrid {
 
     /// Advances past the current output time.
     pub fn advance(&mut self) {
+        if self.k < self.n {
+            self.k += 1;
+            return;
+        }
         if let Some(t) = self.peek() {
             if t >= self.t_end {
                 self.done = true;
@@ -355,6 +363,30 @@ mod tests {
         assert_eq!(v, vec![0.0, 0.3, 0.6, 0.8999999999999999, 1.0]);
         let v = walk(2.0, 1.0);
         assert_eq!(v, vec![0.0, 1.0]);
+    }
+
+    /// Every point but the last is k·dt exactly, the times increase strictly, and the last
+    /// is t_end (also where t_end/dt is an integer only up to rounding).
+    #[test]
+    fn grid_points_are_multiples_of_dt_then_t_end() {
+        for (dt, t_end) in [
+            (0.01, 100.0),
+            (0.07, 1.0),
+            (0.1, 0.3),
+            (1e-3, 0.0101),
+            (0.3, 0.9),
+        ] {
+            let v = walk(dt, t_end);
+            let (last, inner) = v.split_last().unwrap();
+            assert_eq!(*last, t_end, "dt {dt}, t_end {t_end}");
+            for (k, t) in inner.iter().enumerate() {
+                assert_eq!(*t, k as f64 * dt, "dt {dt}, t_end {t_end}, k {k}");
+            }
+            assert!(
+                v.windows(2).all(|w| w[0] < w[1]),
+                "dt {dt}, t_end {t_end}: {v:?}"
+            );
+        }
     }
 
     #[test]
