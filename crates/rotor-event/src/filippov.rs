@@ -56,6 +56,13 @@ impl Default for EventOptions {
     }
 }
 
+/// An extremum is reported only if the velocity moved by more than this many tolerances
+/// (relative to 1 + |ω|) since the extremum found before it: the integration error in ω is
+/// of the order of the tolerance, so smaller turns are not resolved (10: one decade of
+/// margin). Settling onto an equilibrium, the velocity otherwise turns at rounding level
+/// hundreds of times.
+const EXTREMUM_RESOLUTION: f64 = 10.0;
+
 /// Largest number of guard samples per step.
 const MAX_GUARD_SAMPLES: usize = 64;
 
@@ -471,6 +478,11 @@ impl<'a> Integrator<'a> {
         // Time of the last mode switch: the acceleration of a disc leaving stick starts at 0,
         // so its first sign is rounding; extremum roots right at a switch are not extrema.
         let mut t_switch = t_start;
+        // The velocity at the last extremum found per disc since the last mode switch: an
+        // extremum within EXTREMUM_RESOLUTION tolerances of it is below what the integration
+        // resolves (rounding-level turns of a velocity settling onto an equilibrium) and is
+        // not reported.
+        let mut last_extremum: [Option<f64>; 2] = [None; 2];
         while t < t_end {
             // Both discs stuck: the state is frozen and the exit guards are constant.
             if mode.upper == DiscMode::Stick && mode.lower == DiscMode::Stick {
@@ -545,6 +557,19 @@ impl<'a> Integrator<'a> {
                     continue;
                 }
                 let xe = refine_state(&dense, te);
+                if let Guard::Extremum(d, _) = g {
+                    let w = xe[d.index()];
+                    let resolvable = last_extremum[d as usize].replace(w).is_none_or(|w_prev| {
+                        (w - w_prev).abs() > EXTREMUM_RESOLUTION * self.ctl.rtol * (1.0 + w.abs())
+                    });
+                    if !resolvable {
+                        t_lo = resume + 1e-12 * (t1 - t).abs().max(1e-300);
+                        if t_lo >= t1 {
+                            break;
+                        }
+                        continue;
+                    }
+                }
                 let kind = match g {
                     Guard::Extremum(d, true) => EventKind::Max(d),
                     Guard::Extremum(d, false) => EventKind::Min(d),
@@ -655,6 +680,7 @@ impl<'a> Integrator<'a> {
                     }
                     mode = new_mode;
                     t_switch = t;
+                    last_extremum = [None; 2];
                     f0 = f(t, &x, mode);
                     self.ctl.restart();
                     h = h_next.min(h).max(1e-6 * h_next);

@@ -7,6 +7,12 @@ use rotor_model::{
 
 use crate::dopri5::{Dopri5, Dopri5Error, Dopri5Options};
 
+/// An extremum is reported only if ω moved by more than this many tolerances (relative to
+/// 1 + |ω|) since the extremum found before it, without a region change between: the
+/// integration error in ω is of the order of the tolerance, so smaller turns are not
+/// resolved (10: one decade of margin).
+const EXTREMUM_RESOLUTION: f64 = 10.0;
+
 /// Settings of the switch-model solver.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct SwitchOptions {
@@ -463,6 +469,10 @@ impl Solver for SwitchSolver {
         let mut zeno = vec![f64::NEG_INFINITY; o.zeno_count.max(1) as usize];
         let mut zeno_i = 0usize;
         let mut found: Vec<(f64, EventKind)> = Vec::new();
+        // ω at the last extremum found per disc (upper, lower) since the disc's last region
+        // change: an extremum within EXTREMUM_RESOLUTION tolerances of it is not resolved by
+        // the integration (rounding-level turns while settling onto an equilibrium).
+        let mut last_extremum: [Option<f64>; 2] = [None; 2];
 
         while integ.t() < t_end {
             let f = field;
@@ -555,7 +565,18 @@ impl Solver for SwitchSolver {
                 integ.count_rhs(extra_rhs);
                 found.sort_by(|a, b| a.0.total_cmp(&b.0));
                 for &(t, kind) in &found {
-                    sink.emit(t, integ.dense(t), kind);
+                    let y = integ.dense(t);
+                    if let EventKind::Max(d) | EventKind::Min(d) = kind {
+                        let w = y[d.index()];
+                        let slot = &mut last_extremum[usize::from(d == Disc::Lower)];
+                        let resolvable = slot.replace(w).is_none_or(|w_prev| {
+                            (w - w_prev).abs() > EXTREMUM_RESOLUTION * scene.tol * (1.0 + w.abs())
+                        });
+                        if !resolvable {
+                            continue;
+                        }
+                    }
+                    sink.emit(t, y, kind);
                 }
             }
 
@@ -586,6 +607,7 @@ impl Solver for SwitchSolver {
                 };
                 let (r, w, ev) = f.fire(k, g, &y);
                 field.regions[k] = r;
+                last_extremum[k] = None;
                 if let Some(w) = w {
                     y[field.laws[k].idx] = w;
                 }
