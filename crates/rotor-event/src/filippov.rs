@@ -9,7 +9,9 @@
 //! * slipping disc on branch s: `g = s·ω` (reaches 0: stick or reversal, decided from the
 //!   one-sided accelerations, i.e. whether the applied torque lies inside the interval);
 //! * stuck disc: `g = T_f(0⁺) − T_ex` and `g = T_ex − T_f(0⁻)` (stick exit to slip±);
-//! * when extrema are asked: `g = ω̇` of each slipping disc (maxima and minima);
+//! * when extrema are asked: `g = ω̇` of each slipping disc (maxima and minima; a turn of
+//!   less than 10 tolerances since the previous extremum is below resolution and not
+//!   reported);
 //! * when a Poincaré section is asked: `g = ω_l − c`, upward.
 //!
 //! Guards are sampled at interior points of the dense output and, for the velocity guards,

@@ -227,7 +227,9 @@ pub enum EventKind {
     StickEnd(Disc),
     /// The disc's velocity crossed 0 without sticking.
     Reversal(Disc),
-    /// A local maximum of the disc's velocity (only when metrics are asked).
+    /// A local maximum of the disc's velocity (only when metrics are asked). The adaptive
+    /// solvers report a turn only if ω moved by more than 10 tolerances since the extremum
+    /// before it: smaller ones are below their resolution (rounding noise near equilibria).
     Max(Disc),
     /// A local minimum of the disc's velocity (only when metrics are asked).
     Min(Disc),
