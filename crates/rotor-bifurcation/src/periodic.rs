@@ -179,29 +179,16 @@ impl Shooter<'_> {
     /// The stick-exit map `P(w)`: ω_u at the next exit of the lower disc from stick.
     pub fn stick_exit_map(&self, u: f64, w: f64) -> Result<Return, BifError> {
         let (x, mode) = self.exit_state(w);
-        let end = flow(
-            self.model,
-            u,
-            self.tol,
-            x,
-            mode,
-            T_RETURN,
-            StopAt::LowerStickExit,
-        )
-        .map_err(err)?;
-        if !end.reached {
-            return Err(BifError::NoReturn { u });
-        }
-        Ok(Return {
-            x: end.x,
-            t: end.t,
-            stuck: true,
-        })
+        self.flow_to_exit(u, x, mode)
     }
 
     /// The next stick exit reached from a state on the section `ω_l = c`.
     pub fn next_exit(&self, u: f64, x: State) -> Result<Return, BifError> {
-        let mode = self.model.mode_at(&x, u);
+        self.flow_to_exit(u, x, self.model.mode_at(&x, u))
+    }
+
+    /// The flow from `(x, mode)` to the lower disc's next stick exit (where ω_l = 0).
+    fn flow_to_exit(&self, u: f64, x: State, mode: Mode) -> Result<Return, BifError> {
         let end = flow(
             self.model,
             u,
