@@ -6,6 +6,7 @@ use std::process::ExitCode;
 
 use anyhow::{Context, Result, anyhow, bail};
 use clap::{Parser, Subcommand};
+use rotor_compare::SolverKind;
 use rotor_model::{Model, Output, Params, Scene, Solver, State, SteadyState};
 
 /// Two-disc rotor with set-valued friction: three independent solvers, cross-validated.
@@ -111,16 +112,12 @@ struct Common {
     h: Option<f64>,
 }
 
-const SOLVERS: [&str; 3] = ["switch", "event", "moreau"];
-
 fn solver_by_name(name: &str) -> Result<Box<dyn Solver>> {
-    match name {
-        "event" => Ok(Box::new(rotor_event::EventSolver::default())),
-        "switch" => Ok(Box::new(rotor_switch::SwitchSolver::default())),
-        "moreau" => Ok(Box::new(rotor_moreau::MoreauSolver::default())),
-        other => bail!(
-            "--solver {other:?}: unknown solver (expected one of: {})",
-            SOLVERS.join(", ")
+    match SolverKind::ALL.into_iter().find(|k| k.name() == name) {
+        Some(kind) => Ok(kind.solver()),
+        None => bail!(
+            "--solver {name:?}: unknown solver (expected one of: {})",
+            SolverKind::ALL.map(SolverKind::name).join(", ")
         ),
     }
 }

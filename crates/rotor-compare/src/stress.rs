@@ -36,7 +36,7 @@ use std::time::Instant;
 use nalgebra::{Matrix4, Vector4};
 use rotor_model::{
     Disc, Event, EventKind, LowerFriction, Model, OMEGA_L, Output, Params, Scene, SolveError,
-    Solver, State, Stats, SteadyState, Trajectory, UpperFriction,
+    State, Stats, SteadyState, Trajectory, UpperFriction,
 };
 
 use crate::run::SolverKind;
@@ -161,6 +161,19 @@ impl Setting {
             h: 1e-3,
             gate: Gate::Adaptive,
         }
+    }
+
+    /// Every solver at the comparison-grade defaults (tol 1e-10, h = 1e-3), one gate.
+    pub fn every_solver(gate: Gate) -> Vec<Setting> {
+        SolverKind::ALL
+            .iter()
+            .map(|&kind| Setting {
+                kind,
+                tol: 1e-10,
+                h: 1e-3,
+                gate,
+            })
+            .collect()
     }
 
     /// Moreau–Jean at step `h` with a gate.
@@ -301,14 +314,6 @@ impl StressRow {
     }
 }
 
-fn solver(kind: SolverKind) -> Box<dyn Solver> {
-    match kind {
-        SolverKind::Event => Box::new(rotor_event::EventSolver::default()),
-        SolverKind::Switch => Box::new(rotor_switch::SwitchSolver::default()),
-        SolverKind::Moreau => Box::new(rotor_moreau::MoreauSolver::default()),
-    }
-}
-
 fn finite_trajectory(tr: &Trajectory) -> Result<(), f64> {
     let ok = |x: &State| x.iter().all(|v| v.is_finite());
     if let Some(s) = tr.samples.iter().find(|s| !ok(&s.x) || !s.t.is_finite()) {
@@ -332,7 +337,7 @@ fn finite_trajectory(tr: &Trajectory) -> Result<(), f64> {
 /// and the run time.
 fn run(kind: SolverKind, model: &Model, scene: &Scene) -> (Outcome, Option<Trajectory>, f64) {
     let t0 = Instant::now();
-    let res = solver(kind).simulate(model, scene);
+    let res = kind.solver().simulate(model, scene);
     let seconds = t0.elapsed().as_secs_f64();
     match res {
         Err(e) => (Outcome::Failed(e), None, seconds),

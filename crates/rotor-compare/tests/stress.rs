@@ -77,15 +77,7 @@ fn stress_huge_magnitudes_end_in_a_typed_error_or_finite_states() {
         x0,
         t_end: 1.0,
         measure: Measure::Transient { dt: 0.01 },
-        settings: SolverKind::ALL
-            .iter()
-            .map(|&kind| Setting {
-                kind,
-                tol: 1e-10,
-                h: 1e-3,
-                gate: Gate::Unresolved("magnitudes beyond the model"),
-            })
-            .collect(),
+        settings: Setting::every_solver(Gate::Unresolved("magnitudes beyond the model")),
     };
     let mut typed = 0;
     for c in [
@@ -161,15 +153,7 @@ fn stress_mirror_measure_sees_an_asymmetric_friction_law() {
         x0: State::new(0.3, 1.0, -0.5),
         t_end: 10.0,
         measure: Measure::Mirror { dt: 0.01 },
-        settings: SolverKind::ALL
-            .iter()
-            .map(|&kind| Setting {
-                kind,
-                tol: 1e-10,
-                h: 1e-3,
-                gate: Gate::Exact,
-            })
-            .collect(),
+        settings: Setting::every_solver(Gate::Exact),
     };
     for r in run_case(&c) {
         assert_eq!(r.outcome, Outcome::Finished);
@@ -341,12 +325,7 @@ proptest! {
         for kind in SolverKind::ALL {
             let scene = Scene { u, x0, t_end: 10.0, tol: 1e-10, h: 1e-3,
                 output: Output::Grid { dt: 0.01 }, metrics_from: Some(5.0) };
-            let solver: Box<dyn Solver> = match kind {
-                SolverKind::Event => Box::new(rotor_event::EventSolver::default()),
-                SolverKind::Switch => Box::new(rotor_switch::SwitchSolver::default()),
-                SolverKind::Moreau => Box::new(rotor_moreau::MoreauSolver::default()),
-            };
-            match solver.simulate(&m, &scene) {
+            match kind.solver().simulate(&m, &scene) {
                 Ok(tr) => {
                     prop_assert!(tr.samples.iter().all(|s| s.x.iter().all(|v| v.is_finite())),
                         "{}: NaN in samples", kind.name());
