@@ -452,35 +452,24 @@ pub fn integrate<const N: usize>(
 #[allow(clippy::excessive_precision)]
 mod tests {
     use super::*;
-    use nalgebra::{Vector2, Vector4};
+    use nalgebra::Vector2;
+    use rotor_testkit::arenstorf;
 
-    fn arenstorf(_t: f64, y: &Vector4<f64>) -> Vector4<f64> {
-        let mu = 0.012277471;
-        let mup = 1.0 - mu;
-        let d1 = ((y[0] + mu).powi(2) + y[1].powi(2)).powf(1.5);
-        let d2 = ((y[0] - mup).powi(2) + y[1].powi(2)).powf(1.5);
-        Vector4::new(
-            y[2],
-            y[3],
-            y[0] + 2.0 * y[3] - mup * (y[0] + mu) / d1 - mu * (y[0] - mup) / d2,
-            y[1] - 2.0 * y[2] - mup * y[1] / d1 - mu * y[1] / d2,
-        )
-    }
-
-    const ARENSTORF_T: f64 = 17.0652165601579625588917206249;
-
-    fn arenstorf_y0() -> Vector4<f64> {
-        Vector4::new(0.994, 0.0, 0.0, -2.00158510637908252240537862224)
-    }
-
-    /// The Arenstorf orbit is periodic with period ARENSTORF_T: the state returns to y0.
+    /// The Arenstorf orbit is periodic: after one period the state returns to y0.
     /// The global error falls like tol (a few times tol for a proportional controller).
     #[test]
     fn arenstorf_returns_to_start() {
         for tol in [1e-8, 1e-10, 1e-12] {
             let mut c = Dop853::new(tol, tol);
-            let (y, _) = integrate(&mut c, arenstorf, 0.0, arenstorf_y0(), ARENSTORF_T, 0.0);
-            let e = (y - arenstorf_y0()).amax();
+            let (y, _) = integrate(
+                &mut c,
+                arenstorf::field,
+                0.0,
+                arenstorf::y0(),
+                arenstorf::PERIOD,
+                0.0,
+            );
+            let e = (y - arenstorf::y0()).amax();
             // This orbit amplifies local errors by ~1e3–1e4 (close passes to the moon), so
             // the bound is 1e4·tol; a wrong coefficient gives O(1) errors.
             assert!(e < 1e4 * tol, "tol {tol}: error {e}");
@@ -503,7 +492,7 @@ mod tests {
             .unwrap();
         let st = solver.stats();
         let mut c = Dop853::new(1e-7, 1e-7);
-        let (y, n) = integrate(&mut c, arenstorf, x0, arenstorf_y0(), x1, 1e-4);
+        let (y, n) = integrate(&mut c, arenstorf::field, x0, arenstorf::y0(), x1, 1e-4);
         let yr: &Vector = &y0;
         assert_eq!(n.accepted as usize, st.n_accepted);
         assert_eq!(n.rejected as usize, st.n_rejected);

@@ -434,7 +434,8 @@ where
 #[cfg(test)]
 mod tests {
     use super::*;
-    use nalgebra::{Vector2, Vector4};
+    use nalgebra::Vector2;
+    use rotor_testkit::arenstorf;
 
     fn opts(tol: f64) -> Dopri5Options {
         Dopri5Options {
@@ -475,34 +476,14 @@ mod tests {
         assert!(errs[3] < 1e-8, "{errs:?}");
     }
 
-    /// Arenstorf orbit (Hairer–Nørsett–Wanner I, eq. II.0.1), one period.
-    fn arenstorf(t: f64, y: &Vector4<f64>) -> Vector4<f64> {
-        let _ = t;
-        let mu = 0.012277471;
-        let mup = 1.0 - mu;
-        let d1 = ((y[0] + mu).powi(2) + y[1].powi(2)).powf(1.5);
-        let d2 = ((y[0] - mup).powi(2) + y[1].powi(2)).powf(1.5);
-        Vector4::new(
-            y[2],
-            y[3],
-            y[0] + 2.0 * y[3] - mup * (y[0] + mu) / d1 - mu * (y[0] - mup) / d2,
-            y[1] - 2.0 * y[2] - mup * y[1] / d1 - mu * y[1] / d2,
-        )
-    }
-
-    // The literals as published (HNW I, p. 130), more digits than f64 holds.
-    #[allow(clippy::excessive_precision)]
-    const ARENSTORF_T: f64 = 17.0652165601579625588917206249;
-
     #[test]
-    #[allow(clippy::excessive_precision)]
     fn arenstorf_counts_match_hairers_code() {
-        let y0 = Vector4::new(0.994, 0.0, 0.0, -2.00158510637908252240537862224);
+        let y0 = arenstorf::y0();
         let o = Dopri5Options {
             h0: Some(1e-4),
             ..opts(1e-7)
         };
-        let (y, c) = integrate(o, 0.0, y0, ARENSTORF_T, arenstorf, |_| {}).unwrap();
+        let (y, c) = integrate(o, 0.0, y0, arenstorf::PERIOD, arenstorf::field, |_| {}).unwrap();
         // Pinned by russell_ode's DoPri5 Arenstorf test, which matches dopri5.f's counters:
         // 1429 = 1 + 6·(217 + 21). Any tableau or controller typo changes these.
         assert_eq!(c.rhs_evals, 1429);

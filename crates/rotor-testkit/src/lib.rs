@@ -7,7 +7,11 @@
 //! checked around the needles (one line starting with the path, an `error:` line on stderr
 //! with a clean exit code, no report written) stays with each test's own harness.
 //!
+//! It also holds [`arenstorf`], the standard orbit both Runge–Kutta steppers are checked on.
+//!
 //! Dev-dependency only; nothing here is part of the published crates.
+
+pub mod arenstorf;
 
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicUsize, Ordering};
