@@ -96,7 +96,9 @@ pub fn check_pair(
                 n += 1;
             }
         }
-        if count_mismatch {
+        // No sample in the window (or grids that differ): nothing was compared, which must
+        // not read as agreement.
+        if count_mismatch || n == 0 {
             max = f64::NAN;
         }
         let rms = if n > 0 {
@@ -150,10 +152,21 @@ pub fn check_pair(
             });
         }
     }
-    if let (Some(sa), Some(sb)) = (a.metrics, b.metrics)
-        && let Some(rel) = tol.steady_rel
-    {
+    if let Some(rel) = tol.steady_rel {
         let floor = tol.steady_abs.unwrap_or(0.0);
+        let (Some(sa), Some(sb)) = (a.metrics, b.metrics) else {
+            // A gated steady state that a solver did not deliver fails the gate.
+            let which = |tr: &Trajectory| if tr.metrics.is_some() { "yes" } else { "none" };
+            m.push(Measured {
+                quantity: format!("steady metrics ({} vs {})", which(a), which(b)),
+                diff: f64::NAN,
+                tol: rel,
+            });
+            return GateResult {
+                pair: pair.to_owned(),
+                measured: m,
+            };
+        };
         if sa.kind() != sb.kind() {
             m.push(Measured {
                 quantity: format!("steady kind ({} vs {})", sa.kind(), sb.kind()),
@@ -186,4 +199,86 @@ pub fn check_pair(
 /// The steady metrics of a trajectory, if computed.
 pub fn metrics(tr: &Trajectory) -> Option<SteadyState> {
     tr.metrics
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use rotor_model::{DiscMode, Mode, Sample, State, Stats};
+
+    /// A trajectory with samples every 0.01 s on [0, 1] and the given metrics.
+    fn traj(metrics: Option<SteadyState>) -> Trajectory {
+        let samples = (0..=100)
+            .map(|k| {
+                let t = k as f64 * 0.01;
+                Sample {
+                    t,
+                    x: State::new(0.0, 1.0, t.sin()),
+                }
+            })
+            .collect();
+        Trajectory {
+            samples,
+            events: Vec::new(),
+            t_final: 1.0,
+            x_final: State::zeros(),
+            mode_final: Mode {
+                upper: DiscMode::SlipPos,
+                lower: DiscMode::SlipPos,
+            },
+            metrics,
+            stats: Stats::default(),
+        }
+    }
+
+    const EQ: SteadyState = SteadyState::Equilibrium {
+        omega_u: 1.0,
+        omega_l: 1.0,
+        alpha: 0.1,
+    };
+
+    fn tol() -> PairTolerance {
+        PairTolerance {
+            transient_max: Some(1e-9),
+            steady_rel: Some(1e-9),
+            ..PairTolerance::default()
+        }
+    }
+
+    #[test]
+    fn identical_results_pass_and_a_difference_fails() {
+        let a = traj(Some(EQ));
+        let g = check_pair("p", &a, &a, Some([0.0, 1.0]), &tol());
+        // Both the window and the metrics were measured, and passed.
+        assert_eq!(g.measured.len(), 1 + EQ.values().len());
+        assert!(g.failures("s").is_empty());
+        let mut b = a.clone();
+        b.samples[50].x[2] += 1e-6;
+        let f = check_pair("p", &a, &b, Some([0.0, 1.0]), &tol()).failures("s");
+        assert_eq!(f.len(), 1, "{f:?}");
+        assert!(f[0].quantity.contains("transient max"));
+    }
+
+    #[test]
+    fn a_window_without_samples_fails_rather_than_passing_empty() {
+        let a = traj(Some(EQ));
+        // Between grid points 0.50 and 0.51: no sample to compare.
+        let f = check_pair("p", &a, &a, Some([0.501, 0.509]), &tol()).failures("s");
+        assert!(
+            f.iter().any(|f| f.quantity.contains("transient max")),
+            "{f:?}"
+        );
+    }
+
+    #[test]
+    fn gated_metrics_missing_on_one_side_fail() {
+        let (a, b) = (traj(Some(EQ)), traj(None));
+        for (x, y) in [(&a, &b), (&b, &a), (&b, &b)] {
+            let f = check_pair("p", x, y, None, &tol()).failures("s");
+            assert!(
+                f.len() == 1 && f[0].quantity.contains("steady metrics"),
+                "{f:?}"
+            );
+        }
+    }
 }

@@ -101,8 +101,8 @@ pub fn snapshot(r: &ScenarioResult) -> ScenarioSnapshot {
     let floor = tols
         .filter_map(|t| t.steady_abs)
         .fold(f64::INFINITY, f64::min);
-    // No stated steady tolerance: keep 6 digits and a 1e-9 floor (the gate fails such a scenario
-    // anyway, for the missing tolerance).
+    // No stated steady tolerance (a scenario without compare.steady_from has no metrics: the
+    // loader requires steady_rel of every pair when it is set): 6 digits and a 1e-9 floor.
     let floor = if floor.is_finite() { floor } else { 1e-9 };
     let (digits, floor) = if rel.is_finite() && rel > 0.0 {
         ((-rel.log10()).floor().max(1.0) as u32, floor)

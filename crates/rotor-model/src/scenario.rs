@@ -313,6 +313,16 @@ impl Scenario {
                 "must satisfy 0 <= t0 < t1 <= t_end",
             ));
         }
+        // A window shorter than the grid step may hold no sample: its gate would measure nothing.
+        if let Some([a, b]) = raw.compare.transient
+            && b - a < raw.compare.dt
+        {
+            return Err(bad(
+                "compare.transient",
+                format!("[{a}, {b}]"),
+                "is shorter than compare.dt: it may hold no grid sample to compare",
+            ));
+        }
         if let Some(t) = raw.compare.steady_from
             && !(t >= 0.0 && t < raw.t_end)
         {
@@ -346,6 +356,62 @@ impl Scenario {
                         "must be positive and finite",
                     ));
                 }
+            }
+            // Every tolerance must have something to measure, and every compared window a
+            // gate: otherwise a pair would pass having measured nothing.
+            let transient = raw.compare.transient.is_some();
+            let steady = raw.compare.steady_from.is_some();
+            for (name, v, needed, why) in [
+                (
+                    "transient_max",
+                    tol.transient_max,
+                    transient,
+                    "needs compare.transient (the window it gates)",
+                ),
+                (
+                    "transient_rms",
+                    tol.transient_rms,
+                    transient,
+                    "needs compare.transient (the window it gates)",
+                ),
+                (
+                    "event_time",
+                    tol.event_time,
+                    transient,
+                    "needs compare.transient (the window it gates)",
+                ),
+                (
+                    "steady_rel",
+                    tol.steady_rel,
+                    steady,
+                    "needs compare.steady_from (the metrics it gates)",
+                ),
+                (
+                    "steady_abs",
+                    tol.steady_abs,
+                    steady && tol.steady_rel.is_some(),
+                    "is the floor of steady_rel and needs it (and compare.steady_from)",
+                ),
+            ] {
+                if let Some(v) = v
+                    && !needed
+                {
+                    return Err(bad(&format!("tolerance.{pair}.{name}"), v.to_string(), why));
+                }
+            }
+            if transient && tol.transient_max.is_none() {
+                return Err(bad(
+                    &format!("tolerance.{pair}.transient_max"),
+                    "(missing)".into(),
+                    "is required when compare.transient is set: the window would be ungated",
+                ));
+            }
+            if steady && tol.steady_rel.is_none() {
+                return Err(bad(
+                    &format!("tolerance.{pair}.steady_rel"),
+                    "(missing)".into(),
+                    "is required when compare.steady_from is set: the metrics would be ungated",
+                ));
             }
         }
         Ok(Scenario {

@@ -86,10 +86,21 @@ pub fn write_scenario(dir: &Path, contents: &[u8]) -> PathBuf {
 /// [`local_scenario`] with a horizon of 5e-4 s, shorter than the default Moreau step, and no
 /// `h`: every run would fail, so the file is refused. With `h = 1e-4` added after `t_end` it
 /// loads (the library test checks that, so that this case fails only for the missing `h`).
+/// Its transient window is the whole horizon on a 1e-4 s grid, and it has no steady state
+/// (nor the steady tolerances, which would gate nothing).
 pub fn short_horizon_scenario() -> String {
     let s = local_scenario();
-    let s = edit(&s, "transient = [0.0, 20.0]", "transient = [0.0, 5e-4]");
+    let s = edit(
+        &s,
+        "transient = [0.0, 20.0]",
+        "transient = [0.0, 5e-4]\ndt = 1e-4",
+    );
     let s = edit(&s, "steady_from = 100.0", "");
+    let s: String = s
+        .lines()
+        .filter(|l| !l.starts_with("steady_"))
+        .map(|l| format!("{l}\n"))
+        .collect();
     edit(&s, "t_end = 200.0", "t_end = 5e-4")
 }
 
@@ -447,6 +458,33 @@ pub fn bad_scenario_cases() -> Vec<BadFile> {
             "transient_max = 1e-7 ",
             "transient_max = -1e-7 ",
             &["tolerance.event-switch.transient_max = -0.0000001"],
+        ),
+        // A window that may hold no grid sample, tolerances without the window they gate,
+        // and windows without a gate: each would let a pair pass having measured nothing.
+        sc(
+            "transient = [0.0, 20.0]",
+            "transient = [0.0, 0.005]",
+            &["compare.transient = [0, 0.005]", "shorter than compare.dt"],
+        ),
+        sc(
+            "transient = [0.0, 20.0]",
+            "",
+            &["transient_max = ", "needs compare.transient"],
+        ),
+        sc(
+            "steady_from = 100.0",
+            "",
+            &["steady_rel = ", "needs compare.steady_from"],
+        ),
+        sc(
+            "transient_max = 1e-7 ",
+            "",
+            &["tolerance.event-switch.transient_max = (missing)", "ungated"],
+        ),
+        sc(
+            "steady_rel = 2e-6",
+            "",
+            &["tolerance.event-switch.steady_abs = 0.000000001", "needs it"],
         ),
         // A misspelt pair would leave the pair ungated.
         sc(
