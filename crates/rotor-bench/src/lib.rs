@@ -76,6 +76,9 @@ pub enum BenchError {
     /// A peer script failed (recorded in the report, not returned by [`run`]).
     #[error("peer {peer}: {detail}")]
     Peer { peer: String, detail: String },
+    /// The report holds a non-finite number (a bug): nothing is written.
+    #[error("the benchmark report holds {path} = {value}: not written (JSON has no NaN)")]
+    NonFinite { path: String, value: f64 },
 }
 
 /// The whole benchmark's result.

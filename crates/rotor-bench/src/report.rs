@@ -6,7 +6,7 @@ use rotor_plot::{Panel, Series, render};
 
 use crate::measure::Errors;
 use crate::options::SolverKind;
-use crate::{BenchReport, PeerReport};
+use crate::{BenchError, BenchReport, PeerReport};
 
 fn e(v: Option<f64>) -> String {
     v.map_or("-".into(), |x| format!("{x:.1e}"))
@@ -211,13 +211,33 @@ impl BenchReport {
         s
     }
 
-    /// The report as pretty JSON (absent values are `null`, never NaN).
-    pub fn to_json(&self) -> String {
-        serde_json::to_string_pretty(self).unwrap_or_else(|e| format!("{{\"error\": \"{e}\"}}"))
+    /// The first non-finite number of the report, as an error naming its path (e.g.
+    /// `output_levels[0].ratio`). JSON has no NaN: serde_json would write `null`, the same as
+    /// an absent value, so every writer checks this first. (The walk goes through a
+    /// `toml::Value`, which keeps non-finite floats and skips absent fields.)
+    pub fn check_finite(&self) -> Result<(), BenchError> {
+        let v = toml::Value::try_from(self).map_err(|e| BenchError::NonFinite {
+            path: format!("(the report cannot be walked: {e})"),
+            value: f64::NAN,
+        })?;
+        match first_non_finite(&v, String::new()) {
+            Some((path, value)) => Err(BenchError::NonFinite { path, value }),
+            None => Ok(()),
+        }
     }
 
-    /// Every point (ladders and peers) as CSV rows.
-    pub fn to_csv(&self) -> String {
+    /// The report as pretty JSON (absent values are `null`; a non-finite number is an error).
+    pub fn to_json(&self) -> Result<String, BenchError> {
+        self.check_finite()?;
+        serde_json::to_string_pretty(self).map_err(|e| BenchError::NonFinite {
+            path: format!("(JSON: {e})"),
+            value: f64::NAN,
+        })
+    }
+
+    /// Every point (ladders and peers) as CSV rows (a non-finite number is an error).
+    pub fn to_csv(&self) -> Result<String, BenchError> {
+        self.check_finite()?;
         let mut s = String::from(
             "scene,source,setting_name,setting,median_s,min_s,repeats,err_period_s,\
              err_omega_l_max,err_steady_rel,err_transient_max,steps,rejected,rhs_evals,events,\
@@ -300,12 +320,14 @@ impl BenchReport {
                 }
             }
         }
-        s
+        Ok(s)
     }
 
     /// Work-precision plot: per scene, steady-state error and transient error against run
-    /// time, log–log, one line per solver and peer, markers at the points.
-    pub fn to_svg(&self) -> String {
+    /// time, log–log, one line per solver and peer, markers at the points (a non-finite
+    /// number in the report is an error).
+    pub fn to_svg(&self) -> Result<String, BenchError> {
+        self.check_finite()?;
         let mut panels = Vec::new();
         type Pick = fn(&Errors) -> Option<f64>;
         let kinds: [(&str, &str, Pick); 2] = [
@@ -364,7 +386,27 @@ impl BenchReport {
                 panels.push(panel);
             }
         }
-        render(&panels, 760.0, 420.0)
+        Ok(render(&panels, 760.0, 420.0))
+    }
+}
+
+/// Depth-first: the path and value of the first non-finite float in `v`.
+fn first_non_finite(v: &toml::Value, path: String) -> Option<(String, f64)> {
+    match v {
+        toml::Value::Float(x) if !x.is_finite() => Some((path, *x)),
+        toml::Value::Array(a) => a
+            .iter()
+            .enumerate()
+            .find_map(|(i, e)| first_non_finite(e, format!("{path}[{i}]"))),
+        toml::Value::Table(t) => t.iter().find_map(|(k, e)| {
+            let p = if path.is_empty() {
+                k.clone()
+            } else {
+                format!("{path}.{k}")
+            };
+            first_non_finite(e, p)
+        }),
+        _ => None,
     }
 }
 

@@ -96,33 +96,39 @@ fn metrics_only_runs_keep_no_samples() {
 }
 
 #[test]
-fn json_csv_and_svg_are_complete_and_nan_free() {
-    let r = quick();
-    let json = r.to_json();
-    for bad in ["NaN", "nan", "inf"] {
-        assert!(!json.contains(bad), "JSON holds {bad}");
-    }
+fn json_csv_and_svg_are_complete_and_refuse_a_non_finite_number() {
+    let mut r = quick();
+    let json = r.to_json().unwrap();
     let v: serde_json::Value = serde_json::from_str(&json).unwrap();
     assert_eq!(v["scenes"][0]["points"].as_array().unwrap().len(), 9);
     assert_eq!(v["peers"][0]["status"], "skipped");
 
-    let svg = r.to_svg();
+    let svg = r.to_svg().unwrap();
     assert!(svg.starts_with("<svg") && svg.trim_end().ends_with("</svg>"));
     for bad in ["NaN", "inf"] {
         assert!(!svg.contains(bad), "SVG holds {bad}");
     }
-    // Two panels, each with three solver lines and a marker per point (rotor-plot's legend
-    // adds one marker per series).
-    let circles = svg.matches("<circle").count();
-    assert!(
-        (2 * 9..=2 * 9 + 2 * 3).contains(&circles),
-        "{circles} markers"
+    // Two panels (steady and transient error), each with a marker per timed point with a
+    // positive error (a zero has no place on a log axis) and one per solver in the legend.
+    let drawn = |err: fn(&rotor_bench::Errors) -> Option<f64>| {
+        r.scenes[0]
+            .points
+            .iter()
+            .filter(|p| p.timing.is_some() && err(&p.errors).is_some_and(|e| e > 0.0))
+            .count()
+    };
+    // Every quick point ran and has both errors (an exact zero would take a rounding
+    // coincidence).
+    assert_eq!(
+        (drawn(|e| e.steady_rel), drawn(|e| e.transient_max)),
+        (9, 9)
     );
+    assert_eq!(svg.matches("<circle").count(), 2 * 9 + 2 * 3);
     for name in ["event", "switch", "moreau"] {
         assert!(svg.contains(&format!(">{name}</text>")), "legend {name}");
     }
 
-    let csv = r.to_csv();
+    let csv = r.to_csv().unwrap();
     let rows: Vec<&str> = csv.lines().collect();
     assert_eq!(rows.len(), 1 + 9);
     let cols = rows[0].split(',').count();
@@ -131,6 +137,25 @@ fn json_csv_and_svg_are_complete_and_nan_free() {
 
     let table = r.table();
     assert!(table.contains("reference") && table.contains("moreau"));
+
+    // serde_json would write a NaN as `null`, like an absent value: every writer refuses it
+    // and names where it is.
+    r.output_levels[1].ratio = f64::NAN;
+    r.scenes[0].points[4].errors.steady_rel = Some(f64::INFINITY);
+    for e in [
+        r.to_json().unwrap_err(),
+        r.to_csv().unwrap_err(),
+        r.to_svg().unwrap_err(),
+    ] {
+        let e = e.to_string();
+        assert!(e.contains("output_levels[1].ratio = NaN"), "{e}");
+    }
+    r.output_levels[1].ratio = 1.0;
+    let e = r.to_json().unwrap_err().to_string();
+    assert!(
+        e.contains("scenes[0].points[4].errors.steady_rel = inf"),
+        "{e}"
+    );
 }
 
 /// A peer whose interpreter is missing is skipped with the reason, and the run goes on.

@@ -328,9 +328,9 @@ fn bench(
     let report = rotor_bench::run(&opts, |m| eprintln!("{m}"))?;
     print!("{}", report.table());
     for (path, text) in [
-        (json, report.to_json()),
-        (svg, report.to_svg()),
-        (csv, report.to_csv()),
+        (json, report.to_json()?),
+        (svg, report.to_svg()?),
+        (csv, report.to_csv()?),
     ] {
         if let Some(path) = path {
             write_atomic(path, text.as_bytes())
