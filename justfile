@@ -15,3 +15,6 @@ stress:
 # Work-precision benchmark with peers (scipy, Siconos when installed), into reports/bench/.
 bench:
     cargo run --release -- bench --json reports/bench/bench.json --svg reports/bench/bench.svg --csv reports/bench/bench.csv
+# The peer tests, failing if scipy or Siconos is missing (CI has neither: it skips them).
+peers:
+    ROTOR_REQUIRE_PEERS=1 cargo test --release -p rotor-bench --test peers

@@ -1,8 +1,23 @@
 //! The peers, when installed (CI has neither scipy nor Siconos: these tests then return after
-//! saying so). A peer that runs must compute the reference's answer, else its ratio is
-//! meaningless.
+//! saying so, unless `ROTOR_REQUIRE_PEERS=1` makes a missing peer a failure, as on a machine
+//! that quotes the peers' ratios). A peer that runs must compute the reference's answer, else
+//! its ratio is meaningless.
 
 use rotor_bench::{BenchOptions, peer_available, run};
+
+/// Whether the peer can be tested; a missing peer fails when `ROTOR_REQUIRE_PEERS=1`.
+fn peer_present(python: &str, module: &str) -> bool {
+    match peer_available(python, module) {
+        Ok(()) => true,
+        Err(why) if std::env::var("ROTOR_REQUIRE_PEERS").as_deref() == Ok("1") => {
+            panic!("ROTOR_REQUIRE_PEERS=1 but {module} is missing: {why}")
+        }
+        Err(why) => {
+            eprintln!("{module} peer not tested: {why}");
+            false
+        }
+    }
+}
 
 fn options() -> BenchOptions {
     let mut o = BenchOptions::quick();
@@ -22,8 +37,7 @@ fn options() -> BenchOptions {
 #[test]
 fn scipy_peer_agrees_with_the_reference() {
     let o = options();
-    if let Err(why) = peer_available(&o.peers.python, "scipy") {
-        eprintln!("scipy peer not tested: {why}");
+    if !peer_present(&o.peers.python, "scipy") {
         return;
     }
     let o = BenchOptions {
@@ -62,8 +76,7 @@ fn scipy_peer_agrees_with_the_reference() {
 #[test]
 fn siconos_peer_agrees_with_the_reference() {
     let o = options();
-    if let Err(why) = peer_available(&o.peers.siconos_python, "siconos.kernel") {
-        eprintln!("siconos peer not tested: {why}");
+    if !peer_present(&o.peers.siconos_python, "siconos.kernel") {
         return;
     }
     let o = BenchOptions {

@@ -479,12 +479,18 @@ pub fn bad_scenario_cases() -> Vec<BadFile> {
         sc(
             "transient_max = 1e-7 ",
             "",
-            &["tolerance.event-switch.transient_max = (missing)", "ungated"],
+            &[
+                "tolerance.event-switch.transient_max = (missing)",
+                "ungated",
+            ],
         ),
         sc(
             "steady_rel = 2e-6",
             "",
-            &["tolerance.event-switch.steady_abs = 0.000000001", "needs it"],
+            &[
+                "tolerance.event-switch.steady_abs = 0.000000001",
+                "needs it",
+            ],
         ),
         // A misspelt pair would leave the pair ungated.
         sc(
