@@ -253,6 +253,9 @@ pub struct Section {
     pub markdown: String,
     /// File name (relative to the report directory) and contents.
     pub files: Vec<(String, Vec<u8>)>,
+    /// The section's own failed checks, one line each (the run fails after the report is
+    /// written, as it does for a failed agreement gate).
+    pub failures: Vec<String>,
 }
 
 /// Writes the whole report into `dir` and returns the failures.

@@ -215,8 +215,6 @@ pub enum Outcome {
     Finished,
     /// The solver's typed error.
     Failed(SolveError),
-    /// Finished but returned a non-finite sample, event, metric or final state (a bug).
-    NonFinite { t: f64 },
 }
 
 impl Outcome {
@@ -224,7 +222,6 @@ impl Outcome {
     pub fn kind(&self) -> &'static str {
         match self {
             Outcome::Finished => "ok",
-            Outcome::NonFinite { .. } => "non-finite output",
             Outcome::Failed(e) => match e {
                 SolveError::InvalidScene { .. } => "invalid scene",
                 SolveError::StepSizeUnderflow { .. } => "step size underflow",
@@ -234,6 +231,7 @@ impl Outcome {
                 SolveError::TooManySteps { .. } => "step limit",
                 SolveError::NoConvergence { .. } => "no convergence",
                 SolveError::Unsupported { .. } => "unsupported",
+                SolveError::NonFiniteOutput { .. } => "non-finite output",
             },
         }
     }
@@ -243,7 +241,6 @@ impl Outcome {
     pub fn acceptable(&self) -> bool {
         match self {
             Outcome::Finished => true,
-            Outcome::NonFinite { .. } => false,
             Outcome::Failed(e) => matches!(
                 e,
                 SolveError::StepSizeUnderflow { .. }
@@ -259,7 +256,6 @@ impl std::fmt::Display for Outcome {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         match self {
             Outcome::Finished => write!(f, "ok"),
-            Outcome::NonFinite { t } => write!(f, "non-finite output at t = {t}"),
             Outcome::Failed(e) => write!(f, "{e}"),
         }
     }
@@ -314,25 +310,6 @@ impl StressRow {
     }
 }
 
-fn finite_trajectory(tr: &Trajectory) -> Result<(), f64> {
-    let ok = |x: &State| x.iter().all(|v| v.is_finite());
-    if let Some(s) = tr.samples.iter().find(|s| !ok(&s.x) || !s.t.is_finite()) {
-        return Err(s.t);
-    }
-    if let Some(e) = tr.events.iter().find(|e| !ok(&e.x) || !e.t.is_finite()) {
-        return Err(e.t);
-    }
-    if !ok(&tr.x_final) {
-        return Err(tr.t_final);
-    }
-    if let Some(m) = tr.metrics
-        && m.values().iter().any(|(_, v)| !v.is_finite())
-    {
-        return Err(tr.t_final);
-    }
-    Ok(())
-}
-
 /// Runs one solver on a scene: the outcome, the trajectory if it finished with finite output,
 /// and the run time.
 fn run(kind: SolverKind, model: &Model, scene: &Scene) -> (Outcome, Option<Trajectory>, f64) {
@@ -341,9 +318,9 @@ fn run(kind: SolverKind, model: &Model, scene: &Scene) -> (Outcome, Option<Traje
     let seconds = t0.elapsed().as_secs_f64();
     match res {
         Err(e) => (Outcome::Failed(e), None, seconds),
-        Ok(tr) => match finite_trajectory(&tr) {
+        Ok(tr) => match tr.check_finite() {
             Ok(()) => (Outcome::Finished, Some(tr), seconds),
-            Err(t) => (Outcome::NonFinite { t }, None, seconds),
+            Err(e) => (Outcome::Failed(e), None, seconds),
         },
     }
 }

@@ -287,6 +287,31 @@ pub struct Trajectory {
     pub stats: Stats,
 }
 
+impl Trajectory {
+    /// Checks the samples, the events, the final state and the metrics for NaN or ∞: a run
+    /// that finished must deliver finite output. The error names the first offender and its
+    /// time (`t_final` for the final state and the metrics).
+    pub fn check_finite(&self) -> Result<(), SolveError> {
+        let ok = |t: f64, x: &State| t.is_finite() && x.iter().all(|v| v.is_finite());
+        let bad = |t: f64, what| Err(SolveError::NonFiniteOutput { t, what });
+        if let Some(s) = self.samples.iter().find(|s| !ok(s.t, &s.x)) {
+            return bad(s.t, "sample");
+        }
+        if let Some(e) = self.events.iter().find(|e| !ok(e.t, &e.x)) {
+            return bad(e.t, "event");
+        }
+        if !ok(self.t_final, &self.x_final) {
+            return bad(self.t_final, "final state");
+        }
+        if let Some(m) = self.metrics
+            && m.values().iter().any(|(_, v)| !v.is_finite())
+        {
+            return bad(self.t_final, "steady-state metrics");
+        }
+        Ok(())
+    }
+}
+
 /// Why a solver could not finish.
 #[derive(Debug, Error, Clone, PartialEq)]
 pub enum SolveError {
@@ -318,6 +343,10 @@ pub enum SolveError {
     /// The solver does not support what was asked.
     #[error("unsupported: {detail}")]
     Unsupported { detail: String },
+    /// The solver finished, but its output holds a NaN or ∞ (a solver bug, caught by
+    /// [`Trajectory::check_finite`] before anything is written).
+    #[error("non-finite output ({what}) at t = {t}: a solver bug")]
+    NonFiniteOutput { t: f64, what: &'static str },
 }
 
 /// A solver: takes a model and a scene and returns a trajectory.
@@ -343,6 +372,59 @@ pub fn check_finite(t: f64, x: &State) -> Result<(), SolveError> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::{Disc, DiscMode, SteadyState};
+
+    #[test]
+    fn check_finite_names_the_first_non_finite_output() {
+        let x = State::new(0.1, 2.0, 3.0);
+        let good = Trajectory {
+            samples: vec![Sample { t: 0.0, x }, Sample { t: 1.0, x }],
+            events: vec![Event {
+                t: 0.5,
+                x,
+                kind: EventKind::StickStart(Disc::Lower),
+            }],
+            t_final: 1.0,
+            x_final: x,
+            mode_final: Mode {
+                upper: DiscMode::SlipPos,
+                lower: DiscMode::Stick,
+            },
+            metrics: Some(SteadyState::Equilibrium {
+                omega_u: 2.0,
+                omega_l: 3.0,
+                alpha: 0.1,
+            }),
+            stats: Stats::default(),
+        };
+        assert_eq!(good.check_finite(), Ok(()));
+        type Spoil = fn(&mut Trajectory);
+        let spoilt: [(Spoil, f64, &str); 5] = [
+            (|t| t.samples[1].x[2] = f64::NAN, 1.0, "sample"),
+            (|t| t.samples[1].t = f64::INFINITY, f64::INFINITY, "sample"),
+            (|t| t.events[0].x[0] = f64::NEG_INFINITY, 0.5, "event"),
+            (|t| t.x_final[1] = f64::NAN, 1.0, "final state"),
+            (
+                |t| {
+                    t.metrics = Some(SteadyState::Equilibrium {
+                        omega_u: 2.0,
+                        omega_l: f64::NAN,
+                        alpha: 0.1,
+                    })
+                },
+                1.0,
+                "steady-state metrics",
+            ),
+        ];
+        for (spoil, t, what) in spoilt {
+            let mut tr = good.clone();
+            spoil(&mut tr);
+            assert_eq!(
+                tr.check_finite(),
+                Err(SolveError::NonFiniteOutput { t, what })
+            );
+        }
+    }
 
     fn walk(dt: f64, t_end: f64) -> Vec<f64> {
         let mut g = OutputGrid::new(dt, t_end);
