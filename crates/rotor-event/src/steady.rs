@@ -104,16 +104,12 @@ impl Flow<'_> {
         Ok((end, sink))
     }
 
-    /// State and mode just after the lower disc leaves stick upward with upper velocity `w`.
+    /// State and mode just after the lower disc leaves stick with upper velocity `w`, in the
+    /// direction of the torque that breaks it loose (upward for u > 0, downward for u < 0).
     fn exit_state(&self, alpha: f64, w: f64, upper: DiscMode) -> (State, Mode) {
         let x = State::new(alpha, if upper == DiscMode::Stick { 0.0 } else { w }, 0.0);
-        (
-            x,
-            Mode {
-                upper,
-                lower: DiscMode::SlipPos,
-            },
-        )
+        let lower = DiscMode::slip_of(self.model.applied_torque(Disc::Lower, &x, self.u));
+        (x, Mode { upper, lower })
     }
 
     /// Return map at the lower disc's stick exit: ω_u at the next exit (and the mode there).
