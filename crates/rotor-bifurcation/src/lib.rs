@@ -73,6 +73,14 @@ pub enum BifError {
     Io(String),
 }
 
+/// Largest admissible `u_max` \[V\]: the Hopf search samples the slipping branch up to
+/// ω = 1e4 rad/s (`equilibria::omega_reaching`), which Table 1 reaches well above 1000 V (at
+/// 1e4 V both Hopf points were lost); 1000 V is 140 times the source's range.
+pub const U_MAX: f64 = 1000.0;
+
+/// Largest arclength step of the periodic branches: the default range's (7 V / 200).
+const H_MAX: f64 = 7.0 / 200.0;
+
 /// What [`diagram`] computes.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct DiagramOptions {
@@ -127,6 +135,22 @@ impl DiagramOptions {
         }
         if self.u_max <= self.u_min {
             return bad("u_max", self.u_max, "must be greater than u_min");
+        }
+        // The branches are traced with the lower disc driven upward (its stick exits and
+        // sections are upward); for a law odd in ω the u < 0 half is the mirror image.
+        if self.u_min < 0.0 {
+            return bad(
+                "u_min",
+                self.u_min,
+                "must be >= 0: the diagram covers u >= 0 (for a law odd in omega, u < 0 is its mirror image)",
+            );
+        }
+        if self.u_max > U_MAX {
+            return bad(
+                "u_max",
+                self.u_max,
+                "must be <= 1000 V: the Hopf search samples omega up to 1e4 rad/s",
+            );
         }
         if self.n < 2 {
             return bad("n", self.n as f64, "must be at least 2");
@@ -385,7 +409,10 @@ pub fn diagram(model: &Model, opts: &DiagramOptions) -> Result<Diagram, BifError
         model,
         tol: opts.tol,
     };
-    let h_max = (opts.u_max - opts.u_min) / opts.n as f64;
+    // The arclength step shrinks with the range but never grows past the default's (7 V over
+    // 200): a coarser step walks past the grazing point near the lower Hopf point (at 0.6 V,
+    // 0.22 V above it), which a 1.5 V step over [0, 300] V did.
+    let h_max = ((opts.u_max - opts.u_min) / opts.n as f64).min(H_MAX);
     let cont = Continuer {
         sh,
         opts: ContOptions {

@@ -3,7 +3,7 @@
 use rotor_bifurcation::continuation::{ContOptions, Continuer};
 use rotor_bifurcation::equilibria::{complex_pair, hopf_points, omega_reaching};
 use rotor_bifurcation::periodic::{Shooter, eig2};
-use rotor_bifurcation::start_point;
+use rotor_bifurcation::{Diagram, DiagramOptions, diagram, start_point};
 use rotor_event::{EventOptions, SteadyOptions, steady_state};
 use rotor_model::{Model, State, SteadyState};
 
@@ -195,6 +195,38 @@ fn table1_diagram_structure() {
         csv.lines().filter(|l| l.starts_with("periodic,")).count(),
         d.periodic.len()
     );
+}
+
+/// Ranges up to 140 times wider than the source's find the same special points as [0, 7] V:
+/// the branch step does not grow with the range (a 1.5 V step over [0, 300] V once walked past
+/// the grazing point at 0.6 V).
+#[test]
+fn the_widest_range_finds_the_same_special_points() {
+    let m = model("table1");
+    let d = t1_diagram();
+    let kinds = |d: &Diagram| {
+        let mut v: Vec<(&str, f64)> = d.points.iter().map(|p| (p.kind, p.u)).collect();
+        v.sort_by(|a, b| a.0.cmp(&b.0).then(a.1.total_cmp(&b.1)));
+        v
+    };
+    // 300 V is the range that lost the grazing point; U_MAX the widest admitted.
+    for u_max in [300.0, rotor_bifurcation::U_MAX] {
+        let wide = diagram(
+            &m,
+            &DiagramOptions {
+                u_max,
+                ..Default::default()
+            },
+        )
+        .unwrap();
+        let (a, b) = (kinds(d), kinds(&wide));
+        assert_eq!(a.len(), b.len(), "{u_max} V: {a:?} vs {b:?}");
+        for ((ka, ua), (kb, ub)) in a.iter().zip(&b) {
+            // Each point is located to point_tol-level accuracy (≤ 1e-8 V, the diagram's
+            // promise) independently of the branch's sampling.
+            assert!(ka == kb && (ua - ub).abs() < 1e-8, "{ka} {ua} vs {kb} {ub}");
+        }
+    }
 }
 
 #[test]

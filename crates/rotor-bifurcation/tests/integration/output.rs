@@ -222,7 +222,7 @@ fn svg_is_well_formed_labelled_and_dashed_where_unstable() {
 #[test]
 fn options_are_validated_with_the_field_named() {
     let m = Model::table1();
-    let cases: [(DiagramOptions, &str); 6] = [
+    let cases: [(DiagramOptions, &str); 8] = [
         (
             DiagramOptions {
                 u_min: 3.0,
@@ -241,6 +241,20 @@ fn options_are_validated_with_the_field_named() {
         (
             DiagramOptions {
                 u_max: f64::INFINITY,
+                ..Default::default()
+            },
+            "u_max",
+        ),
+        (
+            DiagramOptions {
+                u_min: -1.0,
+                ..Default::default()
+            },
+            "u_min",
+        ),
+        (
+            DiagramOptions {
+                u_max: 2000.0,
                 ..Default::default()
             },
             "u_max",
