@@ -206,7 +206,7 @@ fn the_widest_range_finds_the_same_special_points() {
     let d = t1_diagram();
     let kinds = |d: &Diagram| {
         let mut v: Vec<(&str, f64)> = d.points.iter().map(|p| (p.kind, p.u)).collect();
-        v.sort_by(|a, b| a.0.cmp(&b.0).then(a.1.total_cmp(&b.1)));
+        v.sort_by(|a, b| a.0.cmp(b.0).then(a.1.total_cmp(&b.1)));
         v
     };
     // 300 V is the range that lost the grazing point; U_MAX the widest admitted.
