@@ -113,8 +113,12 @@ struct Common {
 }
 
 fn solver_by_name(name: &str) -> Result<Box<dyn Solver>> {
+    Ok(kind_by_name(name)?.solver())
+}
+
+fn kind_by_name(name: &str) -> Result<SolverKind> {
     match SolverKind::ALL.into_iter().find(|k| k.name() == name) {
-        Some(kind) => Ok(kind.solver()),
+        Some(kind) => Ok(kind),
         None => bail!(
             "--solver {name:?}: unknown solver (expected one of: {})",
             SolverKind::ALL.map(SolverKind::name).join(", ")
@@ -230,15 +234,16 @@ fn steady(common: &Common) -> Result<()> {
             )?
         }
         other => {
-            let solver = solver_by_name(other)?;
-            // From the simulated orbit: a long run, metrics over its second half.
-            let t_end = 600.0;
-            let mut scene = scene_from(common, t_end, Output::Final)?;
-            scene.metrics_from = Some(0.5 * t_end);
-            let traj = solver.simulate(&model, &scene)?;
-            warn_inexact(&traj.stats);
-            traj.metrics
-                .ok_or_else(|| anyhow!("solver {other} returned no metrics"))?
+            // From the simulated orbit, once its metrics stop changing (a slow transient is
+            // an error, not a limit cycle).
+            let kind = kind_by_name(other)?;
+            let opts = rotor_compare::SettleOptions::default();
+            let scene = scene_from(common, opts.chunk, Output::Final)?;
+            scene.validate()?;
+            let s = rotor_compare::settle(kind, &model, &scene, &opts)
+                .with_context(|| format!("solver {other}"))?;
+            warn_inexact(&s.stats);
+            s.state
         }
     };
     for (name, v) in st.values() {

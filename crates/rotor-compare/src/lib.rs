@@ -4,8 +4,10 @@
 pub mod gate;
 pub mod report;
 pub mod run;
+pub mod settle;
 pub mod snapshot;
 pub mod stress;
 
 pub use gate::{Failure, GateResult, Measured, check_pair};
 pub use run::{RunResult, ScenarioResult, SolverKind, run_scenario, solver_settings};
+pub use settle::{SettleError, SettleOptions, Settled, settle};

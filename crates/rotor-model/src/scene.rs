@@ -268,6 +268,21 @@ pub struct Stats {
     pub inexact_steps: u64,
 }
 
+impl std::ops::AddAssign for Stats {
+    /// The counters of two runs, summed (a run continued in chunks).
+    fn add_assign(&mut self, o: Stats) {
+        self.steps += o.steps;
+        self.rejected += o.rejected;
+        self.rhs_evals += o.rhs_evals;
+        self.jac_evals += o.jac_evals;
+        self.events += o.events;
+        self.lcp_solves += o.lcp_solves;
+        self.lcp_skipped += o.lcp_skipped;
+        self.newton_iters += o.newton_iters;
+        self.inexact_steps += o.inexact_steps;
+    }
+}
+
 /// The result of a run.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Trajectory {
