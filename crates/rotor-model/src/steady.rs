@@ -204,6 +204,23 @@ impl MetricsAccumulator {
         }
     }
 
+    /// Relative change of the ω_l amplitude (max − min) between the last two complete cycles,
+    /// if two exist: a focus decaying near a Hopf point keeps its period but not its amplitude.
+    pub fn amplitude_drift(&self) -> Option<f64> {
+        let stream = if self.stick_exits.count >= 1 {
+            &self.stick_exits
+        } else {
+            &self.maxima
+        };
+        match stream.last {
+            [Some(a), Some(b)] => {
+                let (ra, rb) = (a.wl_max - a.wl_min, b.wl_max - b.wl_min);
+                Some((ra - rb).abs() / ra.abs().max(rb.abs()).max(EQUILIBRIUM_AMPLITUDE))
+            }
+            _ => None,
+        }
+    }
+
     /// Relative change of the period between the last two complete cycles (a convergence
     /// indicator), if two exist.
     pub fn period_drift(&self) -> Option<f64> {
