@@ -30,14 +30,22 @@ fn main() {
             p.detail
         );
     }
+    // Each file is complete in memory before it is written, through a temporary file and a
+    // rename: a failure or an interruption leaves no partial file.
+    let write = |path: &str, bytes: &[u8]| {
+        let tmp = format!("{path}.tmp{}", std::process::id());
+        std::fs::write(&tmp, bytes).expect("write");
+        std::fs::rename(&tmp, path).expect("rename");
+    };
     if let Some(j) = args.get(3) {
-        std::fs::write(j, d.to_json().expect("json")).expect("write json");
+        write(j, d.to_json().expect("json").as_bytes());
     }
     if let Some(s) = args.get(5) {
-        std::fs::write(s, d.to_svg(path)).expect("write svg");
+        write(s, d.to_svg(path).as_bytes());
     }
     if let Some(c) = args.get(4) {
-        let mut f = std::fs::File::create(c).expect("create csv");
-        d.write_csv(&mut f).expect("write csv");
+        let mut csv = Vec::new();
+        d.write_csv(&mut csv).expect("csv");
+        write(c, &csv);
     }
 }
