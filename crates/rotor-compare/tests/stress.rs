@@ -377,3 +377,24 @@ fn stress_energy_residual_sees_a_wrong_power() {
         "{r_wrong:e} vs {quad_wrong:e}"
     );
 }
+
+/// An input so large that k_m·u overflows is refused by every solver, naming u (Moreau–Jean
+/// once stayed at rest silently, the adaptive solvers failed mid-run).
+#[test]
+fn stress_overflowing_input_is_refused_by_every_solver() {
+    let m = Model::table1();
+    for u in [1e308, -1e308] {
+        let scene = Scene {
+            u,
+            t_end: 1.0,
+            output: Output::Final,
+            ..Scene::default()
+        };
+        for kind in SolverKind::ALL {
+            match kind.solver().simulate(&m, &scene) {
+                Err(rotor_model::SolveError::InvalidScene { field: "u", .. }) => {}
+                other => panic!("{kind:?} at u = {u:e}: {other:?}"),
+            }
+        }
+    }
+}

@@ -88,7 +88,7 @@ impl Solver for EventSolver {
     }
 
     fn simulate(&self, model: &Model, scene: &Scene) -> Result<Trajectory, SolveError> {
-        scene.validate()?;
+        scene.validate_for(model)?;
         let mode0 = model.mode_at(&scene.x0, scene.u);
         let mut integ = Integrator::new(model, scene.u, scene.tol, self.options);
         integ.extrema = scene.metrics_from.is_some();

@@ -123,6 +123,28 @@ impl Scene {
         Ok(())
     }
 
+    /// [`Scene::validate`], and the scene against a model: the motor torque k_m·u and the
+    /// initial spring torque k_θ·α must be finite (a huge u overflows k_m·u to ∞, and a
+    /// time-stepping scheme would then silently stay at rest).
+    pub fn validate_for(&self, model: &crate::Model) -> Result<(), SolveError> {
+        self.validate()?;
+        if !(model.params.k_m * self.u).is_finite() {
+            return Err(SolveError::InvalidScene {
+                field: "u",
+                value: self.u,
+                reason: "the motor torque k_m u overflows",
+            });
+        }
+        if !(model.params.k_theta * self.x0[0]).is_finite() {
+            return Err(SolveError::InvalidScene {
+                field: "x0[alpha]",
+                value: self.x0[0],
+                reason: "the spring torque k_theta alpha overflows",
+            });
+        }
+        Ok(())
+    }
+
     /// Number of grid intervals for `Output::Grid { dt }`: sample times are `k·dt` for
     /// `k = 0..=n` where `n·dt ≤ t_end` (within rounding), plus `t_end` if not on the grid.
     pub fn grid(&self) -> Option<OutputGrid> {

@@ -309,7 +309,7 @@ impl Solver for MoreauSolver {
     }
 
     fn simulate(&self, model: &Model, scene: &Scene) -> Result<Trajectory, SolveError> {
-        scene.validate()?;
+        scene.validate_for(model)?;
         check_finite(0.0, &scene.x0)?;
         let o = &self.options;
         if !(o.theta >= 0.5 && o.theta <= 1.0) {

@@ -387,7 +387,7 @@ impl Solver for SwitchSolver {
     /// Integrates the switch model over `[0, t_end]` with DOPRI5 at `rtol = atol = scene.tol`,
     /// locating every region change (guards of the crate docs) and restarting there.
     fn simulate(&self, model: &Model, scene: &Scene) -> Result<Trajectory, SolveError> {
-        scene.validate()?;
+        scene.validate_for(model)?;
         let o = self.options;
         let bad = |field: &'static str, value: f64, reason: &'static str| {
             Err(SolveError::InvalidScene {
