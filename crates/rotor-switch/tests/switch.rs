@@ -340,7 +340,7 @@ fn bad_input_gives_typed_errors() {
     assert!(matches!(e, SolveError::InvalidScene { field: "tol", .. }));
     let e = solver(-1.0).simulate(&model, &base).unwrap_err();
     assert!(matches!(e, SolveError::InvalidScene { field: "eta", .. }));
-    // k_m·u overflows to ∞: the field is not finite.
+    // k_m·u overflows to ∞: refused before the run, naming u.
     let e = s
         .simulate(
             &model,
@@ -351,10 +351,7 @@ fn bad_input_gives_typed_errors() {
         )
         .unwrap_err();
     assert!(
-        matches!(
-            e,
-            SolveError::NonFinite { .. } | SolveError::StepSizeUnderflow { .. }
-        ),
+        matches!(e, SolveError::InvalidScene { field: "u", .. }),
         "{e}"
     );
     let tiny = SwitchSolver {
