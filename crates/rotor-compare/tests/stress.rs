@@ -398,3 +398,21 @@ fn stress_overflowing_input_is_refused_by_every_solver() {
         }
     }
 }
+
+/// At u = 0 from rest every solver stays at rest: nothing drives the rotor. (The switch
+/// model once flipped the upper disc's smooth law back and forth at ω_u = 0 until its Zeno
+/// guard stopped it at t = 0.)
+#[test]
+fn stress_rest_at_zero_input_stays_at_rest() {
+    let m = Model::table1();
+    let scene = Scene {
+        u: 0.0,
+        t_end: 10.0,
+        output: Output::Final,
+        ..Scene::default()
+    };
+    for kind in SolverKind::ALL {
+        let tr = kind.solver().simulate(&m, &scene).unwrap();
+        assert_eq!(tr.x_final, State::zeros(), "{kind:?}");
+    }
+}

@@ -325,9 +325,12 @@ fn illinois(mut g: impl FnMut(f64) -> f64, ta: f64, ga: f64, tb: f64, gb: f64) -
 /// guard's own surface it is ±rounding): the first sample `j ≥ 1` with `g_j ≤ 0` is sought;
 /// its bracket `[t_{j−1}, t_j]` is refined by [`illinois`], or, if `g` was already `≤ 0` at
 /// `t_0` and still is at `t_1`, the crossing is `t_0` itself. Interior samples catch a guard
-/// that dips below 0 and back within the step (both ends positive).
+/// that dips below 0 and back within the step (both ends positive). A guard that stays
+/// exactly 0 (a disc at rest on its own switching surface, e.g. a smooth law at u = 0) has
+/// not crossed: firing it would flip the region back and forth forever.
 fn first_crossing(vals: &[(f64, f64)], g: impl FnMut(f64) -> f64) -> Option<f64> {
-    let j = (1..vals.len()).find(|&j| vals[j].1 <= 0.0)?;
+    let j =
+        (1..vals.len()).find(|&j| vals[j].1 < 0.0 || (vals[j].1 == 0.0 && vals[j - 1].1 > 0.0))?;
     let (ta, ga) = vals[j - 1];
     let (tb, gb) = vals[j];
     if ga <= 0.0 {
@@ -689,6 +692,15 @@ mod tests {
         assert_eq!(first_crossing(&sampled(1), g), None, "ends alone miss it");
         let t = first_crossing(&sampled(5), g).expect("interior samples see it");
         assert!((t - (0.5 - 0.02f64.sqrt())).abs() < 1e-14, "{t}");
+    }
+
+    #[test]
+    fn a_guard_resting_on_its_surface_has_not_crossed() {
+        let vals = [(0.0, 0.0), (0.5, 0.0), (1.0, 0.0)];
+        assert_eq!(first_crossing(&vals, |_| unreachable!()), None);
+        // Reaching 0 from inside still fires.
+        let vals = [(0.0, 1.0), (0.5, 0.0), (1.0, 0.0)];
+        assert_eq!(first_crossing(&vals, |_| unreachable!()), Some(0.5));
     }
 
     #[test]
