@@ -179,15 +179,20 @@ impl MetricsAccumulator {
         }
     }
 
-    /// The steady state after a run ending at `(t, x)`: the last complete cycle if the orbit
-    /// still oscillates with amplitude above [`EQUILIBRIUM_AMPLITUDE`], else the final state.
-    pub fn finish(&self, x_final: &State) -> SteadyState {
-        let stream = if self.stick_exits.count >= 1 {
+    /// The cycles the metrics are read from: between stick exits if the lower disc sticks,
+    /// else between ω_l maxima.
+    fn stream(&self) -> &Stream {
+        if self.stick_exits.count >= 1 {
             &self.stick_exits
         } else {
             &self.maxima
-        };
-        match stream.last[0] {
+        }
+    }
+
+    /// The steady state after a run ending at `(t, x)`: the last complete cycle if the orbit
+    /// still oscillates with amplitude above [`EQUILIBRIUM_AMPLITUDE`], else the final state.
+    pub fn finish(&self, x_final: &State) -> SteadyState {
+        match self.stream().last[0] {
             Some(c) if c.wl_max - c.wl_min > EQUILIBRIUM_AMPLITUDE => SteadyState::LimitCycle {
                 period: c.end - c.start,
                 omega_l_max: c.wl_max,
@@ -207,36 +212,21 @@ impl MetricsAccumulator {
     /// Relative change of the ω_l amplitude (max − min) between the last two complete cycles,
     /// if two exist: a focus decaying near a Hopf point keeps its period but not its amplitude.
     pub fn amplitude_drift(&self) -> Option<f64> {
-        let stream = if self.stick_exits.count >= 1 {
-            &self.stick_exits
-        } else {
-            &self.maxima
+        let [Some(a), Some(b)] = self.stream().last else {
+            return None;
         };
-        match stream.last {
-            [Some(a), Some(b)] => {
-                let (ra, rb) = (a.wl_max - a.wl_min, b.wl_max - b.wl_min);
-                Some((ra - rb).abs() / ra.abs().max(rb.abs()).max(EQUILIBRIUM_AMPLITUDE))
-            }
-            _ => None,
-        }
+        let (ra, rb) = (a.wl_max - a.wl_min, b.wl_max - b.wl_min);
+        Some((ra - rb).abs() / ra.abs().max(rb.abs()).max(EQUILIBRIUM_AMPLITUDE))
     }
 
     /// Relative change of the period between the last two complete cycles (a convergence
     /// indicator), if two exist.
     pub fn period_drift(&self) -> Option<f64> {
-        let stream = if self.stick_exits.count >= 1 {
-            &self.stick_exits
-        } else {
-            &self.maxima
+        let [Some(a), Some(b)] = self.stream().last else {
+            return None;
         };
-        match stream.last {
-            [Some(a), Some(b)] => {
-                let ta = a.end - a.start;
-                let tb = b.end - b.start;
-                Some(((ta - tb) / ta).abs())
-            }
-            _ => None,
-        }
+        let (ta, tb) = (a.end - a.start, b.end - b.start);
+        Some(((ta - tb) / ta).abs())
     }
 }
 
@@ -285,6 +275,27 @@ mod tests {
         assert_eq!((omega_l_max, omega_l_min), (3.0, 0.0));
         assert_eq!((omega_u_max, omega_u_min), (1.1, 0.9));
         assert_eq!(m.period_drift(), Some(0.0));
+        assert_eq!(m.amplitude_drift(), Some(0.0));
+    }
+
+    /// A decaying focus: the same period, the ω_l amplitude halving from cycle to cycle
+    /// (cycles between maxima, no stick).
+    #[test]
+    fn amplitude_drift_sees_a_decay_the_period_does_not() {
+        let mut m = MetricsAccumulator::new(0.0);
+        let l = Disc::Lower;
+        for (t, kind, w) in [
+            (0.0, EventKind::Max(l), 5.0),
+            (2.0, EventKind::Min(l), 1.0),
+            (4.0, EventKind::Max(l), 4.0),
+            (6.0, EventKind::Min(l), 2.0),
+            (8.0, EventKind::Max(l), 3.5),
+        ] {
+            m.push(&ev(t, [0.0, 1.0, w], kind));
+        }
+        // Amplitudes 5 − 1 = 4 and 4 − 2 = 2 (each cycle's extremes include its end points).
+        assert_eq!(m.period_drift(), Some(0.0));
+        assert_eq!(m.amplitude_drift(), Some(0.5));
     }
 
     #[test]
