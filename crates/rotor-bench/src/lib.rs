@@ -79,6 +79,9 @@ pub enum BenchError {
     /// The report holds a non-finite number (a bug): nothing is written.
     #[error("the benchmark report holds {path} = {value}: not written (JSON has no NaN)")]
     NonFinite { path: String, value: f64 },
+    /// The report could not be serialised (a bug).
+    #[error("the benchmark report cannot be serialised: {0}")]
+    Serialise(String),
 }
 
 /// The whole benchmark's result.

@@ -216,10 +216,7 @@ impl BenchReport {
     /// an absent value, so every writer checks this first. (The walk goes through a
     /// `toml::Value`, which keeps non-finite floats and skips absent fields.)
     pub fn check_finite(&self) -> Result<(), BenchError> {
-        let v = toml::Value::try_from(self).map_err(|e| BenchError::NonFinite {
-            path: format!("(the report cannot be walked: {e})"),
-            value: f64::NAN,
-        })?;
+        let v = toml::Value::try_from(self).map_err(|e| BenchError::Serialise(e.to_string()))?;
         match first_non_finite(&v, String::new()) {
             Some((path, value)) => Err(BenchError::NonFinite { path, value }),
             None => Ok(()),
@@ -229,10 +226,7 @@ impl BenchReport {
     /// The report as pretty JSON (absent values are `null`; a non-finite number is an error).
     pub fn to_json(&self) -> Result<String, BenchError> {
         self.check_finite()?;
-        serde_json::to_string_pretty(self).map_err(|e| BenchError::NonFinite {
-            path: format!("(JSON: {e})"),
-            value: f64::NAN,
-        })
+        serde_json::to_string_pretty(self).map_err(|e| BenchError::Serialise(e.to_string()))
     }
 
     /// Every point (ladders and peers) as CSV rows (a non-finite number is an error).

@@ -200,8 +200,7 @@ fn simulate(common: &Common, t_end: f64, dt: f64, csv_path: &Path) -> Result<()>
     let model = load_model(common.params.as_deref())?;
     let scene = scene_from(common, t_end, Output::Grid { dt })?;
     let traj = solver
-        .simulate(&model, &scene)
-        .and_then(|tr| tr.check_finite().map(|()| tr))
+        .simulate_finite(&model, &scene)
         .with_context(|| format!("solver {}", solver.name()))?;
     warn_inexact(&traj.stats);
     let mut buf = Vec::with_capacity(traj.samples.len() * 64);
@@ -239,7 +238,6 @@ fn steady(common: &Common) -> Result<()> {
             let kind = kind_by_name(other)?;
             let opts = rotor_compare::SettleOptions::default();
             let scene = scene_from(common, opts.chunk, Output::Final)?;
-            scene.validate()?;
             let s = rotor_compare::settle(kind, &model, &scene, &opts)
                 .with_context(|| format!("solver {other}"))?;
             warn_inexact(&s.stats);

@@ -237,6 +237,8 @@ mod tests {
         alpha: 0.1,
     };
 
+    /// Gates for synthetic data: identical inputs differ by exactly 0, the perturbation below
+    /// is 1e-6, so any gate between the two tells them apart; 1e-9 is one.
     fn tol() -> PairTolerance {
         PairTolerance {
             transient_max: Some(1e-9),

@@ -100,10 +100,7 @@ pub fn run_scenario(sc: &Scenario) -> ScenarioResult {
 fn run_one(kind: SolverKind, model: &Model, scene: &Scene) -> RunResult {
     let t0 = Instant::now();
     // A finished run with a NaN in its output is a failed run: nothing of it is written.
-    let result = kind
-        .solver()
-        .simulate(model, scene)
-        .and_then(|tr| tr.check_finite().map(|()| tr));
+    let result = kind.solver().simulate_finite(model, scene);
     RunResult {
         kind,
         result,

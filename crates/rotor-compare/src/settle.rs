@@ -113,11 +113,10 @@ fn change(a: &SteadyState, b: &SteadyState, abs: f64) -> (String, f64) {
     worst
 }
 
-/// A settled steady state, the simulated time it took and the summed counters of its chunks.
+/// A settled steady state and the summed counters of its chunks.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Settled {
     pub state: SteadyState,
-    pub time: f64,
     pub stats: Stats,
 }
 
@@ -147,8 +146,7 @@ pub fn settle(
             metrics_from: Some(0.5 * opts.chunk),
             ..base.clone()
         };
-        let tr = solver.simulate(model, &scene)?;
-        tr.check_finite()?;
+        let tr = solver.simulate_finite(model, &scene)?;
         t += opts.chunk;
         stats += tr.stats;
         let st = tr.metrics.ok_or(SolveError::Unsupported {
@@ -167,11 +165,7 @@ pub fn settle(
             };
             prev_change = c;
             if settled {
-                return Ok(Settled {
-                    state: st,
-                    time: t,
-                    stats,
-                });
+                return Ok(Settled { state: st, stats });
             }
             if t >= opts.max_time {
                 return Err(SettleError::NotSettled {
@@ -197,6 +191,18 @@ mod tests {
             u,
             ..Scene::default()
         }
+    }
+
+    /// The event-driven solver's refined steady state from rest.
+    fn event_steady(m: &Model, u: f64) -> SteadyState {
+        rotor_event::steady_state(
+            m,
+            u,
+            State::zeros(),
+            &rotor_event::SteadyOptions::default(),
+            &rotor_event::EventOptions::default(),
+        )
+        .unwrap()
     }
 
     /// Just below the first Hopf point (0.3835 V, Table 1) the equilibrium is a stable focus
@@ -268,14 +274,7 @@ mod tests {
     fn near_bifurcations_the_event_steady_state_agrees_with_a_settled_run() {
         let m = Model::table1();
         for u in [0.383, 0.385, 4.7] {
-            let ev = rotor_event::steady_state(
-                &m,
-                u,
-                State::zeros(),
-                &rotor_event::SteadyOptions::default(),
-                &rotor_event::EventOptions::default(),
-            )
-            .unwrap();
+            let ev = event_steady(&m, u);
             let sw = settle(SolverKind::Switch, &m, &base(u), &SettleOptions::default()).unwrap();
             let (what, c) = change(&ev, &sw.state, 1e-8);
             assert!(
@@ -291,14 +290,7 @@ mod tests {
     #[test]
     fn a_settled_cycle_agrees_with_the_refined_one() {
         let m = Model::table1();
-        let reference = rotor_event::steady_state(
-            &m,
-            1.5,
-            State::zeros(),
-            &rotor_event::SteadyOptions::default(),
-            &rotor_event::EventOptions::default(),
-        )
-        .unwrap();
+        let reference = event_steady(&m, 1.5);
         for (kind, gate) in [(SolverKind::Switch, 2e-6), (SolverKind::Moreau, 3e-6)] {
             let s = settle(kind, &m, &base(1.5), &SettleOptions::default()).unwrap();
             let (what, c) = change(&reference, &s.state, 1e-8);

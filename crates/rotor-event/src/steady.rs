@@ -155,10 +155,8 @@ pub fn steady_state(
     };
     // 1. Settle until the period and amplitude stop drifting (or the orbit is at rest).
     let mut run = Settling {
-        model,
-        u,
+        flow: &flow,
         opts,
-        ev,
         x: x0,
         mode: model.mode_at(&x0, u),
         elapsed: 0.0,
@@ -208,10 +206,8 @@ pub fn steady_state(
 
 /// A settling run, continued chunk by chunk.
 struct Settling<'a> {
-    model: &'a Model,
-    u: f64,
+    flow: &'a Flow<'a>,
     opts: &'a SteadyOptions,
-    ev: &'a EventOptions,
     x: State,
     mode: Mode,
     elapsed: f64,
@@ -227,7 +223,8 @@ impl Settling<'_> {
     fn until(&mut self, drift: f64) -> Result<Rough, SolveError> {
         loop {
             let acc = MetricsAccumulator::new(0.5 * self.opts.settle);
-            let mut integ = Integrator::new(self.model, self.u, self.opts.tol, *self.ev);
+            let f = self.flow;
+            let mut integ = Integrator::new(f.model, f.u, f.tol, f.ev);
             integ.extrema = true;
             let mut sink = LastExitSink {
                 acc,

@@ -392,6 +392,14 @@ pub trait Solver: Sync {
     fn name(&self) -> &'static str;
     /// Runs the scene.
     fn simulate(&self, model: &Model, scene: &Scene) -> Result<Trajectory, SolveError>;
+
+    /// Runs the scene, and refuses a finished run whose output holds a NaN or ∞
+    /// ([`Trajectory::check_finite`]): what every report and writer calls.
+    fn simulate_finite(&self, model: &Model, scene: &Scene) -> Result<Trajectory, SolveError> {
+        let tr = self.simulate(model, scene)?;
+        tr.check_finite()?;
+        Ok(tr)
+    }
 }
 
 /// Checks a state for NaN/∞ and reports it as a [`SolveError::NonFinite`].
