@@ -315,22 +315,32 @@ impl<'a> Integrator<'a> {
             for (j, &g) in gs[..n].iter().enumerate() {
                 let gb = value(g, &xb, &fb_rate);
                 let mut hit = Self::fires(g, ga[j], gb).map(|kind| (ta, tb, ga[j], kind));
-                // A shallow dip of a velocity guard between two positive samples: look for
-                // the minimum (root of the guard's rate) and test its value.
                 if hit.is_none()
                     && let Guard::Velocity(disc) = g
-                    && ga[j] > 0.0
-                    && gb > 0.0
                 {
                     let s = mode.of(disc).branch().unwrap_or(1.0);
                     let ra = s * fa_rate[disc.index()];
                     let rb = s * fb_rate[disc.index()];
-                    if ra < 0.0 && rb > 0.0 {
-                        let rate = |t: f64| s * d.eval_with_rate(t).1[disc.index()];
+                    let rate = |t: f64| s * d.eval_with_rate(t).1[disc.index()];
+                    if ga[j] > 0.0 && gb > 0.0 && ra < 0.0 && rb > 0.0 {
+                        // A shallow dip between two positive samples: look for the minimum
+                        // (root of the guard's rate) and test its value.
                         let tm = illinois(&rate, ta, tb, ra, rb);
                         let gm = self.guard(g, &d.eval(tm), mode);
                         if gm <= 0.0 {
                             hit = Some((ta, tm, ga[j], g));
+                        }
+                    } else if ga[j] == 0.0 && ra > 0.0 && gb <= 0.0 && rb < 0.0 {
+                        // An excursion from zero: the disc left ω = 0 at a reversal (the
+                        // guard is exactly 0 there and grows with rate ra > 0) and came back
+                        // within one sample interval — a reversal just past a stick
+                        // boundary, whose short excursion ends in stick. The guard's
+                        // maximum (root of its rate) is positive, and the return root lies
+                        // between it and tb.
+                        let tm = illinois(&rate, ta, tb, ra, rb);
+                        let gm = self.guard(g, &d.eval(tm), mode);
+                        if gm > 0.0 {
+                            hit = Some((tm, tb, gm, g));
                         }
                     }
                 }
