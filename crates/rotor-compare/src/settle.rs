@@ -284,6 +284,34 @@ mod tests {
         }
     }
 
+    /// The Stribeck set at 0.12 V: the upper disc creeps onto the boundary of its stick
+    /// interval (an approach that never ends in finite time, see rotor-event's steady
+    /// state). The switch model's stick band and Moreau–Jean's finite steps stop it there;
+    /// the event-driven solver takes the limit. All within the settling agreement: 1e-5
+    /// relative, and for the velocities at rest its absolute floor, 1e-8 rad/s (measured:
+    /// α within 2e-12 relative; Moreau–Jean's stuck ω_u is 1.1e-13 rad/s, rounding in its
+    /// complementarity solve).
+    #[test]
+    fn creeping_onto_a_stick_boundary_every_solver_rests_at_the_same_point() {
+        let path = concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/../../fixtures/params/stribeck.toml"
+        );
+        let m = Model::new(rotor_model::Params::from_file(std::path::Path::new(path)).unwrap());
+        let ev = event_steady(&m, 0.12);
+        assert!(matches!(ev, SteadyState::Equilibrium { .. }), "{ev:?}");
+        let opts = SettleOptions::default();
+        for kind in [SolverKind::Switch, SolverKind::Moreau] {
+            let s = settle(kind, &m, &base(0.12), &opts).unwrap();
+            // The floor abs/rel makes a relative 1e-5 of it the absolute 1e-8.
+            let (what, c) = change(&ev, &s.state, opts.abs / opts.rel);
+            assert!(
+                c <= opts.rel,
+                "{kind:?}: {what} differs by {c:e}: {ev:?} vs {s:?}"
+            );
+        }
+    }
+
     /// On the 1.5 V stick-slip cycle the settled metrics agree with the event-driven
     /// solver's refined fixed point within the fixtures' gates (switch 2e-6, Moreau–Jean
     /// 3e-6 relative; their origins are in fixtures/scenarios/t1-u1.5-rest.toml).

@@ -290,6 +290,25 @@ fn refine_equilibrium(model: &Model, u: f64, x: &State) -> SteadyState {
             alpha: x[0],
         };
     }
+    // One disc stuck, the other creeping onto the stuck set from outside it (α outside the
+    // set violates the slipping disc's own stick condition: the stuck one's holds). Its slip
+    // field `J ω̇ = T_ex(α) − T_c(ω)` with `α̇ = ±ω` comes to rest only where T_ex = T_c(0±),
+    // the boundary of its stick interval, and approaches it along an overdamped slow mode
+    // (e^{−k_θ t/b} for the Stribeck set's upper disc, 0.03 /s): exponentially, never in
+    // finite time. The limit is that boundary, the set's end nearest α.
+    if let Some(set) = model.stuck_equilibria(u)
+        && (x[1] == 0.0) != (x[2] == 0.0)
+    {
+        let alpha_rate = x[1] - x[2];
+        let limit = x[0].clamp(set.alpha_min, set.alpha_max);
+        if (limit - x[0]) * alpha_rate > 0.0 {
+            return SteadyState::Equilibrium {
+                omega_u: 0.0,
+                omega_l: 0.0,
+                alpha: limit,
+            };
+        }
+    }
     let best = model
         .slip_equilibria(u)
         .into_iter()

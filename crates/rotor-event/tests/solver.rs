@@ -365,6 +365,42 @@ fn stribeck_equilibrium_set_stays_stuck() {
     );
 }
 
+/// The Stribeck set at 0.09–0.15 V: k_m u exceeds the upper disc's static level, so it
+/// slips forward, winding the shaft until the lower disc's stick holds it; it then creeps to
+/// rest along an overdamped slow mode (rate k_θ/b ≈ 0.03 /s), never in finite time. Its slip
+/// field comes to rest where k_m u − k_θ α = T_cu(0+) = t_s + Δt_s: the steady state is that
+/// point (not the creeping state where the settling run stopped, ω_u ≈ 1e-5 rad/s and α off
+/// by 3e-4 relative, as it once was).
+#[test]
+fn creeping_onto_the_stick_boundary_settles_on_it() {
+    let model = Model::new(Params::from_file(&fixtures().join("params/stribeck.toml")).unwrap());
+    let p = &model.params;
+    for u in [0.09, 0.12, 0.15] {
+        let st = steady_state(
+            &model,
+            u,
+            State::zeros(),
+            &SteadyOptions::default(),
+            &EventOptions::default(),
+        )
+        .unwrap();
+        let alpha = (p.k_m * u - (p.upper.t_s + p.upper.dt_s)) / p.k_theta;
+        let SteadyState::Equilibrium {
+            omega_u,
+            omega_l,
+            alpha: a,
+        } = st
+        else {
+            panic!("{u} V: {st:?}");
+        };
+        // Rounding only: the same three operations in another order (1e-12 relative).
+        assert!(
+            omega_u == 0.0 && omega_l == 0.0 && ((a - alpha) / alpha).abs() < 1e-12,
+            "{u} V: {st:?} vs alpha = {alpha}"
+        );
+    }
+}
+
 /// The Zeno guard: mode switches that accumulate faster than `zeno_count` per `zeno_window`
 /// end the run with a typed error at the time they accumulate. On the 1.5 V cycle the lower
 /// disc switches twice per period (4.58 s), so 3 switches within 10 s must trip a guard set to
