@@ -387,7 +387,12 @@ impl Params {
         }
         match self.lower {
             LowerFriction::Exponential {
-                t_s, w_1, w_2, b, ..
+                t_s,
+                t_1,
+                t_2,
+                w_1,
+                w_2,
+                b,
             } => {
                 if t_s < 0.0 {
                     return err("lower.t_s", t_s, "static level must be >= 0");
@@ -400,6 +405,24 @@ impl Params {
                 }
                 if b < 0.0 {
                     return err("lower.b", b, "viscous coefficient must be >= 0");
+                }
+                // t_1 and t_2 may be negative (Table 1's t_2 is), but not so negative that
+                // the friction drives the disc: T_cl(ω) >= 0 for every slip velocity.
+                let (w, tc) = exponential_law_minimum(t_s, t_1, t_2, w_1, w_2, b);
+                if tc < 0.0 {
+                    let (f, v) = if t_1 * (0.5 * w_1 * w).tanh() <= t_2 * (0.5 * w_2 * w).tanh() {
+                        ("lower.t_1", t_1)
+                    } else {
+                        ("lower.t_2", t_2)
+                    };
+                    return err(
+                        f,
+                        v,
+                        &format!(
+                            "makes the lower friction law negative, T_cl = {tc:.3e} N m at \
+                             |ω| = {w:.3e} rad/s (friction must oppose the motion)"
+                        ),
+                    );
                 }
             }
             LowerFriction::Stribeck {
@@ -432,6 +455,39 @@ impl Params {
         }
         Ok(())
     }
+}
+
+/// The smallest value of the exponential law for slip, `min_{ω>0} T_cl(ω)` with
+/// `T_cl(ω) = t_s + t_1 tanh(w_1 ω/2) + t_2 tanh(w_2 ω/2) + b ω` (the form of eq. (5) with
+/// `1 − 2/(1+e^x) = tanh(x/2)`), and where it is taken: `(ω, T_cl)`.
+///
+/// Past `ω_max = 40/min(w_1, w_2)` both tanh terms are within e^{−40} of their limits, so the
+/// law is `t_s + t_1 + t_2 + b ω` there, non-decreasing: the minimum lies in `(0, ω_max]`. It
+/// is bracketed on a log grid (64 points per decade from 1e-9 ω_max: the terms vary on the
+/// scales 1/w_i, far wider than a grid cell) and refined by golden-section search.
+fn exponential_law_minimum(t_s: f64, t_1: f64, t_2: f64, w_1: f64, w_2: f64, b: f64) -> (f64, f64) {
+    let law = |w: f64| t_s + t_1 * (0.5 * w_1 * w).tanh() + t_2 * (0.5 * w_2 * w).tanh() + b * w;
+    let w_max = 40.0 / w_1.min(w_2);
+    let n = 9 * 64;
+    let grid = |k: usize| w_max * 10f64.powf(-9.0 * (n - k) as f64 / n as f64);
+    let k = (0..=n)
+        .min_by(|&i, &j| law(grid(i)).total_cmp(&law(grid(j))))
+        .unwrap_or(n);
+    let (mut a, mut c) = (grid(k.saturating_sub(1)), grid((k + 1).min(n)));
+    if k == 0 {
+        a = 0.0;
+    }
+    let g = 0.5 * (5f64.sqrt() - 1.0);
+    for _ in 0..100 {
+        let (x1, x2) = (c - g * (c - a), a + g * (c - a));
+        if law(x1) <= law(x2) {
+            c = x2;
+        } else {
+            a = x1;
+        }
+    }
+    let w = 0.5 * (a + c);
+    (w, law(w))
 }
 
 /// A path as it appears in a one-line message: control characters (a newline is legal in a
@@ -571,6 +627,53 @@ mod tests {
         assert!(err_of(&t).contains("k_theta = NaN"));
         let t = TABLE1.replace("k_theta = 0.0727", "k_theta = inf");
         assert!(err_of(&t).contains("k_theta = inf"));
+    }
+
+    /// Table 1's t_2 is negative and allowed (the law's minimum is 0.124 N m, at 7.9 rad/s);
+    /// doubled, it makes the law negative past ~1.6 rad/s and is refused, naming t_2.
+    #[test]
+    fn a_negative_level_that_makes_friction_drive_the_disc_is_refused() {
+        let t = TABLE1.replace("t_2 = -0.2267", "t_2 = -0.4534");
+        let e = err_of(&t);
+        assert!(
+            e.contains("lower.t_2 = -0.4534") && e.contains("negative"),
+            "{e}"
+        );
+        // With b = 0 the law tends to t_s + t_1 + t_2 = -0.0022 N m: negative far out.
+        let t = TABLE1.replace("b = 0.0109", "b = 0.0");
+        let e = err_of(&t);
+        assert!(e.contains("lower.t_2 = -0.2267"), "{e}");
+    }
+
+    /// The minimum search against brute force: the law on a uniform grid of 2e6 points over
+    /// [0, 2 ω_max]. The grid misses the true minimum by at most ½ max|T''| (Δ/2)², with
+    /// `|d²/dω² tanh(wω/2)| ≤ w²/2 · 2/(3√3)`; the search must lie below the grid's minimum
+    /// (it finds the true one) by no more than that bound, plus rounding (1e-14 N m).
+    #[test]
+    fn exponential_law_minimum_matches_brute_force() {
+        for (t_s, t_1, t_2, w_1, w_2, b) in [
+            (0.1642, 0.0603, -0.2267, 5.7468, 0.2941, 0.0109),
+            (0.1313, 0.0897, -0.9, 5.9271, 0.2077, 0.0194),
+            (0.05, -0.04, 0.1, 30.0, 0.5, 0.0),
+            (0.2, 0.1, 0.05, 1.0, 2.0, 0.01),
+        ] {
+            let law =
+                |w: f64| t_s + t_1 * (0.5 * w_1 * w).tanh() + t_2 * (0.5 * w_2 * w).tanh() + b * w;
+            let w_max = 40.0 / f64::min(w_1, w_2);
+            let n = 2_000_000;
+            let dw = 2.0 * w_max / n as f64;
+            let brute = (0..=n)
+                .map(|k| law(dw * k as f64))
+                .fold(f64::INFINITY, f64::min);
+            let curv = 1.0 / (3.0 * 3f64.sqrt()) * (t_1.abs() * w_1 * w_1 + t_2.abs() * w_2 * w_2);
+            let bound = 0.5 * curv * (0.5 * dw).powi(2);
+            let (w, tc) = exponential_law_minimum(t_s, t_1, t_2, w_1, w_2, b);
+            assert_eq!(tc, law(w));
+            assert!(
+                tc <= brute + 1e-14 && brute - tc <= bound + 1e-14,
+                "{tc} at {w} vs grid {brute} (bound {bound:e})"
+            );
+        }
     }
 
     #[test]

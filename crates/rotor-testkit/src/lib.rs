@@ -247,6 +247,11 @@ pub fn bad_params_cases() -> Vec<BadFile> {
         t1("dt_s = 0.0", "dt_s = 0.5", &["upper.dt_s = 0.5", "t_s"]),
         t1("b = 2.2247", "b = -2.2", &["upper.b = -2.2", ">= 0"]),
         t1("b = 0.0109", "b = -0.01", &["lower.b = -0.01", ">= 0"]),
+        t1(
+            "t_2 = -0.2267",
+            "t_2 = -0.5",
+            &["lower.t_2 = -0.5", "friction law negative"],
+        ),
         t1("w_1 = 5.7468", "w_1 = 0.0", &["lower.w_1 = 0", "positive"]),
         t1(
             "w_2 = 0.2941",
