@@ -169,7 +169,7 @@ fn warn_inexact(stats: &rotor_model::Stats) {
 /// Checks a numeric option: finite and in range, naming the flag and the value.
 fn check(flag: &str, v: f64, ok: bool, what: &str) -> Result<()> {
     if !v.is_finite() || !ok {
-        bail!("--{flag} {v}: {what}");
+        bail!("--{flag} {}: {what}", rotor_model::Num(v));
     }
     Ok(())
 }
@@ -205,12 +205,31 @@ fn simulate(common: &Common, t_end: f64, dt: f64, csv_path: &Path) -> Result<()>
     warn_inexact(&traj.stats);
     let mut buf = Vec::with_capacity(traj.samples.len() * 64);
     writeln!(buf, "t,alpha,omega_u,omega_l")?;
+    let digits = time_digits(dt);
     for s in &traj.samples {
-        writeln!(buf, "{},{},{},{}", s.t, s.x[0], s.x[1], s.x[2])?;
+        let t = round_to(s.t, digits);
+        writeln!(buf, "{t},{},{},{}", s.x[0], s.x[1], s.x[2])?;
     }
     rotor_compare::report::write_atomic(csv_path, &buf)
         .with_context(|| format!("{}: cannot write", csv_path.display()))?;
     Ok(())
+}
+
+/// Decimals that print a grid time `k·dt` without its binary noise: six past the first
+/// significant digit of dt (the grid's times are k·dt within an ulp, so the printed time is
+/// within 1e-6 dt of the time the state was taken at).
+fn time_digits(dt: f64) -> i32 {
+    (6.0 - dt.log10().floor()).clamp(0.0, 300.0) as i32
+}
+
+/// `t` rounded to `digits` decimals: `3 × 0.3 = 0.8999999999999999` prints as `0.9`.
+/// (Division of an integer-valued float by a power of ten is correctly rounded, so the
+/// result is the float nearest the decimal, which prints as that decimal. Where t·10^digits
+/// exceeds 2^53 the value is already an integer multiple of the spacing and stays.)
+fn round_to(t: f64, digits: i32) -> f64 {
+    let scale = 10f64.powi(digits);
+    let r = (t * scale).round() / scale;
+    if r.is_finite() { r } else { t }
 }
 
 fn steady(common: &Common) -> Result<()> {

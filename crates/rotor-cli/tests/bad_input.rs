@@ -103,7 +103,7 @@ fn bad_flags_name_the_flag_and_value() {
     let dir = tmp_dir();
     let csv = dir.join("out.csv");
     let csv_s = csv.to_str().unwrap();
-    let cases: [(&[&str], &[&str]); 14] = [
+    let cases: [(&[&str], &[&str]); 15] = [
         (&["--solver", "nope", "--u", "1"], &["--solver", "\"nope\""]),
         (&["--solver", "event", "--u", "nan"], &["--u", "NaN"]),
         (&["--solver", "event", "--u", "inf"], &["--u", "inf"]),
@@ -128,7 +128,7 @@ fn bad_flags_name_the_flag_and_value() {
         ),
         (
             &["--solver", "event", "--u", "1", "--tol", "-1e-9"],
-            &["--tol -0.000000001"],
+            &["--tol -1e-9"],
         ),
         (
             &["--solver", "event", "--u", "1", "--x0", "1,2"],
@@ -145,6 +145,11 @@ fn bad_flags_name_the_flag_and_value() {
         (
             &["--solver", "event", "--u", "1", "--t-end", "-1"],
             &["--t-end -1"],
+        ),
+        // A huge value reads as written, not as 309 digits.
+        (
+            &["--solver", "moreau", "--u", "1e308"],
+            &["u = 1e308", "overflows"],
         ),
     ];
     for (args, needles) in cases {

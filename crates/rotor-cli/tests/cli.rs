@@ -38,6 +38,13 @@ fn simulate_writes_the_contract_csv() {
         assert_eq!(lines.len(), 202, "{solver}");
         assert!(lines[1].starts_with("0,"));
         assert!(lines[201].starts_with("2,"));
+        // Every time prints as the decimal k/100 (k·0.01 is 0.35000000000000003 at k = 35,
+        // and 24 of the 201 grid times carry such noise).
+        for (k, l) in lines[1..].iter().enumerate() {
+            let t = l.split(',').next().unwrap();
+            assert_eq!(t.parse::<f64>().unwrap(), k as f64 / 100.0, "{l}");
+            assert!(t.len() <= 4, "{l}");
+        }
     }
 }
 

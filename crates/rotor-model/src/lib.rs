@@ -9,6 +9,7 @@ pub mod dynamics;
 pub mod equilibrium;
 pub mod friction;
 pub mod lagrangian;
+pub mod num;
 pub mod params;
 pub mod scenario;
 pub mod scene;
@@ -18,6 +19,7 @@ pub use dynamics::{ALPHA, Disc, DiscMode, Mode, Model, OMEGA_L, OMEGA_U, State};
 pub use equilibrium::{SlipEquilibrium, StuckSet};
 pub use friction::Friction;
 pub use lagrangian::{Coords, Lagrangian};
+pub use num::Num;
 pub use params::{LowerFriction, Params, ParamsError, UpperFriction};
 pub use scenario::{CompareSpec, PairTolerance, Scenario, ScenarioError};
 pub use scene::{

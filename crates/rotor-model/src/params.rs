@@ -219,7 +219,7 @@ impl Params {
         let bad = |field: &str, value: f64, reason: &str| ParamsError::Invalid {
             path: path.to_owned(),
             field: field.to_owned(),
-            value: value.to_string(),
+            value: crate::Num(value).to_string(),
             reason: reason.to_owned(),
         };
         let lower = match raw.lower.family.as_str() {

@@ -207,33 +207,41 @@ impl Scenario {
         })?;
         let model = Model::new(params);
         if !raw.u.is_finite() {
-            return Err(bad("u", raw.u.to_string(), "must be finite"));
+            return Err(bad("u", crate::Num(raw.u).to_string(), "must be finite"));
         }
         if !(raw.t_end > 0.0 && raw.t_end.is_finite()) {
             return Err(bad(
                 "t_end",
-                raw.t_end.to_string(),
+                crate::Num(raw.t_end).to_string(),
                 "must be positive and finite",
             ));
         }
         if let Some(tol) = raw.tol
             && !(tol > 0.0 && tol < 1.0)
         {
-            return Err(bad("tol", tol.to_string(), "must lie in (0, 1)"));
+            return Err(bad(
+                "tol",
+                crate::Num(tol).to_string(),
+                "must lie in (0, 1)",
+            ));
         }
         if let Some(tol) = raw.tol
             && tol < MIN_TOL
         {
             return Err(bad(
                 "tol",
-                tol.to_string(),
+                crate::Num(tol).to_string(),
                 "is below 1.1e-15 (10 unit roundoffs): double precision cannot deliver it",
             ));
         }
         if let Some(h) = raw.h
             && !(h > 0.0 && h <= raw.t_end)
         {
-            return Err(bad("h", h.to_string(), "must lie in (0, t_end]"));
+            return Err(bad(
+                "h",
+                crate::Num(h).to_string(),
+                "must lie in (0, t_end]",
+            ));
         }
         // Without `h`, the time-stepping solver takes the default step, which must fit in
         // the horizon (Scene::validate), or every run of the scenario would fail.
@@ -241,7 +249,7 @@ impl Scenario {
         if raw.h.is_none() && raw.t_end < h_default {
             return Err(bad(
                 "t_end",
-                raw.t_end.to_string(),
+                crate::Num(raw.t_end).to_string(),
                 &format!("is shorter than the default step h = {h_default}: set h"),
             ));
         }
@@ -259,7 +267,7 @@ impl Scenario {
                     if !v.is_finite() {
                         return Err(bad(
                             &format!("x0_from_equilibrium[{i}]"),
-                            v.to_string(),
+                            crate::Num(*v).to_string(),
                             "must be finite",
                         ));
                     }
@@ -287,20 +295,20 @@ impl Scenario {
         };
         for (i, n) in ["x0[0]", "x0[1]", "x0[2]"].iter().enumerate() {
             if !x0[i].is_finite() {
-                return Err(bad(n, x0[i].to_string(), "must be finite"));
+                return Err(bad(n, crate::Num(x0[i]).to_string(), "must be finite"));
             }
         }
         if !(raw.compare.dt > 0.0 && raw.compare.dt.is_finite()) {
             return Err(bad(
                 "compare.dt",
-                raw.compare.dt.to_string(),
+                crate::Num(raw.compare.dt).to_string(),
                 "must be positive",
             ));
         }
         if raw.t_end / raw.compare.dt > MAX_GRID_ROWS {
             return Err(bad(
                 "compare.dt",
-                raw.compare.dt.to_string(),
+                crate::Num(raw.compare.dt).to_string(),
                 "asks more than 1e7 output rows (t_end/dt): choose a larger dt",
             ));
         }
@@ -328,7 +336,7 @@ impl Scenario {
         {
             return Err(bad(
                 "compare.steady_from",
-                t.to_string(),
+                crate::Num(t).to_string(),
                 "must lie in [0, t_end)",
             ));
         }
@@ -352,7 +360,7 @@ impl Scenario {
                 {
                     return Err(bad(
                         &format!("tolerance.{pair}.{name}"),
-                        v.to_string(),
+                        crate::Num(v).to_string(),
                         "must be positive and finite",
                     ));
                 }
@@ -396,7 +404,11 @@ impl Scenario {
                 if let Some(v) = v
                     && !needed
                 {
-                    return Err(bad(&format!("tolerance.{pair}.{name}"), v.to_string(), why));
+                    return Err(bad(
+                        &format!("tolerance.{pair}.{name}"),
+                        crate::Num(v).to_string(),
+                        why,
+                    ));
                 }
             }
             if transient && tol.transient_max.is_none() {

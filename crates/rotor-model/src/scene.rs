@@ -353,7 +353,7 @@ impl Trajectory {
 #[derive(Debug, Error, Clone, PartialEq)]
 pub enum SolveError {
     /// The scene is not admissible.
-    #[error("invalid scene: {field} = {value}: {reason}")]
+    #[error("invalid scene: {field} = {}: {reason}", crate::Num(*.value))]
     InvalidScene {
         field: &'static str,
         value: f64,
