@@ -174,6 +174,20 @@ fn check(flag: &str, v: f64, ok: bool, what: &str) -> Result<()> {
     Ok(())
 }
 
+/// A flag the chosen solver has no use for is said so, not silently dropped: the adaptive
+/// solvers take no step size, Moreau–Jean no tolerance.
+fn warn_ignored(common: &Common) {
+    match common.solver.as_str() {
+        "moreau" if common.tol.is_some() => eprintln!(
+            "warning: --tol is ignored by moreau (fixed steps: its accuracy is set by --h)"
+        ),
+        s @ ("event" | "switch") if common.h.is_some() => eprintln!(
+            "warning: --h is ignored by {s} (adaptive steps: its accuracy is set by --tol)"
+        ),
+        _ => {}
+    }
+}
+
 fn scene_from(common: &Common, t_end: f64, output: Output) -> Result<Scene> {
     check("u", common.u, true, "must be a finite number")?;
     let d = Scene::default();
@@ -181,7 +195,16 @@ fn scene_from(common: &Common, t_end: f64, output: Output) -> Result<Scene> {
     check("tol", tol, tol > 0.0 && tol < 1.0, "must lie in (0, 1)")?;
     // The default step shrinks to a horizon shorter than itself; an explicit --h does not.
     let h = common.h.unwrap_or(d.h.min(t_end));
-    check("h", h, h > 0.0 && h <= t_end, "must lie in (0, t_end]")?;
+    check(
+        "h",
+        h,
+        h > 0.0 && h <= t_end,
+        &format!(
+            "must lie in (0, {}] s (the run's horizon)",
+            rotor_model::Num(t_end)
+        ),
+    )?;
+    warn_ignored(common);
     Ok(Scene {
         u: common.u,
         x0: parse_x0(common.x0.as_deref())?,
@@ -194,8 +217,8 @@ fn scene_from(common: &Common, t_end: f64, output: Output) -> Result<Scene> {
 }
 
 fn simulate(common: &Common, t_end: f64, dt: f64, csv_path: &Path) -> Result<()> {
-    check("t-end", t_end, t_end > 0.0, "must be positive")?;
-    check("dt", dt, dt > 0.0, "must be positive")?;
+    check("t-end", t_end, t_end > 0.0, "must be positive and finite")?;
+    check("dt", dt, dt > 0.0, "must be positive and finite")?;
     let solver = solver_by_name(&common.solver)?;
     let model = load_model(common.params.as_deref())?;
     let scene = scene_from(common, t_end, Output::Grid { dt })?;

@@ -116,7 +116,7 @@ fn bad_flags_name_the_flag_and_value() {
         ),
         (
             &["--solver", "moreau", "--u", "1", "--h", "5"],
-            &["--h 5", "t_end"],
+            &["--h 5", "(0, 1] s"],
         ),
         (
             &["--solver", "event", "--u", "1", "--tol", "2"],

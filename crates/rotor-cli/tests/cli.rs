@@ -48,6 +48,36 @@ fn simulate_writes_the_contract_csv() {
     }
 }
 
+/// A flag the solver does not use is a warning on stderr, and the run goes on.
+#[test]
+fn flags_a_solver_ignores_are_warned_about() {
+    let dir = std::env::temp_dir().join(format!("rotor-cli-warn-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let csv = dir.join("out.csv");
+    let csv = csv.to_str().unwrap();
+    for (solver, flag, value, needle) in [
+        ("event", "--h", "1e-3", "--h is ignored by event"),
+        ("switch", "--h", "1e-3", "--h is ignored by switch"),
+        ("moreau", "--tol", "1e-8", "--tol is ignored by moreau"),
+    ] {
+        let o = rotor(&[
+            "simulate", "--solver", solver, "--u", "1.5", "--t-end", "0.1", flag, value, "--csv",
+            csv,
+        ]);
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert!(
+            o.status.success() && err.contains(needle),
+            "{solver}: {err}"
+        );
+    }
+    // The flags a solver uses draw no warning.
+    let o = rotor(&[
+        "simulate", "--solver", "moreau", "--u", "1.5", "--t-end", "0.1", "--h", "1e-3", "--csv",
+        csv,
+    ]);
+    assert!(o.status.success() && o.stderr.is_empty(), "{o:?}");
+}
+
 #[test]
 fn steady_prints_one_json_object() {
     let o = rotor(&["steady", "--solver", "event", "--u", "6.0"]);
