@@ -12,6 +12,9 @@ lint:
 # CI runs the fast form as part of `cargo test`.
 stress:
     ROTOR_STRESS=full cargo test --release -p rotor-compare stress -- --nocapture
+# The random stress case with 3000 draws instead of 24 (about a minute).
+proptest-long:
+    PROPTEST_CASES=3000 cargo test --release -p rotor-compare --test stress stress_random
 # Work-precision benchmark with peers (scipy, Siconos when installed), into reports/bench/.
 bench:
     cargo run --release -- bench --json reports/bench/bench.json --svg reports/bench/bench.svg --csv reports/bench/bench.csv
