@@ -183,10 +183,7 @@ fn scene_tolerance_below_roundoff_is_refused() {
     assert!(at(1e-13).is_ok());
     assert!(at(MIN_TOL).is_ok());
     let e = at(1e-20).unwrap_err().to_string();
-    assert!(
-        e.contains("tol = 0.00000000000000000001") && e.contains("roundoff"),
-        "{e}"
-    );
+    assert!(e.contains("tol = 1e-20") && e.contains("roundoff"), "{e}");
 }
 
 #[test]
@@ -206,10 +203,7 @@ fn scene_grid_that_would_exhaust_memory_is_refused() {
     .validate()
     .unwrap_err()
     .to_string();
-    assert!(
-        e.contains("dt = 0.000000000001") && e.contains("1e7"),
-        "{e}"
-    );
+    assert!(e.contains("dt = 1e-12") && e.contains("1e7"), "{e}");
     let e = Scene {
         t_end: 1e300,
         h: 1.0,
