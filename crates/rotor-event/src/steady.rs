@@ -3,7 +3,9 @@
 //! 1. A settling run classifies the attractor reached from `x0` (equilibrium, stick-slip
 //!    cycle, slipping cycle).
 //! 2. An equilibrium is taken from the equilibrium equations (the slipping branch
-//!    `u(ω)` solved for ω, see `rotor_model::equilibrium`), or is the stuck state itself.
+//!    `u(ω)` solved for ω, see `rotor_model::equilibrium`), or is the stuck state itself, or
+//!    — for a disc creeping onto the boundary of its stick interval, which it approaches
+//!    exponentially and never reaches — that boundary.
 //! 3. A stick-slip cycle is the fixed point of the return map from one exit of the lower disc
 //!    from stick to the next. At an exit `k_θ α = T_sl` and `ω_l = 0` are known exactly, so the
 //!    map is one-dimensional in ω_u (zero-dimensional if the upper disc is stuck then); it is
