@@ -3,6 +3,7 @@
 
 use std::sync::OnceLock;
 
+use rotor_bifurcation::continuation::ContOptions;
 use rotor_bifurcation::{Diagram, DiagramOptions, SpecialPoint, diagram};
 use rotor_model::{Model, Params};
 
@@ -11,6 +12,23 @@ pub fn model(name: &str) -> Model {
     let p = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
         .join(format!("../../fixtures/params/{name}.toml"));
     Model::new(Params::from_file(&p).unwrap())
+}
+
+/// Continuation over [0, 7] V as the tests run it: the given arclength cap, Newton
+/// tolerance and node count; the rest is the diagram's (h_min 1e-9, amp_stop 0.02 rad/s,
+/// FD step 1e-6).
+pub fn cont_options(h_max: f64, newton_tol: f64, max_nodes: usize) -> ContOptions {
+    ContOptions {
+        u_min: 0.0,
+        u_max: 7.0,
+        h_max,
+        h_min: 1e-9,
+        newton_tol,
+        amp_stop: 0.02,
+        max_nodes,
+        fd_step: 1e-6,
+        multipliers: Default::default(),
+    }
 }
 
 /// The default diagram of Table 1.

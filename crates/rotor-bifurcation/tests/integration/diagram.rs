@@ -1,13 +1,13 @@
 //! The diagram for both parameter sets, checked against independent facts.
 
-use rotor_bifurcation::continuation::{ContOptions, Continuer};
+use rotor_bifurcation::continuation::Continuer;
 use rotor_bifurcation::equilibria::{complex_pair, hopf_points, omega_reaching};
 use rotor_bifurcation::periodic::{Shooter, eig2};
 use rotor_bifurcation::{Diagram, DiagramOptions, diagram, start_point};
 use rotor_event::{EventOptions, SteadyOptions, steady_state};
 use rotor_model::{Model, State, SteadyState};
 
-use crate::common::{model, points, st_diagram, t1_diagram};
+use crate::common::{cont_options, model, points, st_diagram, t1_diagram};
 
 fn shooter(m: &Model) -> Shooter<'_> {
     Shooter {
@@ -114,17 +114,7 @@ fn branch_period_matches_steady_state_refinement() {
     let z = sh.section_fixed_point(1.5, c, z0, 1e-10).unwrap();
     let cont = Continuer {
         sh,
-        opts: ContOptions {
-            u_min: 0.0,
-            u_max: 7.0,
-            h_max: 0.035,
-            h_min: 1e-9,
-            newton_tol: 1e-9,
-            amp_stop: 0.02,
-            max_nodes: 10,
-            fd_step: 1e-6,
-            multipliers: Default::default(),
-        },
+        opts: cont_options(0.035, 1e-9, 10),
     };
     let info = cont.describe(1.5, c, z).unwrap();
     // Both fixed points to ~1e-10; periods at tolerance 1e-11/1e-12. Measured: period

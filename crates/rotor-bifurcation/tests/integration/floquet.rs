@@ -3,13 +3,13 @@
 //! the return maps, on slipping and stick-slip cycles of both parameter sets.
 
 use nalgebra::{Complex, Matrix3};
-use rotor_bifurcation::continuation::{ContOptions, Continuer, End};
+use rotor_bifurcation::continuation::{Continuer, End};
 use rotor_bifurcation::equilibria::{hopf_points, omega_reaching};
 use rotor_bifurcation::periodic::{SectionDerivs, Shooter, eig2};
 use rotor_bifurcation::start_point;
 use rotor_model::{Disc, EventKind, State};
 
-use crate::common::model;
+use crate::common::{cont_options, model};
 
 /// Flow tolerance of these checks.
 const TOL: f64 = 1e-12;
@@ -32,17 +32,7 @@ fn attractor(sh: &Shooter, u: f64) -> Cycle {
 fn continuer<'a>(sh: Shooter<'a>, max_nodes: usize) -> Continuer<'a> {
     Continuer {
         sh,
-        opts: ContOptions {
-            u_min: 0.0,
-            u_max: 7.0,
-            h_max: 0.035,
-            h_min: 1e-9,
-            newton_tol: 1e-10,
-            amp_stop: 0.02,
-            max_nodes,
-            fd_step: 1e-6,
-            multipliers: Default::default(),
-        },
+        opts: cont_options(0.035, 1e-10, max_nodes),
     }
 }
 

@@ -3,14 +3,14 @@
 //! independent route (sign changes of the condition on either side, the Filippov flow's own
 //! stick detection).
 
-use rotor_bifurcation::continuation::{ContOptions, Continuer, Node};
+use rotor_bifurcation::continuation::{Continuer, Node};
 use rotor_bifurcation::equilibria::complex_pair;
 use rotor_bifurcation::grazing;
 use rotor_bifurcation::periodic::Shooter;
 use rotor_event::{StopAt, flow};
 use rotor_model::Model;
 
-use crate::common::{model, points, st_diagram, t1_diagram};
+use crate::common::{cont_options, model, points, st_diagram, t1_diagram};
 
 /// The goal of the issue: every special point to 1e-8 V.
 const GOAL: f64 = 1e-8;
@@ -48,17 +48,7 @@ fn section_point(sh: &Shooter, u: f64, w: f64) -> ([f64; 2], f64) {
 fn continuer(sh: Shooter<'_>) -> Continuer<'_> {
     Continuer {
         sh,
-        opts: ContOptions {
-            u_min: 0.0,
-            u_max: 7.0,
-            h_max: 0.01,
-            h_min: 1e-9,
-            newton_tol: 1e-11,
-            amp_stop: 0.02,
-            max_nodes: 8,
-            fd_step: 1e-6,
-            multipliers: Default::default(),
-        },
+        opts: cont_options(0.01, 1e-11, 8),
     }
 }
 
