@@ -7,6 +7,7 @@
 
 pub mod dynamics;
 pub mod equilibrium;
+pub mod fast_forward;
 pub mod friction;
 pub mod lagrangian;
 pub mod num;
@@ -17,6 +18,7 @@ pub mod steady;
 
 pub use dynamics::{ALPHA, Disc, DiscMode, Mode, Model, OMEGA_L, OMEGA_U, State};
 pub use equilibrium::{SlipEquilibrium, StuckSet};
+pub use fast_forward::{FastForward, Verdict};
 pub use friction::Friction;
 pub use lagrangian::{Coords, Lagrangian};
 pub use num::Num;

@@ -11,6 +11,12 @@ use crate::steady::SteadyState;
 pub enum Output {
     /// Only the final state and counters: no samples, no event list.
     Final,
+    /// Only the steady-state metrics (over `[metrics_from, t_end]`, or the whole run if
+    /// `metrics_from` is unset), no samples, no event list. Unlike [`Output::Final`], the
+    /// adaptive solvers may skip whole periods once the orbit is on a cycle
+    /// ([`crate::FastForward`]): the metrics are those of an integrated cycle, and the final
+    /// state carries the phase error of the skipped periods.
+    Metrics,
     /// The list of events (stick onsets and exits, reversals, and extrema when metrics are
     /// asked), no samples.
     Events,
@@ -156,7 +162,14 @@ impl Scene {
 
     /// Whether the event list is kept.
     pub fn keeps_events(&self) -> bool {
-        !matches!(self.output, Output::Final)
+        !matches!(self.output, Output::Final | Output::Metrics)
+    }
+
+    /// Start of the metrics window: `metrics_from`, or 0 for [`Output::Metrics`] without it;
+    /// `None` if no metrics are asked.
+    pub fn metrics_start(&self) -> Option<f64> {
+        self.metrics_from
+            .or((self.output == Output::Metrics).then_some(0.0))
     }
 }
 
@@ -288,6 +301,8 @@ pub struct Stats {
     /// fixed-point iterate was taken (Moreau–Jean at very large h only). Zero in every
     /// scenario the agreement gates cover; nonzero flags an answer to distrust.
     pub inexact_steps: u64,
+    /// Whole periods skipped by [`Output::Metrics`] ([`crate::FastForward`]).
+    pub skipped_periods: u64,
 }
 
 impl std::ops::AddAssign for Stats {
@@ -302,6 +317,7 @@ impl std::ops::AddAssign for Stats {
         self.lcp_skipped += o.lcp_skipped;
         self.newton_iters += o.newton_iters;
         self.inexact_steps += o.inexact_steps;
+        self.skipped_periods += o.skipped_periods;
     }
 }
 

@@ -179,6 +179,28 @@ impl MetricsAccumulator {
         }
     }
 
+    /// The run skips `dt` (whole periods) right after `anchor`, the event pushed last, and
+    /// continues from its state ([`crate::FastForward`]): the cycles kept so far and the one in
+    /// progress move by `dt`. An anchor before the window opens the window at its new time.
+    pub fn fast_forward(&mut self, anchor: &Event, dt: f64) {
+        if anchor.t < self.t_from {
+            self.push(&Event {
+                t: anchor.t + dt,
+                ..*anchor
+            });
+            return;
+        }
+        for s in [&mut self.stick_exits, &mut self.maxima] {
+            for c in s.open.iter_mut().chain(s.last.iter_mut().flatten()) {
+                c.start += dt;
+                c.end += dt;
+            }
+        }
+        if let Some(t) = self.stick_since.as_mut() {
+            *t += dt;
+        }
+    }
+
     /// The cycles the metrics are read from: between stick exits if the lower disc sticks,
     /// else between ω_l maxima.
     fn stream(&self) -> &Stream {
@@ -296,6 +318,47 @@ mod tests {
         // Amplitudes 5 − 1 = 4 and 4 − 2 = 2 (each cycle's extremes include its end points).
         assert_eq!(m.period_drift(), Some(0.0));
         assert_eq!(m.amplitude_drift(), Some(0.5));
+    }
+
+    /// Skipping whole periods after an anchor gives the metrics of the full run, whether the
+    /// anchor lies in the window or before it.
+    #[test]
+    fn fast_forward_keeps_the_metrics_of_the_skipped_run() {
+        let l = Disc::Lower;
+        // A stick-slip cycle of period 3: exit, max, stick onset.
+        let cycle = |k: f64| {
+            [
+                ev(3.0 * k, [2.2, 1.0, 0.0], EventKind::StickEnd(l)),
+                ev(3.0 * k + 1.0, [1.0, 1.1, 3.0], EventKind::Max(l)),
+                ev(3.0 * k + 2.5, [1.0, 0.9, 0.0], EventKind::StickStart(l)),
+            ]
+        };
+        for t_from in [1.0, 20.0] {
+            let mut full = MetricsAccumulator::new(t_from);
+            for k in 0..12 {
+                cycle(k as f64).iter().for_each(|e| full.push(e));
+            }
+            full.push(&cycle(12.0)[0]);
+            // Skip cycles 3..=9 right after the exit at t = 9.
+            let mut skip = MetricsAccumulator::new(t_from);
+            for k in 0..3 {
+                cycle(k as f64).iter().for_each(|e| skip.push(e));
+            }
+            let anchor = cycle(3.0)[0];
+            skip.push(&anchor);
+            skip.fast_forward(&anchor, 21.0);
+            for e in &cycle(10.0)[1..] {
+                skip.push(e);
+            }
+            cycle(11.0).iter().for_each(|e| skip.push(e));
+            skip.push(&cycle(12.0)[0]);
+            let x = State::zeros();
+            assert_eq!(skip.finish(&x), full.finish(&x), "t_from = {t_from}");
+            assert!(
+                matches!(full.finish(&x), SteadyState::LimitCycle { period, stick_time, .. }
+                if period == 3.0 && stick_time == 0.5)
+            );
+        }
     }
 
     #[test]

@@ -1,0 +1,392 @@
+//! Skipping whole periods of a converged cycle when a scene asks for the steady state only
+//! ([`Output::Metrics`]).
+//!
+//! The metrics of a run are those of its last complete cycle in `[metrics_from, t_end]`
+//! ([`crate::MetricsAccumulator`]). Once the orbit is on a periodic orbit, every later cycle
+//! repeats it, and integrating them changes nothing but the rounding. A [`FastForward`]
+//! watches the run's returns to an *anchor*: the lower disc's exits from stick, or the maxima
+//! of ω_l if the lower disc never sticks (the anchors the metrics use). Return n has the
+//! signature `s_n = (x_n, P_n)`: the state there and the time since the previous return.
+//!
+//! **When to skip.** With the increments `d_n = ‖s_n − s_{n−1}‖` in units of the tolerance
+//! (`max_i |Δs_i| / (tol·(1 + |s_i|))`, the solvers' own error norm) and their ratio
+//! `ρ = d_n/d_{n−1}`, a return map that contracts geometrically by ρ per cycle has its fixed
+//! point within `d_n·ρ/(1 − ρ)` of `s_n`. When that bound is at most one tolerance and
+//! `ρ ≤ 1/2`, the orbit is on its cycle to within one local error of the integration, and the
+//! run continues from `(t_n + m·P_n, x_n)`: `m ≥ 1` whole periods later, chosen so that one
+//! complete cycle and the tail to `t_end` are still integrated (the reported cycle is an
+//! integrated one) and that cycle lies in the metrics window. A stick-slip orbit of the
+//! source's diagram contracts by its nontrivial Floquet multiplier, 1e-5 (Table 1, 1.5 V) or
+//! 3e-8 (Stribeck), per cycle: three returns after the transient suffice.
+//!
+//! **Verification.** The first return after the jump must come back within
+//! [`VERIFY_TOLERANCES`] of `s_n`. If it does not, or the run ends before it returns, the
+//! solver undoes the jump and integrates the skipped periods after all ([`Verdict::Undo`]);
+//! it does not try again. A false convergence (a ratio that is small by chance, a spiralling
+//! approach) therefore costs time, never accuracy.
+//!
+//! **What it changes.** The metrics (period, extremes, stick time) are invariant under the
+//! shift and differ from a full run's by the convergence bound, ≤ one tolerance. The final
+//! state carries the phase error of the skipped periods, `m·|P_n − P*|`, of the same order as
+//! the phase error a full run accumulates over those periods.
+
+use crate::dynamics::{Disc, State};
+use crate::scene::{Event, EventKind, Output, Scene};
+
+/// A return after the jump must lie within this many tolerances of the return before it: both
+/// lie within one tolerance of the fixed point (the skip criterion), and the integration adds
+/// at most about one more.
+pub const VERIFY_TOLERANCES: f64 = 3.0;
+
+/// Largest contraction ratio per cycle for which the geometric bound is trusted.
+pub const MAX_RATIO: f64 = 0.5;
+
+/// What a solver does after an event.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Verdict {
+    /// Go on.
+    Continue,
+    /// Stop at this event and continue from its state `dt` later (whole periods).
+    Jump { dt: f64 },
+    /// The return after the jump does not confirm it: go back to the state at the jump and
+    /// integrate from there, without skipping again.
+    Undo,
+}
+
+/// The returns to one anchor.
+#[derive(Debug, Clone, Copy)]
+struct Track {
+    kind: EventKind,
+    /// Time and state of the last return.
+    last: Option<(f64, State)>,
+    /// Signature of the last return (needs the one before it).
+    sig: Option<[f64; 4]>,
+    /// Increment at the last return, in tolerances.
+    d: Option<f64>,
+}
+
+impl Track {
+    const fn new(kind: EventKind) -> Track {
+        Track {
+            kind,
+            last: None,
+            sig: None,
+            d: None,
+        }
+    }
+}
+
+#[derive(Debug, Clone, Copy)]
+enum Phase {
+    Watching,
+    /// Jumped from the return with signature `sig` to `t_jump`; waiting for the next return.
+    Verifying {
+        track: usize,
+        sig: [f64; 4],
+        t_jump: f64,
+    },
+    Done,
+}
+
+/// Decides when a run may skip whole periods of a converged cycle (module docs).
+#[derive(Debug, Clone, Copy)]
+pub struct FastForward {
+    tol: f64,
+    t_from: f64,
+    t_end: f64,
+    tracks: [Track; 2],
+    phase: Phase,
+    verify: f64,
+    skipped: f64,
+    periods: u64,
+}
+
+impl FastForward {
+    /// For a scene asking [`Output::Metrics`], with the solver's tolerance `tol` (relative =
+    /// absolute); `None` for every other output, which integrates the whole horizon.
+    pub fn for_scene(scene: &Scene, tol: f64) -> Option<FastForward> {
+        (scene.output == Output::Metrics)
+            .then(|| FastForward::new(tol, scene.metrics_start().unwrap_or(0.0), scene.t_end))
+    }
+
+    /// Watches returns for metrics over `[t_from, t_end]` at tolerance `tol`.
+    pub fn new(tol: f64, t_from: f64, t_end: f64) -> FastForward {
+        FastForward {
+            tol,
+            t_from,
+            t_end,
+            tracks: [
+                Track::new(EventKind::StickEnd(Disc::Lower)),
+                Track::new(EventKind::Max(Disc::Lower)),
+            ],
+            phase: Phase::Watching,
+            verify: VERIFY_TOLERANCES,
+            skipped: 0.0,
+            periods: 0,
+        }
+    }
+
+    /// The same, with the return after a jump checked to within `v` tolerances instead of
+    /// [`VERIFY_TOLERANCES`] (0 rejects every jump: a check of the solvers' undo).
+    pub fn verify_within(self, v: f64) -> FastForward {
+        FastForward { verify: v, ..self }
+    }
+
+    /// Skipped time [s] (0 if no jump, or if the jump was undone).
+    pub fn skipped(&self) -> f64 {
+        self.skipped
+    }
+
+    /// Skipped whole periods (0 if no jump, or if the jump was undone).
+    pub fn skipped_periods(&self) -> u64 {
+        self.periods
+    }
+
+    /// `‖a − b‖` in tolerances (module docs).
+    fn distance(&self, a: &[f64; 4], b: &[f64; 4]) -> f64 {
+        a.iter()
+            .zip(b)
+            .map(|(x, y)| (x - y).abs() / (self.tol * (1.0 + x.abs().max(y.abs()))))
+            .fold(0.0, f64::max)
+    }
+
+    /// Feeds an event (in time order, after the metrics have seen it).
+    pub fn observe(&mut self, e: &Event) -> Verdict {
+        match self.phase {
+            Phase::Done => Verdict::Continue,
+            Phase::Verifying { track, sig, t_jump } => {
+                if e.kind != self.tracks[track].kind {
+                    return Verdict::Continue;
+                }
+                let s = [e.x[0], e.x[1], e.x[2], e.t - t_jump];
+                self.phase = Phase::Done;
+                if self.distance(&s, &sig) <= self.verify {
+                    Verdict::Continue
+                } else {
+                    (self.skipped, self.periods) = (0.0, 0);
+                    Verdict::Undo
+                }
+            }
+            Phase::Watching => self.watch(e),
+        }
+    }
+
+    fn watch(&mut self, e: &Event) -> Verdict {
+        // Stick exits when the lower disc sticks at all, else maxima (as the metrics).
+        let i = match e.kind {
+            k if k == self.tracks[0].kind => 0,
+            k if k == self.tracks[1].kind && self.tracks[0].last.is_none() => 1,
+            _ => return Verdict::Continue,
+        };
+        let mut verdict = Verdict::Continue;
+        let tr = self.tracks[i];
+        let mut next = Track {
+            last: Some((e.t, e.x)),
+            ..tr
+        };
+        if let Some((tp, _)) = tr.last {
+            let s = [e.x[0], e.x[1], e.x[2], e.t - tp];
+            if let Some(sp) = tr.sig {
+                let d = self.distance(&s, &sp);
+                if let Some(dp) = tr.d {
+                    let rho = if d == 0.0 { 0.0 } else { d / dp };
+                    if rho <= MAX_RATIO && d * rho / (1.0 - rho) <= 1.0 {
+                        verdict = self.jump(i, e.t, s);
+                    }
+                }
+                next.d = Some(d);
+            }
+            next.sig = Some(s);
+        }
+        self.tracks[i] = next;
+        verdict
+    }
+
+    /// The jump from a converged return at `t` with signature `s`, if the horizon leaves room
+    /// for whole periods to skip.
+    fn jump(&mut self, track: usize, t: f64, s: [f64; 4]) -> Verdict {
+        let p = s[3];
+        // Returns still to come in a full run: ⌊(t_end − t)/P⌋ (with a margin of 1e-6 P so
+        // that the return after the jump is not lost to the phase error at t_end). Skip all
+        // but the last, whose cycle is integrated.
+        let m = ((self.t_end - t) / p - 1e-6).floor() - 1.0;
+        if !(m >= 1.0 && p > 0.0) {
+            return Verdict::Continue;
+        }
+        let dt = m * p;
+        if t + dt < self.t_from {
+            return Verdict::Continue;
+        }
+        self.phase = Phase::Verifying {
+            track,
+            sig: s,
+            t_jump: t + dt,
+        };
+        (self.skipped, self.periods) = (dt, m as u64);
+        Verdict::Jump { dt }
+    }
+
+    /// At the end of the run: [`Verdict::Undo`] if a jump is still unconfirmed.
+    pub fn finish(&mut self) -> Verdict {
+        if let Phase::Verifying { .. } = self.phase {
+            self.phase = Phase::Done;
+            (self.skipped, self.periods) = (0.0, 0);
+            Verdict::Undo
+        } else {
+            Verdict::Continue
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn exit(t: f64, w: f64) -> Event {
+        Event {
+            t,
+            x: State::new(2.0, w, 0.0),
+            kind: EventKind::StickEnd(Disc::Lower),
+        }
+    }
+
+    /// Returns `t_n = n·P + c·ρⁿ`, `ω_n = w* + ρⁿ`: a return map contracting by ρ.
+    fn returns(rho: f64, n: usize) -> Vec<Event> {
+        (0..n)
+            .map(|k| {
+                let r = rho.powi(k as i32);
+                exit(k as f64 * 4.0 + 0.1 * r, 2.5 + r)
+            })
+            .collect()
+    }
+
+    fn first_jump(ff: &mut FastForward, evs: &[Event]) -> Option<(usize, f64)> {
+        evs.iter()
+            .enumerate()
+            .find_map(|(k, e)| match ff.observe(e) {
+                Verdict::Jump { dt } => Some((k, dt)),
+                _ => None,
+            })
+    }
+
+    #[test]
+    fn a_contraction_jumps_at_the_first_return_whose_bound_is_below_one_tolerance() {
+        let tol = 1e-10;
+        // t_end = 102, not on a return (a return at t_end exactly is the margin's case).
+        let mut ff = FastForward::new(tol, 50.0, 102.0);
+        // ρ = 0.01: the period increments dominate, P_k − P_{k−1} = 0.1·ρ^(k−2)·(1 − ρ)², so
+        // d_k ≈ 0.098·ρ^(k−2)/(tol·(1 + 4)) and the bound d_k·ρ/(1−ρ) ≈ 2e8·ρ^(k−1) is
+        // ≈ 2 at k = 5 and ≈ 0.02 at k = 6.
+        let evs = returns(0.01, 12);
+        let (k, dt) = first_jump(&mut ff, &evs).expect("a jump");
+        assert_eq!(k, 6);
+        let d = |k: usize| {
+            let (a, b) = (&evs[k], &evs[k - 1]);
+            let (c, e) = (&evs[k - 1], &evs[k - 2]);
+            ff.distance(
+                &[a.x[0], a.x[1], a.x[2], a.t - c.t],
+                &[b.x[0], b.x[1], b.x[2], c.t - e.t],
+            )
+        };
+        let bound = |k: usize| {
+            let rho = d(k) / d(k - 1);
+            d(k) * rho / (1.0 - rho)
+        };
+        assert!(
+            bound(6) <= 1.0 && bound(5) > 1.0,
+            "{} {}",
+            bound(6),
+            bound(5)
+        );
+        assert!(true_distance(&ff, &evs, k) <= 1.0);
+        // m whole periods (of the last measured period, 4 s up to 1e-9), leaving one cycle
+        // and the tail before t_end = 102, in the window [50, 102].
+        let t = evs[k].t;
+        let p = t - evs[k - 1].t;
+        let m = dt / p;
+        assert!((m - m.round()).abs() < 1e-12, "dt = {dt}");
+        assert!(
+            t + dt + p <= 102.0 && t + dt + 2.0 * p > 102.0,
+            "t = {t}, dt = {dt}"
+        );
+        assert!(t + dt >= 50.0);
+        // The next return (one period after the jump, the same state) confirms it.
+        let back = exit(t + dt + p, evs[k].x[1]);
+        assert_eq!(ff.observe(&back), Verdict::Continue);
+        assert_eq!(ff.finish(), Verdict::Continue);
+        assert_eq!(ff.skipped(), dt);
+        assert_eq!(ff.skipped_periods() as f64, m.round());
+    }
+
+    /// Distance in tolerances of return k's signature from the fixed point of [`returns`],
+    /// `(2, 2.5, 0, 4)`.
+    fn true_distance(ff: &FastForward, evs: &[Event], k: usize) -> f64 {
+        let (a, b) = (&evs[k], &evs[k - 1]);
+        ff.distance(&[a.x[0], a.x[1], a.x[2], a.t - b.t], &[2.0, 2.5, 0.0, 4.0])
+    }
+
+    #[test]
+    fn a_slow_contraction_jumps_only_once_it_is_within_a_tolerance() {
+        // ρ = 0.9 > MAX_RATIO: the geometric bound is not trusted while the increments are
+        // resolved; the run jumps only once they are lost in rounding, and then the returns
+        // are within a tolerance of the fixed point.
+        let mut ff = FastForward::new(1e-10, 0.0, 1e6);
+        let evs = returns(0.9, 400);
+        let (k, _) = first_jump(&mut ff, &evs).expect("a jump once converged");
+        let k0 = (2..evs.len())
+            .find(|&j| true_distance(&ff, &evs, j) <= 1.0)
+            .unwrap();
+        assert!(
+            k >= k0 && true_distance(&ff, &evs, k) <= 1.0,
+            "k = {k}, k0 = {k0}"
+        );
+    }
+
+    #[test]
+    fn a_return_that_does_not_confirm_the_jump_undoes_it() {
+        let mut ff = FastForward::new(1e-10, 0.0, 100.0);
+        let evs = returns(1e-5, 10);
+        let (k, dt) = first_jump(&mut ff, &evs).expect("a jump");
+        let off = exit(evs[k].t + dt + 4.0, evs[k].x[1] + 1e-8);
+        assert_eq!(ff.observe(&off), Verdict::Undo);
+        assert_eq!(ff.skipped(), 0.0);
+        // No second attempt.
+        assert_eq!(first_jump(&mut ff, &returns(1e-5, 10)), None);
+    }
+
+    #[test]
+    fn a_run_that_ends_before_the_confirming_return_undoes_the_jump() {
+        let mut ff = FastForward::new(1e-10, 0.0, 100.0);
+        first_jump(&mut ff, &returns(1e-5, 10)).expect("a jump");
+        assert_eq!(ff.finish(), Verdict::Undo);
+    }
+
+    #[test]
+    fn no_room_before_t_end_or_before_the_window_means_no_jump() {
+        // The first possible jump is at the fourth return (t = 12, three increments); less
+        // than two periods are left after it: nothing to skip.
+        let mut ff = FastForward::new(1e-10, 0.0, 12.0 + 1.9 * 4.0);
+        let evs = returns(1e-5, 5);
+        assert_eq!(first_jump(&mut ff, &evs), None);
+        // The metrics window starts after where the jump would land.
+        let mut ff = FastForward::new(1e-10, 99.0, 100.0);
+        assert_eq!(first_jump(&mut ff, &returns(1e-5, 10)), None);
+    }
+
+    #[test]
+    fn maxima_anchor_only_an_orbit_without_stick() {
+        let max = |t: f64, w: f64| Event {
+            t,
+            x: State::new(2.0, 2.5, w),
+            kind: EventKind::Max(Disc::Lower),
+        };
+        // Maxima alone: a slipping cycle, jumps.
+        let mut ff = FastForward::new(1e-10, 0.0, 100.0);
+        let evs: Vec<Event> = (0..10).map(|k| max(4.0 * k as f64, 3.0)).collect();
+        assert!(first_jump(&mut ff, &evs).is_some());
+        // Once a stick exit has been seen, maxima are ignored.
+        let mut ff = FastForward::new(1e-10, 0.0, 100.0);
+        ff.observe(&exit(0.5, 2.5));
+        assert_eq!(first_jump(&mut ff, &evs), None);
+    }
+}
