@@ -44,6 +44,10 @@ pub struct EventOptions {
     pub zeno_window: f64,
     /// Sample intervals per step for guard detection (at most 64).
     pub guard_samples: usize,
+    /// [`rotor_model::Output::Metrics`]: how close, in tolerances, the first return after
+    /// skipped periods must come to the return before them ([`rotor_model::FastForward`]);
+    /// 0 rejects every skip (a check of the undo).
+    pub skip_verify: f64,
 }
 
 impl Default for EventOptions {
@@ -54,6 +58,7 @@ impl Default for EventOptions {
             zeno_count: 64,
             zeno_window: 1e-9,
             guard_samples: 4,
+            skip_verify: rotor_model::fast_forward::VERIFY_TOLERANCES,
         }
     }
 }

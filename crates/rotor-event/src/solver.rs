@@ -1,8 +1,8 @@
 //! The [`Solver`] seam for the event-driven method.
 
 use rotor_model::{
-    Event, MetricsAccumulator, Mode, Model, Output, OutputGrid, Sample, Scene, SolveError, Solver,
-    State, Trajectory,
+    Event, FastForward, MetricsAccumulator, Mode, Model, Output, OutputGrid, Sample, Scene,
+    SolveError, Solver, State, Stats, Trajectory, Verdict,
 };
 
 use crate::dop853::Dense;
@@ -22,6 +22,10 @@ pub(crate) struct SceneSink {
     pub samples: Vec<Sample>,
     pub events: Vec<Event>,
     pub metrics: Option<MetricsAccumulator>,
+    /// Whole periods skipped for [`Output::Metrics`], and the verdict that stopped the run.
+    pub fast_forward: Option<FastForward>,
+    pub verdict: Verdict,
+    pub anchor: Option<Event>,
 }
 
 impl SceneSink {
@@ -38,7 +42,10 @@ impl SceneSink {
             keep_events: scene.keeps_events(),
             samples: Vec::with_capacity(cap),
             events: Vec::new(),
-            metrics: scene.metrics_from.map(MetricsAccumulator::new),
+            metrics: scene.metrics_start().map(MetricsAccumulator::new),
+            fast_forward: None,
+            verdict: Verdict::Continue,
+            anchor: None,
         };
         if s.keep_steps {
             s.samples.push(Sample {
@@ -80,6 +87,15 @@ impl Sink for SceneSink {
             m.push(e);
         }
     }
+
+    fn stop_after(&mut self, e: &Event) -> bool {
+        let Some(ff) = self.fast_forward.as_mut() else {
+            return false;
+        };
+        self.verdict = ff.observe(e);
+        self.anchor = Some(*e);
+        self.verdict != Verdict::Continue
+    }
 }
 
 impl Solver for EventSolver {
@@ -91,9 +107,38 @@ impl Solver for EventSolver {
         scene.validate_for(model)?;
         let mode0 = model.mode_at(&scene.x0, scene.u);
         let mut integ = Integrator::new(model, scene.u, scene.tol, self.options);
-        integ.extrema = scene.metrics_from.is_some();
+        integ.extrema = scene.metrics_start().is_some();
         let mut sink = SceneSink::new(scene);
-        let end = integ.run(0.0, scene.x0, mode0, scene.t_end, &mut sink)?;
+        sink.fast_forward = FastForward::for_scene(scene, scene.tol)
+            .map(|f| f.verify_within(self.options.skip_verify));
+        let (mut t, mut x, mut mode) = (0.0, scene.x0, mode0);
+        // The run end at a jump and the metrics there, to go back to if it is undone.
+        let mut saved = None;
+        let end = loop {
+            let end = integ.run(t, x, mode, scene.t_end, &mut sink)?;
+            let mut verdict = std::mem::replace(&mut sink.verdict, Verdict::Continue);
+            if verdict == Verdict::Continue
+                && let Some(ff) = sink.fast_forward.as_mut()
+            {
+                verdict = ff.finish();
+            }
+            match verdict {
+                Verdict::Continue => break end,
+                Verdict::Jump { dt } => {
+                    saved = Some((end, sink.metrics));
+                    if let (Some(m), Some(a)) = (sink.metrics.as_mut(), sink.anchor) {
+                        m.fast_forward(&a, dt);
+                    }
+                    (t, x, mode) = (end.t + dt, end.x, end.mode);
+                }
+                Verdict::Undo => {
+                    let (at, metrics): (crate::filippov::RunEnd, _) =
+                        saved.take().expect("a jump before its undo");
+                    sink.metrics = metrics;
+                    (t, x, mode) = (at.t, at.x, at.mode);
+                }
+            }
+        };
         let metrics = sink.metrics.as_ref().map(|m| m.finish(&end.x));
         Ok(Trajectory {
             samples: sink.samples,
@@ -102,7 +147,10 @@ impl Solver for EventSolver {
             x_final: end.x,
             mode_final: end.mode,
             metrics,
-            stats: integ.stats,
+            stats: Stats {
+                skipped_periods: sink.fast_forward.map_or(0, |f| f.skipped_periods()),
+                ..integ.stats
+            },
         })
     }
 }

@@ -131,8 +131,8 @@ pub mod onestep;
 pub mod stepper;
 
 use rotor_model::{
-    Disc, DiscMode, Event, EventKind, MetricsAccumulator, Mode, Model, Output, Sample, Scene,
-    SolveError, Solver, State, Stats, Trajectory, check_finite,
+    Disc, DiscMode, Event, EventKind, FastForward, MetricsAccumulator, Mode, Model, Output, Sample,
+    Scene, SolveError, Solver, State, Stats, Trajectory, Verdict, check_finite,
 };
 
 pub use onestep::{Branch, EnumError, OneStepProblem, OneStepSolution, StickData};
@@ -171,6 +171,10 @@ pub struct MoreauOptions {
     pub newton_estimate_stop: bool,
     /// Maximum number of steps of one run (default 1e9).
     pub max_steps: u64,
+    /// [`Output::Metrics`]: how close, in units of h², the first return after skipped
+    /// periods must come to the return before them ([`rotor_model::FastForward`]); 0 rejects
+    /// every skip (a check of the undo).
+    pub skip_verify: f64,
 }
 
 impl Default for MoreauOptions {
@@ -182,6 +186,7 @@ impl Default for MoreauOptions {
             max_newton: 50,
             newton_estimate_stop: true,
             max_steps: 1_000_000_000,
+            skip_verify: rotor_model::fast_forward::VERIFY_TOLERANCES,
         }
     }
 }
@@ -203,6 +208,7 @@ impl MoreauSolver {
 const PENDING: usize = 16;
 
 /// Events detected but not yet released in time order.
+#[derive(Clone, Copy)]
 struct Pending {
     buf: [Option<Event>; PENDING],
     len: usize,
@@ -230,10 +236,19 @@ impl Pending {
         self.len += 1;
     }
 
-    /// Releases up to `max` events with `t < t_limit`, earliest first.
+    /// Moves the pending events by `dt` (a jump of whole periods).
+    fn shift(&mut self, dt: f64) {
+        for e in self.buf[..self.len].iter_mut().flatten() {
+            e.t += dt;
+        }
+    }
+
+    /// Releases up to `max` events with `t < t_limit`, earliest first; stops after an event
+    /// on which the sink asks to jump or to go back.
     fn release_before(&mut self, t_limit: f64, sink: &mut Sink, max: usize) {
         let mut n = 0;
-        while n < max.min(self.len) && self.buf[n].is_some_and(|e| e.t < t_limit) {
+        while n < max.min(self.len) && self.buf[n].is_some_and(|e| e.t < t_limit) && !sink.halted()
+        {
             if let Some(e) = self.buf[n] {
                 sink.take(&e);
             }
@@ -256,6 +271,11 @@ struct Sink {
     events: Option<Vec<Event>>,
     metrics: Option<MetricsAccumulator>,
     count: u64,
+    /// Whole periods skipped for [`Output::Metrics`]: a jump decided on an anchor event (its
+    /// length and the event), or a jump to undo.
+    fast_forward: Option<FastForward>,
+    jump: Option<(f64, Event)>,
+    undo: bool,
 }
 
 impl Sink {
@@ -267,7 +287,30 @@ impl Sink {
         if let Some(m) = self.metrics.as_mut() {
             m.push(e);
         }
+        if let Some(ff) = self.fast_forward.as_mut() {
+            match ff.observe(e) {
+                Verdict::Continue => {}
+                Verdict::Jump { dt } => self.jump = Some((dt, *e)),
+                Verdict::Undo => self.undo = true,
+            }
+        }
     }
+
+    /// Whether a jump or an undo waits for the end of the step.
+    fn halted(&self) -> bool {
+        self.jump.is_some() || self.undo
+    }
+}
+
+/// The run at the end of the step on which a jump was decided, to go back to if it is undone.
+struct Saved {
+    cur: Point,
+    prev: Option<Point>,
+    pending: Pending,
+    metrics: Option<MetricsAccumulator>,
+    base: f64,
+    k: u64,
+    n: u64,
 }
 
 /// A step end kept for event location.
@@ -338,11 +381,11 @@ impl Solver for MoreauSolver {
                 max_steps: o.max_steps,
             });
         }
-        let n = n_f as u64;
+        let mut n = n_f as u64;
         let stepper = Stepper::new(model, u, o);
         let full = stepper.step_size(0.0, h)?;
         let keep_events = scene.keeps_events();
-        let want_extrema = scene.metrics_from.is_some();
+        let want_extrema = scene.metrics_start().is_some();
 
         let mut samples = Vec::new();
         let mut grid = scene.grid();
@@ -353,8 +396,14 @@ impl Solver for MoreauSolver {
         }
         let mut sink = Sink {
             events: keep_events.then(Vec::new),
-            metrics: scene.metrics_from.map(MetricsAccumulator::new),
+            metrics: scene.metrics_start().map(MetricsAccumulator::new),
             count: 0,
+            // The scheme's error on the fixtures' cycles is second order, ≈ 0.6·h² in the
+            // period (crate docs), so h² plays the adaptive solvers' tolerance.
+            fast_forward: FastForward::for_scene(scene, h * h)
+                .map(|f| f.verify_within(o.skip_verify)),
+            jump: None,
+            undo: false,
         };
         let mut pending = Pending::new();
 
@@ -380,167 +429,212 @@ impl Solver for MoreauSolver {
         }
 
         let mut stats = Stats::default();
-        for k in 1..=n {
-            let t_next = if k == n { t_end } else { k as f64 * h };
-            let hk = t_next - cur.t;
-            // Every step but the last has size h (t_next − t differs from h by roundings of
-            // t only); the last lands on t_end.
-            let out = if k < n {
-                stepper.step_with(cur.t, &cur.x, &full)?
-            } else {
-                stepper.step(cur.t, &cur.x, hk)?
-            };
-            check_finite(t_next, &out.x)?;
-            stats.steps += 1;
-            stats.newton_iters += u64::from(out.newton_iters);
-            stats.rhs_evals += u64::from(out.evals);
-            stats.inexact_steps += u64::from(!out.exact);
-            if out.used_enumeration {
-                stats.lcp_solves += 1;
-            } else {
-                stats.lcp_skipped += 1;
-            }
-            let next = Point {
-                t: t_next,
-                x: out.x,
-                mode: out.mode,
-            };
+        // Steps are taken at base + k·h, k = 1..=n, the last landing on t_end; a jump moves
+        // the base.
+        let (mut base, mut k) = (0.0, 0u64);
+        let mut saved: Option<Saved> = None;
+        'run: loop {
+            while k < n {
+                k += 1;
+                let t_next = if k == n { t_end } else { base + k as f64 * h };
+                let hk = t_next - cur.t;
+                // Every step but the last has size h (t_next − t differs from h by roundings of
+                // t only); the last lands on t_end.
+                let out = if k < n {
+                    stepper.step_with(cur.t, &cur.x, &full)?
+                } else {
+                    stepper.step(cur.t, &cur.x, hk)?
+                };
+                check_finite(t_next, &out.x)?;
+                stats.steps += 1;
+                stats.newton_iters += u64::from(out.newton_iters);
+                stats.rhs_evals += u64::from(out.evals);
+                stats.inexact_steps += u64::from(!out.exact);
+                if out.used_enumeration {
+                    stats.lcp_solves += 1;
+                } else {
+                    stats.lcp_skipped += 1;
+                }
+                let next = Point {
+                    t: t_next,
+                    x: out.x,
+                    mode: out.mode,
+                };
 
-            if keep_events || want_extrema {
-                for (i, d) in Disc::BOTH.into_iter().enumerate() {
-                    let wi = d.index();
-                    let (m_a, m_b) = (cur.mode[i], next.mode[i]);
-                    let kind_t = match (m_a, m_b) {
-                        (DiscMode::Stick, DiscMode::Stick) => None,
-                        (DiscMode::Stick, slip) => {
-                            // Excess of the applied torque over the interval, at both ends.
-                            let (lo, hi) = model.friction(d).static_interval();
-                            let z = |x: &State| {
-                                let ta = model.applied_torque(d, x, u);
-                                if slip == DiscMode::SlipPos {
-                                    ta - hi
-                                } else {
-                                    lo - ta
-                                }
-                            };
-                            let (za, zb) = (z(&cur.x), z(&next.x));
-                            let t0 = prev.map_or(cur.t, |p| p.t);
-                            let t = if zb > za {
-                                (cur.t - za * (next.t - cur.t) / (zb - za)).clamp(t0, next.t)
-                            } else {
-                                cur.t + o.theta * (next.t - cur.t)
-                            };
-                            Some((EventKind::StickEnd(d), t))
-                        }
-                        (slip, DiscMode::Stick) => {
-                            // Zero of ω(t_k + Δ) ≈ ω + aΔ + ½jΔ², a and j = ω̈ from the
-                            // model's vector field and Jacobian in the slipping mode.
-                            let w = cur.x[wi];
-                            let mut mode = to_mode(&cur.mode);
-                            mode.set(d, slip);
-                            let f = model.rhs(&cur.x, u, mode);
-                            let acc = f[wi];
-                            let jerk = (model.jacobian(&cur.x, u, mode) * f)[wi];
-                            let t = if acc * w < 0.0 {
-                                let d1 = -w / acc;
-                                let den = acc + jerk * d1;
-                                let d2 = if den * acc > 0.0 {
-                                    d1 - 0.5 * jerk * d1 * d1 / den
-                                } else {
-                                    d1
+                if keep_events || want_extrema {
+                    for (i, d) in Disc::BOTH.into_iter().enumerate() {
+                        let wi = d.index();
+                        let (m_a, m_b) = (cur.mode[i], next.mode[i]);
+                        let kind_t = match (m_a, m_b) {
+                            (DiscMode::Stick, DiscMode::Stick) => None,
+                            (DiscMode::Stick, slip) => {
+                                // Excess of the applied torque over the interval, at both ends.
+                                let (lo, hi) = model.friction(d).static_interval();
+                                let z = |x: &State| {
+                                    let ta = model.applied_torque(d, x, u);
+                                    if slip == DiscMode::SlipPos {
+                                        ta - hi
+                                    } else {
+                                        lo - ta
+                                    }
                                 };
-                                (cur.t + d2).clamp(cur.t, next.t)
-                            } else {
-                                next.t
-                            };
-                            Some((EventKind::StickStart(d), t))
-                        }
-                        (a, b) if a != b => {
-                            let (wa, wb) = (cur.x[wi], next.x[wi]);
-                            let t = if wa != wb {
-                                (cur.t + wa * (next.t - cur.t) / (wa - wb)).clamp(cur.t, next.t)
-                            } else {
-                                next.t
-                            };
-                            Some((EventKind::Reversal(d), t))
-                        }
-                        _ => None,
-                    };
-                    if let Some((kind, t)) = kind_t {
-                        let mut x = if t >= cur.t {
-                            lerp(&cur, &next, t)
-                        } else {
-                            prev.map_or(cur.x, |p| lerp(&p, &cur, t))
+                                let (za, zb) = (z(&cur.x), z(&next.x));
+                                let t0 = prev.map_or(cur.t, |p| p.t);
+                                let t = if zb > za {
+                                    (cur.t - za * (next.t - cur.t) / (zb - za)).clamp(t0, next.t)
+                                } else {
+                                    cur.t + o.theta * (next.t - cur.t)
+                                };
+                                Some((EventKind::StickEnd(d), t))
+                            }
+                            (slip, DiscMode::Stick) => {
+                                // Zero of ω(t_k + Δ) ≈ ω + aΔ + ½jΔ², a and j = ω̈ from the
+                                // model's vector field and Jacobian in the slipping mode.
+                                let w = cur.x[wi];
+                                let mut mode = to_mode(&cur.mode);
+                                mode.set(d, slip);
+                                let f = model.rhs(&cur.x, u, mode);
+                                let acc = f[wi];
+                                let jerk = (model.jacobian(&cur.x, u, mode) * f)[wi];
+                                let t = if acc * w < 0.0 {
+                                    let d1 = -w / acc;
+                                    let den = acc + jerk * d1;
+                                    let d2 = if den * acc > 0.0 {
+                                        d1 - 0.5 * jerk * d1 * d1 / den
+                                    } else {
+                                        d1
+                                    };
+                                    (cur.t + d2).clamp(cur.t, next.t)
+                                } else {
+                                    next.t
+                                };
+                                Some((EventKind::StickStart(d), t))
+                            }
+                            (a, b) if a != b => {
+                                let (wa, wb) = (cur.x[wi], next.x[wi]);
+                                let t = if wa != wb {
+                                    (cur.t + wa * (next.t - cur.t) / (wa - wb)).clamp(cur.t, next.t)
+                                } else {
+                                    next.t
+                                };
+                                Some((EventKind::Reversal(d), t))
+                            }
+                            _ => None,
                         };
-                        x[wi] = 0.0;
-                        pending.push(Event { t, x, kind }, &mut sink);
-                    }
-                    // Extrema of the velocity while slipping.
-                    if want_extrema
-                        && let Some(p) = prev
-                        && p.mode[i] != DiscMode::Stick
-                        && m_a != DiscMode::Stick
-                        && m_b != DiscMode::Stick
-                    {
-                        let (y0, y1, y2) = (p.x[wi], cur.x[wi], next.x[wi]);
-                        let (d1, d2) = (y1 - y0, y2 - y1);
-                        // Rounding noise filter: increments of a few ulps are no extremum.
-                        let noise = 8.0 * f64::EPSILON * (1.0 + y1.abs());
-                        let kind = if d1 > 0.0 && d2 <= 0.0 {
-                            Some(EventKind::Max(d))
-                        } else if d1 < 0.0 && d2 >= 0.0 {
-                            Some(EventKind::Min(d))
-                        } else {
-                            None
-                        };
-                        if let Some(kind) = kind
-                            && d1.abs().max(d2.abs()) > noise
-                        {
-                            // Vertex of the parabola through the three points.
-                            let (ha, hb) = (cur.t - p.t, next.t - cur.t);
-                            let s1 = d1 / ha;
-                            let s2 = d2 / hb;
-                            let curv = (s2 - s1) / (0.5 * (ha + hb));
-                            let t = if curv != 0.0 {
-                                let tm1 = p.t + 0.5 * ha; // slope s1 at the midpoint
-                                (tm1 - s1 / curv).clamp(p.t, next.t)
+                        if let Some((kind, t)) = kind_t {
+                            let mut x = if t >= cur.t {
+                                lerp(&cur, &next, t)
                             } else {
-                                cur.t
+                                prev.map_or(cur.x, |p| lerp(&p, &cur, t))
                             };
-                            let x = quad([&p, &cur, &next], t);
+                            x[wi] = 0.0;
                             pending.push(Event { t, x, kind }, &mut sink);
                         }
-                    }
-                }
-                // Events detected later are at t ≥ cur.t.
-                pending.release_before(cur.t, &mut sink, usize::MAX);
-            }
-
-            match scene.output {
-                Output::Steps => samples.push(Sample {
-                    t: next.t,
-                    x: next.x,
-                }),
-                Output::Grid { .. } => {
-                    if let Some(g) = grid.as_mut() {
-                        while let Some(tg) = g.peek() {
-                            if tg > next.t {
-                                break;
+                        // Extrema of the velocity while slipping.
+                        if want_extrema
+                            && let Some(p) = prev
+                            && p.mode[i] != DiscMode::Stick
+                            && m_a != DiscMode::Stick
+                            && m_b != DiscMode::Stick
+                        {
+                            let (y0, y1, y2) = (p.x[wi], cur.x[wi], next.x[wi]);
+                            let (d1, d2) = (y1 - y0, y2 - y1);
+                            // Rounding noise filter: increments of a few ulps are no extremum.
+                            let noise = 8.0 * f64::EPSILON * (1.0 + y1.abs());
+                            let kind = if d1 > 0.0 && d2 <= 0.0 {
+                                Some(EventKind::Max(d))
+                            } else if d1 < 0.0 && d2 >= 0.0 {
+                                Some(EventKind::Min(d))
+                            } else {
+                                None
+                            };
+                            if let Some(kind) = kind
+                                && d1.abs().max(d2.abs()) > noise
+                            {
+                                // Vertex of the parabola through the three points.
+                                let (ha, hb) = (cur.t - p.t, next.t - cur.t);
+                                let s1 = d1 / ha;
+                                let s2 = d2 / hb;
+                                let curv = (s2 - s1) / (0.5 * (ha + hb));
+                                let t = if curv != 0.0 {
+                                    let tm1 = p.t + 0.5 * ha; // slope s1 at the midpoint
+                                    (tm1 - s1 / curv).clamp(p.t, next.t)
+                                } else {
+                                    cur.t
+                                };
+                                let x = quad([&p, &cur, &next], t);
+                                pending.push(Event { t, x, kind }, &mut sink);
                             }
-                            samples.push(Sample {
-                                t: tg,
-                                x: lerp(&cur, &next, tg.max(cur.t)),
-                            });
-                            g.advance();
                         }
                     }
+                    // Events detected later are at t ≥ cur.t.
+                    pending.release_before(cur.t, &mut sink, usize::MAX);
                 }
-                _ => {}
+
+                match scene.output {
+                    Output::Steps => samples.push(Sample {
+                        t: next.t,
+                        x: next.x,
+                    }),
+                    Output::Grid { .. } => {
+                        if let Some(g) = grid.as_mut() {
+                            while let Some(tg) = g.peek() {
+                                if tg > next.t {
+                                    break;
+                                }
+                                samples.push(Sample {
+                                    t: tg,
+                                    x: lerp(&cur, &next, tg.max(cur.t)),
+                                });
+                                g.advance();
+                            }
+                        }
+                    }
+                    _ => {}
+                }
+                prev = Some(cur);
+                cur = next;
+                if let Some((dt, anchor)) = sink.jump.take() {
+                    saved = Some(Saved {
+                        cur,
+                        prev,
+                        pending,
+                        metrics: sink.metrics,
+                        base,
+                        k,
+                        n,
+                    });
+                    if let Some(m) = sink.metrics.as_mut() {
+                        m.fast_forward(&anchor, dt);
+                    }
+                    cur.t += dt;
+                    if let Some(p) = prev.as_mut() {
+                        p.t += dt;
+                    }
+                    pending.shift(dt);
+                    (base, k) = (cur.t, 0);
+                    n = ((t_end - base) / h - 1e-9).ceil().max(1.0) as u64;
+                    // Events of the step's end that waited for the jump.
+                    pending.release_before(cur.t, &mut sink, usize::MAX);
+                }
+                if sink.undo {
+                    break;
+                }
             }
-            prev = Some(cur);
-            cur = next;
+            // (Nothing is released while an undo waits.)
+            pending.release_before(f64::INFINITY, &mut sink, usize::MAX);
+            if sink.undo
+                || sink.fast_forward.as_mut().map(FastForward::finish) == Some(Verdict::Undo)
+            {
+                let sv = saved.take().expect("a jump before its undo");
+                (cur, prev, pending) = (sv.cur, sv.prev, sv.pending);
+                (base, k, n) = (sv.base, sv.k, sv.n);
+                sink.metrics = sv.metrics;
+                sink.undo = false;
+                continue 'run;
+            }
+            break;
         }
-        pending.release_before(f64::INFINITY, &mut sink, usize::MAX);
         if let Some(g) = grid.as_mut() {
             while let Some(tg) = g.peek() {
                 samples.push(Sample { t: tg, x: cur.x });
@@ -548,6 +642,7 @@ impl Solver for MoreauSolver {
             }
         }
         stats.events = sink.count;
+        stats.skipped_periods = sink.fast_forward.map_or(0, |f| f.skipped_periods());
         let metrics = sink.metrics.map(|m| m.finish(&cur.x));
         Ok(Trajectory {
             samples,

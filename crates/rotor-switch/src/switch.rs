@@ -1,8 +1,9 @@
 //! The switch-model field, its guards, and the event-located integration loop.
 
 use rotor_model::{
-    Disc, DiscMode, Event, EventKind, MetricsAccumulator, Mode, Model, OMEGA_L, OMEGA_U, Output,
-    Sample, Scene, SolveError, Solver, State, Stats, Trajectory, check_finite,
+    Disc, DiscMode, Event, EventKind, FastForward, MetricsAccumulator, Mode, Model, OMEGA_L,
+    OMEGA_U, Output, Sample, Scene, SolveError, Solver, State, Stats, Trajectory, Verdict,
+    check_finite,
 };
 
 use crate::dopri5::{Dopri5, Dopri5Error, Dopri5Options};
@@ -38,6 +39,10 @@ pub struct SwitchOptions {
     pub zeno_count: u32,
     /// Zeno guard window, in s.
     pub zeno_window: f64,
+    /// [`rotor_model::Output::Metrics`]: how close, in tolerances, the first return after
+    /// skipped periods must come to the return before them ([`rotor_model::FastForward`]);
+    /// 0 rejects every skip (a check of the undo).
+    pub skip_verify: f64,
 }
 
 impl Default for SwitchOptions {
@@ -49,6 +54,7 @@ impl Default for SwitchOptions {
             guard_samples: 5,
             zeno_count: 1000,
             zeno_window: 1e-9,
+            skip_verify: rotor_model::fast_forward::VERIFY_TOLERANCES,
         }
     }
 }
@@ -356,6 +362,11 @@ struct Sink {
     events: Vec<Event>,
     metrics: Option<MetricsAccumulator>,
     count: u64,
+    /// Whole periods skipped for [`Output::Metrics`]: the verdict on the last event, and
+    /// that event.
+    fast_forward: Option<FastForward>,
+    verdict: Verdict,
+    anchor: Option<Event>,
 }
 
 impl Sink {
@@ -368,7 +379,20 @@ impl Sink {
         if self.keep_events {
             self.events.push(e);
         }
+        if let Some(ff) = self.fast_forward.as_mut() {
+            self.verdict = ff.observe(&e);
+            self.anchor = Some(e);
+        }
     }
+}
+
+/// What the run goes back to if a jump is undone.
+struct Saved {
+    t: f64,
+    y: State,
+    regions: [Region; 2],
+    last_extremum: [Option<f64>; 2],
+    metrics: Option<MetricsAccumulator>,
 }
 
 fn map_err(e: Dopri5Error, x: &State) -> SolveError {
@@ -445,8 +469,12 @@ impl Solver for SwitchSolver {
         let mut sink = Sink {
             keep_events: scene.keeps_events(),
             events: Vec::new(),
-            metrics: scene.metrics_from.map(MetricsAccumulator::new),
+            metrics: scene.metrics_start().map(MetricsAccumulator::new),
             count: 0,
+            fast_forward: FastForward::for_scene(scene, scene.tol)
+                .map(|f| f.verify_within(o.skip_verify)),
+            verdict: Verdict::Continue,
+            anchor: None,
         };
         let markers = sink.keep_events || sink.metrics.is_some();
         let extrema = sink.metrics.is_some();
@@ -476,170 +504,216 @@ impl Solver for SwitchSolver {
         // change: an extremum within EXTREMUM_RESOLUTION tolerances of it is not resolved by
         // the integration (rounding-level turns while settling onto an equilibrium).
         let mut last_extremum: [Option<f64>; 2] = [None; 2];
+        let mut saved: Option<Saved> = None;
 
-        while integ.t() < t_end {
-            let f = field;
-            let before = *integ.y();
-            integ
-                .step(&mut |_t, y: &State| f.rhs(y), t_end)
-                .map_err(|e| {
-                    let y = *integ.y();
-                    if f.rhs(&y).iter().any(|v| !v.is_finite()) {
-                        SolveError::NonFinite {
-                            t: integ.t(),
-                            x: [y[0], y[1], y[2]],
-                        }
-                    } else {
-                        map_err(e, &before)
-                    }
-                })?;
-            check_finite(integ.t(), integ.y())?;
-            let (t0, t1) = integ.last_step();
-
-            // 1. Earliest guard root on the dense output of [t0, t1].
-            let mut hit: Option<(f64, usize, Guard)> = None;
-            let mut xs = [State::zeros(); 17];
-            for (j, t) in sample_times(t0, t1, m).enumerate() {
-                xs[j] = if j == m { *integ.y() } else { integ.dense(t) };
-            }
-            for k in 0..2 {
-                for g in f.guards(k).into_iter().flatten() {
-                    let mut vals = [(0.0, 0.0); 17];
-                    for (j, t) in sample_times(t0, t1, m).enumerate() {
-                        vals[j] = (t, f.guard_value(k, g, &xs[j]));
-                    }
-                    let root =
-                        first_crossing(&vals[..=m], |tt| f.guard_value(k, g, &integ.dense(tt)));
-                    if let Some(tr) = root
-                        && hit.is_none_or(|h| tr < h.0)
-                    {
-                        hit = Some((tr, k, g));
-                    }
+        'run: loop {
+            if integ.t() >= t_end {
+                match sink.fast_forward.as_mut().map(FastForward::finish) {
+                    Some(Verdict::Undo) => sink.verdict = Verdict::Undo,
+                    _ => break,
                 }
             }
-            let te = hit.map_or(t1, |h| h.0);
+            'step: {
+                if sink.verdict != Verdict::Continue {
+                    break 'step;
+                }
+                let f = field;
+                let before = *integ.y();
+                integ
+                    .step(&mut |_t, y: &State| f.rhs(y), t_end)
+                    .map_err(|e| {
+                        let y = *integ.y();
+                        if f.rhs(&y).iter().any(|v| !v.is_finite()) {
+                            SolveError::NonFinite {
+                                t: integ.t(),
+                                x: [y[0], y[1], y[2]],
+                            }
+                        } else {
+                            map_err(e, &before)
+                        }
+                    })?;
+                check_finite(integ.t(), integ.y())?;
+                let (t0, t1) = integ.last_step();
 
-            // 2. Markers (reversals inside the band, extrema of ω) in (t0, te].
-            if markers && te > t0 {
-                found.clear();
-                let mut extra_rhs = 0u64;
+                // 1. Earliest guard root on the dense output of [t0, t1].
+                let mut hit: Option<(f64, usize, Guard)> = None;
+                let mut xs = [State::zeros(); 17];
+                for (j, t) in sample_times(t0, t1, m).enumerate() {
+                    xs[j] = if j == m { *integ.y() } else { integ.dense(t) };
+                }
                 for k in 0..2 {
-                    let l = f.laws[k];
-                    let (kind_pos, kind_neg, sign): (EventKind, EventKind, f64) = match f.regions[k]
-                    {
-                        Region::Trans(s) => {
-                            (EventKind::Reversal(l.disc), EventKind::Reversal(l.disc), s)
+                    for g in f.guards(k).into_iter().flatten() {
+                        let mut vals = [(0.0, 0.0); 17];
+                        for (j, t) in sample_times(t0, t1, m).enumerate() {
+                            vals[j] = (t, f.guard_value(k, g, &xs[j]));
                         }
-                        Region::Slip(_) if extrema => {
-                            (EventKind::Max(l.disc), EventKind::Min(l.disc), 0.0)
-                        }
-                        _ => continue,
-                    };
-                    // Reversal: g = s·ω upward through 0; extrema: g = ω̇, either way.
-                    let mut gfun = |t: f64| {
-                        let y = if t == t1 { *integ.y() } else { integ.dense(t) };
-                        if sign != 0.0 {
-                            sign * y[l.idx]
-                        } else {
-                            extra_rhs += 1;
-                            f.accel(k, &y)
-                        }
-                    };
-                    let mut prev = (t0, gfun(t0));
-                    for t in sample_times(t0, te, m).skip(1) {
-                        let gv = gfun(t);
-                        let crossing = if sign != 0.0 {
-                            prev.1 < 0.0 && gv >= 0.0
-                        } else {
-                            prev.1 != 0.0 && (gv == 0.0 || (prev.1 > 0.0) != (gv > 0.0))
-                        };
-                        if crossing {
-                            let (tr, _) = illinois(&mut gfun, prev.0, prev.1, t, gv);
-                            let kind = if sign != 0.0 || prev.1 > 0.0 {
-                                kind_pos
-                            } else {
-                                kind_neg
-                            };
-                            found.push((tr, kind));
-                        }
-                        prev = (t, gv);
-                    }
-                }
-                integ.count_rhs(extra_rhs);
-                found.sort_by(|a, b| a.0.total_cmp(&b.0));
-                for &(t, kind) in &found {
-                    let y = integ.dense(t);
-                    if let EventKind::Max(d) | EventKind::Min(d) = kind {
-                        let w = y[d.index()];
-                        let slot = &mut last_extremum[usize::from(d == Disc::Lower)];
-                        let resolvable = slot.replace(w).is_none_or(|w_prev| {
-                            (w - w_prev).abs() > EXTREMUM_RESOLUTION * scene.tol * (1.0 + w.abs())
-                        });
-                        if !resolvable {
-                            continue;
+                        let root =
+                            first_crossing(&vals[..=m], |tt| f.guard_value(k, g, &integ.dense(tt)));
+                        if let Some(tr) = root
+                            && hit.is_none_or(|h| tr < h.0)
+                        {
+                            hit = Some((tr, k, g));
                         }
                     }
-                    sink.emit(t, y, kind);
                 }
-            }
+                let te = hit.map_or(t1, |h| h.0);
 
-            // 3. Grid samples in (previous, te], by dense output.
-            if let Some(g) = grid.as_mut() {
-                while let Some(tg) = g.peek() {
-                    if tg > te {
-                        break;
+                // 2. Markers (reversals inside the band, extrema of ω) in (t0, te].
+                if markers && te > t0 {
+                    found.clear();
+                    let mut extra_rhs = 0u64;
+                    for k in 0..2 {
+                        let l = f.laws[k];
+                        let (kind_pos, kind_neg, sign): (EventKind, EventKind, f64) =
+                            match f.regions[k] {
+                                Region::Trans(s) => {
+                                    (EventKind::Reversal(l.disc), EventKind::Reversal(l.disc), s)
+                                }
+                                Region::Slip(_) if extrema => {
+                                    (EventKind::Max(l.disc), EventKind::Min(l.disc), 0.0)
+                                }
+                                _ => continue,
+                            };
+                        // Reversal: g = s·ω upward through 0; extrema: g = ω̇, either way.
+                        let mut gfun = |t: f64| {
+                            let y = if t == t1 { *integ.y() } else { integ.dense(t) };
+                            if sign != 0.0 {
+                                sign * y[l.idx]
+                            } else {
+                                extra_rhs += 1;
+                                f.accel(k, &y)
+                            }
+                        };
+                        let mut prev = (t0, gfun(t0));
+                        for t in sample_times(t0, te, m).skip(1) {
+                            let gv = gfun(t);
+                            let crossing = if sign != 0.0 {
+                                prev.1 < 0.0 && gv >= 0.0
+                            } else {
+                                prev.1 != 0.0 && (gv == 0.0 || (prev.1 > 0.0) != (gv > 0.0))
+                            };
+                            if crossing {
+                                let (tr, _) = illinois(&mut gfun, prev.0, prev.1, t, gv);
+                                let kind = if sign != 0.0 || prev.1 > 0.0 {
+                                    kind_pos
+                                } else {
+                                    kind_neg
+                                };
+                                found.push((tr, kind));
+                            }
+                            prev = (t, gv);
+                        }
                     }
-                    let y = if tg <= t0 {
-                        before
-                    } else if tg == t1 {
+                    integ.count_rhs(extra_rhs);
+                    found.sort_by(|a, b| a.0.total_cmp(&b.0));
+                    for &(t, kind) in &found {
+                        let y = integ.dense(t);
+                        if let EventKind::Max(d) | EventKind::Min(d) = kind {
+                            let w = y[d.index()];
+                            let slot = &mut last_extremum[usize::from(d == Disc::Lower)];
+                            let resolvable = slot.replace(w).is_none_or(|w_prev| {
+                                (w - w_prev).abs()
+                                    > EXTREMUM_RESOLUTION * scene.tol * (1.0 + w.abs())
+                            });
+                            if !resolvable {
+                                continue;
+                            }
+                        }
+                        sink.emit(t, y, kind);
+                        if sink.verdict != Verdict::Continue {
+                            break 'step;
+                        }
+                    }
+                }
+
+                // 3. Grid samples in (previous, te], by dense output.
+                if let Some(g) = grid.as_mut() {
+                    while let Some(tg) = g.peek() {
+                        if tg > te {
+                            break;
+                        }
+                        let y = if tg <= t0 {
+                            before
+                        } else if tg == t1 {
+                            *integ.y()
+                        } else {
+                            integ.dense(tg)
+                        };
+                        samples.push(Sample { t: tg, x: y });
+                        g.advance();
+                    }
+                }
+
+                // 4. The switch.
+                if let Some((tr, k, g)) = hit {
+                    let mut y = if tr == t1 {
                         *integ.y()
                     } else {
-                        integ.dense(tg)
+                        integ.dense(tr)
                     };
-                    samples.push(Sample { t: tg, x: y });
-                    g.advance();
+                    let (r, w, ev) = f.fire(k, g, &y);
+                    field.regions[k] = r;
+                    last_extremum[k] = None;
+                    if let Some(w) = w {
+                        y[field.laws[k].idx] = w;
+                    }
+                    if let Some(kind) = ev {
+                        sink.emit(tr, y, kind);
+                    } else {
+                        sink.count += 1;
+                    }
+                    // Zeno guard: zeno_count switches within zeno_window seconds.
+                    let oldest = zeno[zeno_i];
+                    zeno[zeno_i] = tr;
+                    zeno_i = (zeno_i + 1) % zeno.len();
+                    if tr - oldest < o.zeno_window {
+                        return Err(SolveError::Zeno {
+                            t: tr,
+                            count: o.zeno_count,
+                            window: o.zeno_window,
+                        });
+                    }
+                    if sink.verdict != Verdict::Continue {
+                        break 'step;
+                    }
+                    let f2 = field;
+                    integ.restart(tr, y, &mut |_t, y: &State| f2.rhs(y));
+                    check_finite(tr, &y)?;
                 }
-            }
-
-            // 4. The switch.
-            if let Some((tr, k, g)) = hit {
-                let mut y = if tr == t1 {
-                    *integ.y()
-                } else {
-                    integ.dense(tr)
-                };
-                let (r, w, ev) = f.fire(k, g, &y);
-                field.regions[k] = r;
-                last_extremum[k] = None;
-                if let Some(w) = w {
-                    y[field.laws[k].idx] = w;
-                }
-                if let Some(kind) = ev {
-                    sink.emit(tr, y, kind);
-                } else {
-                    sink.count += 1;
-                }
-                // Zeno guard: zeno_count switches within zeno_window seconds.
-                let oldest = zeno[zeno_i];
-                zeno[zeno_i] = tr;
-                zeno_i = (zeno_i + 1) % zeno.len();
-                if tr - oldest < o.zeno_window {
-                    return Err(SolveError::Zeno {
-                        t: tr,
-                        count: o.zeno_count,
-                        window: o.zeno_window,
+                if keep_steps {
+                    samples.push(Sample {
+                        t: integ.t(),
+                        x: *integ.y(),
                     });
                 }
-                let f2 = field;
-                integ.restart(tr, y, &mut |_t, y: &State| f2.rhs(y));
-                check_finite(tr, &y)?;
+                continue 'run;
             }
-            if keep_steps {
-                samples.push(Sample {
-                    t: integ.t(),
-                    x: *integ.y(),
-                });
-            }
+            // A jump after the anchor event, or going back to where it started.
+            let (t, y) = match std::mem::replace(&mut sink.verdict, Verdict::Continue) {
+                Verdict::Jump { dt } => {
+                    let a = sink.anchor.expect("a jump has an anchor");
+                    saved = Some(Saved {
+                        t: a.t,
+                        y: a.x,
+                        regions: field.regions,
+                        last_extremum,
+                        metrics: sink.metrics,
+                    });
+                    if let Some(m) = sink.metrics.as_mut() {
+                        m.fast_forward(&a, dt);
+                    }
+                    (a.t + dt, a.x)
+                }
+                _ => {
+                    let sv = saved.take().expect("a jump before its undo");
+                    field.regions = sv.regions;
+                    last_extremum = sv.last_extremum;
+                    sink.metrics = sv.metrics;
+                    (sv.t, sv.y)
+                }
+            };
+            let f2 = field;
+            integ.restart(t, y, &mut |_t, y: &State| f2.rhs(y));
         }
 
         let x_final = *integ.y();
@@ -661,6 +735,7 @@ impl Solver for SwitchSolver {
                 rejected: c.rejected,
                 rhs_evals: c.rhs_evals,
                 events: sink.count,
+                skipped_periods: sink.fast_forward.map_or(0, |f| f.skipped_periods()),
                 ..Stats::default()
             },
         })
