@@ -1,0 +1,217 @@
+//! `Output::Metrics`: a scene that asks for the steady state only skips whole periods once the
+//! orbit is on its cycle (`rotor_model::FastForward`). Its answer must pass the same agreement
+//! gate as the full run; where nothing is skipped it must be the full run, bit for bit; and a
+//! skip that the return after it does not confirm must be undone.
+
+use std::path::Path;
+use std::sync::OnceLock;
+
+use rotor_compare::SolverKind;
+use rotor_compare::gate::check_pair;
+use rotor_compare::run::scene_for;
+use rotor_event::{EventOptions, EventSolver};
+use rotor_model::{Output, Scenario, Scene, Solver, SteadyState, Trajectory};
+use rotor_moreau::{MoreauOptions, MoreauSolver};
+use rotor_switch::{SwitchOptions, SwitchSolver};
+
+/// The event solver's metrics-only answer against its own full run: two integrations at tol
+/// 1e-12 whose step sequences differ (the skip restarts the integrator at the anchor), each
+/// within ~1e-12 relative of the truth on the cycles (`rotor bench`: steady error 1.4e-12 and
+/// 7.3e-13 at tol 1e-12 against tol 1e-13). Measured over the fixtures: ≤ 1.9e-11 relative
+/// (t1-u4.5-rest). 2e-10 = 10× that.
+const EVENT_SELF_REL: f64 = 2e-10;
+
+fn scenarios() -> &'static [Scenario] {
+    static ALL: OnceLock<Vec<Scenario>> = OnceLock::new();
+    ALL.get_or_init(|| {
+        let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../fixtures/scenarios");
+        let v: Vec<Scenario> = Scenario::list_dir(&dir)
+            .unwrap()
+            .iter()
+            .map(|f| Scenario::from_file(f).unwrap())
+            .collect();
+        assert!(v.len() >= 14);
+        v
+    })
+}
+
+fn run(solver: &dyn Solver, sc: &Scenario, kind: SolverKind, output: Output) -> Trajectory {
+    let scene = Scene {
+        output,
+        ..scene_for(kind, sc)
+    };
+    solver.simulate_finite(&sc.model, &scene).unwrap()
+}
+
+/// The full run of the event solver at the comparison's setting: the reference.
+fn reference(sc: &Scenario) -> Trajectory {
+    run(
+        &EventSolver::default(),
+        sc,
+        SolverKind::Event,
+        Output::Final,
+    )
+}
+
+/// Failures of `fast` against the reference under the scenario's steady gate for `kind`
+/// (the event solver against its own full run, [`EVENT_SELF_REL`]).
+fn gate(sc: &Scenario, kind: SolverKind, reference: &Trajectory, fast: &Trajectory) -> Vec<String> {
+    let (Some(a), Some(b)) = (reference.metrics, fast.metrics) else {
+        return vec![format!("{} {}: no metrics", sc.name, kind.name())];
+    };
+    if a.kind() != b.kind() {
+        return vec![format!(
+            "{} {}: {} vs {}",
+            sc.name,
+            kind.name(),
+            a.kind(),
+            b.kind()
+        )];
+    }
+    if kind == SolverKind::Event {
+        return a
+            .values()
+            .into_iter()
+            .zip(b.values())
+            .filter(|((_, va), (_, vb))| {
+                (va - vb).abs() > EVENT_SELF_REL * va.abs().max(vb.abs()).max(1.0)
+            })
+            .map(|((n, va), (_, vb))| format!("{} event {n}: {va} vs {vb}", sc.name))
+            .collect();
+    }
+    let pair = format!("event-{}", kind.name());
+    let tol = &sc.tolerance[&pair];
+    check_pair(&pair, reference, fast, None, tol)
+        .failures(&sc.name)
+        .iter()
+        .map(|f| format!("{f:?}"))
+        .collect()
+}
+
+#[test]
+fn metrics_only_scenes_pass_the_gate_and_skip_only_converged_cycles() {
+    use rayon::prelude::*;
+    let rows: Vec<(String, SolverKind, u64, u64, u64, Vec<String>)> = scenarios()
+        .par_iter()
+        .flat_map(|sc| {
+            let reference = reference(sc);
+            SolverKind::ALL
+                .iter()
+                .map(|&kind| {
+                    let s = kind.solver();
+                    let full = run(&*s, sc, kind, Output::Final);
+                    let fast = run(&*s, sc, kind, Output::Metrics);
+                    assert!(fast.samples.is_empty() && fast.events.is_empty());
+                    let mut bad = gate(sc, kind, &reference, &fast);
+                    // Nothing skipped: the run was never stopped, so it is the full run.
+                    if fast.stats.skipped_periods == 0
+                        && (fast.metrics != full.metrics
+                            || fast.x_final != full.x_final
+                            || fast.stats != full.stats)
+                    {
+                        bad.push(format!(
+                            "{} {}: no skip, yet not the full run",
+                            sc.name,
+                            kind.name()
+                        ));
+                    }
+                    (
+                        sc.name.clone(),
+                        kind,
+                        fast.stats.skipped_periods,
+                        fast.stats.steps,
+                        full.stats.steps,
+                        bad,
+                    )
+                })
+                .collect::<Vec<_>>()
+        })
+        .collect();
+    let failures: Vec<&String> = rows.iter().flat_map(|r| &r.5).collect();
+    assert!(failures.is_empty(), "{failures:#?}");
+    for (name, kind, skipped, steps, full_steps, _) in &rows {
+        println!(
+            "{name:16} {:7} skipped {skipped:3} periods, steps {steps} of {full_steps}",
+            kind.name()
+        );
+        if *skipped > 0 {
+            assert!(steps < full_steps, "{name} {}", kind.name());
+        }
+    }
+    // The 1.5 V stick-slip cycles (the bench's scenes) are reached within ~20 s and contract
+    // by 1e-5 (Table 1) or 3e-8 (Stribeck) per period (the diagrams' Floquet multipliers), so
+    // every solver skips, and integrates about the transient plus two periods of 200 s:
+    // fewer than a third of the steps.
+    for name in ["t1-u1.5-rest", "st-u1.5-rest"] {
+        for (n, kind, skipped, steps, full_steps, _) in rows.iter().filter(|r| r.0 == name) {
+            assert!(
+                *skipped > 0 && 3 * steps < *full_steps,
+                "{n} {}: skipped {skipped}, steps {steps} of {full_steps}",
+                kind.name()
+            );
+        }
+    }
+}
+
+#[test]
+fn a_skip_that_the_next_return_does_not_confirm_is_undone() {
+    let sc = scenarios()
+        .iter()
+        .find(|s| s.name == "t1-u1.5-rest")
+        .unwrap();
+    let reference = reference(sc);
+    let solvers: [(SolverKind, Box<dyn Solver>); 3] = [
+        (
+            SolverKind::Event,
+            Box::new(EventSolver {
+                options: EventOptions {
+                    skip_verify: 0.0,
+                    ..EventOptions::default()
+                },
+            }),
+        ),
+        (
+            SolverKind::Switch,
+            Box::new(SwitchSolver {
+                options: SwitchOptions {
+                    skip_verify: 0.0,
+                    ..SwitchOptions::default()
+                },
+            }),
+        ),
+        (
+            SolverKind::Moreau,
+            Box::new(MoreauSolver::new(MoreauOptions {
+                skip_verify: 0.0,
+                ..MoreauOptions::default()
+            })),
+        ),
+    ];
+    for (kind, s) in solvers {
+        let undone = run(&*s, sc, kind, Output::Metrics);
+        let skipping = run(&*kind.solver(), sc, kind, Output::Metrics);
+        let full = run(&*kind.solver(), sc, kind, Output::Final);
+        let name = kind.name();
+        assert!(skipping.stats.skipped_periods > 0, "{name}");
+        assert_eq!(undone.stats.skipped_periods, 0, "{name}");
+        assert!(matches!(
+            undone.metrics,
+            Some(SteadyState::LimitCycle { .. })
+        ));
+        let bad = gate(sc, kind, &reference, &undone);
+        assert!(bad.is_empty(), "{bad:#?}");
+        // The skipped periods were integrated after all, plus the cycle after the skip.
+        assert!(
+            undone.stats.steps > skipping.stats.steps && undone.stats.steps >= full.stats.steps,
+            "{name}: {} vs {} and {}",
+            undone.stats.steps,
+            skipping.stats.steps,
+            full.stats.steps
+        );
+        // Moreau–Jean goes back to the saved step end and takes the very steps of the full run.
+        if kind == SolverKind::Moreau {
+            assert_eq!(undone.metrics, full.metrics);
+            assert_eq!(undone.x_final, full.x_final);
+        }
+    }
+}
