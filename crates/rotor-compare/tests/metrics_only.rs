@@ -103,8 +103,10 @@ fn metrics_only_scenes_pass_the_gate_and_skip_only_converged_cycles() {
                     let fast = run(&*s, sc, kind, Output::Metrics);
                     assert!(fast.samples.is_empty() && fast.events.is_empty());
                     let mut bad = gate(sc, kind, &reference, &fast);
-                    // Nothing skipped: the run was never stopped, so it is the full run.
+                    // Nothing skipped or undone: the run was never stopped, so it is the full
+                    // run.
                     if fast.stats.skipped_periods == 0
+                        && fast.stats.undone_skips == 0
                         && (fast.metrics != full.metrics
                             || fast.x_final != full.x_final
                             || fast.stats != full.stats)
@@ -194,6 +196,12 @@ fn a_skip_that_the_next_return_does_not_confirm_is_undone() {
         let name = kind.name();
         assert!(skipping.stats.skipped_periods > 0, "{name}");
         assert_eq!(undone.stats.skipped_periods, 0, "{name}");
+        // Watching resumes after an undo: every attempt fails its check.
+        assert_eq!(
+            undone.stats.undone_skips,
+            u64::from(rotor_model::fast_forward::MAX_JUMPS),
+            "{name}"
+        );
         assert!(matches!(
             undone.metrics,
             Some(SteadyState::LimitCycle { .. })

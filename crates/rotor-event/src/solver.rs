@@ -149,6 +149,7 @@ impl Solver for EventSolver {
             metrics,
             stats: Stats {
                 skipped_periods: sink.fast_forward.map_or(0, |f| f.skipped_periods()),
+                undone_skips: sink.fast_forward.map_or(0, |f| f.undone_jumps()),
                 ..integ.stats
             },
         })

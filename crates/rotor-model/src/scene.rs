@@ -303,6 +303,9 @@ pub struct Stats {
     pub inexact_steps: u64,
     /// Whole periods skipped by [`Output::Metrics`] ([`crate::FastForward`]).
     pub skipped_periods: u64,
+    /// Skips of [`Output::Metrics`] undone because the return after them did not confirm
+    /// them: each cost a cycle, and the periods were integrated after all.
+    pub undone_skips: u64,
 }
 
 impl std::ops::AddAssign for Stats {
@@ -318,6 +321,7 @@ impl std::ops::AddAssign for Stats {
         self.newton_iters += o.newton_iters;
         self.inexact_steps += o.inexact_steps;
         self.skipped_periods += o.skipped_periods;
+        self.undone_skips += o.undone_skips;
     }
 }
 

@@ -736,6 +736,7 @@ impl Solver for SwitchSolver {
                 rhs_evals: c.rhs_evals,
                 events: sink.count,
                 skipped_periods: sink.fast_forward.map_or(0, |f| f.skipped_periods()),
+                undone_skips: sink.fast_forward.map_or(0, |f| f.undone_jumps()),
                 ..Stats::default()
             },
         })
