@@ -91,7 +91,7 @@
 //! continuous (no impacts), so the O(h²) local error of a step containing a stick onset or
 //! exit does not spoil the global order. **Not across a velocity reversal:** a disc whose
 //! velocity passes through zero without sticking is held at rest for the one step that
-//! contains the reversal (reported as a StickStart/StickEnd pair, not a Reversal), a local
+//! contains the reversal (reported as a Reversal, see below), a local
 //! error O(h) that makes the global error first order (measured by rotor-compare's stress
 //! case "far from rest": 2.2e-4, 1.9e-5, 3.8e-6 rad/s at h = 1e-3, 1e-4, 1e-5). No fixture
 //! scenario has a reversal; the second order above holds on stick-slip and slipping cycles.
@@ -121,6 +121,11 @@
 //!   velocity's first-order Taylor expansion from the last slipping step end, with the
 //!   model's acceleration there ([`rotor_model::Model::disc_accel`]), clamped to the step: O(h²).
 //! * `Reversal(d)`: the velocity changes sign without sticking; linear interpolation: O(h²).
+//!   A disc held at rest for exactly one step between slips of opposite sign also reverses
+//!   (at the scheme's resolution): its stick onset is withdrawn and a Reversal is reported at
+//!   the zero of ω interpolated between the two slipping step ends (O(h)). Reported as a stick
+//!   phase, its exit would anchor a spurious cycle in the metrics (a random-parameter test found
+//!   a 2.0 s "period" on a 7.4 s cycle).
 //! * `Max(d)` / `Min(d)` (only when `scene.metrics_from` is set): a sign change of the
 //!   discrete velocity increments while slipping; vertex of the parabola through the three
 //!   step values.
@@ -234,6 +239,22 @@ impl Pending {
         }
         self.buf[i] = Some(e);
         self.len += 1;
+    }
+
+    /// Removes the latest pending event of `kind`; whether there was one.
+    fn remove(&mut self, kind: EventKind) -> bool {
+        let Some(i) = (0..self.len)
+            .rev()
+            .find(|&i| self.buf[i].is_some_and(|e| e.kind == kind))
+        else {
+            return false;
+        };
+        for j in i + 1..self.len {
+            self.buf[j - 1] = self.buf[j];
+        }
+        self.len -= 1;
+        self.buf[self.len] = None;
+        true
     }
 
     /// Moves the pending events by `dt` (a jump of whole periods).
@@ -521,7 +542,21 @@ impl Solver for MoreauSolver {
                             }
                             _ => None,
                         };
-                        if let Some((kind, t)) = kind_t {
+                        // Held at rest for exactly one step between slips of opposite sign: a
+                        // reversal at the scheme's resolution (crate docs), not a stick phase.
+                        let reversal = matches!(kind_t, Some((EventKind::StickEnd(_), _)))
+                            && prev
+                                .is_some_and(|p| p.mode[i] != DiscMode::Stick && p.mode[i] != m_b)
+                            && pending.remove(EventKind::StickStart(d));
+                        if reversal && let Some(p) = prev {
+                            // Zero of ω between the slipping ends of the two steps.
+                            let (wa, wb) = (p.x[wi], next.x[wi]);
+                            let t = (p.t + wa * (next.t - p.t) / (wa - wb)).clamp(p.t, next.t);
+                            let mut x = lerp(&p, &next, t);
+                            x[wi] = 0.0;
+                            let kind = EventKind::Reversal(d);
+                            pending.push(Event { t, x, kind }, &mut sink);
+                        } else if let Some((kind, t)) = kind_t {
                             let mut x = if t >= cur.t {
                                 lerp(&cur, &next, t)
                             } else {
@@ -643,6 +678,7 @@ impl Solver for MoreauSolver {
         }
         stats.events = sink.count;
         stats.skipped_periods = sink.fast_forward.map_or(0, |f| f.skipped_periods());
+        stats.undone_skips = sink.fast_forward.map_or(0, |f| f.undone_jumps());
         let metrics = sink.metrics.map(|m| m.finish(&cur.x));
         Ok(Trajectory {
             samples,
