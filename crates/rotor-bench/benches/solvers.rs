@@ -1,6 +1,7 @@
 //! Criterion benches: each solver on Table 1 at u = 1.5 V from rest over 100 s at its
 //! default setting (event and switch tol 1e-10, Moreau–Jean h = 1e-3), with the full 0.01 s
-//! trace and metrics; then metrics-only (`Output::Final`) vs full trace per solver.
+//! trace and metrics; then metrics-only (`Output::Metrics`), final-only (`Output::Final`) and
+//! full trace per solver.
 //!
 //! `cargo bench -p rotor-bench` (all), `cargo bench -p rotor-bench -- output` (one group).
 //! The work-precision ladders and the peers are in `rotor_bench::run`, not here.
@@ -37,7 +38,8 @@ fn output_levels(c: &mut Criterion) {
     for kind in SolverKind::ALL {
         let s = solver(kind);
         for (name, output) in [
-            ("metrics_only", Output::Final),
+            ("metrics_only", Output::Metrics),
+            ("final_only", Output::Final),
             ("full_trace", Output::Grid { dt: 0.01 }),
         ] {
             let sc = Scene {

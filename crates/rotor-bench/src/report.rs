@@ -152,39 +152,60 @@ impl BenchReport {
         if !self.output_levels.is_empty() {
             let _ = writeln!(
                 s,
-                "output levels (first scene, metrics on): metrics-only = Output::Final, full \
-                 trace = Output::Grid"
+                "output levels (first scene, metrics on): metrics-only = Output::Metrics (skips \
+                 whole periods once the cycle has converged), final = Output::Final (whole \
+                 horizon, nothing kept), full trace = Output::Grid"
             );
             let _ = writeln!(
                 s,
-                "{:<7} {:>11} {:>16} {:>16} {:>7} {:>16} {:>8} {:>6}",
+                "{:<7} {:>11} {:>13} {:>9} {:>13} {:>7} {:>7} {:>8} {:>9} {:>8} {:>6}",
                 "solver",
                 "setting",
-                "metrics-only ms",
-                "full trace ms",
+                "metrics-only",
+                "final",
+                "full trace",
                 "ratio",
-                "kept (final)",
+                "final",
+                "skipped",
+                "metrics",
                 "kept",
                 "same"
+            );
+            let _ = writeln!(
+                s,
+                "{:<7} {:>11} {:>13} {:>9} {:>13} {:>7} {:>7} {:>8} {:>9} {:>8} {:>6}",
+                "", "", "ms", "ms", "ms", "", "ratio", "periods", "diff", "", ""
             );
             for o in &self.output_levels {
                 let _ = writeln!(
                     s,
-                    "{:<7} {:>11} {:>16} {:>16} {:>7.2} {:>16} {:>8} {:>6}",
+                    "{:<7} {:>11} {:>13} {:>9} {:>13} {:>7.2} {:>7.2} {:>8} {:>9} {:>8} {:>6}",
                     o.solver.name(),
                     format!("{} {:.0e}", o.setting_name, o.setting),
                     ms(o.metrics_only.median_s),
+                    ms(o.final_only.median_s),
                     ms(o.full_trace.median_s),
                     o.ratio,
-                    format!("{}/{}", o.metrics_only_samples, o.metrics_only_events),
-                    o.full_trace_samples,
+                    o.final_ratio,
+                    if o.undone_skips > 0 {
+                        format!("{} ({} undone)", o.skipped_periods, o.undone_skips)
+                    } else {
+                        o.skipped_periods.to_string()
+                    },
+                    o.metrics_diff.map_or("KIND".into(), |d| format!("{d:.1e}")),
+                    format!(
+                        "{}/{}/{}",
+                        o.metrics_only_samples, o.metrics_only_events, o.full_trace_samples
+                    ),
                     if o.same_answer { "yes" } else { "NO" }
                 );
             }
             let _ = writeln!(
                 s,
-                "(kept (final) = samples/events of the metrics-only run; same = same metrics \
-                 and final state)\n"
+                "(ratio = full trace / metrics-only, final ratio = full trace / final; metrics \
+                 diff = largest |metrics-only - full trace| / max(|m|, 1); kept = samples/events \
+                 of the metrics-only run / samples of the trace; same = the final run has the \
+                 trace's metrics and final state)\n"
             );
         }
         for p in &self.peers {
