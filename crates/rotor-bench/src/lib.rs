@@ -13,8 +13,9 @@
 //!   tenfold tighter tolerance ([`ReferenceReport::check`]).
 //! * **Run time**: the median of repeated runs (`std::time::Instant`), after one untimed
 //!   warm-up; the work counters ([`rotor_model::Stats`]).
-//! * **Output levels**: per solver, metrics-only (`Output::Final`) vs full trace
-//!   (`Output::Grid { dt: 0.01 }`), both with metrics, timed alternately.
+//! * **Output levels**: per solver, metrics-only (`Output::Metrics`, which skips the periods
+//!   of a converged cycle), final-only (`Output::Final`) and the full trace
+//!   (`Output::Grid { dt: 0.01 }`), all with metrics, timed in turn.
 //! * **Peers**, run as subprocesses in the same run: a plain scipy `solve_ivp` implementation
 //!   (`bench/peers/scipy_rotor.py`) compared at equal error, and Siconos' `MoreauJeanOSI`
 //!   (`bench/peers/siconos_rotor.py`) compared per step at equal h. A peer whose answer does

@@ -330,7 +330,7 @@ impl std::ops::AddAssign for Stats {
 pub struct Trajectory {
     /// Samples, as asked by the scene's [`Output`].
     pub samples: Vec<Sample>,
-    /// Events, unless the scene asked for [`Output::Final`].
+    /// Events, unless the scene asked for [`Output::Final`] or [`Output::Metrics`].
     pub events: Vec<Event>,
     /// Final time (= t_end).
     pub t_final: f64,
