@@ -154,7 +154,7 @@ impl FastForward {
         FastForward { verify: v, ..self }
     }
 
-    /// Skipped time [s] (0 if no jump, or if the jump was undone).
+    /// Skipped time in seconds (0 if no jump, or if the jump was undone).
     pub fn skipped(&self) -> f64 {
         self.skipped
     }
