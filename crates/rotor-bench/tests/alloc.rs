@@ -82,7 +82,12 @@ fn check(solver: &dyn Solver) {
                 };
                 let (am, nm) = allocations(solver, &m, &sm);
                 assert!(nm < n10, "{}: the metrics-only run skips", solver.name());
-                assert_eq!(am, a10, "{} {set}: Output::Metrics allocates", solver.name());
+                assert_eq!(
+                    am,
+                    a10,
+                    "{} {set}: Output::Metrics allocates",
+                    solver.name()
+                );
             }
         }
     }
