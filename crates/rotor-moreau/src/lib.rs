@@ -229,7 +229,14 @@ impl Pending {
 
     fn push(&mut self, e: Event, sink: &mut Sink) {
         if self.len == PENDING {
-            self.release_before(f64::INFINITY, sink, 1);
+            // Never with a step's at most six events; released even while a jump waits, so
+            // that the buffer cannot overflow.
+            if let Some(first) = self.buf[0] {
+                sink.take(&first);
+            }
+            self.buf.copy_within(1.., 0);
+            self.len -= 1;
+            self.buf[self.len] = None;
         }
         // Insertion into the time-ordered buffer.
         let mut i = self.len;
@@ -689,5 +696,63 @@ impl Solver for MoreauSolver {
             metrics,
             stats,
         })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn sink() -> Sink {
+        Sink {
+            events: Some(Vec::new()),
+            metrics: None,
+            count: 0,
+            fast_forward: None,
+            jump: None,
+            undo: false,
+        }
+    }
+
+    fn ev(t: f64) -> Event {
+        Event {
+            t,
+            x: State::zeros(),
+            kind: EventKind::Max(Disc::Lower),
+        }
+    }
+
+    /// Events come out in time order, an overfull buffer releases its earliest (even while a
+    /// jump waits), and a waiting jump stops the ordinary release.
+    #[test]
+    fn pending_events_leave_in_time_order_and_never_overflow() {
+        let times = |s: &Sink, from: usize| -> Vec<f64> {
+            s.events.as_ref().unwrap()[from..]
+                .iter()
+                .map(|e| e.t)
+                .collect()
+        };
+        let mut p = Pending::new();
+        let mut s = sink();
+        s.jump = Some((1.0, ev(0.0)));
+        for k in 0..PENDING + 4 {
+            p.push(ev(k as f64), &mut s);
+        }
+        assert_eq!(
+            times(&s, 0),
+            [0.0, 1.0, 2.0, 3.0],
+            "the overflow released the earliest"
+        );
+        p.release_before(f64::INFINITY, &mut s, usize::MAX);
+        assert_eq!(times(&s, 0).len(), 4, "halted by the waiting jump");
+        s.jump = None;
+        p.release_before(8.0, &mut s, usize::MAX);
+        assert_eq!(times(&s, 4), [4.0, 5.0, 6.0, 7.0]);
+        assert!(p.remove(EventKind::Max(Disc::Lower)));
+        assert!(!p.remove(EventKind::Min(Disc::Lower)));
+        p.shift(100.0);
+        p.release_before(f64::INFINITY, &mut s, usize::MAX);
+        // 19 was the latest and was removed; the rest moved by 100 s.
+        assert_eq!(times(&s, 8), (108..=118).map(f64::from).collect::<Vec<_>>());
     }
 }
