@@ -2,7 +2,7 @@
 
 use rotor_model::{
     Event, FastForward, MetricsAccumulator, Mode, Model, Output, OutputGrid, Sample, Scene,
-    SolveError, Solver, State, Stats, Trajectory, Verdict,
+    SolveError, Solver, State, Trajectory, Verdict,
 };
 
 use crate::dop853::Dense;
@@ -147,11 +147,7 @@ impl Solver for EventSolver {
             x_final: end.x,
             mode_final: end.mode,
             metrics,
-            stats: Stats {
-                skipped_periods: sink.fast_forward.map_or(0, |f| f.skipped_periods()),
-                undone_skips: sink.fast_forward.map_or(0, |f| f.undone_jumps()),
-                ..integ.stats
-            },
+            stats: FastForward::counted(sink.fast_forward.as_ref(), integ.stats),
         })
     }
 }

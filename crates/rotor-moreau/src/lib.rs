@@ -684,8 +684,7 @@ impl Solver for MoreauSolver {
             }
         }
         stats.events = sink.count;
-        stats.skipped_periods = sink.fast_forward.map_or(0, |f| f.skipped_periods());
-        stats.undone_skips = sink.fast_forward.map_or(0, |f| f.undone_jumps());
+        let stats = FastForward::counted(sink.fast_forward.as_ref(), stats);
         let metrics = sink.metrics.map(|m| m.finish(&cur.x));
         Ok(Trajectory {
             samples,

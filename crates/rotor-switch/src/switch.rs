@@ -730,15 +730,16 @@ impl Solver for SwitchSolver {
                 lower: field.regions[1].disc_mode(),
             },
             metrics,
-            stats: Stats {
-                steps: c.accepted,
-                rejected: c.rejected,
-                rhs_evals: c.rhs_evals,
-                events: sink.count,
-                skipped_periods: sink.fast_forward.map_or(0, |f| f.skipped_periods()),
-                undone_skips: sink.fast_forward.map_or(0, |f| f.undone_jumps()),
-                ..Stats::default()
-            },
+            stats: FastForward::counted(
+                sink.fast_forward.as_ref(),
+                Stats {
+                    steps: c.accepted,
+                    rejected: c.rejected,
+                    rhs_evals: c.rhs_evals,
+                    events: sink.count,
+                    ..Stats::default()
+                },
+            ),
         })
     }
 }
