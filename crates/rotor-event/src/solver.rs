@@ -132,8 +132,7 @@ impl Solver for EventSolver {
                     (t, x, mode) = (end.t + dt, end.x, end.mode);
                 }
                 Verdict::Undo => {
-                    let (at, metrics): (crate::filippov::RunEnd, _) =
-                        saved.take().expect("a jump before its undo");
+                    let (at, metrics) = saved.take().expect("a jump before its undo");
                     sink.metrics = metrics;
                     (t, x, mode) = (at.t, at.x, at.mode);
                 }
