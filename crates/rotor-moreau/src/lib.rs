@@ -604,7 +604,22 @@ impl Solver for MoreauSolver {
                                 } else {
                                     cur.t
                                 };
-                                let x = quad([&p, &cur, &next], t);
+                                let mut x = quad([&p, &cur, &next], t);
+                                // The other disc's velocity is smooth over the three points
+                                // only if its mode is: across its stick onset or exit the
+                                // parabola would overshoot ω = 0 (a negative ω_l in a
+                                // stick-slip cycle's metrics, with no reversal). There it
+                                // is interpolated on the step that holds t, which keeps its
+                                // sign.
+                                let o = 1 - i;
+                                if p.mode[o] != cur.mode[o] || cur.mode[o] != next.mode[o] {
+                                    let (a, b) = if t <= cur.t {
+                                        (&p, &cur)
+                                    } else {
+                                        (&cur, &next)
+                                    };
+                                    x[1 + o] = lerp(a, b, t)[1 + o];
+                                }
                                 pending.push(Event { t, x, kind }, &mut sink);
                             }
                         }
