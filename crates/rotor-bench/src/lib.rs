@@ -244,10 +244,12 @@ pub struct PeerPoint {
 pub struct Agreement {
     /// The peer setting checked (its most accurate one).
     pub setting: f64,
-    pub steady_rel: Option<f64>,
+    pub period_rel: Option<f64>,
+    pub omega_l_max_rel: Option<f64>,
     pub transient_max: Option<f64>,
     /// Gates, from the scenario file's tolerance table.
-    pub gate_steady_rel: f64,
+    pub gate_period_rel: f64,
+    pub gate_omega_l_rel: f64,
     pub gate_transient_max: f64,
     /// Which table entry the gates come from.
     pub gate_origin: String,
@@ -625,15 +627,20 @@ fn agreement(points: &[PeerPoint], gate: Option<(&str, PairTolerance)>) -> Optio
         .filter(|p| p.timing.is_some())
         .min_by(|a, b| a.setting.total_cmp(&b.setting))?;
     let (origin, tol) = gate?;
-    let gs = tol.steady_rel?;
+    let gp = tol.period_rel?;
+    let gw = tol.omega_l_rel?;
     let gt = tol.transient_max?;
-    let agrees = best.errors.steady_rel.is_some_and(|e| e <= gs)
-        && best.errors.transient_max.is_some_and(|e| e <= gt);
+    let e = &best.errors;
+    let agrees = e.period_rel.is_some_and(|e| e <= gp)
+        && e.omega_l_max_rel.is_some_and(|e| e <= gw)
+        && e.transient_max.is_some_and(|e| e <= gt);
     Some(Agreement {
         setting: best.setting,
-        steady_rel: best.errors.steady_rel,
-        transient_max: best.errors.transient_max,
-        gate_steady_rel: gs,
+        period_rel: e.period_rel,
+        omega_l_max_rel: e.omega_l_max_rel,
+        transient_max: e.transient_max,
+        gate_period_rel: gp,
+        gate_omega_l_rel: gw,
         gate_transient_max: gt,
         gate_origin: origin.to_string(),
         agrees,

@@ -140,13 +140,17 @@ impl RefData {
             ),
             None => (None, None),
         };
-        let steady_rel = match (period, omega_l_max) {
-            (Some(p), Some(w)) => Some((p / self.period).max(w / self.omega_l_max.abs())),
+        let period_rel = period.map(|p| p / self.period);
+        let omega_l_max_rel = omega_l_max.map(|w| w / self.omega_l_max.abs());
+        let steady_rel = match (period_rel, omega_l_max_rel) {
+            (Some(p), Some(w)) => Some(p.max(w)),
             _ => None,
         };
         Errors {
             period,
             omega_l_max,
+            period_rel,
+            omega_l_max_rel,
             steady_rel,
             transient_max: self.transient_max(samples),
         }
@@ -183,6 +187,10 @@ pub struct Errors {
     pub period: Option<f64>,
     /// |max ω_l − ref| (rad/s).
     pub omega_l_max: Option<f64>,
+    /// |ΔT|/T_ref.
+    pub period_rel: Option<f64>,
+    /// |Δ max ω_l|/max ω_l,ref.
+    pub omega_l_max_rel: Option<f64>,
     /// max(|ΔT|/T_ref, |Δ max ω_l|/max ω_l,ref): the steady-state error.
     pub steady_rel: Option<f64>,
     /// max |ω_l − ω_l,ref| over the transient window (rad/s).

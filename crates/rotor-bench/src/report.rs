@@ -441,12 +441,14 @@ fn peer_table(s: &mut String, p: &PeerReport) {
     if let Some(a) = &p.agreement {
         let _ = writeln!(
             s,
-            "agreement at {} {:e}: steady {} (gate {:.0e}), transient {} (gate {:.0e}) from \
-             {}: {}",
+            "agreement at {} {:e}: period {} (gate {:.0e}), max omega_l {} (gate {:.0e}), \
+             transient {} (gate {:.0e}) from {}: {}",
             p.setting_name,
             a.setting,
-            e(a.steady_rel),
-            a.gate_steady_rel,
+            e(a.period_rel),
+            a.gate_period_rel,
+            e(a.omega_l_max_rel),
+            a.gate_omega_l_rel,
             e(a.transient_max),
             a.gate_transient_max,
             a.gate_origin,

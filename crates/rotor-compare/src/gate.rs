@@ -1,9 +1,10 @@
 //! Agreement gates between two solvers' results on one scenario.
 //!
 //! (a) the transient window, sample by sample on the common grid: max and RMS of the
-//! difference in ω_u and ω_l; (b) the steady state: kind, and every metric within
-//! `steady_rel` relative (with `steady_abs` as a floor); (c) events: lower-disc stick
-//! onsets and exits in the transient window matched one to one within `event_time`.
+//! difference in ω_u and ω_l; (b) the steady state: kind, and each metric within its own
+//! tolerance (period, ω_l extremes, ω_u extremes and the equilibrium relative with `steady_abs`
+//! as a floor, the stick time in seconds); (c) events: lower-disc stick onsets and exits in
+//! the transient window matched one to one within `event_time`.
 //! Every comparison is written `!(diff <= tol)` so that a NaN fails.
 
 use rotor_model::{Disc, EventKind, PairTolerance, SteadyState, Trajectory};
@@ -152,7 +153,7 @@ pub fn check_pair(
             });
         }
     }
-    if let Some(rel) = tol.steady_rel {
+    if tol.gates_steady() {
         let floor = tol.steady_abs.unwrap_or(0.0);
         let (Some(sa), Some(sb)) = (a.metrics, b.metrics) else {
             // A gated steady state that a solver did not deliver fails the gate.
@@ -160,7 +161,7 @@ pub fn check_pair(
             m.push(Measured {
                 quantity: format!("steady metrics ({} vs {})", which(a), which(b)),
                 diff: f64::NAN,
-                tol: rel,
+                tol: 0.0,
             });
             return GateResult {
                 pair: pair.to_owned(),
@@ -174,26 +175,60 @@ pub fn check_pair(
                 tol: 0.0,
             });
         } else {
-            for ((name, va), (_, vb)) in sa.values().into_iter().zip(sb.values()) {
-                // Scaled so that `diff ≤ rel` ⇔ |va − vb| ≤ max(rel·max(|va|,|vb|), floor).
-                let scale = (va.abs().max(vb.abs()) * rel).max(floor);
-                let diff = if scale > 0.0 {
-                    (va - vb).abs() / scale * rel
-                } else {
-                    (va - vb).abs()
-                };
-                m.push(Measured {
-                    quantity: format!("steady {name}"),
-                    diff,
-                    tol: rel,
-                });
-            }
+            m.extend(steady_differences(&sa, &sb, tol, floor));
         }
     }
     GateResult {
         pair: pair.to_owned(),
         measured: m,
     }
+}
+
+/// The steady metrics of two results of the same kind, each against its own tolerance
+/// ([`PairTolerance::for_metric`]). A relative difference is scaled so that `diff ≤ tol` ⇔
+/// `|va − vb| ≤ max(tol·max(|va|, |vb|), floor)`; `stick_time` is absolute. A metric whose
+/// tolerance the file does not state is measured against 0 and fails: the file must gate
+/// every metric of the steady state it reaches.
+pub fn steady_differences(
+    sa: &SteadyState,
+    sb: &SteadyState,
+    tol: &PairTolerance,
+    floor: f64,
+) -> Vec<Measured> {
+    sa.values()
+        .into_iter()
+        .zip(sb.values())
+        .map(|((name, va), (_, vb))| {
+            let (q, t) = tol
+                .for_metric(name)
+                .expect("every metric of SteadyState::values has a quantity");
+            let t = t.unwrap_or(0.0);
+            let d = (va - vb).abs();
+            let diff = if !q.relative {
+                d
+            } else {
+                let scale = va
+                    .abs()
+                    .max(vb.abs())
+                    .max(if t > 0.0 { floor / t } else { 0.0 });
+                if scale > 0.0 { d / scale } else { d }
+            };
+            let missing = if tol.get(q.key).is_none() {
+                format!(" (no {} stated)", q.key)
+            } else {
+                String::new()
+            };
+            Measured {
+                quantity: format!("steady {name}{missing}"),
+                diff: if missing.is_empty() {
+                    diff
+                } else {
+                    f64::INFINITY
+                },
+                tol: t,
+            }
+        })
+        .collect()
 }
 
 /// The steady metrics of a trajectory, if computed.
@@ -242,7 +277,7 @@ mod tests {
     fn tol() -> PairTolerance {
         PairTolerance {
             transient_max: Some(1e-9),
-            steady_rel: Some(1e-9),
+            equilibrium_rel: Some(1e-9),
             ..PairTolerance::default()
         }
     }
@@ -269,6 +304,190 @@ mod tests {
         assert!(
             f.iter().any(|f| f.quantity.contains("transient max")),
             "{f:?}"
+        );
+    }
+
+    const CYCLE: SteadyState = SteadyState::LimitCycle {
+        period: 4.5,
+        omega_l_max: 6.3,
+        omega_l_min: 0.0,
+        omega_u_max: 2.7,
+        omega_u_min: 2.5,
+        stick_time: 0.87,
+    };
+
+    /// Each steady metric is gated by its own tolerance: a shift of twice a metric's gate
+    /// fails exactly that metric, a shift of half of it passes, and a metric whose kind has
+    /// no tolerance in the file fails.
+    #[test]
+    fn each_steady_metric_has_its_own_gate() {
+        let tol = PairTolerance {
+            period_rel: Some(1e-10),
+            omega_l_rel: Some(1e-9),
+            omega_u_rel: Some(1e-11),
+            stick_time: Some(1e-8),
+            steady_abs: Some(1e-12),
+            ..PairTolerance::default()
+        };
+        let a = traj(Some(CYCLE));
+        assert!(check_pair("p", &a, &a, None, &tol).failures("s").is_empty());
+        type Shift = fn(&mut SteadyState, f64);
+        let shifts: [(&str, Shift, f64); 5] = [
+            (
+                "period",
+                |m, f| {
+                    if let SteadyState::LimitCycle { period, .. } = m {
+                        *period *= 1.0 + f
+                    }
+                },
+                1e-10,
+            ),
+            (
+                "omega_l_max",
+                |m, f| {
+                    if let SteadyState::LimitCycle { omega_l_max, .. } = m {
+                        *omega_l_max *= 1.0 + f
+                    }
+                },
+                1e-9,
+            ),
+            (
+                "omega_l_min",
+                |m, f| {
+                    if let SteadyState::LimitCycle { omega_l_min, .. } = m {
+                        *omega_l_min += f * 1e-3
+                    }
+                },
+                1e-9,
+            ),
+            (
+                "omega_u_min",
+                |m, f| {
+                    if let SteadyState::LimitCycle { omega_u_min, .. } = m {
+                        *omega_u_min *= 1.0 + f
+                    }
+                },
+                1e-11,
+            ),
+            (
+                "stick_time",
+                |m, f| {
+                    if let SteadyState::LimitCycle { stick_time, .. } = m {
+                        *stick_time += f
+                    }
+                },
+                1e-8,
+            ),
+        ];
+        for (name, shift, gate) in shifts {
+            for (factor, fails) in [(2.0, true), (0.5, false)] {
+                let mut b = a.clone();
+                shift(b.metrics.as_mut().unwrap(), factor * gate);
+                let f = check_pair("p", &a, &b, None, &tol).failures("s");
+                // ω_l's minimum is 0: the floor 1e-12 gates it absolutely, so a shift of
+                // 2e-12 fails and 5e-13 passes.
+                assert_eq!(!f.is_empty(), fails, "{name} x{factor}: {f:?}");
+                if fails {
+                    assert!(
+                        f.len() == 1 && f[0].quantity == format!("steady {name}"),
+                        "{f:?}"
+                    );
+                }
+            }
+        }
+        // An equilibrium gated with cycle tolerances only: its metrics are not gated, so fail.
+        let e = traj(Some(EQ));
+        let f = check_pair("p", &e, &e, None, &tol).failures("s");
+        assert_eq!(f.len(), 3, "{f:?}");
+        assert!(f[0].quantity.contains("no equilibrium_rel stated"), "{f:?}");
+    }
+
+    /// The transient gates: max, RMS, and the stick event times (count and kind too).
+    #[test]
+    fn transient_and_event_gates_each_fail_their_negative_control() {
+        let tol = PairTolerance {
+            transient_max: Some(1e-6),
+            transient_rms: Some(1e-7),
+            event_time: Some(1e-5),
+            ..PairTolerance::default()
+        };
+        let mut a = traj(None);
+        let ev = |t: f64, kind| rotor_model::Event {
+            t,
+            x: State::zeros(),
+            kind,
+        };
+        a.events = vec![
+            ev(0.2, EventKind::StickStart(Disc::Lower)),
+            ev(0.4, EventKind::StickEnd(Disc::Lower)),
+        ];
+        assert!(
+            check_pair("p", &a, &a, Some([0.0, 1.0]), &tol)
+                .failures("s")
+                .is_empty()
+        );
+        let fails = |b: &Trajectory| {
+            check_pair("p", &a, b, Some([0.0, 1.0]), &tol)
+                .failures("s")
+                .into_iter()
+                .map(|f| f.quantity)
+                .collect::<Vec<_>>()
+        };
+        // One sample off by 2e-6: the max fails; the RMS over 202 values is 1.4e-7 and fails too.
+        let mut b = a.clone();
+        b.samples[10].x[1] += 2e-6;
+        assert_eq!(fails(&b).len(), 2, "{:?}", fails(&b));
+        // Every sample off by 2e-7: max passes, RMS fails.
+        let mut b = a.clone();
+        b.samples.iter_mut().for_each(|s| s.x[2] += 2e-7);
+        assert_eq!(fails(&b), vec!["transient rms d_omega"]);
+        // An event 2e-5 s late; one missing; one of another kind.
+        let mut b = a.clone();
+        b.events[1].t += 2e-5;
+        assert!(
+            fails(&b)[0].starts_with("stick event times"),
+            "{:?}",
+            fails(&b)
+        );
+        let mut b = a.clone();
+        b.events.pop();
+        assert!(fails(&b)[0].contains("(2 vs 1 events)"), "{:?}", fails(&b));
+        let mut b = a.clone();
+        b.events[1].kind = EventKind::StickStart(Disc::Lower);
+        assert!(
+            fails(&b)[0].starts_with("stick event times"),
+            "{:?}",
+            fails(&b)
+        );
+        // Half the gate passes.
+        let mut b = a.clone();
+        b.events[1].t += 5e-6;
+        b.samples[10].x[1] += 5e-7;
+        assert!(fails(&b).is_empty(), "{:?}", fails(&b));
+    }
+
+    /// A gate of 0 is exact agreement: any difference fails it.
+    #[test]
+    fn a_zero_gate_demands_exact_agreement() {
+        let tol = PairTolerance {
+            transient_max: Some(0.0),
+            equilibrium_rel: Some(0.0),
+            ..PairTolerance::default()
+        };
+        let a = traj(Some(EQ));
+        assert!(
+            check_pair("p", &a, &a, Some([0.0, 1.0]), &tol)
+                .failures("s")
+                .is_empty()
+        );
+        let mut b = a.clone();
+        // Sample 0 has ω_l = sin 0 = 0, so 1e-300 is representable there.
+        b.samples[0].x[2] += 1e-300;
+        assert_eq!(
+            check_pair("p", &a, &b, Some([0.0, 1.0]), &tol)
+                .failures("s")
+                .len(),
+            1
         );
     }
 

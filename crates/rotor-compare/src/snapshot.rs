@@ -1,13 +1,21 @@
 //! Snapshot records: per scenario and solver, the steady-state metrics rounded to the digits
-//! the scenario's agreement tolerance justifies, and the solver's work counters.
+//! that metric's agreement tolerance justifies, the solver's work counters, and each pair's
+//! measured differences to one significant digit.
 //!
-//! The metrics are rounded to `⌊−log10 steady_rel⌋` significant digits (the tightest
-//! `steady_rel` of the scenario's pairs: 2e-6 → 5 digits), and values below the tightest
-//! `steady_abs` are written as 0. A snapshot therefore changes only when a solver's answer
-//! moves by about the agreement tolerance, not with the last bits of the floating-point
-//! arithmetic of a machine.
+//! **Metrics.** Each metric is rounded by the tightest tolerance stated for it among the pairs
+//! the solver belongs to (the event-driven reference: both pairs; the others: their pair with
+//! the reference): a relative tolerance `r` keeps `⌊−log10 r⌋` significant digits (at most
+//! [`MAX_DIGITS`]), the absolute `stick_time` tolerance `a` keeps `⌊−log10 a⌋` decimals, and
+//! values below the scenario's `steady_abs` floor are written as 0. A snapshot therefore moves
+//! when a solver's answer moves by about its gate — also when all three move alike, which no
+//! pair gate can see — and not with the last bits of another machine's arithmetic.
 //!
-//! The counters are rounded to 3 significant digits: a last-bit change of the friction law
+//! **Differences.** Every gated quantity of every pair, to one significant digit: a change in
+//! how well two solvers agree shows in review even while it stays inside the gate. A
+//! difference below [`ROUNDING`] is written as 0: there it is floating-point rounding of the
+//! runs, which another machine's `libm` changes.
+//!
+//! **Counters** are rounded to 3 significant digits: a last-bit change of the friction law
 //! (measured: replacing libm's `tanh` by a one-`exp` form) moves step and evaluation counts
 //! by up to 0.1 %, so 3 digits show any real change in the work a solver does (≥ 1 %) but
 //! not another machine's `libm`. The event count is left out when the run settles on an
@@ -29,6 +37,8 @@ pub struct SolverSnapshot {
     pub steady: String,
     /// Rounded metrics, by name (empty on error).
     pub metrics: BTreeMap<&'static str, f64>,
+    /// Digits kept per metric: significant digits, or decimals for `stick_time`.
+    pub digits: BTreeMap<&'static str, u32>,
     pub counters: Counters,
     /// The typed error, if the run failed.
     pub error: Option<String>,
@@ -72,11 +82,22 @@ impl Counters {
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct ScenarioSnapshot {
     pub scenario: String,
-    /// Significant digits kept, and the absolute floor below which a metric is written as 0.
-    pub digits: u32,
+    /// Metrics below this are written as 0 (the scenario's tightest `steady_abs`).
     pub floor: f64,
     pub solvers: Vec<SolverSnapshot>,
+    /// Per pair, every gated quantity's measured difference to one significant digit
+    /// (written `4e-11`; `0` below [`ROUNDING`]).
+    pub differences: BTreeMap<String, BTreeMap<String, String>>,
 }
+
+/// Most significant digits a metric keeps: independent runs that converge to the same
+/// equilibrium agree to ~1e-14 relative (a few dozen ulps), so a 13th digit would change
+/// with another machine's rounding.
+pub const MAX_DIGITS: u32 = 12;
+
+/// Differences below this are floating-point rounding of the runs (a few hundred ulps of
+/// O(1) values, measured up to 5e-15 between two solvers on the same equilibrium).
+pub const ROUNDING: f64 = 1e-13;
 
 /// Rounds `v` to `digits` significant digits; `|v| < floor` gives 0 (never −0).
 pub fn round_sig(v: f64, digits: u32, floor: f64) -> f64 {
@@ -91,60 +112,117 @@ pub fn round_sig(v: f64, digits: u32, floor: f64) -> f64 {
     s.parse().unwrap_or(r)
 }
 
-/// Builds the snapshot of one scenario's results.
+/// A difference to one significant digit, as `4e-11`; `0` below [`ROUNDING`].
+pub fn one_digit(d: f64) -> String {
+    if d.is_finite() && d < ROUNDING {
+        "0".into()
+    } else {
+        format!("{:.0e}", d)
+    }
+}
+
+/// Rounds `v` to `decimals` decimal places (never −0).
+pub fn round_decimals(v: f64, decimals: u32) -> f64 {
+    if !v.is_finite() {
+        return v;
+    }
+    let s = format!("{:.*}", decimals as usize, v);
+    let r: f64 = s.parse().unwrap_or(v);
+    if r == 0.0 { 0.0 } else { r }
+}
+
+/// Digits a tolerance justifies: `⌊−log10 tol⌋`, at least 1, at most [`MAX_DIGITS`]
+/// (a tolerance of 0, exact agreement, keeps the most).
+pub fn digits_for(tol: f64) -> u32 {
+    if tol > 0.0 {
+        ((-tol.log10()).floor().max(1.0) as u32).min(MAX_DIGITS)
+    } else {
+        MAX_DIGITS
+    }
+}
+
+/// The snapshot of one scenario's results (the differences from [`crate::report::gate_scenario`]).
 pub fn snapshot(r: &ScenarioResult) -> ScenarioSnapshot {
-    let tols = r.scenario.tolerance.values();
-    let rel = tols
-        .clone()
-        .filter_map(|t| t.steady_rel)
-        .fold(f64::INFINITY, f64::min);
-    let floor = tols
+    let sc = &r.scenario;
+    let floor = sc
+        .tolerance
+        .values()
         .filter_map(|t| t.steady_abs)
         .fold(f64::INFINITY, f64::min);
-    // No stated steady tolerance (a scenario without compare.steady_from has no metrics: the
-    // loader requires steady_rel of every pair when it is set): 6 digits and a 1e-9 floor.
-    let floor = if floor.is_finite() { floor } else { 1e-9 };
-    let (digits, floor) = if rel.is_finite() && rel > 0.0 {
-        ((-rel.log10()).floor().max(1.0) as u32, floor)
-    } else {
-        (6, 1e-9)
-    };
+    let floor = if floor.is_finite() { floor } else { 0.0 };
     let solvers = r
         .runs
         .iter()
-        .map(|run| match &run.result {
-            Ok(t) => SolverSnapshot {
-                solver: run.kind.name(),
-                steady: t.metrics.map_or("none", |m| m.kind()).to_owned(),
-                metrics: t
-                    .metrics
-                    .map(|m| {
-                        m.values()
-                            .into_iter()
-                            .map(|(k, v)| (k, round_sig(v, digits, floor)))
-                            .collect()
-                    })
-                    .unwrap_or_default(),
-                counters: Counters::new(
-                    t.stats,
-                    matches!(t.metrics, Some(SteadyState::Equilibrium { .. })),
-                ),
-                error: None,
-            },
-            Err(e) => SolverSnapshot {
-                solver: run.kind.name(),
-                steady: "error".into(),
-                metrics: BTreeMap::new(),
-                counters: Counters::new(Stats::default(), false),
-                error: Some(e.to_string()),
-            },
+        .map(|run| {
+            // The tolerances of the pairs this solver is in.
+            let tols: Vec<_> = sc
+                .tolerance
+                .iter()
+                .filter(|(pair, _)| pair.split('-').any(|s| s == run.kind.name()))
+                .map(|(_, t)| *t)
+                .collect();
+            match &run.result {
+                Ok(t) => {
+                    let mut metrics = BTreeMap::new();
+                    let mut digits = BTreeMap::new();
+                    for (name, v) in t.metrics.map(|m| m.values()).unwrap_or_default() {
+                        let tightest = tols
+                            .iter()
+                            .filter_map(|p| p.for_metric(name).and_then(|(_, t)| t))
+                            .fold(f64::INFINITY, f64::min);
+                        let relative = tols
+                            .first()
+                            .and_then(|p| p.for_metric(name))
+                            .is_none_or(|(q, _)| q.relative);
+                        let d = digits_for(tightest);
+                        let rounded = if relative {
+                            round_sig(v, d, floor)
+                        } else {
+                            round_decimals(v, d)
+                        };
+                        metrics.insert(name, rounded);
+                        digits.insert(name, d);
+                    }
+                    SolverSnapshot {
+                        solver: run.kind.name(),
+                        steady: t.metrics.map_or("none", |m| m.kind()).to_owned(),
+                        metrics,
+                        digits,
+                        counters: Counters::new(
+                            t.stats,
+                            matches!(t.metrics, Some(SteadyState::Equilibrium { .. })),
+                        ),
+                        error: None,
+                    }
+                }
+                Err(e) => SolverSnapshot {
+                    solver: run.kind.name(),
+                    steady: "error".into(),
+                    metrics: BTreeMap::new(),
+                    digits: BTreeMap::new(),
+                    counters: Counters::new(Stats::default(), false),
+                    error: Some(e.to_string()),
+                },
+            }
+        })
+        .collect();
+    let differences = crate::report::gate_scenario(r)
+        .0
+        .into_iter()
+        .map(|g| {
+            let q = g
+                .measured
+                .iter()
+                .map(|m| (m.quantity.clone(), one_digit(m.diff)))
+                .collect();
+            (g.pair, q)
         })
         .collect();
     ScenarioSnapshot {
-        scenario: r.scenario.name.clone(),
-        digits,
+        scenario: sc.name.clone(),
         floor,
         solvers,
+        differences,
     }
 }
 
@@ -161,6 +239,28 @@ mod tests {
         assert!(round_sig(-3e-12, 5, 1e-9).is_sign_positive());
         assert_eq!(round_sig(99999.7, 5, 1e-9), 100000.0);
         assert_eq!(format!("{}", round_sig(0.1 + 0.2, 5, 0.0)), "0.3");
+    }
+
+    #[test]
+    fn differences_keep_one_digit_and_drop_rounding() {
+        assert_eq!(one_digit(3.22e-11), "3e-11");
+        assert_eq!(one_digit(5.59e-9), "6e-9");
+        assert_eq!(one_digit(5.4e-15), "0");
+        assert_eq!(one_digit(0.0), "0");
+        assert_eq!(one_digit(f64::INFINITY), "inf");
+        assert_eq!(one_digit(f64::NAN), "NaN");
+    }
+
+    #[test]
+    fn decimals_and_digits_from_tolerances() {
+        assert_eq!(round_decimals(0.870771234, 7), 0.8707712);
+        assert_eq!(round_decimals(-1e-12, 7), 0.0);
+        assert!(round_decimals(-1e-12, 7).is_sign_positive());
+        assert_eq!(digits_for(2e-10), 9);
+        assert_eq!(digits_for(1e-6), 6);
+        assert_eq!(digits_for(0.5), 1);
+        assert_eq!(digits_for(1e-20), MAX_DIGITS);
+        assert_eq!(digits_for(0.0), MAX_DIGITS);
     }
 
     #[test]

@@ -5,10 +5,10 @@ use std::path::Path;
 
 use std::sync::OnceLock;
 
-use rotor_compare::report::gate_scenario;
+use rotor_compare::report::{PAIRS, gate_scenario};
 use rotor_compare::snapshot::snapshot;
 use rotor_compare::{ScenarioResult, SolverKind, run_scenario};
-use rotor_model::Scenario;
+use rotor_model::{Disc, Event, EventKind, Scenario, State, SteadyState, Trajectory};
 
 /// Every fixture through the three solvers, once per test binary (shared by the tests).
 fn all() -> Vec<ScenarioResult> {
@@ -106,4 +106,149 @@ fn every_fixture_agrees_across_the_three_solvers_and_a_perturbation_is_caught() 
         fails.iter().all(|f| f.pair == "event-switch"),
         "only the perturbed pair fails"
     );
+}
+
+/// Moves one metric of a steady state by `by` (absolute).
+fn shift_metric(m: &mut SteadyState, name: &str, by: f64) {
+    let v = match (m, name) {
+        (SteadyState::Equilibrium { omega_u, .. }, "omega_u") => omega_u,
+        (SteadyState::Equilibrium { omega_l, .. }, "omega_l") => omega_l,
+        (SteadyState::Equilibrium { alpha, .. }, "alpha") => alpha,
+        (SteadyState::LimitCycle { period, .. }, "period") => period,
+        (SteadyState::LimitCycle { omega_l_max, .. }, "omega_l_max") => omega_l_max,
+        (SteadyState::LimitCycle { omega_l_min, .. }, "omega_l_min") => omega_l_min,
+        (SteadyState::LimitCycle { omega_u_max, .. }, "omega_u_max") => omega_u_max,
+        (SteadyState::LimitCycle { omega_u_min, .. }, "omega_u_min") => omega_u_min,
+        (SteadyState::LimitCycle { stick_time, .. }, "stick_time") => stick_time,
+        (m, n) => panic!("{n} is not a metric of {m:?}"),
+    };
+    *v += by;
+}
+
+/// The negative control of every gate of every fixture: each stated tolerance, one at a time,
+/// is exceeded (three times the gate, plus the measured difference) in one solver's result,
+/// and exactly that quantity must fail. So no gate is stated but not applied, or applied to
+/// another quantity.
+#[test]
+fn every_gate_of_every_fixture_fails_its_negative_control() {
+    let results = all();
+    let mut checked = 0;
+    for r in &results {
+        let sc = &r.scenario;
+        let [t0, t1] = sc.compare.transient.unwrap();
+        for (a, b) in PAIRS {
+            let pair = format!("{}-{}", a.name(), b.name());
+            let tol = sc.tolerance[&pair];
+            let base = gate_scenario(r)
+                .0
+                .into_iter()
+                .find(|g| g.pair == pair)
+                .unwrap();
+            for m in &base.measured {
+                let mut p = r.clone();
+                let run = p.runs.iter_mut().find(|run| run.kind == b).unwrap();
+                let tr: &mut Trajectory = run.result.as_mut().unwrap();
+                let excess = 3.0 * m.tol + m.diff + 1e-12;
+                let q = m.quantity.as_str();
+                if q.starts_with("transient max") {
+                    let s = tr
+                        .samples
+                        .iter_mut()
+                        .find(|s| s.t >= t0 && s.t <= t1)
+                        .unwrap();
+                    s.x[2] += excess;
+                } else if q.starts_with("transient rms") {
+                    for s in tr.samples.iter_mut().filter(|s| s.t >= t0 && s.t <= t1) {
+                        s.x[2] += excess;
+                    }
+                } else if q.starts_with("stick event times") {
+                    match tr.events.iter_mut().find(|e| {
+                        e.t >= t0
+                            && e.t <= t1
+                            && matches!(e.kind, EventKind::StickStart(Disc::Lower))
+                    }) {
+                        Some(e) => e.t += excess,
+                        // No stick event in the window: one that appears must fail.
+                        None => tr.events.push(Event {
+                            t: 0.5 * (t0 + t1),
+                            x: State::zeros(),
+                            kind: EventKind::StickStart(Disc::Lower),
+                        }),
+                    }
+                } else if let Some(name) = q.strip_prefix("steady ") {
+                    let metrics = tr.metrics.as_mut().unwrap();
+                    let v = metrics
+                        .values()
+                        .into_iter()
+                        .find(|v| v.0 == name)
+                        .unwrap()
+                        .1;
+                    let (quantity, gate) = tol.for_metric(name).unwrap();
+                    let gate = gate.unwrap();
+                    let by = if quantity.relative {
+                        3.0 * (gate * v.abs()).max(tol.steady_abs.unwrap_or(0.0))
+                            + m.diff * v.abs()
+                            + 1e-12
+                    } else {
+                        excess
+                    };
+                    shift_metric(metrics, name, by);
+                } else {
+                    panic!("{}: unknown quantity {q}", sc.name);
+                }
+                let fails = gate_scenario(&p).1;
+                assert!(
+                    fails.iter().any(|f| f.pair == pair
+                        && f.quantity
+                            .starts_with(&q[..q.find(" (").unwrap_or(q.len())])),
+                    "{} {pair}: {q} exceeded but not caught: {fails:?}",
+                    sc.name
+                );
+                assert!(
+                    fails.iter().all(|f| f.pair == pair),
+                    "{} {pair}: {q}: another pair failed: {fails:?}",
+                    sc.name
+                );
+                checked += 1;
+            }
+        }
+    }
+    // 14 fixtures x 2 pairs x (3 transient + 3 equilibrium or 6 cycle metrics).
+    assert!(checked >= 14 * 2 * 6, "{checked}");
+}
+
+/// A shift of 1e-6 (relative) of a cycle's period in all three solvers alike passes every pair
+/// gate (they compare solvers with each other); the snapshot must see it.
+#[test]
+fn a_shift_of_every_solver_alike_changes_the_snapshot() {
+    let results = all();
+    let mut cycles = 0;
+    for r in &results {
+        let mut p = r.clone();
+        let mut any = false;
+        for run in &mut p.runs {
+            if let Some(SteadyState::LimitCycle { period, .. }) =
+                run.result.as_mut().unwrap().metrics.as_mut()
+            {
+                *period *= 1.0 + 1e-6;
+                any = true;
+            }
+        }
+        if !any {
+            continue;
+        }
+        cycles += 1;
+        assert!(gate_scenario(&p).1.is_empty(), "{}", r.scenario.name);
+        // The reference and the switch model keep the digits of the tight event-switch gate;
+        // Moreau-Jean's value keeps those of its own (looser) gate and may not move.
+        let (a, b) = (snapshot(r), snapshot(&p));
+        for (sa, sb) in a.solvers.iter().zip(&b.solvers).take(2) {
+            assert_ne!(
+                sa.metrics["period"], sb.metrics["period"],
+                "{} {}: the snapshot does not see a 1e-6 shift",
+                r.scenario.name, sa.solver
+            );
+        }
+    }
+    assert!(cycles >= 7, "{cycles}");
 }

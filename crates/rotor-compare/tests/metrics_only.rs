@@ -1,25 +1,33 @@
 //! `Output::Metrics`: a scene that asks for the steady state only skips whole periods once the
-//! orbit is on its cycle (`rotor_model::FastForward`). Its answer must pass the same agreement
-//! gate as the full run; where nothing is skipped it must be the full run, bit for bit; and a
-//! skip that the return after it does not confirm must be undone.
+//! orbit is on its cycle (`rotor_model::FastForward`). Its answer must be the solver's full-run
+//! answer within what the skip may change (below); where nothing is skipped it must be the full
+//! run, bit for bit; and a skip that the return after it does not confirm must be undone. (The
+//! full runs pass the fixtures' agreement gates in `fixtures.rs`.)
 
 use std::path::Path;
 use std::sync::OnceLock;
 
 use rotor_compare::SolverKind;
-use rotor_compare::gate::check_pair;
 use rotor_compare::run::scene_for;
 use rotor_event::{EventOptions, EventSolver};
 use rotor_model::{Output, Scenario, Scene, Solver, SteadyState, Trajectory};
 use rotor_moreau::{MoreauOptions, MoreauSolver};
 use rotor_switch::{SwitchOptions, SwitchSolver};
 
-/// The event solver's metrics-only answer against its own full run: two integrations at tol
-/// 1e-12 whose step sequences differ (the skip restarts the integrator at the anchor), each
-/// within ~1e-12 relative of the truth on the cycles (`rotor bench`: steady error 1.4e-12 and
-/// 7.3e-13 at tol 1e-12 against tol 1e-13). Measured over the fixtures: ≤ 1.9e-11 relative
-/// (t1-u4.5-rest). 2e-10 = 10× that.
-const EVENT_SELF_REL: f64 = 2e-10;
+/// How far a solver's metrics-only answer may lie from its own full run, relative to
+/// `max(|m|, 1)`. The skip restarts the integration at the anchor, so the adaptive solvers'
+/// step sequences differ afterwards (each run within its tolerance of the truth), and
+/// Moreau–Jean's step grid lands at another phase of the cycle, which moves its O(h²) event
+/// location errors. Measured over the fixtures (comparison settings: event tol 1e-12, switch
+/// 1e-10, Moreau–Jean h = 1e-3): event ≤ 8.4e-12, switch ≤ 1.7e-12, Moreau–Jean ≤ 1.5e-7
+/// (= 0.15 h²). Gates about 5× those.
+fn self_gate(kind: SolverKind) -> f64 {
+    match kind {
+        SolverKind::Event => 4e-11,
+        SolverKind::Switch => 1e-11,
+        SolverKind::Moreau => 8e-7,
+    }
+}
 
 fn scenarios() -> &'static [Scenario] {
     static ALL: OnceLock<Vec<Scenario>> = OnceLock::new();
@@ -43,20 +51,9 @@ fn run(solver: &dyn Solver, sc: &Scenario, kind: SolverKind, output: Output) -> 
     solver.simulate_finite(&sc.model, &scene).unwrap()
 }
 
-/// The full run of the event solver at the comparison's setting: the reference.
-fn reference(sc: &Scenario) -> Trajectory {
-    run(
-        &EventSolver::default(),
-        sc,
-        SolverKind::Event,
-        Output::Final,
-    )
-}
-
-/// Failures of `fast` against the reference under the scenario's steady gate for `kind`
-/// (the event solver against its own full run, [`EVENT_SELF_REL`]).
-fn gate(sc: &Scenario, kind: SolverKind, reference: &Trajectory, fast: &Trajectory) -> Vec<String> {
-    let (Some(a), Some(b)) = (reference.metrics, fast.metrics) else {
+/// Failures of a metrics-only answer `fast` against the same solver's full run.
+fn gate(sc: &Scenario, kind: SolverKind, full: &Trajectory, fast: &Trajectory) -> Vec<String> {
+    let (Some(a), Some(b)) = (full.metrics, fast.metrics) else {
         return vec![format!("{} {}: no metrics", sc.name, kind.name())];
     };
     if a.kind() != b.kind() {
@@ -68,33 +65,26 @@ fn gate(sc: &Scenario, kind: SolverKind, reference: &Trajectory, fast: &Trajecto
             b.kind()
         )];
     }
-    if kind == SolverKind::Event {
-        return a
-            .values()
-            .into_iter()
-            .zip(b.values())
-            .filter(|((_, va), (_, vb))| {
-                (va - vb).abs() > EVENT_SELF_REL * va.abs().max(vb.abs()).max(1.0)
-            })
-            .map(|((n, va), (_, vb))| format!("{} event {n}: {va} vs {vb}", sc.name))
-            .collect();
-    }
-    let pair = format!("event-{}", kind.name());
-    let tol = &sc.tolerance[&pair];
-    check_pair(&pair, reference, fast, None, tol)
-        .failures(&sc.name)
-        .iter()
-        .map(|f| format!("{f:?}"))
+    let g = self_gate(kind);
+    a.values()
+        .into_iter()
+        .zip(b.values())
+        .filter(|((_, va), (_, vb))| {
+            let d = (va - vb).abs();
+            d.is_nan() || d > g * va.abs().max(vb.abs()).max(1.0)
+        })
+        .map(|((n, va), (_, vb))| {
+            format!("{} {} {n}: {va} vs {vb} (gate {g:e})", sc.name, kind.name())
+        })
         .collect()
 }
 
 #[test]
-fn metrics_only_scenes_pass_the_gate_and_skip_only_converged_cycles() {
+fn metrics_only_scenes_give_the_full_answer_and_skip_only_converged_cycles() {
     use rayon::prelude::*;
     let rows: Vec<(String, SolverKind, u64, u64, u64, Vec<String>)> = scenarios()
         .par_iter()
         .flat_map(|sc| {
-            let reference = reference(sc);
             SolverKind::ALL
                 .iter()
                 .map(|&kind| {
@@ -102,7 +92,7 @@ fn metrics_only_scenes_pass_the_gate_and_skip_only_converged_cycles() {
                     let full = run(&*s, sc, kind, Output::Final);
                     let fast = run(&*s, sc, kind, Output::Metrics);
                     assert!(fast.samples.is_empty() && fast.events.is_empty());
-                    let mut bad = gate(sc, kind, &reference, &fast);
+                    let mut bad = gate(sc, kind, &full, &fast);
                     // Nothing skipped or undone: the run was never stopped, so it is the full
                     // run.
                     if fast.stats.skipped_periods == 0
@@ -161,7 +151,6 @@ fn a_skip_that_the_next_return_does_not_confirm_is_undone() {
         .iter()
         .find(|s| s.name == "t1-u1.5-rest")
         .unwrap();
-    let reference = reference(sc);
     let solvers: [(SolverKind, Box<dyn Solver>); 3] = [
         (
             SolverKind::Event,
@@ -206,7 +195,7 @@ fn a_skip_that_the_next_return_does_not_confirm_is_undone() {
             undone.metrics,
             Some(SteadyState::LimitCycle { .. })
         ));
-        let bad = gate(sc, kind, &reference, &undone);
+        let bad = gate(sc, kind, &full, &undone);
         assert!(bad.is_empty(), "{bad:#?}");
         // The skipped periods were integrated after all, plus the cycle after the skip.
         assert!(

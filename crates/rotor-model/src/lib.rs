@@ -23,7 +23,9 @@ pub use friction::Friction;
 pub use lagrangian::{Coords, Lagrangian};
 pub use num::Num;
 pub use params::{LowerFriction, Params, ParamsError, UpperFriction};
-pub use scenario::{CompareSpec, PairTolerance, Scenario, ScenarioError};
+pub use scenario::{
+    CompareSpec, PairTolerance, STEADY_QUANTITIES, Scenario, ScenarioError, SteadyQuantity,
+};
 pub use scene::{
     Event, EventKind, Output, OutputGrid, Sample, Scene, SolveError, Solver, Stats, Trajectory,
     check_finite,

@@ -9,8 +9,10 @@
 //! [compare]
 //! transient = [0.0, 20.0]            # s, compared sample by sample
 //! steady_from = 100.0                # s, steady-state metrics over [steady_from, t_end]
-//! [tolerance.event-switch]           # per solver pair; each value with its origin
-//! transient_max = 1e-6
+//! [tolerance.event-switch]           # per solver pair and quantity, each with its origin
+//! transient_max = 3e-8               # rad/s
+//! period_rel = 2e-10                 # relative; also omega_l_rel, omega_u_rel,
+//! stick_time = 1e-7                  # s                   equilibrium_rel, steady_abs
 //! ```
 
 use std::collections::BTreeMap;
@@ -80,20 +82,121 @@ impl Default for CompareSpec {
     }
 }
 
-/// Agreement tolerances for one solver pair (each with its origin in a comment in the file).
+/// Agreement tolerances for one solver pair, one per quantity, each with its origin in a
+/// comment in the file. The steady-state ones are relative (with `steady_abs` as the floor for
+/// values near 0), except `stick_time`, which is in seconds: a stick phase is located to an
+/// absolute time, whatever its length.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct PairTolerance {
-    /// Max |Δω| over the transient window [rad/s].
+    /// Max |Δω| (both discs) over the transient window [rad/s].
     pub transient_max: Option<f64>,
-    /// RMS of Δω over the transient window [rad/s].
+    /// RMS of Δω (both discs) over the transient window [rad/s].
     pub transient_rms: Option<f64>,
-    /// Relative difference of each steady-state metric (with `steady_abs` as a floor).
-    pub steady_rel: Option<f64>,
-    /// Absolute floor of the steady-state comparison [s or rad/s].
-    pub steady_abs: Option<f64>,
-    /// Max difference of matched event times [s].
+    /// Max difference of matched lower-disc stick event times in the window [s].
     pub event_time: Option<f64>,
+    /// Period of a limit cycle, relative.
+    pub period_rel: Option<f64>,
+    /// Max and min of ω_l over a cycle, relative.
+    pub omega_l_rel: Option<f64>,
+    /// Max and min of ω_u over a cycle, relative.
+    pub omega_u_rel: Option<f64>,
+    /// Time per period with ω_l = 0 [s].
+    pub stick_time: Option<f64>,
+    /// The equilibrium's ω_u, ω_l and α, relative.
+    pub equilibrium_rel: Option<f64>,
+    /// Absolute floor of the relative steady-state tolerances [s or rad/s or rad]: a value
+    /// that is ~0 (ω_l's minimum on a stick-slip cycle) is compared absolutely.
+    pub steady_abs: Option<f64>,
+}
+
+/// The steady-state quantities a [`PairTolerance`] gates: the metric names of
+/// [`crate::SteadyState::values`] they cover, whether the tolerance is relative, and its
+/// key in the file.
+pub const STEADY_QUANTITIES: [SteadyQuantity; 5] = [
+    SteadyQuantity {
+        key: "period_rel",
+        metrics: &["period"],
+        relative: true,
+    },
+    SteadyQuantity {
+        key: "omega_l_rel",
+        metrics: &["omega_l_max", "omega_l_min"],
+        relative: true,
+    },
+    SteadyQuantity {
+        key: "omega_u_rel",
+        metrics: &["omega_u_max", "omega_u_min"],
+        relative: true,
+    },
+    SteadyQuantity {
+        key: "stick_time",
+        metrics: &["stick_time"],
+        relative: false,
+    },
+    SteadyQuantity {
+        key: "equilibrium_rel",
+        metrics: &["omega_u", "omega_l", "alpha"],
+        relative: true,
+    },
+];
+
+/// One steady-state tolerance: its key in the file and the metrics it covers.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct SteadyQuantity {
+    pub key: &'static str,
+    pub metrics: &'static [&'static str],
+    pub relative: bool,
+}
+
+impl PairTolerance {
+    /// The tolerance stated under `key` (a [`SteadyQuantity::key`] or a transient key).
+    pub fn get(&self, key: &str) -> Option<f64> {
+        match key {
+            "transient_max" => self.transient_max,
+            "transient_rms" => self.transient_rms,
+            "event_time" => self.event_time,
+            "period_rel" => self.period_rel,
+            "omega_l_rel" => self.omega_l_rel,
+            "omega_u_rel" => self.omega_u_rel,
+            "stick_time" => self.stick_time,
+            "equilibrium_rel" => self.equilibrium_rel,
+            "steady_abs" => self.steady_abs,
+            _ => None,
+        }
+    }
+
+    /// Every stated tolerance with its key, in file order.
+    pub fn stated(&self) -> Vec<(&'static str, f64)> {
+        [
+            "transient_max",
+            "transient_rms",
+            "event_time",
+            "period_rel",
+            "omega_l_rel",
+            "omega_u_rel",
+            "stick_time",
+            "equilibrium_rel",
+            "steady_abs",
+        ]
+        .into_iter()
+        .filter_map(|k| self.get(k).map(|v| (k, v)))
+        .collect()
+    }
+
+    /// The steady-state quantity gating a metric of [`crate::SteadyState::values`], and its
+    /// tolerance if stated.
+    pub fn for_metric(&self, metric: &str) -> Option<(SteadyQuantity, Option<f64>)> {
+        STEADY_QUANTITIES
+            .into_iter()
+            .find(|q| q.metrics.contains(&metric))
+            .map(|q| (q, self.get(q.key)))
+    }
+
+    /// Whether any steady-state tolerance is stated.
+    pub fn gates_steady(&self) -> bool {
+        STEADY_QUANTITIES.iter().any(|q| self.get(q.key).is_some())
+    }
 }
 
 #[derive(Debug, Deserialize)]
@@ -348,20 +451,14 @@ impl Scenario {
                     "unknown solver pair (expected \"event-switch\" or \"event-moreau\")",
                 ));
             }
-            for (name, v) in [
-                ("transient_max", tol.transient_max),
-                ("transient_rms", tol.transient_rms),
-                ("steady_rel", tol.steady_rel),
-                ("steady_abs", tol.steady_abs),
-                ("event_time", tol.event_time),
-            ] {
-                if let Some(v) = v
-                    && !(v > 0.0 && v.is_finite())
-                {
+            // Non-negative: 0 is a gate of exact agreement (both discs stuck from rest, where
+            // every solver must return x = 0 exactly).
+            for (name, v) in tol.stated() {
+                if !(v >= 0.0 && v.is_finite()) {
                     return Err(bad(
                         &format!("tolerance.{pair}.{name}"),
                         crate::Num(v).to_string(),
-                        "must be positive and finite",
+                        "must be non-negative and finite",
                     ));
                 }
             }
@@ -369,41 +466,18 @@ impl Scenario {
             // gate: otherwise a pair would pass having measured nothing.
             let transient = raw.compare.transient.is_some();
             let steady = raw.compare.steady_from.is_some();
-            for (name, v, needed, why) in [
-                (
-                    "transient_max",
-                    tol.transient_max,
-                    transient,
-                    "needs compare.transient (the window it gates)",
-                ),
-                (
-                    "transient_rms",
-                    tol.transient_rms,
-                    transient,
-                    "needs compare.transient (the window it gates)",
-                ),
-                (
-                    "event_time",
-                    tol.event_time,
-                    transient,
-                    "needs compare.transient (the window it gates)",
-                ),
-                (
-                    "steady_rel",
-                    tol.steady_rel,
-                    steady,
-                    "needs compare.steady_from (the metrics it gates)",
-                ),
-                (
-                    "steady_abs",
-                    tol.steady_abs,
-                    steady && tol.steady_rel.is_some(),
-                    "is the floor of steady_rel and needs it (and compare.steady_from)",
-                ),
-            ] {
-                if let Some(v) = v
-                    && !needed
-                {
+            for (name, v) in tol.stated() {
+                let (needed, why) = match name {
+                    "transient_max" | "transient_rms" | "event_time" => {
+                        (transient, "needs compare.transient (the window it gates)")
+                    }
+                    "steady_abs" => (
+                        steady && tol.gates_steady(),
+                        "is the floor of the steady-state tolerances and needs one of them (and compare.steady_from)",
+                    ),
+                    _ => (steady, "needs compare.steady_from (the metrics it gates)"),
+                };
+                if !needed {
                     return Err(bad(
                         &format!("tolerance.{pair}.{name}"),
                         crate::Num(v).to_string(),
@@ -418,11 +492,24 @@ impl Scenario {
                     "is required when compare.transient is set: the window would be ungated",
                 ));
             }
-            if steady && tol.steady_rel.is_none() {
+            // A steady state is gated either as an equilibrium or as a cycle, with every
+            // metric of its kind: a cycle tolerance that is missing would leave that metric
+            // ungated (the gate fails a steady state whose kind has no tolerances).
+            if steady && !tol.gates_steady() {
                 return Err(bad(
-                    &format!("tolerance.{pair}.steady_rel"),
+                    &format!("tolerance.{pair}.equilibrium_rel"),
                     "(missing)".into(),
-                    "is required when compare.steady_from is set: the metrics would be ungated",
+                    "is required when compare.steady_from is set, unless the cycle tolerances (period_rel, omega_l_rel, omega_u_rel, stick_time) are given: the metrics would be ungated",
+                ));
+            }
+            let cycle = ["period_rel", "omega_l_rel", "omega_u_rel", "stick_time"];
+            if cycle.iter().any(|k| tol.get(k).is_some())
+                && let Some(missing) = cycle.iter().find(|k| tol.get(k).is_none())
+            {
+                return Err(bad(
+                    &format!("tolerance.{pair}.{missing}"),
+                    "(missing)".into(),
+                    "is required with the other cycle tolerances: that metric would be ungated",
                 ));
             }
         }

@@ -98,10 +98,32 @@ pub fn short_horizon_scenario() -> String {
     let s = edit(&s, "steady_from = 100.0", "");
     let s: String = s
         .lines()
-        .filter(|l| !l.starts_with("steady_"))
+        .filter(|l| !STEADY_KEYS.iter().any(|k| l.starts_with(k)))
         .map(|l| format!("{l}\n"))
         .collect();
     edit(&s, "t_end = 200.0", "t_end = 5e-4")
+}
+
+/// The keys of a `[tolerance.*]` table that gate the steady state.
+const STEADY_KEYS: [&str; 6] = [
+    "period_rel",
+    "omega_l_rel",
+    "omega_u_rel",
+    "stick_time",
+    "equilibrium_rel",
+    "steady_abs",
+];
+
+/// [`local_scenario`] with the steady-state tolerances of its first pair commented out, except
+/// those in `keep`.
+fn without_steady_gates(keep: &[&str]) -> String {
+    let mut s = local_scenario();
+    for k in STEADY_KEYS.iter().filter(|k| !keep.contains(k)) {
+        if s.lines().any(|l| l.starts_with(&format!("{k} = "))) {
+            s = edit(&s, &format!("{k} = "), &format!("# {k} = "));
+        }
+    }
+    s
 }
 
 /// One bad file: its contents and what the error message must contain.
@@ -403,9 +425,9 @@ pub fn bad_scenario_cases() -> Vec<BadFile> {
             &["unknown field", "window = 3"],
         ),
         sc(
-            "transient_rms = 2e-8",
-            "transient_rsm = 2e-8",
-            &["unknown field", "transient_rsm = 2e-8"],
+            "transient_rms = ",
+            "transient_rsm = ",
+            &["unknown field", "transient_rsm = "],
         ),
         // Missing keys.
         sc("u = 1.5", "", &["missing field", "`u`"]),
@@ -460,9 +482,17 @@ pub fn bad_scenario_cases() -> Vec<BadFile> {
             &["compare.steady_from = 250"],
         ),
         sc(
-            "transient_max = 1e-7 ",
-            "transient_max = -1e-7 ",
-            &["tolerance.event-switch.transient_max = -1e-7"],
+            "transient_max = ",
+            "transient_max = -",
+            &["tolerance.event-switch.transient_max = -", "non-negative"],
+        ),
+        sc(
+            "stick_time = ",
+            "stick_time = inf #",
+            &[
+                "tolerance.event-switch.stick_time = inf",
+                "non-negative and finite",
+            ],
         ),
         // A window that may hold no grid sample, tolerances without the window they gate,
         // and windows without a gate: each would let a pair pass having measured nothing.
@@ -479,20 +509,37 @@ pub fn bad_scenario_cases() -> Vec<BadFile> {
         sc(
             "steady_from = 100.0",
             "",
-            &["steady_rel = ", "needs compare.steady_from"],
+            &["period_rel = ", "needs compare.steady_from"],
         ),
         sc(
-            "transient_max = 1e-7 ",
-            "",
+            "transient_max = ",
+            "# transient_max = ",
             &[
                 "tolerance.event-switch.transient_max = (missing)",
                 "ungated",
             ],
         ),
+        // A cycle gated without one of its metrics, or a steady state without any gate.
         sc(
-            "steady_rel = 2e-6",
-            "",
-            &["tolerance.event-switch.steady_abs = 1e-9", "needs it"],
+            "period_rel = ",
+            "# period_rel = ",
+            &[
+                "tolerance.event-switch.period_rel = (missing)",
+                "other cycle tolerances",
+            ],
+        ),
+        raw(
+            "the steady floor without a steady tolerance",
+            without_steady_gates(&["steady_abs"]),
+            &["tolerance.event-switch.steady_abs = ", "needs one of them"],
+        ),
+        raw(
+            "no steady tolerance while compare.steady_from is set",
+            without_steady_gates(&[]),
+            &[
+                "tolerance.event-switch.equilibrium_rel = (missing)",
+                "ungated",
+            ],
         ),
         // A misspelt pair would leave the pair ungated.
         sc(
