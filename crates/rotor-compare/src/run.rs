@@ -28,6 +28,11 @@ impl SolverKind {
         }
     }
 
+    /// Whether the accuracy knob is a fixed step h (else a tolerance).
+    pub fn is_fixed_step(self) -> bool {
+        self.setting_name() == "h"
+    }
+
     /// Short name (as the CLI's `--solver`).
     pub fn name(self) -> &'static str {
         match self {

@@ -13,15 +13,14 @@
 //!   skips converged periods) gives each solver's full-run answer within its error.
 
 use proptest::prelude::*;
+use proptest::test_runner::TestCaseError;
 use rayon::prelude::*;
 use rotor_compare::SolverKind;
 use rotor_compare::stress::{
-    Gate, Measure, Outcome, Setting, StressCase, StressRow, cases, full_from_env, linear_exact,
-    run_case, stress_table_markdown,
+    Gate, MAX_LOOSENESS, Measure, Outcome, Setting, StressCase, StressRow, cases, full_from_env,
+    linear_exact, run_case, stress_table_markdown,
 };
-use rotor_model::{
-    Event, LowerFriction, Model, Output, Params, Scene, Solver, State, UpperFriction,
-};
+use rotor_model::{Event, LowerFriction, Model, Output, Params, Scene, State, UpperFriction};
 
 #[test]
 fn stress_cases_finish_and_agree_within_their_gates() {
@@ -53,6 +52,30 @@ fn stress_cases_finish_and_agree_within_their_gates() {
     for r in &rows {
         assert_eq!(r.outcome, Outcome::Finished, "{} / {}", r.case, r.setting);
     }
+    // Every gate is within MAX_LOOSENESS of what it measures (a measured 0 needs a gate of 0):
+    // a looser gate would pass a real regression.
+    let loose: Vec<String> = rows
+        .iter()
+        .filter(|r| {
+            r.looseness()
+                .is_some_and(|l| l.is_nan() || l > MAX_LOOSENESS)
+        })
+        .map(|r| {
+            format!(
+                "{} / {} {}: gate {:?} vs measured {:?}",
+                r.case,
+                r.solver.name(),
+                r.setting,
+                r.gate,
+                r.agreement
+            )
+        })
+        .collect();
+    assert!(
+        loose.is_empty(),
+        "gates looser than {MAX_LOOSENESS}x:\n{}",
+        loose.join("\n")
+    );
     // Every finished, gated row was measured.
     for r in &rows {
         if r.gate.is_some() {
@@ -301,91 +324,179 @@ fn energy_residual(m: &Model, u: f64, samples: &[(f64, State)], events: &[Event]
     (worst, bound)
 }
 
-fn event_run(m: &Model, u: f64, x0: State, tol: f64) -> (Vec<(f64, State)>, Vec<Event>) {
+/// A run for the energy balance: the event-driven and switch models at `tol` sampled every
+/// 1e-4 s, Moreau–Jean at step h = 1e-4 with its state after every step (the initial state
+/// first); samples and events.
+fn energy_run(
+    kind: SolverKind,
+    m: &Model,
+    u: f64,
+    x0: State,
+    tol: f64,
+) -> (Vec<(f64, State)>, Vec<Event>) {
+    let fixed = kind.is_fixed_step();
     let scene = Scene {
         u,
         x0,
         t_end: 10.0,
         tol,
-        h: 1e-3,
-        output: Output::Grid { dt: 1e-4 },
+        h: 1e-4,
+        output: if fixed {
+            Output::Steps
+        } else {
+            Output::Grid { dt: 1e-4 }
+        },
         metrics_from: None,
     };
-    let tr = rotor_event::EventSolver::default()
-        .simulate(m, &scene)
-        .expect("event-driven run");
-    (tr.samples.iter().map(|s| (s.t, s.x)).collect(), tr.events)
+    let tr = kind.solver().simulate(m, &scene).expect("energy run");
+    let mut s: Vec<(f64, State)> = tr.samples.iter().map(|s| (s.t, s.x)).collect();
+    if fixed {
+        s.insert(0, (0.0, x0));
+    }
+    (s, tr.events)
+}
+
+/// Tolerance of the adaptive solvers' energy runs.
+const ENERGY_TOL: f64 = 1e-10;
+
+/// The solver's share of the energy residual, set in advance from its accuracy setting,
+/// relative to the energy scale `1 + max E`:
+/// * event-driven: `2e4·tol`. Measured (residual − quadrature bound) ≤ 7.0e3·tol over 150
+///   random sets at tol 1e-10 and 1e-8 (DOP853's dense output between its long steps);
+/// * switch model: `2·tol`, measured ≤ 0.48·tol at tol 1e-8 and 0 at 1e-10;
+/// * Moreau–Jean: 0. The θ = 1/2 step changes the energy by exactly h times the power at the
+///   step's midpoint (`E_{k+1} − E_k = v_{k+1/2}·M(v_{k+1} − v_k) + …`), so along its own
+///   steps the residual is the trapezoid rule's quadrature error, which the bound covers
+///   (measured: never above it in 150 sets at h = 1e-3 and 1e-4).
+fn solver_share(kind: SolverKind) -> f64 {
+    match kind {
+        SolverKind::Event => 2e4 * ENERGY_TOL,
+        SolverKind::Switch => 2.0 * ENERGY_TOL,
+        SolverKind::Moreau => 0.0,
+    }
+}
+
+/// Rounding of ~1e5 additions of O(scale) terms, relative to the energy scale.
+const ENERGY_ROUNDING: f64 = 1e-11;
+
+/// The energy balance of one solver's run: `(residual, allowed)`, the allowed residual being
+/// the quadrature bound plus the solver's share and rounding (both times the energy scale).
+fn energy_check(
+    kind: SolverKind,
+    m: &Model,
+    u: f64,
+    s: &[(f64, State)],
+    e: &[Event],
+) -> (f64, f64, f64) {
+    let (r, quad) = energy_residual(m, u, s, e);
+    let scale = 1.0 + s.iter().map(|s| m.energy(&s.1)).fold(0.0, f64::max);
+    (
+        r,
+        quad + (solver_share(kind) + ENERGY_ROUNDING) * scale,
+        quad / scale,
+    )
+}
+
+/// `max |x(−u, −x0) + x(u, x0)|` over two runs' samples (∞ if their grids differ).
+fn mirror_gap(a: &rotor_model::Trajectory, b: &rotor_model::Trajectory) -> f64 {
+    if a.samples.len() != b.samples.len() {
+        return f64::INFINITY;
+    }
+    a.samples
+        .iter()
+        .zip(&b.samples)
+        .map(|(p, q)| {
+            if p.t != q.t {
+                return f64::INFINITY;
+            }
+            (0..3).map(|i| (p.x[i] + q.x[i]).abs()).fold(0.0, f64::max)
+        })
+        .fold(0.0, f64::max)
 }
 
 proptest! {
     #![proptest_config(ProptestConfig { cases: 24, ..ProptestConfig::default() })]
 
     #[test]
-    fn stress_random_parameters_no_nan_and_energy_balance(
+    fn stress_random_parameters_no_nan_mirror_and_energy_balance(
         p in params_near_table1(),
         x0 in state_near_rest(),
         fu in 0.5..2.0f64,
     ) {
         let m = Model::new(p);
         let u = 1.5 * fu;
-        // No panic, no NaN in any solver.
         for kind in SolverKind::ALL {
+            // No panic, no NaN.
             let scene = Scene { u, x0, t_end: 10.0, tol: 1e-10, h: 1e-3,
                 output: Output::Grid { dt: 0.01 }, metrics_from: Some(5.0) };
-            match kind.solver().simulate(&m, &scene) {
-                Ok(tr) => {
-                    prop_assert!(tr.samples.iter().all(|s| s.x.iter().all(|v| v.is_finite())),
-                        "{}: NaN in samples", kind.name());
-                    prop_assert!(tr.metrics.is_some_and(|s| s.values().iter().all(|v| v.1.is_finite())));
-                }
-                Err(e) => prop_assert!(false, "{}: {e}", kind.name()),
-            }
+            let tr = match kind.solver().simulate(&m, &scene) {
+                Ok(tr) => tr,
+                Err(e) => return Err(TestCaseError::fail(format!("{}: {e}", kind.name()))),
+            };
+            prop_assert!(tr.samples.iter().all(|s| s.x.iter().all(|v| v.is_finite())),
+                "{}: NaN in samples", kind.name());
+            prop_assert!(tr.metrics.is_some_and(|s| s.values().iter().all(|v| v.1.is_finite())));
+            // Mirror symmetry: both friction laws are odd here (the generator keeps Table 1's
+            // symmetric upper disc), and every solver's arithmetic is sign-symmetric, so the
+            // mirrored run is the negated run bit for bit.
+            let mirrored = kind.solver().simulate(&m, &Scene { u: -u, x0: -x0, ..scene })
+                .map_err(|e| TestCaseError::fail(format!("{} mirrored: {e}", kind.name())))?;
+            let gap = mirror_gap(&tr, &mirrored);
+            prop_assert!(gap == 0.0, "{}: x(-u, -x0) + x(u, x0) reaches {gap:e}", kind.name());
+            // Energy balance along the solution, with the solver's share set in advance.
+            let (s, e) = energy_run(kind, &m, u, x0, ENERGY_TOL);
+            let (r, allowed, quad_rel) = energy_check(kind, &m, u, &s, &e);
+            prop_assert!(r <= allowed,
+                "{}: |E(t) - E(0) - int P| = {r:e} > allowed {allowed:e}", kind.name());
+            // The bound means something: the balance is checked to 1e-5 of the energy (measured
+            // quadrature bounds are 3e-9 ... 7.5e-7 of it).
+            prop_assert!(quad_rel < 1e-5, "{}: quadrature bound {quad_rel:e} of the energy", kind.name());
         }
-        // Energy balance along the event-driven solution at tol 1e-12 …
-        let (s12, e12) = event_run(&m, u, x0, 1e-12);
-        let (r12, quad) = energy_residual(&m, u, &s12, &e12);
-        // … with the solver's share bounded by the residual's change from tol 1e-10 to 1e-12:
-        // the solver error scales with tol, so its share at 1e-12 is ~1/100 of that change.
-        let (s10, e10) = event_run(&m, u, x0, 1e-10);
-        let (r10, _) = energy_residual(&m, u, &s10, &e10);
-        let solver_share = (r10 - r12).abs();
-        let scale = 1.0 + s12.iter().map(|s| m.energy(&s.1)).fold(0.0, f64::max);
-        // Rounding of ~1e5 additions of O(scale) terms: 1e-11·scale.
-        let rounding = 1e-11 * scale;
-        prop_assert!(
-            r12 <= quad + solver_share + rounding,
-            "|E(t) - E(0) - int P| = {r12:e} > quadrature {quad:e} + solver {solver_share:e} + rounding {rounding:e}"
-        );
-        // The bound means something: the balance is checked to 1e-5 of the energy (measured
-        // residuals are ~0.5 of the bound, 1e-7 … 1e-6 of the energy).
-        prop_assert!(quad < 1e-5 * scale, "quadrature bound {quad:e} vs energy {scale:e}");
     }
 }
 
+/// The energy check can fail: each solver's own run on Table 1 at 1.5 V passes, and the same
+/// run with ω_l off by 1e-4 relative after t = 5 s (a velocity error a solver could make at an
+/// event: momentum not conserved) violates it.
 #[test]
-fn stress_energy_residual_sees_a_wrong_power() {
-    // The check can fail: the same run with the power off by 1e-3 relative (a friction
-    // coefficient slightly wrong) violates the bound.
+fn stress_energy_balance_sees_a_perturbed_trajectory() {
     let m = Model::table1();
-    let (s, e) = event_run(&m, 1.5, State::zeros(), 1e-12);
-    let (r, quad) = energy_residual(&m, 1.5, &s, &e);
-    // 1e-9 J: the solver's share at tol 1e-12 plus rounding (1e-11 of the energy, ≲ 10 J
-    // here), as in the random test. Measured: residual 7.1e-8 J, bound 1.7e-7 J.
-    assert!(r <= quad + 1e-9, "true power: {r:e} vs {quad:e}");
-    let wrong = Model::new(Params {
-        upper: UpperFriction {
-            b: Params::table1().upper.b * 1.001,
-            ..Params::table1().upper
-        },
-        ..Params::table1()
-    });
-    let (r_wrong, quad_wrong) = energy_residual(&wrong, 1.5, &s, &e);
-    // Measured: 0.15 J against a bound of 1.7e-7 J; 10× the bound is a wide margin that a
-    // real error in the power still clears by 1e5.
-    assert!(
-        r_wrong > 10.0 * (quad_wrong + 1e-9),
-        "{r_wrong:e} vs {quad_wrong:e}"
-    );
+    for kind in SolverKind::ALL {
+        let (s, e) = energy_run(kind, &m, 1.5, State::zeros(), ENERGY_TOL);
+        let (r, allowed, _) = energy_check(kind, &m, 1.5, &s, &e);
+        assert!(
+            r <= allowed,
+            "{}: true run {r:e} > {allowed:e}",
+            kind.name()
+        );
+        let spoil = |x: &State, t: f64| {
+            let mut x = *x;
+            if t >= 5.0 {
+                x[rotor_model::OMEGA_L] *= 1.0 + 1e-4;
+            }
+            x
+        };
+        let s2: Vec<(f64, State)> = s.iter().map(|(t, x)| (*t, spoil(x, *t))).collect();
+        let e2: Vec<Event> = e
+            .iter()
+            .map(|ev| Event {
+                x: spoil(&ev.x, ev.t),
+                ..*ev
+            })
+            .collect();
+        let (r2, allowed2, _) = energy_check(kind, &m, 1.5, &s2, &e2);
+        // Measured: residuals 7e-8 ... 9e-8 J unperturbed, 2.1e-4 J perturbed, against an
+        // allowed 1.7e-7 (switch, Moreau–Jean) and 7.1e-6 J (event).
+        println!(
+            "{}: true {r:.2e}, perturbed {r2:.2e}, allowed {allowed2:.2e}",
+            kind.name()
+        );
+        assert!(
+            r2 > allowed2,
+            "{}: perturbed run {r2:e} <= {allowed2:e}",
+            kind.name()
+        );
+    }
 }
 
 /// An input so large that k_m·u overflows is refused by every solver, naming u (Moreau–Jean
@@ -446,49 +557,76 @@ fn metrics_only_gate(kind: SolverKind, h: f64, reversal: bool) -> f64 {
     }
 }
 
-proptest! {
-    #![proptest_config(ProptestConfig { cases: 12, ..ProptestConfig::default() })]
-
-    #[test]
-    fn stress_random_parameters_metrics_only_matches_the_full_run(
-        p in params_near_table1(),
-        x0 in state_near_rest(),
-        fu in 0.5..2.0f64,
-    ) {
-        let m = Model::new(p);
-        let u = 1.5 * fu;
-        let scene = Scene { u, x0, t_end: 100.0, tol: 1e-10, h: 1e-3,
-            output: Output::Events, metrics_from: Some(50.0) };
-        // Whether a disc reverses in the metrics window (the event solver's full run).
-        let Ok(events) = SolverKind::Event.solver().simulate(&m, &scene) else {
-            return Ok(());
-        };
-        let reversal = events.events.iter()
-            .any(|e| e.t >= 50.0 && matches!(e.kind, rotor_model::EventKind::Reversal(_)));
-        for kind in SolverKind::ALL {
-            let gate = metrics_only_gate(kind, scene.h, reversal);
-            let full = kind.solver().simulate(&m, &Scene { output: Output::Final, ..scene });
-            let fast = kind.solver().simulate(&m, &Scene { output: Output::Metrics, ..scene });
-            let (full, fast) = match (full, fast) {
-                (Ok(a), Ok(b)) => (a, b),
-                (a, b) => {
-                    prop_assert!(a.is_err() && b.is_err(), "{}: {a:?} vs {b:?}", kind.name());
-                    continue;
+/// A metrics-only scene gives each solver's full-run answer within its gate on random
+/// parameter sets (12 draws; `PROPTEST_CASES` sets more). Every run must succeed (the
+/// generator draws only admissible sets), and the skips are counted: every solver must have
+/// skipped periods in some draw, or the test would not have exercised the fast path.
+#[test]
+fn stress_random_parameters_metrics_only_matches_the_full_run() {
+    use proptest::test_runner::{TestRunner, contextualize_config};
+    use std::sync::atomic::{AtomicU64, Ordering};
+    let mut config = contextualize_config(ProptestConfig {
+        cases: 12,
+        ..ProptestConfig::default()
+    });
+    config.source_file = Some(file!());
+    let draws = AtomicU64::new(0);
+    let skipping = [AtomicU64::new(0), AtomicU64::new(0), AtomicU64::new(0)];
+    let result = TestRunner::new(config).run(
+        &(params_near_table1(), state_near_rest(), 0.5..2.0f64),
+        |(p, x0, fu)| {
+            let m = Model::new(p);
+            let u = 1.5 * fu;
+            let scene = Scene { u, x0, t_end: 100.0, tol: 1e-10, h: 1e-3,
+                output: Output::Events, metrics_from: Some(50.0) };
+            // Whether a disc reverses in the metrics window (the event solver's full run).
+            let events = SolverKind::Event.solver().simulate(&m, &scene)
+                .map_err(|e| TestCaseError::fail(format!("event (events): {e}")))?;
+            let reversal = events.events.iter()
+                .any(|e| e.t >= 50.0 && matches!(e.kind, rotor_model::EventKind::Reversal(_)));
+            let mut skipped = [false; 3];
+            for (i, kind) in SolverKind::ALL.into_iter().enumerate() {
+                let gate = metrics_only_gate(kind, scene.h, reversal);
+                let run = |output| kind.solver().simulate(&m, &Scene { output, ..scene })
+                    .map_err(|e| TestCaseError::fail(format!("{} ({output:?}): {e}", kind.name())));
+                let (full, fast) = (run(Output::Final)?, run(Output::Metrics)?);
+                let (a, b) = (full.metrics.unwrap(), fast.metrics.unwrap());
+                prop_assert_eq!(a.kind(), b.kind(), "{}", kind.name());
+                skipped[i] = fast.stats.skipped_periods > 0;
+                if fast.stats.skipped_periods == 0 && fast.stats.undone_skips == 0 {
+                    prop_assert!(a == b && full.x_final == fast.x_final, "{}: not the full run", kind.name());
                 }
-            };
-            let (a, b) = (full.metrics.unwrap(), fast.metrics.unwrap());
-            prop_assert_eq!(a.kind(), b.kind(), "{}", kind.name());
-            if fast.stats.skipped_periods == 0 && fast.stats.undone_skips == 0 {
-                prop_assert!(a == b && full.x_final == fast.x_final, "{}: not the full run", kind.name());
+                for ((name, va), (_, vb)) in a.values().into_iter().zip(b.values()) {
+                    prop_assert!(
+                        (va - vb).abs() <= gate * va.abs().max(vb.abs()).max(1.0),
+                        "{} {name}: full {va} vs metrics-only {vb} (skipped {}, reversal {reversal})",
+                        kind.name(), fast.stats.skipped_periods
+                    );
+                }
             }
-            for ((name, va), (_, vb)) in a.values().into_iter().zip(b.values()) {
-                prop_assert!(
-                    (va - vb).abs() <= gate * va.abs().max(vb.abs()).max(1.0),
-                    "{} {name}: full {va} vs metrics-only {vb} (skipped {}, reversal {reversal})",
-                    kind.name(), fast.stats.skipped_periods
-                );
+            draws.fetch_add(1, Ordering::Relaxed);
+            for (c, s) in skipping.iter().zip(skipped) {
+                c.fetch_add(u64::from(s), Ordering::Relaxed);
             }
-        }
+            Ok(())
+        },
+    );
+    if let Err(e) = result {
+        panic!("{e}");
+    }
+    let n = draws.load(Ordering::Relaxed);
+    let counts: Vec<u64> = skipping.iter().map(|c| c.load(Ordering::Relaxed)).collect();
+    println!(
+        "metrics-only: {n} draws; draws with skipped periods (event, switch, moreau): {counts:?}"
+    );
+    // Measured: 22-25 of 42 draws skip for each solver (about 55 %); with 12 draws the chance
+    // that one solver never skips is ~0.45^12 ≈ 7e-5.
+    for (kind, c) in SolverKind::ALL.iter().zip(&counts) {
+        assert!(
+            *c > 0,
+            "{}: no draw skipped a period: the fast path was not tested",
+            kind.name()
+        );
     }
 }
 
@@ -554,4 +692,108 @@ fn stress_moreau_reports_a_one_step_hold_between_opposite_slips_as_a_reversal() 
         period(&moreau),
         period(&event)
     );
+}
+
+/// Two random sets (drawn by the metrics-only property test) on which Moreau–Jean reported a
+/// negative ω_l minimum on a stick-slip cycle without any reversal: an extremum of ω_u located
+/// by a parabola through three steps that straddle the lower disc's stick onset carried that
+/// parabola's overshoot of ω_l below 0 into the metrics (−2.5e-4 rad/s). A stuck disc's
+/// velocity is 0, and a cycle that sticks and never reverses has min ω_l = 0 in every solver.
+#[test]
+fn stress_an_extremum_of_one_disc_keeps_the_other_discs_stick() {
+    let exp = |t_s, t_1, t_2, w_1, w_2, b| LowerFriction::Exponential {
+        t_s,
+        t_1,
+        t_2,
+        w_1,
+        w_2,
+        b,
+    };
+    let upper = |b| UpperFriction {
+        t_s: 0.0,
+        dt_s: 0.0,
+        b,
+        db: 0.0,
+    };
+    let cases = [
+        (
+            Params {
+                j_u: 0.8355950341717823,
+                k_m: 2.323122035042223,
+                k_theta: 0.11764637285083793,
+                j_l: 0.057476890870608276,
+                upper: upper(3.6692668076162374),
+                lower: exp(
+                    0.2902148232640389,
+                    0.04184805962422886,
+                    -0.31752542154990837,
+                    4.8171198051249915,
+                    0.5080312248969411,
+                    0.008237645015716699,
+                ),
+            },
+            1.370137572017139,
+        ),
+        (
+            Params {
+                j_u: 0.4947428617806874,
+                k_m: 4.871533028352826,
+                k_theta: 0.08726423287021479,
+                j_l: 0.04225974868183638,
+                upper: upper(2.2126229254450633),
+                lower: exp(
+                    0.3118354500202757,
+                    0.11566805549810975,
+                    -0.35797843852965516,
+                    8.084682567393783,
+                    0.581366658596531,
+                    0.016343757912594833,
+                ),
+            },
+            0.5436687208714125,
+        ),
+    ];
+    for (p, fu) in cases {
+        let m = Model::new(p);
+        let scene = Scene {
+            u: 1.5 * fu,
+            x0: State::zeros(),
+            t_end: 100.0,
+            tol: 1e-10,
+            h: 1e-3,
+            output: Output::Events,
+            metrics_from: Some(50.0),
+        };
+        for kind in SolverKind::ALL {
+            let tr = kind.solver().simulate(&m, &scene).unwrap();
+            assert!(
+                tr.events
+                    .iter()
+                    .all(|e| e.kind != rotor_model::EventKind::Reversal(rotor_model::Disc::Lower)),
+                "{}: the cycle does not reverse",
+                kind.name()
+            );
+            let Some(rotor_model::SteadyState::LimitCycle {
+                omega_l_min,
+                stick_time,
+                ..
+            }) = tr.metrics
+            else {
+                panic!("{}: {:?}", kind.name(), tr.metrics);
+            };
+            assert!(
+                stick_time > 1.0,
+                "{}: a stick-slip cycle ({stick_time} s stuck)",
+                kind.name()
+            );
+            assert_eq!(omega_l_min, 0.0, "{}", kind.name());
+            // No event state has the lower disc moving backwards.
+            let worst = tr
+                .events
+                .iter()
+                .map(|e| e.x[rotor_model::OMEGA_L])
+                .fold(0.0, f64::min);
+            assert_eq!(worst, 0.0, "{}", kind.name());
+        }
+    }
 }
