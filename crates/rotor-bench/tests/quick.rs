@@ -35,8 +35,21 @@ fn errors_fall_as_the_setting_tightens() {
                 p.setting,
                 p.failure
             );
-            assert!(p.timing.unwrap().median_s > 0.0);
-            assert!(p.stats.steps > 0);
+        }
+        // The work grows as the setting tightens (the counters are those of the timed run):
+        // Moreau–Jean takes exactly t_end/h steps, the adaptive solvers more steps at a
+        // tighter tolerance.
+        for w in pts.windows(2) {
+            assert!(
+                w[1].stats.steps > w[0].stats.steps,
+                "{kind:?}: {:?}",
+                pts.iter().map(|p| p.stats.steps).collect::<Vec<_>>()
+            );
+        }
+        if kind == SolverKind::Moreau {
+            for p in &pts {
+                assert_eq!(p.stats.steps, (sc.t_end / p.setting).round() as u64);
+            }
         }
         let steady: Vec<f64> = pts.iter().map(|p| p.errors.steady_rel.unwrap()).collect();
         let transient: Vec<f64> = pts
@@ -115,8 +128,6 @@ fn metrics_only_runs_keep_no_samples() {
         );
         assert_eq!(o.full_trace_samples, 3001, "{:?}: 30 s at 0.01 s", o.solver);
         assert!(o.same_answer, "{:?}", o.solver);
-        assert!(o.ratio.is_finite() && o.ratio > 0.0);
-        assert!(o.final_ratio.is_finite() && o.final_ratio > 0.0);
         // 30 s from rest at 1.5 V: the cycle (4.6 s) has converged by ~15 s, leaving room to
         // skip; the answer passes the metrics-only gates of rotor-compare's property test.
         assert!(o.skipped_periods > 0, "{:?}", o.solver);

@@ -295,8 +295,8 @@ fn output_levels_are_honoured() {
     }
     assert_eq!(g.peek(), None);
     assert_eq!(grid.x_final, fin.x_final);
-    // Grid samples come from the dense output, not from clamped steps: a step sample and a
-    // grid sample agree to the integration tolerance where their times meet (t_end here).
+    // The last grid sample is t_end, where the last step ends: the same state. (Samples
+    // between steps are checked against the event-driven solver in rotor-compare's cross.rs.)
     assert_eq!(
         grid.samples.last().unwrap().x,
         steps.samples.last().unwrap().x
@@ -304,7 +304,7 @@ fn output_levels_are_honoured() {
 }
 
 #[test]
-fn reversal_without_sticking_matches_filippov() {
+fn the_band_moves_a_reversal_without_sticking_by_order_eta() {
     // Lower disc spinning backward with a wound spring (k_θ α = 0.36 > T_sl): it passes
     // through ω_l = 0 without sticking.
     let model = Model::table1();
