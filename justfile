@@ -8,16 +8,19 @@ ci:
 lint:
     cargo fmt --all -- --check
     cargo clippy --workspace --all-targets --release -- -D warnings
-# Numerical stress, full form (1e5 s horizon, whole tolerance and step ladders; minutes).
-# CI runs the fast form as part of `cargo test`.
+# Numerical stress, full form (1e5 s horizon, whole tolerance and step ladders; ~25 s).
+# `cargo test` runs the fast form; .ci/run runs both.
 stress:
     ROTOR_STRESS=full cargo test --release -p rotor-compare stress -- --nocapture
-# The random stress case with 3000 draws instead of 24 (about a minute).
+# Every property test with thousands of fresh draws (CI draws a fixed seed; run this before a
+# change lands and keep what it finds in the *.proptest-regressions files). About 10 minutes.
 proptest-long:
     PROPTEST_CASES=3000 cargo test --release -p rotor-compare --test stress stress_random
+    PROPTEST_CASES=50000 cargo test --release -p rotor-moreau --test integration properties
+    PROPTEST_CASES=20000 cargo test --release -p rotor-model --test fuzz_files
 # Work-precision benchmark with peers (scipy, Siconos when installed), into reports/bench/.
 bench:
     cargo run --release -- bench --json reports/bench/bench.json --svg reports/bench/bench.svg --csv reports/bench/bench.csv
-# The peer tests, failing if scipy or Siconos is missing (CI has neither: it skips them).
+# The peer tests, failing if scipy or Siconos is missing (.ci/run installs both and runs this).
 peers:
     ROTOR_REQUIRE_PEERS=1 cargo test --release -p rotor-bench --test peers

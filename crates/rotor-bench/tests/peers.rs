@@ -1,6 +1,6 @@
-//! The peers, when installed (CI has neither scipy nor Siconos: these tests then return after
-//! saying so, unless `ROTOR_REQUIRE_PEERS=1` makes a missing peer a failure, as on a machine
-//! that quotes the peers' ratios). A peer that runs must compute the reference's answer, else
+//! The peers, when installed (where they are not, these tests return after saying so, unless
+//! `ROTOR_REQUIRE_PEERS=1` makes a missing peer a failure, as `.ci/run` does after installing
+//! both). A peer that runs must compute the reference's answer, else
 //! its ratio is meaningless.
 
 use rotor_bench::{BenchOptions, peer_available, run};
