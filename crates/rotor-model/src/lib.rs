@@ -12,6 +12,7 @@ pub mod friction;
 pub mod lagrangian;
 pub mod num;
 pub mod params;
+pub mod record;
 pub mod scenario;
 pub mod scene;
 pub mod steady;
@@ -23,6 +24,7 @@ pub use friction::Friction;
 pub use lagrangian::{Coords, Lagrangian};
 pub use num::Num;
 pub use params::{LowerFriction, Params, ParamsError, UpperFriction};
+pub use record::{Integration, Recorder};
 pub use scenario::{
     CompareSpec, PairTolerance, STEADY_QUANTITIES, Scenario, ScenarioError, SteadyQuantity,
 };

@@ -1,9 +1,8 @@
 //! The switch-model field, its guards, and the event-located integration loop.
 
 use rotor_model::{
-    Disc, DiscMode, Event, EventKind, FastForward, MetricsAccumulator, Mode, Model, OMEGA_L,
-    OMEGA_U, Output, Sample, Scene, SolveError, Solver, State, Stats, Trajectory, Verdict,
-    check_finite,
+    Disc, DiscMode, Event, EventKind, Integration, Mode, Model, OMEGA_L, OMEGA_U, Recorder, Scene,
+    SolveError, Solver, State, Stats, Trajectory, check_finite,
 };
 
 use crate::dopri5::{Dopri5, Dopri5Error, Dopri5Options};
@@ -356,43 +355,47 @@ fn sample_times(t0: f64, t1: f64, m: usize) -> impl Iterator<Item = f64> {
     })
 }
 
-/// Where the run's outputs go.
-struct Sink {
-    keep_events: bool,
-    events: Vec<Event>,
-    metrics: Option<MetricsAccumulator>,
-    count: u64,
-    /// Whole periods skipped for [`Output::Metrics`]: the verdict on the last event, and
-    /// that event.
-    fast_forward: Option<FastForward>,
-    verdict: Verdict,
-    anchor: Option<Event>,
+/// The time of each of the last `count` switches: that many within `window` seconds is a
+/// Zeno-like accumulation.
+struct Zeno {
+    times: Vec<f64>,
+    next: usize,
+    count: u32,
+    window: f64,
 }
 
-impl Sink {
-    fn emit(&mut self, t: f64, x: State, kind: EventKind) {
-        let e = Event { t, x, kind };
-        self.count += 1;
-        if let Some(m) = self.metrics.as_mut() {
-            m.push(&e);
+impl Zeno {
+    fn new(count: u32, window: f64) -> Zeno {
+        Zeno {
+            times: vec![f64::NEG_INFINITY; count.max(1) as usize],
+            next: 0,
+            count,
+            window,
         }
-        if self.keep_events {
-            self.events.push(e);
+    }
+
+    /// Records a switch at `t`; the error if it completes an accumulation.
+    fn record(&mut self, t: f64) -> Result<(), SolveError> {
+        let oldest = std::mem::replace(&mut self.times[self.next], t);
+        self.next = (self.next + 1) % self.times.len();
+        if t - oldest < self.window {
+            return Err(SolveError::Zeno {
+                t,
+                count: self.count,
+                window: self.window,
+            });
         }
-        if let Some(ff) = self.fast_forward.as_mut() {
-            self.verdict = ff.observe(&e);
-            self.anchor = Some(e);
-        }
+        Ok(())
     }
 }
 
-/// What the run goes back to if a jump is undone.
+/// What the run goes back to if a jump is undone: the anchor's time and state, and the
+/// regions and extremum memory there.
 struct Saved {
     t: f64,
     y: State,
     regions: [Region; 2],
     last_extremum: [Option<f64>; 2],
-    metrics: Option<MetricsAccumulator>,
 }
 
 fn map_err(e: Dopri5Error, x: &State) -> SolveError {
@@ -406,16 +409,218 @@ fn map_err(e: Dopri5Error, x: &State) -> SolveError {
     }
 }
 
-impl Solver for SwitchSolver {
-    fn name(&self) -> &'static str {
-        "switch"
+/// The switch-model integration: DOPRI5 on the field of the current regions, cut at every
+/// region change (the earliest guard root on the step's dense output) and restarted there.
+struct Run<'a> {
+    field: Field<'a>,
+    integ: Dopri5<3>,
+    t_end: f64,
+    tol: f64,
+    /// Guard samples per step.
+    samples: usize,
+    zeno: Zeno,
+    /// ω at the last extremum found per disc (upper, lower) since the disc's last region
+    /// change: an extremum within EXTREMUM_RESOLUTION tolerances of it is not resolved by the
+    /// integration (rounding-level turns while settling onto an equilibrium).
+    last_extremum: [Option<f64>; 2],
+    /// Markers found in one step (reused).
+    found: Vec<(f64, EventKind)>,
+}
+
+impl Run<'_> {
+    /// Restarts the integration at `(t, y)` with the current regions' field.
+    fn restart(&mut self, t: f64, y: State) {
+        let f = self.field;
+        self.integ.restart(t, y, &mut |_t, y: &State| f.rhs(y));
     }
 
-    /// Integrates the switch model over `[0, t_end]` with DOPRI5 at `rtol = atol = scene.tol`,
-    /// locating every region change (guards of the crate docs) and restarting there.
-    fn simulate(&self, model: &Model, scene: &Scene) -> Result<Trajectory, SolveError> {
-        scene.validate_for(model)?;
-        let o = self.options;
+    /// One accepted step, up to its first region change: the markers before it, the samples,
+    /// the switch itself, and the restart after it.
+    fn step(&mut self, rec: &mut Recorder) -> Result<(), SolveError> {
+        let f = self.field;
+        let before = *self.integ.y();
+        self.integ
+            .step(&mut |_t, y: &State| f.rhs(y), self.t_end)
+            .map_err(|e| {
+                let y = *self.integ.y();
+                if f.rhs(&y).iter().any(|v| !v.is_finite()) {
+                    SolveError::NonFinite {
+                        t: self.integ.t(),
+                        x: [y[0], y[1], y[2]],
+                    }
+                } else {
+                    map_err(e, &before)
+                }
+            })?;
+        check_finite(self.integ.t(), self.integ.y())?;
+        let (t0, t1) = self.integ.last_step();
+        let hit = self.first_switch(t0, t1);
+        let te = hit.map_or(t1, |h| h.0);
+        if rec.wants_events() && te > t0 {
+            self.markers(rec, t0, t1, te);
+            if rec.halted() {
+                return Ok(());
+            }
+        }
+        let integ = &self.integ;
+        let Some((tr, k, g)) = hit else {
+            rec.step(t0, t1, integ.y(), |t| integ.dense(t));
+            return Ok(());
+        };
+        let mut y = if tr == t1 {
+            *integ.y()
+        } else {
+            integ.dense(tr)
+        };
+        let (r, w, ev) = f.fire(k, g, &y);
+        if let Some(w) = w {
+            y[f.laws[k].idx] = w;
+        }
+        rec.step(t0, tr, &y, |t| integ.dense(t));
+        self.field.regions[k] = r;
+        self.last_extremum[k] = None;
+        match ev {
+            Some(kind) => rec.event(Event { t: tr, x: y, kind }),
+            None => rec.count_switch(),
+        }
+        self.zeno.record(tr)?;
+        if rec.halted() {
+            return Ok(());
+        }
+        self.restart(tr, y);
+        check_finite(tr, &y)
+    }
+
+    /// The earliest guard root on the dense output of `[t0, t1]`: its time, disc and guard.
+    fn first_switch(&self, t0: f64, t1: f64) -> Option<(f64, usize, Guard)> {
+        let (f, integ, m) = (&self.field, &self.integ, self.samples);
+        let mut xs = [State::zeros(); 17];
+        for (j, t) in sample_times(t0, t1, m).enumerate() {
+            xs[j] = if j == m { *integ.y() } else { integ.dense(t) };
+        }
+        let mut hit: Option<(f64, usize, Guard)> = None;
+        for k in 0..2 {
+            for g in f.guards(k).into_iter().flatten() {
+                let mut vals = [(0.0, 0.0); 17];
+                for (j, t) in sample_times(t0, t1, m).enumerate() {
+                    vals[j] = (t, f.guard_value(k, g, &xs[j]));
+                }
+                let root = first_crossing(&vals[..=m], |tt| f.guard_value(k, g, &integ.dense(tt)));
+                if let Some(tr) = root
+                    && hit.is_none_or(|h| tr < h.0)
+                {
+                    hit = Some((tr, k, g));
+                }
+            }
+        }
+        hit
+    }
+
+    /// Markers in `(t0, te]` (reversals inside the band, extrema of ω when metrics are asked),
+    /// in time order, to the recorder; stops after an event on which it halts.
+    fn markers(&mut self, rec: &mut Recorder, t0: f64, t1: f64, te: f64) {
+        let (f, m) = (self.field, self.samples);
+        let extrema = rec.wants_extrema();
+        self.found.clear();
+        let mut extra_rhs = 0u64;
+        for k in 0..2 {
+            let l = f.laws[k];
+            let (kind_pos, kind_neg, sign): (EventKind, EventKind, f64) = match f.regions[k] {
+                Region::Trans(s) => (EventKind::Reversal(l.disc), EventKind::Reversal(l.disc), s),
+                Region::Slip(_) if extrema => (EventKind::Max(l.disc), EventKind::Min(l.disc), 0.0),
+                _ => continue,
+            };
+            let integ = &self.integ;
+            // Reversal: g = s·ω upward through 0; extrema: g = ω̇, either way.
+            let mut gfun = |t: f64| {
+                let y = if t == t1 { *integ.y() } else { integ.dense(t) };
+                if sign != 0.0 {
+                    sign * y[l.idx]
+                } else {
+                    extra_rhs += 1;
+                    f.accel(k, &y)
+                }
+            };
+            let mut prev = (t0, gfun(t0));
+            for t in sample_times(t0, te, m).skip(1) {
+                let gv = gfun(t);
+                let crossing = if sign != 0.0 {
+                    prev.1 < 0.0 && gv >= 0.0
+                } else {
+                    prev.1 != 0.0 && (gv == 0.0 || (prev.1 > 0.0) != (gv > 0.0))
+                };
+                if crossing {
+                    let (tr, _) = illinois(&mut gfun, prev.0, prev.1, t, gv);
+                    let kind = if sign != 0.0 || prev.1 > 0.0 {
+                        kind_pos
+                    } else {
+                        kind_neg
+                    };
+                    self.found.push((tr, kind));
+                }
+                prev = (t, gv);
+            }
+        }
+        self.integ.count_rhs(extra_rhs);
+        self.found.sort_by(|a, b| a.0.total_cmp(&b.0));
+        for i in 0..self.found.len() {
+            let (t, kind) = self.found[i];
+            let y = self.integ.dense(t);
+            if let EventKind::Max(d) | EventKind::Min(d) = kind {
+                let w = y[d.index()];
+                let slot = &mut self.last_extremum[usize::from(d == Disc::Lower)];
+                let resolvable = slot.replace(w).is_none_or(|w_prev| {
+                    (w - w_prev).abs() > EXTREMUM_RESOLUTION * self.tol * (1.0 + w.abs())
+                });
+                if !resolvable {
+                    continue;
+                }
+            }
+            rec.event(Event { t, x: y, kind });
+            if rec.halted() {
+                return;
+            }
+        }
+    }
+}
+
+impl Integration for Run<'_> {
+    type Checkpoint = Saved;
+
+    fn advance(&mut self, rec: &mut Recorder) -> Result<(), SolveError> {
+        while self.integ.t() < self.t_end {
+            self.step(rec)?;
+            if rec.halted() {
+                break;
+            }
+        }
+        Ok(())
+    }
+
+    /// The anchor's time and state (the run stops at the event it halts on).
+    fn checkpoint(&self, anchor: &Event) -> Saved {
+        Saved {
+            t: anchor.t,
+            y: anchor.x,
+            regions: self.field.regions,
+            last_extremum: self.last_extremum,
+        }
+    }
+
+    fn restore(&mut self, sv: Saved) {
+        self.field.regions = sv.regions;
+        self.last_extremum = sv.last_extremum;
+        self.restart(sv.t, sv.y);
+    }
+
+    fn shift(&mut self, anchor: &Event, dt: f64) {
+        self.restart(anchor.t + dt, anchor.x);
+    }
+}
+
+impl SwitchOptions {
+    /// Checks the options; the error names the field and the bad value.
+    fn validate(&self) -> Result<(), SolveError> {
         let bad = |field: &'static str, value: f64, reason: &'static str| {
             Err(SolveError::InvalidScene {
                 field,
@@ -423,18 +628,23 @@ impl Solver for SwitchSolver {
                 reason,
             })
         };
-        if !(o.eta >= 0.0 && o.eta.is_finite()) {
-            return bad("eta", o.eta, "must be finite and >= 0");
+        if !(self.eta >= 0.0 && self.eta.is_finite()) {
+            return bad("eta", self.eta, "must be finite and >= 0");
         }
-        if o.h_max.is_nan() || o.h_max <= 0.0 {
-            return bad("h_max", o.h_max, "must be positive");
+        if self.h_max.is_nan() || self.h_max <= 0.0 {
+            return bad("h_max", self.h_max, "must be positive");
         }
-        if o.zeno_window.is_nan() || o.zeno_window < 0.0 {
-            return bad("zeno_window", o.zeno_window, "must be >= 0");
+        if self.zeno_window.is_nan() || self.zeno_window < 0.0 {
+            return bad("zeno_window", self.zeno_window, "must be >= 0");
         }
-        let m = o.guard_samples.clamp(1, 16);
-        let u = scene.u;
-        let t_end = scene.t_end;
+        Ok(())
+    }
+}
+
+impl<'a> Field<'a> {
+    /// The field of `model` at input `u` with band `eta`, both discs in `Stick` until
+    /// [`Field::start`] sets their regions.
+    fn new(model: &'a Model, u: f64, eta: f64) -> Field<'a> {
         let law = |disc: Disc| {
             let f = model.friction(disc);
             let (lo, hi) = f.static_interval();
@@ -445,46 +655,49 @@ impl Solver for SwitchSolver {
                 lo,
                 hi,
                 set_valued: f.is_set_valued(),
-                edge_pos: f.torque(o.eta, 1.0),
-                edge_neg: f.torque(-o.eta, -1.0),
+                edge_pos: f.torque(eta, 1.0),
+                edge_neg: f.torque(-eta, -1.0),
             }
         };
-        let mut field = Field {
+        Field {
             model,
             u,
-            eta: o.eta,
+            eta,
             laws: [law(Disc::Upper), law(Disc::Lower)],
             regions: [Region::Stick; 2],
-        };
-        let mut x = scene.x0;
+        }
+    }
+
+    /// Sets the initial regions at `x` and returns the state the run starts from (a velocity
+    /// in the band of a stuck disc is set to 0, or to the band's edge).
+    fn start(&mut self, x: &State) -> State {
+        let mut x = *x;
         for k in 0..2 {
-            let (r, w) = field.initial_region(k, &x);
-            field.regions[k] = r;
+            let (r, w) = self.initial_region(k, &x);
+            self.regions[k] = r;
             if let Some(w) = w {
-                x[field.laws[k].idx] = w;
+                x[self.laws[k].idx] = w;
             }
         }
-        check_finite(0.0, &x)?;
+        x
+    }
+}
 
-        let mut sink = Sink {
-            keep_events: scene.keeps_events(),
-            events: Vec::new(),
-            metrics: scene.metrics_start().map(MetricsAccumulator::new),
-            count: 0,
-            fast_forward: FastForward::for_scene(scene, scene.tol)
-                .map(|f| f.verify_within(o.skip_verify)),
-            verdict: Verdict::Continue,
-            anchor: None,
-        };
-        let markers = sink.keep_events || sink.metrics.is_some();
-        let extrema = sink.metrics.is_some();
-        let mut grid = scene.grid();
-        let keep_steps = matches!(scene.output, Output::Steps);
-        let mut samples = Vec::new();
-        if keep_steps {
-            samples.push(Sample { t: 0.0, x });
-        }
+impl Solver for SwitchSolver {
+    fn name(&self) -> &'static str {
+        "switch"
+    }
 
+    /// Integrates the switch model over `[0, t_end]` with DOPRI5 at `rtol = atol = scene.tol`,
+    /// locating every region change (guards of the crate docs) and restarting there.
+    fn simulate(&self, model: &Model, scene: &Scene) -> Result<Trajectory, SolveError> {
+        scene.validate_for(model)?;
+        let o = self.options;
+        o.validate()?;
+        let mut field = Field::new(model, scene.u, o.eta);
+        let x0 = field.start(&scene.x0);
+        check_finite(0.0, &x0)?;
+        let mut rec = Recorder::new(scene, x0, scene.tol, o.skip_verify);
         let dopts = Dopri5Options {
             rtol: scene.tol,
             atol: scene.tol,
@@ -493,254 +706,34 @@ impl Solver for SwitchSolver {
             max_steps: o.max_steps,
             ..Dopri5Options::default()
         };
-        let mut integ = {
-            let f = field;
-            Dopri5::new(dopts, 0.0, x, t_end, &mut |_t, y: &State| f.rhs(y))
+        let integ = Dopri5::new(dopts, 0.0, x0, scene.t_end, &mut |_t, y: &State| {
+            field.rhs(y)
+        });
+        let mut run = Run {
+            field,
+            integ,
+            t_end: scene.t_end,
+            tol: scene.tol,
+            samples: o.guard_samples.clamp(1, 16),
+            zeno: Zeno::new(o.zeno_count, o.zeno_window),
+            last_extremum: [None; 2],
+            found: Vec::new(),
         };
-        let mut zeno = vec![f64::NEG_INFINITY; o.zeno_count.max(1) as usize];
-        let mut zeno_i = 0usize;
-        let mut found: Vec<(f64, EventKind)> = Vec::new();
-        // ω at the last extremum found per disc (upper, lower) since the disc's last region
-        // change: an extremum within EXTREMUM_RESOLUTION tolerances of it is not resolved by
-        // the integration (rounding-level turns while settling onto an equilibrium).
-        let mut last_extremum: [Option<f64>; 2] = [None; 2];
-        let mut saved: Option<Saved> = None;
-
-        'run: loop {
-            if integ.t() >= t_end {
-                match sink.fast_forward.as_mut().map(FastForward::finish) {
-                    Some(Verdict::Undo) => sink.verdict = Verdict::Undo,
-                    _ => break,
-                }
-            }
-            'step: {
-                if sink.verdict != Verdict::Continue {
-                    break 'step;
-                }
-                let f = field;
-                let before = *integ.y();
-                integ
-                    .step(&mut |_t, y: &State| f.rhs(y), t_end)
-                    .map_err(|e| {
-                        let y = *integ.y();
-                        if f.rhs(&y).iter().any(|v| !v.is_finite()) {
-                            SolveError::NonFinite {
-                                t: integ.t(),
-                                x: [y[0], y[1], y[2]],
-                            }
-                        } else {
-                            map_err(e, &before)
-                        }
-                    })?;
-                check_finite(integ.t(), integ.y())?;
-                let (t0, t1) = integ.last_step();
-
-                // 1. Earliest guard root on the dense output of [t0, t1].
-                let mut hit: Option<(f64, usize, Guard)> = None;
-                let mut xs = [State::zeros(); 17];
-                for (j, t) in sample_times(t0, t1, m).enumerate() {
-                    xs[j] = if j == m { *integ.y() } else { integ.dense(t) };
-                }
-                for k in 0..2 {
-                    for g in f.guards(k).into_iter().flatten() {
-                        let mut vals = [(0.0, 0.0); 17];
-                        for (j, t) in sample_times(t0, t1, m).enumerate() {
-                            vals[j] = (t, f.guard_value(k, g, &xs[j]));
-                        }
-                        let root =
-                            first_crossing(&vals[..=m], |tt| f.guard_value(k, g, &integ.dense(tt)));
-                        if let Some(tr) = root
-                            && hit.is_none_or(|h| tr < h.0)
-                        {
-                            hit = Some((tr, k, g));
-                        }
-                    }
-                }
-                let te = hit.map_or(t1, |h| h.0);
-
-                // 2. Markers (reversals inside the band, extrema of ω) in (t0, te].
-                if markers && te > t0 {
-                    found.clear();
-                    let mut extra_rhs = 0u64;
-                    for k in 0..2 {
-                        let l = f.laws[k];
-                        let (kind_pos, kind_neg, sign): (EventKind, EventKind, f64) =
-                            match f.regions[k] {
-                                Region::Trans(s) => {
-                                    (EventKind::Reversal(l.disc), EventKind::Reversal(l.disc), s)
-                                }
-                                Region::Slip(_) if extrema => {
-                                    (EventKind::Max(l.disc), EventKind::Min(l.disc), 0.0)
-                                }
-                                _ => continue,
-                            };
-                        // Reversal: g = s·ω upward through 0; extrema: g = ω̇, either way.
-                        let mut gfun = |t: f64| {
-                            let y = if t == t1 { *integ.y() } else { integ.dense(t) };
-                            if sign != 0.0 {
-                                sign * y[l.idx]
-                            } else {
-                                extra_rhs += 1;
-                                f.accel(k, &y)
-                            }
-                        };
-                        let mut prev = (t0, gfun(t0));
-                        for t in sample_times(t0, te, m).skip(1) {
-                            let gv = gfun(t);
-                            let crossing = if sign != 0.0 {
-                                prev.1 < 0.0 && gv >= 0.0
-                            } else {
-                                prev.1 != 0.0 && (gv == 0.0 || (prev.1 > 0.0) != (gv > 0.0))
-                            };
-                            if crossing {
-                                let (tr, _) = illinois(&mut gfun, prev.0, prev.1, t, gv);
-                                let kind = if sign != 0.0 || prev.1 > 0.0 {
-                                    kind_pos
-                                } else {
-                                    kind_neg
-                                };
-                                found.push((tr, kind));
-                            }
-                            prev = (t, gv);
-                        }
-                    }
-                    integ.count_rhs(extra_rhs);
-                    found.sort_by(|a, b| a.0.total_cmp(&b.0));
-                    for &(t, kind) in &found {
-                        let y = integ.dense(t);
-                        if let EventKind::Max(d) | EventKind::Min(d) = kind {
-                            let w = y[d.index()];
-                            let slot = &mut last_extremum[usize::from(d == Disc::Lower)];
-                            let resolvable = slot.replace(w).is_none_or(|w_prev| {
-                                (w - w_prev).abs()
-                                    > EXTREMUM_RESOLUTION * scene.tol * (1.0 + w.abs())
-                            });
-                            if !resolvable {
-                                continue;
-                            }
-                        }
-                        sink.emit(t, y, kind);
-                        if sink.verdict != Verdict::Continue {
-                            break 'step;
-                        }
-                    }
-                }
-
-                // 3. Grid samples in (previous, te], by dense output.
-                if let Some(g) = grid.as_mut() {
-                    while let Some(tg) = g.peek() {
-                        if tg > te {
-                            break;
-                        }
-                        let y = if tg <= t0 {
-                            before
-                        } else if tg == t1 {
-                            *integ.y()
-                        } else {
-                            integ.dense(tg)
-                        };
-                        samples.push(Sample { t: tg, x: y });
-                        g.advance();
-                    }
-                }
-
-                // 4. The switch.
-                if let Some((tr, k, g)) = hit {
-                    let mut y = if tr == t1 {
-                        *integ.y()
-                    } else {
-                        integ.dense(tr)
-                    };
-                    let (r, w, ev) = f.fire(k, g, &y);
-                    field.regions[k] = r;
-                    last_extremum[k] = None;
-                    if let Some(w) = w {
-                        y[field.laws[k].idx] = w;
-                    }
-                    if let Some(kind) = ev {
-                        sink.emit(tr, y, kind);
-                    } else {
-                        sink.count += 1;
-                    }
-                    // Zeno guard: zeno_count switches within zeno_window seconds.
-                    let oldest = zeno[zeno_i];
-                    zeno[zeno_i] = tr;
-                    zeno_i = (zeno_i + 1) % zeno.len();
-                    if tr - oldest < o.zeno_window {
-                        return Err(SolveError::Zeno {
-                            t: tr,
-                            count: o.zeno_count,
-                            window: o.zeno_window,
-                        });
-                    }
-                    if sink.verdict != Verdict::Continue {
-                        break 'step;
-                    }
-                    let f2 = field;
-                    integ.restart(tr, y, &mut |_t, y: &State| f2.rhs(y));
-                    check_finite(tr, &y)?;
-                }
-                if keep_steps {
-                    samples.push(Sample {
-                        t: integ.t(),
-                        x: *integ.y(),
-                    });
-                }
-                continue 'run;
-            }
-            // A jump after the anchor event, or going back to where it started.
-            let (t, y) = match std::mem::replace(&mut sink.verdict, Verdict::Continue) {
-                Verdict::Jump { dt } => {
-                    let a = sink.anchor.expect("a jump has an anchor");
-                    saved = Some(Saved {
-                        t: a.t,
-                        y: a.x,
-                        regions: field.regions,
-                        last_extremum,
-                        metrics: sink.metrics,
-                    });
-                    if let Some(m) = sink.metrics.as_mut() {
-                        m.fast_forward(&a, dt);
-                    }
-                    (a.t + dt, a.x)
-                }
-                _ => {
-                    let sv = saved.take().expect("a jump before its undo");
-                    field.regions = sv.regions;
-                    last_extremum = sv.last_extremum;
-                    sink.metrics = sv.metrics;
-                    (sv.t, sv.y)
-                }
-            };
-            let f2 = field;
-            integ.restart(t, y, &mut |_t, y: &State| f2.rhs(y));
-        }
-
-        let x_final = *integ.y();
-        check_finite(integ.t(), &x_final)?;
-        let c = integ.counters();
-        let metrics = sink.metrics.as_ref().map(|m| m.finish(&x_final));
-        Ok(Trajectory {
-            samples,
-            events: sink.events,
-            t_final: t_end,
-            x_final,
-            mode_final: Mode {
-                upper: field.regions[0].disc_mode(),
-                lower: field.regions[1].disc_mode(),
-            },
-            metrics,
-            stats: FastForward::counted(
-                sink.fast_forward.as_ref(),
-                Stats {
-                    steps: c.accepted,
-                    rejected: c.rejected,
-                    rhs_evals: c.rhs_evals,
-                    events: sink.count,
-                    ..Stats::default()
-                },
-            ),
-        })
+        rec.drive(&mut run)?;
+        let x_final = *run.integ.y();
+        check_finite(run.integ.t(), &x_final)?;
+        let c = run.integ.counters();
+        let mode = Mode {
+            upper: run.field.regions[0].disc_mode(),
+            lower: run.field.regions[1].disc_mode(),
+        };
+        let stats = Stats {
+            steps: c.accepted,
+            rejected: c.rejected,
+            rhs_evals: c.rhs_evals,
+            ..Stats::default()
+        };
+        Ok(rec.finish(scene.t_end, x_final, mode, stats))
     }
 }
 

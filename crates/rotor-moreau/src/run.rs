@@ -1,0 +1,569 @@
+//! The run: steps of the [`Stepper`] on the grid `base + k·h`, the events located between step
+//! ends (stick onsets and exits, reversals, extrema), released in time order to the
+//! [`Recorder`], which keeps what the scene asks for and drives the metrics-only skip.
+
+use rotor_model::{
+    Disc, DiscMode, Event, EventKind, Integration, Mode, Model, Recorder, Scene, SolveError,
+    Solver, State, Stats, Trajectory, check_finite,
+};
+
+use crate::stepper::{StepSize, Stepper};
+use crate::{MoreauOptions, MoreauSolver};
+
+/// Capacity of the reorder buffer for events (a step detects at most six).
+const PENDING: usize = 16;
+
+/// Where released events go: the recorder (or a test's list).
+trait Release {
+    fn take(&mut self, e: &Event);
+    /// Whether a jump or an undo waits for the end of the step (nothing more is released).
+    fn halted(&self) -> bool;
+}
+
+impl Release for Recorder {
+    fn take(&mut self, e: &Event) {
+        self.event(*e);
+    }
+
+    fn halted(&self) -> bool {
+        Recorder::halted(self)
+    }
+}
+
+/// Events detected but not yet released in time order.
+#[derive(Clone, Copy)]
+struct Pending {
+    buf: [Option<Event>; PENDING],
+    len: usize,
+}
+
+impl Pending {
+    fn new() -> Pending {
+        Pending {
+            buf: [None; PENDING],
+            len: 0,
+        }
+    }
+
+    fn push(&mut self, e: Event, sink: &mut impl Release) {
+        if self.len == PENDING {
+            // Never with a step's at most six events; released even while a jump waits, so
+            // that the buffer cannot overflow.
+            if let Some(first) = self.buf[0] {
+                sink.take(&first);
+            }
+            self.buf.copy_within(1.., 0);
+            self.len -= 1;
+            self.buf[self.len] = None;
+        }
+        // Insertion into the time-ordered buffer.
+        let mut i = self.len;
+        while i > 0 && self.buf[i - 1].is_some_and(|p| p.t > e.t) {
+            self.buf[i] = self.buf[i - 1];
+            i -= 1;
+        }
+        self.buf[i] = Some(e);
+        self.len += 1;
+    }
+
+    /// Removes the latest pending event of `kind`; whether there was one.
+    fn remove(&mut self, kind: EventKind) -> bool {
+        let Some(i) = (0..self.len)
+            .rev()
+            .find(|&i| self.buf[i].is_some_and(|e| e.kind == kind))
+        else {
+            return false;
+        };
+        for j in i + 1..self.len {
+            self.buf[j - 1] = self.buf[j];
+        }
+        self.len -= 1;
+        self.buf[self.len] = None;
+        true
+    }
+
+    /// Moves the pending events by `dt` (a jump of whole periods).
+    fn shift(&mut self, dt: f64) {
+        for e in self.buf[..self.len].iter_mut().flatten() {
+            e.t += dt;
+        }
+    }
+
+    /// Releases the events with `t < t_limit`, earliest first; stops after an event on which
+    /// the sink halts.
+    fn release_before(&mut self, t_limit: f64, sink: &mut impl Release) {
+        let mut n = 0;
+        while n < self.len && self.buf[n].is_some_and(|e| e.t < t_limit) && !sink.halted() {
+            if let Some(e) = self.buf[n] {
+                sink.take(&e);
+            }
+            n += 1;
+        }
+        if n > 0 {
+            for i in n..self.len {
+                self.buf[i - n] = self.buf[i];
+            }
+            for i in self.len - n..self.len {
+                self.buf[i] = None;
+            }
+            self.len -= n;
+        }
+    }
+}
+
+/// A step end kept for event location.
+#[derive(Debug, Clone, Copy)]
+struct Point {
+    t: f64,
+    x: State,
+    mode: [DiscMode; 2],
+}
+
+fn lerp(a: &Point, b: &Point, t: f64) -> State {
+    let dt = b.t - a.t;
+    if dt <= 0.0 {
+        return b.x;
+    }
+    let s = (t - a.t) / dt;
+    a.x + (b.x - a.x) * s
+}
+
+/// Quadratic (Lagrange) interpolation through three points.
+fn quad(p: [&Point; 3], t: f64) -> State {
+    let [a, b, c] = p;
+    let la = (t - b.t) * (t - c.t) / ((a.t - b.t) * (a.t - c.t));
+    let lb = (t - a.t) * (t - c.t) / ((b.t - a.t) * (b.t - c.t));
+    let lc = (t - a.t) * (t - b.t) / ((c.t - a.t) * (c.t - b.t));
+    a.x * la + b.x * lb + c.x * lc
+}
+
+fn to_mode(m: &[DiscMode; 2]) -> Mode {
+    Mode {
+        upper: m[0],
+        lower: m[1],
+    }
+}
+
+/// What the run goes back to if a jump is undone: the end of the step on which it was
+/// decided.
+#[derive(Clone, Copy)]
+struct Saved {
+    cur: Point,
+    prev: Option<Point>,
+    pending: Pending,
+    base: f64,
+    k: u64,
+    n: u64,
+}
+
+/// The integration as the recorder drives it: step `k` of `n` on the grid `base + k·h`, the
+/// last landing on `t_end`; a jump moves the base.
+struct Run<'a> {
+    model: &'a Model,
+    stepper: Stepper,
+    /// The step size `h` with its factorisations (every step but the last).
+    full: StepSize,
+    u: f64,
+    h: f64,
+    t_end: f64,
+    theta: f64,
+    base: f64,
+    k: u64,
+    n: u64,
+    cur: Point,
+    prev: Option<Point>,
+    pending: Pending,
+    /// After a jump, the events of the step's end that waited for it are released first.
+    release_waiting: bool,
+    stats: Stats,
+}
+
+/// Number of steps from `base` to `t_end`: the last one is shortened to land on `t_end` (a
+/// remainder below 1e-9·h is merged into the previous step).
+fn steps_to(t_end: f64, base: f64, h: f64) -> f64 {
+    ((t_end - base) / h - 1e-9).ceil().max(1.0)
+}
+
+impl Run<'_> {
+    /// One step, its events (when the recorder wants them) and its samples.
+    fn step(&mut self, rec: &mut Recorder) -> Result<(), SolveError> {
+        self.k += 1;
+        let (k, n) = (self.k, self.n);
+        let t_next = if k == n {
+            self.t_end
+        } else {
+            self.base + k as f64 * self.h
+        };
+        // Every step but the last has size h (t_next − t differs from h by roundings of t
+        // only); the last lands on t_end.
+        let out = if k < n {
+            self.stepper
+                .step_with(self.cur.t, &self.cur.x, &self.full)?
+        } else {
+            self.stepper
+                .step(self.cur.t, &self.cur.x, t_next - self.cur.t)?
+        };
+        check_finite(t_next, &out.x)?;
+        let s = &mut self.stats;
+        s.steps += 1;
+        s.newton_iters += u64::from(out.newton_iters);
+        s.rhs_evals += u64::from(out.evals);
+        s.inexact_steps += u64::from(!out.exact);
+        if out.used_enumeration {
+            s.lcp_solves += 1;
+        } else {
+            s.lcp_skipped += 1;
+        }
+        let next = Point {
+            t: t_next,
+            x: out.x,
+            mode: out.mode,
+        };
+        if rec.wants_events() {
+            for (i, d) in Disc::BOTH.into_iter().enumerate() {
+                self.mode_change(i, d, &next, rec);
+                if rec.wants_extrema() {
+                    self.extremum(i, d, &next, rec);
+                }
+            }
+            // Events detected later are at t ≥ cur.t.
+            self.pending.release_before(self.cur.t, rec);
+        }
+        let cur = self.cur;
+        rec.step(cur.t, next.t, &next.x, |t| lerp(&cur, &next, t));
+        self.prev = Some(cur);
+        self.cur = next;
+        Ok(())
+    }
+
+    /// The stick onset, stick exit or reversal of disc `d` (index `i`) in the step to `next`.
+    fn mode_change(&mut self, i: usize, d: Disc, next: &Point, rec: &mut Recorder) {
+        let (cur, prev) = (self.cur, self.prev);
+        let wi = d.index();
+        let (m_a, m_b) = (cur.mode[i], next.mode[i]);
+        let kind_t = match (m_a, m_b) {
+            (DiscMode::Stick, DiscMode::Stick) => None,
+            (DiscMode::Stick, slip) => {
+                Some((EventKind::StickEnd(d), self.exit_time(d, slip, next)))
+            }
+            (slip, DiscMode::Stick) => {
+                Some((EventKind::StickStart(d), self.onset_time(d, slip, next)))
+            }
+            (a, b) if a != b => {
+                let (wa, wb) = (cur.x[wi], next.x[wi]);
+                let t = if wa != wb {
+                    (cur.t + wa * (next.t - cur.t) / (wa - wb)).clamp(cur.t, next.t)
+                } else {
+                    next.t
+                };
+                Some((EventKind::Reversal(d), t))
+            }
+            _ => None,
+        };
+        // Held at rest for exactly one step between slips of opposite sign: a reversal at
+        // the scheme's resolution (crate docs), not a stick phase.
+        let reversal = matches!(kind_t, Some((EventKind::StickEnd(_), _)))
+            && prev.is_some_and(|p| p.mode[i] != DiscMode::Stick && p.mode[i] != m_b)
+            && self.pending.remove(EventKind::StickStart(d));
+        if reversal && let Some(p) = prev {
+            // Zero of ω between the slipping ends of the two steps.
+            let (wa, wb) = (p.x[wi], next.x[wi]);
+            let t = (p.t + wa * (next.t - p.t) / (wa - wb)).clamp(p.t, next.t);
+            let mut x = lerp(&p, next, t);
+            x[wi] = 0.0;
+            let kind = EventKind::Reversal(d);
+            self.pending.push(Event { t, x, kind }, rec);
+        } else if let Some((kind, t)) = kind_t {
+            let mut x = if t >= cur.t {
+                lerp(&cur, next, t)
+            } else {
+                prev.map_or(cur.x, |p| lerp(&p, &cur, t))
+            };
+            x[wi] = 0.0;
+            self.pending.push(Event { t, x, kind }, rec);
+        }
+    }
+
+    /// Stick exit of disc `d` into `slip` within the step to `next`: the zero of the applied
+    /// torque's excess over the stick interval, linear between the step's ends (it may lie in
+    /// the step before: the disc may have been held one step too long).
+    fn exit_time(&self, d: Disc, slip: DiscMode, next: &Point) -> f64 {
+        let (model, cur) = (self.model, &self.cur);
+        let (lo, hi) = model.friction(d).static_interval();
+        let z = |x: &State| {
+            let ta = model.applied_torque(d, x, self.u);
+            if slip == DiscMode::SlipPos {
+                ta - hi
+            } else {
+                lo - ta
+            }
+        };
+        let (za, zb) = (z(&cur.x), z(&next.x));
+        let t0 = self.prev.map_or(cur.t, |p| p.t);
+        if zb > za {
+            (cur.t - za * (next.t - cur.t) / (zb - za)).clamp(t0, next.t)
+        } else {
+            cur.t + self.theta * (next.t - cur.t)
+        }
+    }
+
+    /// Stick onset of disc `d` from `slip` within the step to `next`: the zero of
+    /// `ω(t_k + Δ) ≈ ω + aΔ + ½jΔ²`, with `a` and `j = ω̈` from the model's vector field and
+    /// Jacobian in the slipping mode.
+    fn onset_time(&self, d: Disc, slip: DiscMode, next: &Point) -> f64 {
+        let (model, cur) = (self.model, &self.cur);
+        let wi = d.index();
+        let w = cur.x[wi];
+        let mut mode = to_mode(&cur.mode);
+        mode.set(d, slip);
+        let f = model.rhs(&cur.x, self.u, mode);
+        let acc = f[wi];
+        let jerk = (model.jacobian(&cur.x, self.u, mode) * f)[wi];
+        if acc * w < 0.0 {
+            let d1 = -w / acc;
+            let den = acc + jerk * d1;
+            let d2 = if den * acc > 0.0 {
+                d1 - 0.5 * jerk * d1 * d1 / den
+            } else {
+                d1
+            };
+            (cur.t + d2).clamp(cur.t, next.t)
+        } else {
+            next.t
+        }
+    }
+
+    /// An extremum of disc `d`'s velocity while it slips over the last three step ends: the
+    /// vertex of the parabola through them.
+    fn extremum(&mut self, i: usize, d: Disc, next: &Point, rec: &mut Recorder) {
+        let cur = self.cur;
+        let Some(p) = self.prev else {
+            return;
+        };
+        if [p.mode[i], cur.mode[i], next.mode[i]].contains(&DiscMode::Stick) {
+            return;
+        }
+        let wi = d.index();
+        let (y0, y1, y2) = (p.x[wi], cur.x[wi], next.x[wi]);
+        let (d1, d2) = (y1 - y0, y2 - y1);
+        // Rounding noise filter: increments of a few ulps are no extremum.
+        let noise = 8.0 * f64::EPSILON * (1.0 + y1.abs());
+        let kind = if d1 > 0.0 && d2 <= 0.0 {
+            EventKind::Max(d)
+        } else if d1 < 0.0 && d2 >= 0.0 {
+            EventKind::Min(d)
+        } else {
+            return;
+        };
+        if d1.abs().max(d2.abs()) <= noise {
+            return;
+        }
+        let (ha, hb) = (cur.t - p.t, next.t - cur.t);
+        let s1 = d1 / ha;
+        let s2 = d2 / hb;
+        let curv = (s2 - s1) / (0.5 * (ha + hb));
+        let t = if curv != 0.0 {
+            let tm1 = p.t + 0.5 * ha; // slope s1 at the midpoint
+            (tm1 - s1 / curv).clamp(p.t, next.t)
+        } else {
+            cur.t
+        };
+        let mut x = quad([&p, &cur, next], t);
+        // The other disc's velocity is smooth over the three points only if its mode is:
+        // across its stick onset or exit the parabola would overshoot ω = 0 (a negative ω_l
+        // in a stick-slip cycle's metrics, with no reversal). There it is interpolated on the
+        // step that holds t, which keeps its sign.
+        let o = 1 - i;
+        if p.mode[o] != cur.mode[o] || cur.mode[o] != next.mode[o] {
+            let (a, b) = if t <= cur.t { (&p, &cur) } else { (&cur, next) };
+            x[1 + o] = lerp(a, b, t)[1 + o];
+        }
+        self.pending.push(Event { t, x, kind }, rec);
+    }
+}
+
+impl Integration for Run<'_> {
+    type Checkpoint = Saved;
+
+    fn advance(&mut self, rec: &mut Recorder) -> Result<(), SolveError> {
+        if std::mem::take(&mut self.release_waiting) {
+            self.pending.release_before(self.cur.t, rec);
+            if rec.halted() {
+                return Ok(());
+            }
+        }
+        while self.k < self.n {
+            self.step(rec)?;
+            if rec.halted() {
+                return Ok(());
+            }
+        }
+        self.pending.release_before(f64::INFINITY, rec);
+        Ok(())
+    }
+
+    /// The end of the step on which the jump was decided (its pending events included).
+    fn checkpoint(&self, _anchor: &Event) -> Saved {
+        Saved {
+            cur: self.cur,
+            prev: self.prev,
+            pending: self.pending,
+            base: self.base,
+            k: self.k,
+            n: self.n,
+        }
+    }
+
+    fn restore(&mut self, sv: Saved) {
+        (self.cur, self.prev, self.pending) = (sv.cur, sv.prev, sv.pending);
+        (self.base, self.k, self.n) = (sv.base, sv.k, sv.n);
+        self.release_waiting = false;
+    }
+
+    /// The step grid restarts at the shifted step end.
+    fn shift(&mut self, _anchor: &Event, dt: f64) {
+        self.cur.t += dt;
+        if let Some(p) = self.prev.as_mut() {
+            p.t += dt;
+        }
+        self.pending.shift(dt);
+        (self.base, self.k) = (self.cur.t, 0);
+        self.n = steps_to(self.t_end, self.base, self.h) as u64;
+        self.release_waiting = true;
+    }
+}
+
+impl MoreauOptions {
+    /// Checks the options; the error names the field and the bad value.
+    fn validate(&self) -> Result<(), SolveError> {
+        if !(self.theta >= 0.5 && self.theta <= 1.0) {
+            return Err(SolveError::InvalidScene {
+                field: "theta",
+                value: self.theta,
+                reason: "must lie in [1/2, 1]",
+            });
+        }
+        if self.max_newton == 0 {
+            return Err(SolveError::InvalidScene {
+                field: "max_newton",
+                value: 0.0,
+                reason: "must be at least 1",
+            });
+        }
+        Ok(())
+    }
+}
+
+impl Solver for MoreauSolver {
+    fn name(&self) -> &'static str {
+        "moreau"
+    }
+
+    fn simulate(&self, model: &Model, scene: &Scene) -> Result<Trajectory, SolveError> {
+        scene.validate_for(model)?;
+        check_finite(0.0, &scene.x0)?;
+        let o = &self.options;
+        o.validate()?;
+        let (u, h, t_end) = (scene.u, scene.h, scene.t_end);
+        let n = steps_to(t_end, 0.0, h);
+        if n.is_nan() || n > o.max_steps as f64 {
+            return Err(SolveError::TooManySteps {
+                t: 0.0,
+                max_steps: o.max_steps,
+            });
+        }
+        let n = n as u64;
+        let stepper = Stepper::new(model, u, o);
+        let full = stepper.step_size(0.0, h)?;
+        // The scheme's error on the fixtures' cycles is second order, ≈ 0.6·h² in the period
+        // (crate docs), so h² plays the adaptive solvers' tolerance.
+        let mut rec = Recorder::new(scene, scene.x0, h * h, o.skip_verify);
+        rec.reserve(n as usize);
+        let m0 = model.mode_at(&scene.x0, u);
+        let mut run = Run {
+            model,
+            stepper,
+            full,
+            u,
+            h,
+            t_end,
+            theta: o.theta,
+            base: 0.0,
+            k: 0,
+            n,
+            cur: Point {
+                t: 0.0,
+                x: scene.x0,
+                mode: [m0.upper, m0.lower],
+            },
+            prev: None,
+            pending: Pending::new(),
+            release_waiting: false,
+            stats: Stats::default(),
+        };
+        rec.drive(&mut run)?;
+        let cur = run.cur;
+        Ok(rec.finish(t_end, cur.x, to_mode(&cur.mode), run.stats))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A list of released events, halted while `halt` is set.
+    struct List {
+        events: Vec<Event>,
+        halt: bool,
+    }
+
+    impl Release for List {
+        fn take(&mut self, e: &Event) {
+            self.events.push(*e);
+        }
+
+        fn halted(&self) -> bool {
+            self.halt
+        }
+    }
+
+    fn ev(t: f64) -> Event {
+        Event {
+            t,
+            x: State::zeros(),
+            kind: EventKind::Max(Disc::Lower),
+        }
+    }
+
+    /// Events come out in time order, an overfull buffer releases its earliest (even while a
+    /// jump waits), and a waiting jump stops the ordinary release.
+    #[test]
+    fn pending_events_leave_in_time_order_and_never_overflow() {
+        let times =
+            |s: &List, from: usize| -> Vec<f64> { s.events[from..].iter().map(|e| e.t).collect() };
+        let mut p = Pending::new();
+        let mut s = List {
+            events: Vec::new(),
+            halt: true,
+        };
+        for k in 0..PENDING + 4 {
+            p.push(ev(k as f64), &mut s);
+        }
+        assert_eq!(
+            times(&s, 0),
+            [0.0, 1.0, 2.0, 3.0],
+            "the overflow released the earliest"
+        );
+        p.release_before(f64::INFINITY, &mut s);
+        assert_eq!(times(&s, 0).len(), 4, "halted by the waiting jump");
+        s.halt = false;
+        p.release_before(8.0, &mut s);
+        assert_eq!(times(&s, 4), [4.0, 5.0, 6.0, 7.0]);
+        assert!(p.remove(EventKind::Max(Disc::Lower)));
+        assert!(!p.remove(EventKind::Min(Disc::Lower)));
+        p.shift(100.0);
+        p.release_before(f64::INFINITY, &mut s);
+        // 19 was the latest and was removed; the rest moved by 100 s.
+        assert_eq!(times(&s, 8), (108..=118).map(f64::from).collect::<Vec<_>>());
+    }
+}
