@@ -130,6 +130,70 @@ struct Detected {
     resume: f64,
 }
 
+/// Where a run is between steps.
+struct Cursor {
+    t: f64,
+    x: State,
+    mode: Mode,
+    /// The field at `(t, x)`.
+    f0: State,
+    /// The next step size to try.
+    h: f64,
+    /// Time of the last mode switch: the acceleration of a disc leaving stick starts at 0, so
+    /// its first sign is rounding; extremum roots right at a switch are not extrema.
+    t_switch: f64,
+    /// The velocity at the last extremum found per disc since the last mode switch: an
+    /// extremum within EXTREMUM_RESOLUTION tolerances of it is below what the integration
+    /// resolves (rounding-level turns of a velocity settling onto an equilibrium) and is not
+    /// reported.
+    last_extremum: [Option<f64>; 2],
+}
+
+/// How the events of an accepted step end it.
+enum Scan {
+    /// No terminal guard: the step stands.
+    Through,
+    /// The first terminal guard (a mode switch) at this time.
+    Terminal(f64, Guard),
+    /// The sink stopped the run after an event.
+    Stop(RunEnd),
+}
+
+/// The times of the last `n` mode switches (the Zeno guard).
+struct Recent {
+    times: [f64; 64],
+    count: usize,
+    n: usize,
+}
+
+impl Recent {
+    fn new(n: usize) -> Recent {
+        Recent {
+            times: [f64::NEG_INFINITY; 64],
+            count: 0,
+            n,
+        }
+    }
+
+    /// Records a switch at `t`: `n` of them within `window·max(1, |t|)` seconds is an error.
+    fn record(&mut self, t: f64, window: f64) -> Result<(), SolveError> {
+        self.times[self.count % self.n] = t;
+        self.count += 1;
+        if self.count >= self.n {
+            let oldest = self.times[self.count % self.n];
+            let window = window * t.abs().max(1.0);
+            if t - oldest < window {
+                return Err(SolveError::Zeno {
+                    t,
+                    count: self.n as u32,
+                    window,
+                });
+            }
+        }
+        Ok(())
+    }
+}
+
 /// One integration run of the Filippov system.
 pub(crate) struct Integrator<'a> {
     pub model: &'a Model,
@@ -270,6 +334,87 @@ impl<'a> Integrator<'a> {
         }
     }
 
+    /// A velocity guard's crossing that its samples at `ta` and `tb` do not show: a shallow
+    /// dip below 0 between two positive samples (found at the minimum, the root of the guard's
+    /// rate), or an excursion from exactly 0 at `ta` that returns to ≤ 0 by `tb` (a reversal
+    /// just past a stick boundary, whose short excursion ends in stick: the return root lies
+    /// between the guard's positive maximum and `tb`). `rates` are the velocity's rates at
+    /// the two samples. Returns the bracket, the guard's value at its start, and the guard.
+    fn hidden_crossing(
+        &self,
+        d: &Dense<3>,
+        disc: Disc,
+        mode: Mode,
+        (ta, tb): (f64, f64),
+        (ga, gb): (f64, f64),
+        rates: (f64, f64),
+    ) -> Option<(f64, f64, f64, Guard)> {
+        let g = Guard::Velocity(disc);
+        let s = mode.of(disc).branch().unwrap_or(1.0);
+        let (ra, rb) = (s * rates.0, s * rates.1);
+        let rate = |t: f64| s * d.eval_with_rate(t).1[disc.index()];
+        if ga > 0.0 && gb > 0.0 && ra < 0.0 && rb > 0.0 {
+            let tm = illinois(&rate, ta, tb, ra, rb);
+            let gm = self.guard(g, &d.eval(tm), mode);
+            (gm <= 0.0).then_some((ta, tm, ga, g))
+        } else if ga == 0.0 && ra > 0.0 && gb <= 0.0 && rb < 0.0 {
+            let tm = illinois(&rate, ta, tb, ra, rb);
+            let gm = self.guard(g, &d.eval(tm), mode);
+            (gm > 0.0).then_some((tm, tb, gm, g))
+        } else {
+            None
+        }
+    }
+
+    /// The root of guard `g` (firing as `kind`) in the bracket `(a, b)` where it starts at
+    /// `fa`: an extremum on the dense output's rate, polished onto the field's acceleration;
+    /// any other guard on its value along the dense output.
+    fn locate(
+        &self,
+        d: &Dense<3>,
+        g: Guard,
+        kind: Guard,
+        (a, b): (f64, f64),
+        fa: f64,
+        step: (f64, f64),
+        mode: Mode,
+    ) -> Detected {
+        match g {
+            Guard::Extremum(disc, _) => {
+                let f = |t: f64| d.eval_with_rate(t).1[disc.index()];
+                let fb = f(b);
+                let r = if fb == 0.0 {
+                    b
+                } else {
+                    illinois(&f, a, b, fa, fb)
+                };
+                let is_max = matches!(kind, Guard::Extremum(_, true));
+                let te = self.polish_extremum(disc, is_max, d, r, step, mode);
+                // The interpolant's root may lie after the polished one: a search resumed
+                // before it would find this extremum again.
+                Detected {
+                    t: te,
+                    guard: kind,
+                    resume: te.max(r),
+                }
+            }
+            _ => {
+                let f = |t: f64| self.guard(g, &d.eval(t), mode);
+                let fb = f(b);
+                let t = if fb == 0.0 {
+                    b
+                } else {
+                    illinois(&f, a, b, fa, fb)
+                };
+                Detected {
+                    t,
+                    guard: kind,
+                    resume: t,
+                }
+            }
+        }
+    }
+
     /// Finds the earliest guard event in `[t0, t1]` of the step with dense output `d`. The
     /// step's end state and field `end = (y1, f1)` are known (the field was evaluated for
     /// the dense output), and so is the start's when `t0` is the step's start: those samples
@@ -319,74 +464,20 @@ impl<'a> Integrator<'a> {
             let mut best: Option<Detected> = None;
             for (j, &g) in gs[..n].iter().enumerate() {
                 let gb = value(g, &xb, &fb_rate);
-                let mut hit = Self::fires(g, ga[j], gb).map(|kind| (ta, tb, ga[j], kind));
-                if hit.is_none()
-                    && let Guard::Velocity(disc) = g
-                {
-                    let s = mode.of(disc).branch().unwrap_or(1.0);
-                    let ra = s * fa_rate[disc.index()];
-                    let rb = s * fb_rate[disc.index()];
-                    let rate = |t: f64| s * d.eval_with_rate(t).1[disc.index()];
-                    if ga[j] > 0.0 && gb > 0.0 && ra < 0.0 && rb > 0.0 {
-                        // A shallow dip between two positive samples: look for the minimum
-                        // (root of the guard's rate) and test its value.
-                        let tm = illinois(&rate, ta, tb, ra, rb);
-                        let gm = self.guard(g, &d.eval(tm), mode);
-                        if gm <= 0.0 {
-                            hit = Some((ta, tm, ga[j], g));
+                let hit = Self::fires(g, ga[j], gb)
+                    .map(|kind| (ta, tb, ga[j], kind))
+                    .or_else(|| match g {
+                        Guard::Velocity(disc) => {
+                            let rates = (fa_rate[disc.index()], fb_rate[disc.index()]);
+                            self.hidden_crossing(d, disc, mode, (ta, tb), (ga[j], gb), rates)
                         }
-                    } else if ga[j] == 0.0 && ra > 0.0 && gb <= 0.0 && rb < 0.0 {
-                        // An excursion from zero: the disc left ω = 0 at a reversal (the
-                        // guard is exactly 0 there and grows with rate ra > 0) and came back
-                        // within one sample interval — a reversal just past a stick
-                        // boundary, whose short excursion ends in stick. The guard's
-                        // maximum (root of its rate) is positive, and the return root lies
-                        // between it and tb.
-                        let tm = illinois(&rate, ta, tb, ra, rb);
-                        let gm = self.guard(g, &d.eval(tm), mode);
-                        if gm > 0.0 {
-                            hit = Some((tm, tb, gm, g));
-                        }
-                    }
-                }
+                        _ => None,
+                    });
                 ga[j] = gb;
                 let Some((a, b, fa, kind)) = hit else {
                     continue;
                 };
-                let found = match g {
-                    Guard::Extremum(disc, _) => {
-                        let f = |t: f64| d.eval_with_rate(t).1[disc.index()];
-                        let fb = f(b);
-                        let r = if fb == 0.0 {
-                            b
-                        } else {
-                            illinois(&f, a, b, fa, fb)
-                        };
-                        let is_max = matches!(kind, Guard::Extremum(_, true));
-                        let te = self.polish_extremum(disc, is_max, d, r, (t0, t1), mode);
-                        // The interpolant's root may lie after the polished one: a search
-                        // resumed before it would find this extremum again.
-                        Detected {
-                            t: te,
-                            guard: kind,
-                            resume: te.max(r),
-                        }
-                    }
-                    _ => {
-                        let f = |t: f64| self.guard(g, &d.eval(t), mode);
-                        let fb = f(b);
-                        let t = if fb == 0.0 {
-                            b
-                        } else {
-                            illinois(&f, a, b, fa, fb)
-                        };
-                        Detected {
-                            t,
-                            guard: kind,
-                            resume: t,
-                        }
-                    }
-                };
+                let found = self.locate(d, g, kind, (a, b), fa, (t0, t1), mode);
                 if best.is_none_or(|b| found.t < b.t) {
                     best = Some(found);
                 }
@@ -467,245 +558,297 @@ impl<'a> Integrator<'a> {
         t_end: f64,
         sink: &mut impl Sink,
     ) -> Result<RunEnd, SolveError> {
-        let model = self.model;
-        let u = self.u;
-        let mut t = t_start;
+        let (model, u) = (self.model, self.u);
+        let evals = Cell::new(0u64);
+        let field = |y: &State, mode: Mode| {
+            evals.set(evals.get() + 1);
+            model.rhs(y, u, mode)
+        };
+        let end = self.steps(t_start, x_start, mode_start, t_end, &field, sink);
+        self.stats.rhs_evals += evals.get() + self.extra_evals.take();
+        end
+    }
+
+    /// [`Integrator::run`] with the counted field `field`.
+    fn steps(
+        &mut self,
+        t_start: f64,
+        x_start: State,
+        mode: Mode,
+        t_end: f64,
+        field: &impl Fn(&State, Mode) -> State,
+        sink: &mut impl Sink,
+    ) -> Result<RunEnd, SolveError> {
         let mut x = x_start;
-        let mut mode = mode_start;
         for d in Disc::BOTH {
             if mode.of(d) == DiscMode::Stick {
                 x[d.index()] = 0.0;
             }
         }
-        let mut rhs_evals = 0u64;
-        let mut f = |_t: f64, y: &State, mode: Mode| {
-            rhs_evals += 1;
-            model.rhs(y, u, mode)
-        };
-        let mut f0 = f(t, &x, mode);
-        let mut h = {
-            let mut fm = |tt: f64, y: &State| f(tt, y, mode);
-            self.ctl.initial_step(&mut fm, t, &x, &f0)
-        };
+        let f0 = field(&x, mode);
+        let h = self
+            .ctl
+            .initial_step(&mut |_t, y: &State| field(y, mode), t_start, &x, &f0);
         self.ctl.restart();
-        let mut recent = [f64::NEG_INFINITY; 64];
-        let mut n_switch: usize = 0;
-        let zeno_n = (self.opts.zeno_count as usize).clamp(2, 64);
+        let mut c = Cursor {
+            t: t_start,
+            x,
+            mode,
+            f0,
+            h,
+            t_switch: t_start,
+            last_extremum: [None; 2],
+        };
+        let mut recent = Recent::new((self.opts.zeno_count as usize).clamp(2, 64));
         let mut steps_total = 0u64;
-        // Time of the last mode switch: the acceleration of a disc leaving stick starts at 0,
-        // so its first sign is rounding; extremum roots right at a switch are not extrema.
-        let mut t_switch = t_start;
-        // The velocity at the last extremum found per disc since the last mode switch: an
-        // extremum within EXTREMUM_RESOLUTION tolerances of it is below what the integration
-        // resolves (rounding-level turns of a velocity settling onto an equilibrium) and is
-        // not reported.
-        let mut last_extremum: [Option<f64>; 2] = [None; 2];
-        while t < t_end {
+        while c.t < t_end {
             // Both discs stuck: the state is frozen and the exit guards are constant.
-            if mode.upper == DiscMode::Stick && mode.lower == DiscMode::Stick {
-                let mut stays = true;
-                for d in Disc::BOTH {
-                    if model.stick_exit(d, &x, u).is_some() {
-                        stays = false;
-                    }
-                }
-                if stays {
-                    let d = frozen_dense(t, t_end - t, &x);
-                    sink.step(&d, t, t_end, &x, mode);
-                    t = t_end;
-                    break;
-                }
+            if c.mode.upper == DiscMode::Stick
+                && c.mode.lower == DiscMode::Stick
+                && Disc::BOTH
+                    .iter()
+                    .all(|&d| self.model.stick_exit(d, &c.x, self.u).is_none())
+            {
+                let d = frozen_dense(c.t, t_end - c.t, &c.x);
+                sink.step(&d, c.t, t_end, &c.x, c.mode);
+                c.t = t_end;
+                break;
             }
             steps_total += 1;
             if steps_total > self.opts.max_steps {
                 return Err(SolveError::TooManySteps {
-                    t,
+                    t: c.t,
                     max_steps: self.opts.max_steps,
                 });
             }
-            let mut last = false;
-            if t + 1.01 * h >= t_end {
-                h = t_end - t;
-                last = true;
+            if let Some(end) = self.step(&mut c, t_end, field, &mut recent, sink)? {
+                return Ok(end);
             }
-            if h <= 4.0 * f64::EPSILON * t.abs().max(1.0) {
-                return Err(SolveError::StepSizeUnderflow {
-                    t,
-                    h,
-                    x: [x[0], x[1], x[2]],
-                });
+        }
+        Ok(RunEnd {
+            t: c.t,
+            x: c.x,
+            mode: c.mode,
+        })
+    }
+
+    /// One step attempt from the cursor: rejected (a smaller step next), or accepted with
+    /// its events; `Some` if the sink stopped the run at one of them.
+    fn step(
+        &mut self,
+        c: &mut Cursor,
+        t_end: f64,
+        field: &impl Fn(&State, Mode) -> State,
+        recent: &mut Recent,
+        sink: &mut impl Sink,
+    ) -> Result<Option<RunEnd>, SolveError> {
+        let mut h = c.h;
+        let mut last = false;
+        if c.t + 1.01 * h >= t_end {
+            h = t_end - c.t;
+            last = true;
+        }
+        if h <= 4.0 * f64::EPSILON * c.t.abs().max(1.0) {
+            return Err(SolveError::StepSizeUnderflow {
+                t: c.t,
+                h,
+                x: [c.x[0], c.x[1], c.x[2]],
+            });
+        }
+        let mode = c.mode;
+        let mut fm = |_t: f64, y: &State| field(y, mode);
+        let tr = self.ctl.trial(&mut fm, c.t, &c.x, &c.f0, h);
+        if !Dop853::acceptable(&tr) {
+            self.stats.rejected += 1;
+            c.h = self.ctl.reject(tr.err, h);
+            return Ok(None);
+        }
+        let h_next = self.ctl.accept(tr.err, h);
+        self.stats.steps += 1;
+        let t1 = if last { t_end } else { c.t + h };
+        let f1 = fm(t1, &tr.y1);
+        let dense = self.ctl.dense(&mut fm, &tr, &f1);
+        match self.scan(c, &dense, t1, (&tr.y1, &f1), sink) {
+            Scan::Stop(end) => Ok(Some(end)),
+            Scan::Through => {
+                sink.step(&dense, c.t, t1, &tr.y1, mode);
+                (c.t, c.x, c.f0, c.h) = (t1, tr.y1, f1, h_next);
+                check_finite(c.t, &c.x)?;
+                Ok(None)
             }
-            let mut fm = |tt: f64, y: &State| f(tt, y, mode);
-            let tr = self.ctl.trial(&mut fm, t, &x, &f0, h);
-            if !Dop853::acceptable(&tr) {
-                self.stats.rejected += 1;
-                h = self.ctl.reject(tr.err, h);
-                continue;
+            Scan::Terminal(te, g) => {
+                let (tev, xe) = self.refine(c, g, te, t1, &tr.y1, &mut fm);
+                sink.step(&dense, c.t, tev, &xe, mode);
+                check_finite(tev, &xe)?;
+                (c.t, c.x) = (tev, xe);
+                if let Some(end) = self.switch(c, g, recent, sink)? {
+                    return Ok(Some(end));
+                }
+                c.f0 = field(&c.x, c.mode);
+                self.ctl.restart();
+                c.h = h_next.min(h).max(1e-6 * h_next);
+                Ok(None)
             }
-            let h_next = self.ctl.accept(tr.err, h);
-            self.stats.steps += 1;
-            let t1 = if last { t_end } else { t + h };
-            let f1 = fm(t1, &tr.y1);
-            let dense = self.ctl.dense(&mut fm, &tr, &f1);
-            // Earliest event in the step; non-terminal events before it are recorded.
-            let mut t_lo = t;
-            let mut stop_here = None;
-            while let Some(Detected {
-                t: te,
-                guard: g,
-                resume,
-            }) = self.detect(
-                &dense,
-                t_lo,
-                t1,
-                mode,
-                (t_lo == t).then_some((&x, &f0)),
-                (&tr.y1, &f1),
-            ) {
-                if g.terminal() {
-                    stop_here = Some((te, g));
+        }
+    }
+
+    /// The events of an accepted step `[c.t, t1]` in time order: non-terminal ones (extrema,
+    /// section crossings) go to the sink, which may stop the run there; the first terminal
+    /// guard (a mode switch) ends the scan.
+    fn scan(
+        &mut self,
+        c: &mut Cursor,
+        dense: &Dense<3>,
+        t1: f64,
+        end: (&State, &State),
+        sink: &mut impl Sink,
+    ) -> Scan {
+        let (t, mode) = (c.t, c.mode);
+        // Just past a root: where the search for the next one in the step starts.
+        let past = |resume: f64| resume + 1e-12 * (t1 - t).abs().max(1e-300);
+        let mut t_lo = t;
+        while let Some(Detected {
+            t: te,
+            guard: g,
+            resume,
+        }) = self.detect(
+            dense,
+            t_lo,
+            t1,
+            mode,
+            (t_lo == t).then_some((&c.x, &c.f0)),
+            end,
+        ) {
+            if g.terminal() {
+                return Scan::Terminal(te, g);
+            }
+            t_lo = past(resume);
+            if matches!(g, Guard::Extremum(..)) && te - c.t_switch <= 1e-9 * te.abs().max(1.0) {
+                if t_lo >= t1 {
                     break;
                 }
-                if matches!(g, Guard::Extremum(..)) && te - t_switch <= 1e-9 * te.abs().max(1.0) {
-                    t_lo = resume + 1e-12 * (t1 - t).abs().max(1e-300);
+                continue;
+            }
+            let xe = refine_state(dense, te);
+            if let Guard::Extremum(d, _) = g {
+                let w = xe[d.index()];
+                let resolvable = c.last_extremum[d as usize].replace(w).is_none_or(|w_prev| {
+                    (w - w_prev).abs() > EXTREMUM_RESOLUTION * self.ctl.rtol * (1.0 + w.abs())
+                });
+                if !resolvable {
                     if t_lo >= t1 {
                         break;
                     }
                     continue;
                 }
-                let xe = refine_state(&dense, te);
-                if let Guard::Extremum(d, _) = g {
-                    let w = xe[d.index()];
-                    let resolvable = last_extremum[d as usize].replace(w).is_none_or(|w_prev| {
-                        (w - w_prev).abs() > EXTREMUM_RESOLUTION * self.ctl.rtol * (1.0 + w.abs())
-                    });
-                    if !resolvable {
-                        t_lo = resume + 1e-12 * (t1 - t).abs().max(1e-300);
-                        if t_lo >= t1 {
-                            break;
-                        }
-                        continue;
-                    }
-                }
+            }
+            let stop = if g == Guard::Section {
+                sink.section(te, &xe)
+            } else {
                 let kind = match g {
-                    Guard::Extremum(d, true) => EventKind::Max(d),
                     Guard::Extremum(d, false) => EventKind::Min(d),
+                    Guard::Extremum(d, true) => EventKind::Max(d),
                     _ => EventKind::Max(Disc::Lower),
                 };
                 let ev = Event { t: te, x: xe, kind };
-                if g == Guard::Section {
-                    if sink.section(te, &xe) {
-                        sink.step(&dense, t, te, &xe, mode);
-                        self.stats.rhs_evals += rhs_evals + self.extra_evals.take();
-                        return Ok(RunEnd { t: te, x: xe, mode });
-                    }
-                } else {
-                    self.stats.events += 1;
-                    sink.event(&ev);
-                    if sink.stop_after(&ev) {
-                        sink.step(&dense, t, te, &xe, mode);
-                        self.stats.rhs_evals += rhs_evals + self.extra_evals.take();
-                        return Ok(RunEnd { t: te, x: xe, mode });
-                    }
-                }
-                // Continue the search just past this root.
-                t_lo = resume + 1e-12 * (t1 - t).abs().max(1e-300);
-                if t_lo >= t1 {
-                    break;
-                }
+                self.stats.events += 1;
+                sink.event(&ev);
+                sink.stop_after(&ev)
+            };
+            if stop {
+                sink.step(dense, t, te, &xe, mode);
+                return Scan::Stop(RunEnd { t: te, x: xe, mode });
             }
-            match stop_here {
-                None => {
-                    sink.step(&dense, t, t1, &tr.y1, mode);
-                    t = t1;
-                    x = tr.y1;
-                    f0 = f1;
-                    h = h_next;
-                    check_finite(t, &x)?;
-                }
-                Some((te, g)) => {
-                    // Refine: an exact RK step from t to the root, then a Newton correction.
-                    let mut tev = te;
-                    let mut xe = tr.y1;
-                    for _ in 0..3 {
-                        let hh = tev - t;
-                        xe = if hh > 0.0 {
-                            self.ctl.trial(&mut fm, t, &x, &f0, hh).y1
-                        } else {
-                            x
-                        };
-                        let fe = self.field(&xe, mode);
-                        let gv = self.guard(g, &xe, mode);
-                        let gr = self.guard_rate(g, &xe, &fe, mode);
-                        if gr == 0.0 || !gr.is_finite() {
-                            break;
-                        }
-                        let dt = -gv / gr;
-                        // Keep the correction inside the step and stop at rounding level.
-                        if dt.abs() <= 1e-15 * tev.abs().max(1.0) || tev + dt <= t || tev + dt > t1
-                        {
-                            break;
-                        }
-                        // A correction far inside the tolerance: a first-order Taylor step
-                        // along the field instead of another RK step. Its error ½dt²|ẍ|, with
-                        // |ẍ| bounded by the field's change over the step, must be below a
-                        // thousandth of the tolerance (typically dt ~ 1e-12 s, error ~1e-23).
-                        // The terminal guards are linear in x, so the moved state meets the
-                        // guard to rounding.
-                        let small = hh > 0.0
-                            && (0..3).all(|i| {
-                                let acc = (fe[i] - f0[i]).abs() / hh;
-                                0.5 * dt * dt * acc
-                                    <= 1e-3 * self.ctl.rtol.min(self.ctl.atol) * (1.0 + xe[i].abs())
-                            });
-                        tev += dt;
-                        if small {
-                            xe += fe * dt;
-                            break;
-                        }
-                    }
-                    sink.step(&dense, t, tev, &xe, mode);
-                    check_finite(tev, &xe)?;
-                    t = tev;
-                    x = xe;
-                    let (new_mode, kind) = self.transition(g, &mut x, mode);
-                    self.stats.events += u64::from(kind.is_some());
-                    if let Some(kind) = kind {
-                        let ev = Event { t, x, kind };
-                        sink.event(&ev);
-                        recent[n_switch % zeno_n] = t;
-                        n_switch += 1;
-                        if n_switch >= zeno_n {
-                            let oldest = recent[n_switch % zeno_n];
-                            let window = self.opts.zeno_window * t.abs().max(1.0);
-                            if t - oldest < window {
-                                return Err(SolveError::Zeno {
-                                    t,
-                                    count: zeno_n as u32,
-                                    window,
-                                });
-                            }
-                        }
-                        if sink.stop_after(&ev) {
-                            self.stats.rhs_evals += rhs_evals + self.extra_evals.take();
-                            return Ok(RunEnd {
-                                t,
-                                x,
-                                mode: new_mode,
-                            });
-                        }
-                    }
-                    mode = new_mode;
-                    t_switch = t;
-                    last_extremum = [None; 2];
-                    f0 = f(t, &x, mode);
-                    self.ctl.restart();
-                    h = h_next.min(h).max(1e-6 * h_next);
-                }
+            if t_lo >= t1 {
+                break;
             }
         }
-        self.stats.rhs_evals += rhs_evals + self.extra_evals.take();
-        Ok(RunEnd { t, x, mode })
+        Scan::Through
+    }
+
+    /// A terminal guard's root located to rounding: an exact RK step from the step's start to
+    /// the root found on the dense output, then Newton corrections along the guard's rate.
+    fn refine(
+        &mut self,
+        c: &Cursor,
+        g: Guard,
+        te: f64,
+        t1: f64,
+        y1: &State,
+        fm: &mut impl FnMut(f64, &State) -> State,
+    ) -> (f64, State) {
+        let (t, mode) = (c.t, c.mode);
+        let mut tev = te;
+        let mut xe = *y1;
+        for _ in 0..3 {
+            let hh = tev - t;
+            xe = if hh > 0.0 {
+                self.ctl.trial(fm, t, &c.x, &c.f0, hh).y1
+            } else {
+                c.x
+            };
+            let fe = self.field(&xe, mode);
+            let gv = self.guard(g, &xe, mode);
+            let gr = self.guard_rate(g, &xe, &fe, mode);
+            if gr == 0.0 || !gr.is_finite() {
+                break;
+            }
+            let dt = -gv / gr;
+            // Keep the correction inside the step and stop at rounding level.
+            if dt.abs() <= 1e-15 * tev.abs().max(1.0) || tev + dt <= t || tev + dt > t1 {
+                break;
+            }
+            // A correction far inside the tolerance: a first-order Taylor step along the
+            // field instead of another RK step. Its error ½dt²|ẍ|, with |ẍ| bounded by the
+            // field's change over the step, must be below a thousandth of the tolerance
+            // (typically dt ~ 1e-12 s, error ~1e-23). The terminal guards are linear in x, so
+            // the moved state meets the guard to rounding.
+            let small = hh > 0.0
+                && (0..3).all(|i| {
+                    let acc = (fe[i] - c.f0[i]).abs() / hh;
+                    0.5 * dt * dt * acc
+                        <= 1e-3 * self.ctl.rtol.min(self.ctl.atol) * (1.0 + xe[i].abs())
+                });
+            tev += dt;
+            if small {
+                xe += fe * dt;
+                break;
+            }
+        }
+        (tev, xe)
+    }
+
+    /// The mode switch at the cursor (a terminal guard `g` located there): the new mode, the
+    /// event, the Zeno guard; `Some` if the sink stops the run after the event.
+    fn switch(
+        &mut self,
+        c: &mut Cursor,
+        g: Guard,
+        recent: &mut Recent,
+        sink: &mut impl Sink,
+    ) -> Result<Option<RunEnd>, SolveError> {
+        let (new_mode, kind) = self.transition(g, &mut c.x, c.mode);
+        if let Some(kind) = kind {
+            self.stats.events += 1;
+            let ev = Event {
+                t: c.t,
+                x: c.x,
+                kind,
+            };
+            sink.event(&ev);
+            recent.record(c.t, self.opts.zeno_window)?;
+            if sink.stop_after(&ev) {
+                return Ok(Some(RunEnd {
+                    t: c.t,
+                    x: c.x,
+                    mode: new_mode,
+                }));
+            }
+        }
+        c.mode = new_mode;
+        c.t_switch = c.t;
+        c.last_extremum = [None; 2];
+        Ok(None)
     }
 
     /// The mode after a terminal guard, and the event to report.

@@ -73,6 +73,21 @@ fn eval_branch(f: &Friction, db: f64, w: f64, s: f64) -> BranchEval {
 
 /// What the slip branches of one step are built from: the step's constants and the
 /// friction evaluations at the start velocity.
+/// Counters of one step: friction evaluations and Newton (or Picard) iterations.
+#[derive(Default)]
+struct Counts {
+    evals: u32,
+    newton: u32,
+}
+
+/// The start-of-step terms of a step ([`Stepper::start_terms`]).
+struct StartTerms {
+    b: Vector2<f64>,
+    p_start: [f64; 2],
+    stick: [StickData; 2],
+    start: [(f64, BranchEval); 2],
+}
+
 struct BranchCtx<'a> {
     stepper: &'a Stepper,
     /// `hθ`.
@@ -220,9 +235,68 @@ impl Stepper {
         let implicit = self.level == FrictionLevel::Implicit;
         let v = Vector2::new(x[1], x[2]);
         let StepSize { h, a, w_inv } = *size;
-        let mut evals = 0u32;
+        let mut n = Counts::default();
+        let st = self.start_terms(x, h, &mut n);
+        let ctx = BranchCtx {
+            stepper: self,
+            ht: h * th,
+            implicit,
+            p_start: st.p_start,
+            v,
+            start: st.start,
+        };
+        // The step problem before any slip branch is linearised into it.
+        let base = OneStepProblem {
+            a,
+            b: st.b,
+            slip: [[Branch::default(); 2]; 2],
+            stick: st.stick,
+        };
+        let mut result = None;
+        if self.skip_free && self.no_contact_can_change(&ctx, st.b, &w_inv, &mut n) {
+            result = self.newton_in_slip_mode(&ctx, &base, &mut n);
+        }
+        let (used_enumeration, mut exact) = (result.is_none(), true);
+        if result.is_none() {
+            result = match self.semi_smooth_newton(&ctx, &base, &mut n) {
+                Ok(sol) => Some(sol),
+                Err(w) => {
+                    let (sol, converged) = self.picard(&base, w, h, &st.p_start, t, &mut n)?;
+                    exact = converged;
+                    sol
+                }
+            };
+        }
+        let sol = result.ok_or_else(|| SolveError::NoConvergence {
+            detail: format!("Moreau step at t = {t}: no iterate (max_newton = 0?)"),
+        })?;
+        debug_assert!(
+            !exact || self.check_complementarity(&sol, &st.p_start, h),
+            "chosen mode violates complementarity at t = {t}: {sol:?}"
+        );
 
-        // Start-of-step terms.
+        let vp = sol.v;
+        let alpha = x[0] + h * ((1.0 - th) * (v[0] - v[1]) + th * (vp[0] - vp[1]));
+        Ok(StepOutcome {
+            x: State::new(alpha, vp[0], vp[1]),
+            mode: sol.mode,
+            r: sol.r,
+            p: sol.p,
+            used_enumeration,
+            exact,
+            newton_iters: n.newton,
+            evals: n.evals,
+        })
+    }
+
+    /// The start-of-step terms: the right-hand side `b`, the cone bound's start part and the
+    /// stick data. The friction of branch `s0 = sign(v_i)` at the start velocity is evaluated
+    /// once here and reused by the skip test and by the first Newton iteration (which
+    /// linearise at `w = v` on the same branch): one evaluation per disc instead of three.
+    fn start_terms(&self, x: &State, h: f64, n: &mut Counts) -> StartTerms {
+        let th = self.theta;
+        let implicit = self.level == FrictionLevel::Implicit;
+        let v = Vector2::new(x[1], x[2]);
         let kv = self.k * (v[0] - v[1]);
         let kq = self.k * x[0];
         let mut b = Vector2::new(
@@ -230,10 +304,6 @@ impl Stepper {
                 + h * self.f_ext,
             (self.j[1] - (1.0 - th) * h * self.c[1]) * v[1] + th * (1.0 - th) * h * h * kv + h * kq,
         );
-        // Start-of-step contact bound part and stick data.
-        // The friction of branch s0 = sign(v_i) at the start velocity is evaluated once here
-        // and reused by the skip test and by the first Newton iteration (which linearise at
-        // w = v on the same branch): one evaluation per disc instead of three.
         let mut p_start = [0.0; 2];
         let mut stick = [StickData::default(); 2];
         let mut start = [(1.0, BranchEval::default()); 2];
@@ -241,7 +311,7 @@ impl Stepper {
             let s0 = if v[i] < 0.0 { -1.0 } else { 1.0 };
             let e0 = eval_branch(&self.law[i], self.db[i], v[i], s0);
             start[i] = (s0, e0);
-            evals += 1;
+            n.evals += 1;
             // Negative part of the level, as a smooth force −sign(ω)·min(N, 0).
             let neg0 = -s0 * e0.level.min(0.0);
             let npos0 = e0.level.max(0.0);
@@ -263,194 +333,172 @@ impl Stepper {
                 };
             }
         }
-
-        let ctx = BranchCtx {
-            stepper: self,
-            ht: h * th,
-            implicit,
-            p_start,
-            v,
-            start,
-        };
-        let branch = |i: usize, s: f64, w: f64, evals: &mut u32| ctx.branch(i, s, w, evals);
-
-        // Skip test (the spec's criterion): the frozen-bound free velocity of each disc is
-        // more than twice as far from 0 as any admissible impulse can move it.
-        let mut skip = self.skip_free;
-        {
-            let mut rhs = b;
-            let mut pmax = [0.0; 2];
-            for i in 0..2 {
-                if !skip || v[i] == 0.0 {
-                    skip = false;
-                    break;
-                }
-                let s = v[i].signum();
-                let br = branch(i, s, v[i], &mut evals);
-                rhs[i] += br.c + br.d * v[i] + s * (br.pc + br.pd * v[i]);
-                pmax[i] = (br.pc + br.pd * v[i]).abs();
-            }
-            if skip {
-                let vf = w_inv * rhs;
-                for i in 0..2 {
-                    let reach =
-                        2.0 * (w_inv[(i, 0)].abs() * pmax[0] + w_inv[(i, 1)].abs() * pmax[1]);
-                    if !(vf[i] * v[i] > 0.0 && vf[i].abs() > reach) {
-                        skip = false;
-                    }
-                }
-            }
-        }
-
-        // The step problem before any slip branch is linearised into it.
-        let base = OneStepProblem {
-            a,
+        StartTerms {
             b,
-            slip: [[Branch::default(); 2]; 2],
+            p_start,
             stick,
-        };
-        let mut newton_iters = 0u32;
-        let mut used_enum = false;
-        let mut result: Option<OneStepSolution> = None;
-
-        if skip {
-            // Newton in the fixed slip mode sign(v), verified at convergence.
-            let s = [v[0].signum(), v[1].signum()];
-            let mode = [DiscMode::slip_of(v[0]), DiscMode::slip_of(v[1])];
-            let mut w = v;
-            let mut dv_prev = f64::INFINITY;
-            let mut prob = base;
-            for _ in 0..self.max_newton {
-                newton_iters += 1;
-                for i in 0..2 {
-                    let bi = if s[i] > 0.0 { 0 } else { 1 };
-                    prob.slip[i][bi] = branch(i, s[i], w[i], &mut evals);
-                }
-                let Some(sol) = prob.solve_mode(mode) else {
-                    break;
-                };
-                let dv = (sol.v - w).amax();
-                w = sol.v;
-                let done = self.converged(mode, dv, dv_prev, w.amax());
-                dv_prev = dv;
-                if done {
-                    if OneStepProblem::is_admissible(&sol, 0.0, 0.0) {
-                        result = Some(sol);
-                    }
-                    break;
-                }
-            }
+            start,
         }
+    }
 
-        let mut exact = true;
-        if result.is_none() {
-            used_enum = true;
-            // Semi-smooth Newton: linearise, solve the piecewise-linear problem exactly.
-            let mut w = v;
-            let mut prev: Option<[DiscMode; 2]> = None;
-            let mut dv_prev = f64::INFINITY;
-            let mut newton_failed = false;
-            let mut prob = base;
-            for _ in 0..self.max_newton {
-                newton_iters += 1;
-                for i in 0..2 {
-                    prob.slip[i] = [
-                        branch(i, 1.0, w[i], &mut evals),
-                        branch(i, -1.0, w[i], &mut evals),
-                    ];
-                }
-                let Ok(sol) = prob.solve() else {
-                    newton_failed = true;
-                    break;
-                };
-                let dv = (sol.v - w).amax();
-                let same = prev == Some(sol.mode);
-                w = sol.v;
-                prev = Some(sol.mode);
-                // A mode change makes the previous update no Newton step of this mode.
-                let done = self.converged(
-                    sol.mode,
-                    dv,
-                    if same { dv_prev } else { f64::INFINITY },
-                    w.amax(),
-                );
-                dv_prev = dv;
-                if (same || self.exact_linearisation(sol.mode)) && done {
-                    result = Some(sol);
-                    break;
-                }
+    /// The skip test: the frozen-bound free velocity of each disc is more than twice as far
+    /// from 0 as any admissible impulse can move it.
+    fn no_contact_can_change(
+        &self,
+        ctx: &BranchCtx,
+        b: Vector2<f64>,
+        w_inv: &Matrix2<f64>,
+        n: &mut Counts,
+    ) -> bool {
+        let v = ctx.v;
+        let mut rhs = b;
+        let mut pmax = [0.0; 2];
+        for i in 0..2 {
+            if v[i] == 0.0 {
+                return false;
             }
-            if result.is_none() {
-                // Newton failed: with a level falling faster than M̂ can absorb (very large
-                // h) the linearised slip branches become ill-posed, and the nonlinear step
-                // problem itself may have no or several solutions. Picard iteration on the
-                // frozen problem: every mode of disc i sees the same smooth impulse g_i and
-                // the same bound P_i, evaluated at the iterate; that is the KKT system of a
-                // strictly convex box QP (W = M̂⁻¹ SPD), with exactly one solution. A fixed
-                // point is an exact solution of the step problem.
-                let mut w = if newton_failed { v } else { w };
-                let mut last: Option<OneStepSolution> = None;
-                let mut prev: Option<[DiscMode; 2]> = None;
-                exact = false;
-                for _ in 0..self.max_newton {
-                    newton_iters += 1;
-                    let mut prob = base;
-                    for i in 0..2 {
-                        let s = if w[i] < 0.0 { -1.0 } else { 1.0 };
-                        let e = eval_branch(&self.law[i], self.db[i], w[i], s);
-                        evals += 1;
-                        let (mut g, mut p) = (h * th * e.off, p_start[i]);
-                        if implicit {
-                            g -= s * h * th * e.level.min(0.0);
-                            p += h * th * e.level.max(0.0);
-                        }
-                        prob.slip[i] = [1.0, -1.0].map(|sb| Branch {
-                            c: g - sb * p,
-                            d: 0.0,
-                            pc: p,
-                            pd: 0.0,
-                        });
-                        prob.stick[i] = StickData { e: g, p };
-                    }
-                    let sol = prob.solve().map_err(|err| SolveError::Complementarity {
-                        t,
-                        detail: format!("frozen one-step problem (h = {h:e}): {err:?}"),
-                    })?;
-                    let dv = (sol.v - w).amax();
-                    let same = prev == Some(sol.mode);
-                    w = sol.v;
-                    prev = Some(sol.mode);
-                    last = Some(sol);
-                    if same && dv <= 1e-12 * (1.0 + w.amax()) {
-                        exact = true;
-                        break;
-                    }
-                }
-                // Not converged: the last Picard iterate (the exact solution of a frozen
-                // problem, bounded) is taken; `StepOutcome::exact` says so.
-                result = last;
-            }
+            let s = v[i].signum();
+            let br = ctx.branch(i, s, v[i], &mut n.evals);
+            rhs[i] += br.c + br.d * v[i] + s * (br.pc + br.pd * v[i]);
+            pmax[i] = (br.pc + br.pd * v[i]).abs();
         }
-        let sol = result.ok_or_else(|| SolveError::NoConvergence {
-            detail: format!("Moreau step at t = {t}: no iterate (max_newton = 0?)"),
-        })?;
-        debug_assert!(
-            !exact || self.check_complementarity(&sol, &p_start, h),
-            "chosen mode violates complementarity at t = {t}: {sol:?}"
-        );
-
-        let vp = sol.v;
-        let alpha = x[0] + h * ((1.0 - th) * (v[0] - v[1]) + th * (vp[0] - vp[1]));
-        Ok(StepOutcome {
-            x: State::new(alpha, vp[0], vp[1]),
-            mode: sol.mode,
-            r: sol.r,
-            p: sol.p,
-            used_enumeration: used_enum,
-            exact,
-            newton_iters,
-            evals,
+        let vf = w_inv * rhs;
+        (0..2).all(|i| {
+            let reach = 2.0 * (w_inv[(i, 0)].abs() * pmax[0] + w_inv[(i, 1)].abs() * pmax[1]);
+            vf[i] * v[i] > 0.0 && vf[i].abs() > reach
         })
+    }
+
+    /// Newton in the fixed slip mode `sign(v)`, verified at convergence: `None` if it does
+    /// not converge to an admissible solution.
+    fn newton_in_slip_mode(
+        &self,
+        ctx: &BranchCtx,
+        base: &OneStepProblem,
+        n: &mut Counts,
+    ) -> Option<OneStepSolution> {
+        let v = ctx.v;
+        let s = [v[0].signum(), v[1].signum()];
+        let mode = [DiscMode::slip_of(v[0]), DiscMode::slip_of(v[1])];
+        let mut w = v;
+        let mut dv_prev = f64::INFINITY;
+        let mut prob = *base;
+        for _ in 0..self.max_newton {
+            n.newton += 1;
+            for i in 0..2 {
+                let bi = if s[i] > 0.0 { 0 } else { 1 };
+                prob.slip[i][bi] = ctx.branch(i, s[i], w[i], &mut n.evals);
+            }
+            let sol = prob.solve_mode(mode)?;
+            let dv = (sol.v - w).amax();
+            w = sol.v;
+            let done = self.converged(mode, dv, dv_prev, w.amax());
+            dv_prev = dv;
+            if done {
+                return OneStepProblem::is_admissible(&sol, 0.0, 0.0).then_some(sol);
+            }
+        }
+        None
+    }
+
+    /// Semi-smooth Newton: linearise the slip branches at the iterate, solve the piecewise
+    /// linear problem exactly. On failure, the iterate to start Picard iteration from (the
+    /// start velocity if a linearised problem had no solution).
+    fn semi_smooth_newton(
+        &self,
+        ctx: &BranchCtx,
+        base: &OneStepProblem,
+        n: &mut Counts,
+    ) -> Result<OneStepSolution, Vector2<f64>> {
+        let mut w = ctx.v;
+        let mut prev: Option<[DiscMode; 2]> = None;
+        let mut dv_prev = f64::INFINITY;
+        let mut prob = *base;
+        for _ in 0..self.max_newton {
+            n.newton += 1;
+            for i in 0..2 {
+                prob.slip[i] = [
+                    ctx.branch(i, 1.0, w[i], &mut n.evals),
+                    ctx.branch(i, -1.0, w[i], &mut n.evals),
+                ];
+            }
+            let Ok(sol) = prob.solve() else {
+                return Err(ctx.v);
+            };
+            let dv = (sol.v - w).amax();
+            let same = prev == Some(sol.mode);
+            w = sol.v;
+            prev = Some(sol.mode);
+            // A mode change makes the previous update no Newton step of this mode.
+            let done = self.converged(
+                sol.mode,
+                dv,
+                if same { dv_prev } else { f64::INFINITY },
+                w.amax(),
+            );
+            dv_prev = dv;
+            if (same || self.exact_linearisation(sol.mode)) && done {
+                return Ok(sol);
+            }
+        }
+        Err(w)
+    }
+
+    /// Newton failed: with a level falling faster than M̂ can absorb (very large h) the
+    /// linearised slip branches become ill-posed, and the nonlinear step problem itself may
+    /// have no or several solutions. Picard iteration on the frozen problem from `w`: every
+    /// mode of disc i sees the same smooth impulse g_i and the same bound P_i, evaluated at
+    /// the iterate; that is the KKT system of a strictly convex box QP (W = M̂⁻¹ SPD), with
+    /// exactly one solution. A fixed point is an exact solution of the step problem; if none
+    /// is reached, the last iterate (the exact solution of a frozen problem, bounded) is
+    /// taken and the second value, `StepOutcome::exact`, says so.
+    fn picard(
+        &self,
+        base: &OneStepProblem,
+        mut w: Vector2<f64>,
+        h: f64,
+        p_start: &[f64; 2],
+        t: f64,
+        n: &mut Counts,
+    ) -> Result<(Option<OneStepSolution>, bool), SolveError> {
+        let th = self.theta;
+        let implicit = self.level == FrictionLevel::Implicit;
+        let mut last: Option<OneStepSolution> = None;
+        let mut prev: Option<[DiscMode; 2]> = None;
+        for _ in 0..self.max_newton {
+            n.newton += 1;
+            let mut prob = *base;
+            for i in 0..2 {
+                let s = if w[i] < 0.0 { -1.0 } else { 1.0 };
+                let e = eval_branch(&self.law[i], self.db[i], w[i], s);
+                n.evals += 1;
+                let (mut g, mut p) = (h * th * e.off, p_start[i]);
+                if implicit {
+                    g -= s * h * th * e.level.min(0.0);
+                    p += h * th * e.level.max(0.0);
+                }
+                prob.slip[i] = [1.0, -1.0].map(|sb| Branch {
+                    c: g - sb * p,
+                    d: 0.0,
+                    pc: p,
+                    pd: 0.0,
+                });
+                prob.stick[i] = StickData { e: g, p };
+            }
+            let sol = prob.solve().map_err(|err| SolveError::Complementarity {
+                t,
+                detail: format!("frozen one-step problem (h = {h:e}): {err:?}"),
+            })?;
+            let dv = (sol.v - w).amax();
+            let same = prev == Some(sol.mode);
+            w = sol.v;
+            prev = Some(sol.mode);
+            last = Some(sol);
+            if same && dv <= 1e-12 * (1.0 + w.amax()) {
+                return Ok((last, true));
+            }
+        }
+        Ok((last, false))
     }
 
     /// Whether the linearised step problem of `mode` is the step problem itself: explicit
