@@ -6,11 +6,12 @@
 //! `cargo bench -p rotor-bench` (all), `cargo bench -p rotor-bench -- output` (one group).
 //! The work-precision ladders and the peers are in `rotor_bench::run`, not here.
 
+use rotor_compare::SOLVERS;
 use std::hint::black_box;
 use std::time::Duration;
 
 use criterion::{Criterion, criterion_group, criterion_main};
-use rotor_bench::{SceneSpec, SolverKind, scene_of, solver, workspace_root};
+use rotor_bench::{SceneSpec, scene_of, solver, workspace_root};
 use rotor_model::{Model, Output, Scene};
 
 fn setup() -> (Model, Scene) {
@@ -22,7 +23,7 @@ fn solvers(c: &mut Criterion) {
     let (model, scene) = setup();
     let mut g = c.benchmark_group("solver_u1.5_100s_trace");
     g.sample_size(20).measurement_time(Duration::from_secs(5));
-    for kind in SolverKind::ALL {
+    for kind in SOLVERS {
         let s = solver(kind);
         g.bench_function(kind.name(), |b| {
             b.iter(|| s.simulate(&model, black_box(&scene)).unwrap())
@@ -35,7 +36,7 @@ fn output_levels(c: &mut Criterion) {
     let (model, scene) = setup();
     let mut g = c.benchmark_group("output_level_u1.5_100s");
     g.sample_size(20).measurement_time(Duration::from_secs(5));
-    for kind in SolverKind::ALL {
+    for kind in SOLVERS {
         let s = solver(kind);
         for (name, output) in [
             ("metrics_only", Output::Metrics),

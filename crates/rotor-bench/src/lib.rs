@@ -322,13 +322,15 @@ fn validate(opts: &BenchOptions) -> Result<(), BenchError> {
             ));
         }
     }
-    for (name, v) in [
-        ("event_tols", &opts.event_tols),
-        ("switch_tols", &opts.switch_tols),
-        ("moreau_hs", &opts.moreau_hs),
-        ("peers.scipy_tols", &opts.peers.scipy_tols),
-        ("peers.siconos_hs", &opts.peers.siconos_hs),
-    ] {
+    let ladders = opts
+        .ladders
+        .iter()
+        .map(|(k, v)| (format!("ladders[{}]", k.name()), v));
+    let peers = [
+        ("peers.scipy_tols".to_string(), &opts.peers.scipy_tols),
+        ("peers.siconos_hs".to_string(), &opts.peers.siconos_hs),
+    ];
+    for (name, v) in ladders.chain(peers) {
         if let Some(x) = v.iter().find(|x| !(**x > 0.0 && x.is_finite())) {
             return bad(format!("{name} holds {x}: every setting must be positive"));
         }
@@ -347,7 +349,7 @@ fn load(
     spec: &SceneSpec,
     progress: &mut impl FnMut(&str),
 ) -> Result<(Loaded, ReferenceReport), BenchError> {
-    let scenario = Scenario::from_file(&spec.scenario)?;
+    let scenario = rotor_compare::load_scenario(&spec.scenario)?;
     let base = Scene {
         u: scenario.u,
         x0: scenario.x0,
@@ -361,7 +363,7 @@ fn load(
         "{}: reference (event, tol {:e})",
         scenario.name, opts.reference_tol
     ));
-    let ev = solver(SolverKind::Event);
+    let ev = solver(SolverKind::EVENT);
     let (tr, timing) = timed(1, 0.0, || ev.simulate(&scenario.model, &base)).map_err(|source| {
         BenchError::Reference {
             scene: scenario.name.clone(),
@@ -396,7 +398,7 @@ fn load(
         Err(e) => (None, Some(e.to_string())),
     };
     let reference = ReferenceReport {
-        solver: SolverKind::Event,
+        solver: SolverKind::EVENT,
         tol: opts.reference_tol,
         period: refd.period,
         omega_l_max: refd.omega_l_max,
@@ -419,8 +421,9 @@ fn load(
 
 fn ladders(opts: &BenchOptions, l: &Loaded, progress: &mut impl FnMut(&str)) -> Vec<LadderPoint> {
     let mut points = Vec::new();
-    for kind in SolverKind::ALL {
-        for &setting in opts.ladder(kind) {
+    for (kind, ladder) in &opts.ladders {
+        let kind = *kind;
+        for &setting in ladder {
             progress(&format!(
                 "{}: {} {} = {setting:e}",
                 l.scenario.name,
@@ -500,11 +503,9 @@ fn output_levels(
     progress: &mut impl FnMut(&str),
 ) -> Result<Vec<OutputLevel>, BenchError> {
     let mut v = Vec::new();
-    for kind in SolverKind::ALL {
-        let setting = match kind {
-            SolverKind::Moreau => opts.output_level_h,
-            _ => opts.output_level_tol,
-        };
+    for (kind, _) in &opts.ladders {
+        let kind = *kind;
+        let setting = kind.info().default;
         progress(&format!(
             "{}: output levels, {} {} = {setting:e}",
             l.scenario.name,
@@ -767,7 +768,7 @@ fn scipy_peer(
             let curve = |min: bool| -> Vec<(f64, f64)> {
                 points
                     .iter()
-                    .filter(|q| q.solver == SolverKind::Event)
+                    .filter(|q| q.solver == SolverKind::EVENT)
                     .filter_map(|q| {
                         let t = q.timing?;
                         Some((pick(&q.errors)?, if min { t.min_s } else { t.median_s }))
@@ -781,7 +782,7 @@ fn scipy_peer(
                 };
                 if let Some((rt, bound)) = time_at_error(&median_curve, e) {
                     ratios.push(Ratio {
-                        against: SolverKind::Event,
+                        against: SolverKind::EVENT,
                         error_kind: kind_name,
                         peer_setting: pp.setting,
                         error: e,
@@ -839,9 +840,9 @@ fn siconos_peer(opts: &BenchOptions, l: &Loaded, progress: &mut impl FnMut(&str)
             "{}: moreau at the siconos step h = {:e}",
             l.scenario.name, pp.setting
         ));
-        let scene = scene_at(&l.base, SolverKind::Moreau, pp.setting, l.base.output);
+        let scene = scene_at(&l.base, SolverKind::MOREAU, pp.setting, l.base.output);
         if let Ok((tr, mt, me)) = run_point(
-            SolverKind::Moreau,
+            SolverKind::MOREAU,
             &scene,
             &l.scenario.model,
             &l.refd,
@@ -930,7 +931,7 @@ pub fn run(opts: &BenchOptions, mut progress: impl FnMut(&str)) -> Result<BenchR
 /// The model and base scene of a scene spec (for benches and tests that drive the solvers
 /// directly): the spec's horizon, full trace on its grid, metrics on.
 pub fn scene_of(spec: &SceneSpec) -> Result<(Model, Scene), BenchError> {
-    let sc = Scenario::from_file(&spec.scenario)?;
+    let sc = rotor_compare::load_scenario(&spec.scenario)?;
     Ok((
         sc.model,
         Scene {

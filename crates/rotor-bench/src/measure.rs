@@ -65,15 +65,16 @@ pub fn solver(kind: SolverKind) -> Box<dyn Solver> {
     kind.solver()
 }
 
-/// The scene for one solver at one accuracy setting (tol, or h for Moreau–Jean).
+/// The scene for one solver at one accuracy setting (its tolerance or its step).
 pub fn scene_at(base: &Scene, kind: SolverKind, setting: f64, output: Output) -> Scene {
     let mut s = Scene {
         output,
         ..base.clone()
     };
-    match kind {
-        SolverKind::Moreau => s.h = setting,
-        _ => s.tol = setting,
+    if kind.is_fixed_step() {
+        s.h = setting;
+    } else {
+        s.tol = setting;
     }
     s
 }

@@ -2,6 +2,7 @@
 
 use std::path::{Path, PathBuf};
 
+use rotor_compare::SOLVERS;
 pub use rotor_compare::SolverKind;
 
 /// One benchmark scene: a scenario file, a horizon, and the windows the errors are read on.
@@ -67,12 +68,9 @@ pub struct PeerOptions {
 pub struct BenchOptions {
     /// Scenes; the first one is also used for the output-level ratios and the peers.
     pub scenes: Vec<SceneSpec>,
-    /// Tolerance ladder of the event-driven solver.
-    pub event_tols: Vec<f64>,
-    /// Tolerance ladder of the switch-model solver.
-    pub switch_tols: Vec<f64>,
-    /// Step ladder of Moreau–Jean (s).
-    pub moreau_hs: Vec<f64>,
+    /// Each solver with its ladder of settings (tolerances or steps), in report order;
+    /// default: every solver of `rotor_compare::SOLVERS` with its own ladder.
+    pub ladders: Vec<(SolverKind, Vec<f64>)>,
     /// Tolerance of the reference run (event-driven solver).
     pub reference_tol: f64,
     /// A tighter tolerance run once to estimate the reference's own error
@@ -83,11 +81,9 @@ pub struct BenchOptions {
     /// Seconds of timing per point: a point whose single run takes longer is timed fewer
     /// times (down to its untimed-warm-up-free single run).
     pub time_budget: f64,
-    /// Measure metrics-only vs full-trace run time for each solver at its default setting.
+    /// Measure metrics-only vs full-trace run time for each solver at its default setting
+    /// (`SolverInfo::default`).
     pub output_levels: bool,
-    /// Settings for the output-level ratio: event/switch tolerance and Moreau step.
-    pub output_level_tol: f64,
-    pub output_level_h: f64,
     /// Peers.
     pub peers: PeerOptions,
 }
@@ -107,15 +103,12 @@ fn decades(from: i32, to: i32) -> Vec<f64> {
 }
 
 impl Default for BenchOptions {
-    /// The full benchmark: Table 1 and the Stribeck set at 1.5 V from rest over 100 s; event
-    /// and switch at tol 1e-3 … 1e-12, Moreau–Jean at h = 1e-2 … 1e-5, reference = event at
-    /// tol 1e-13, median of up to 15 runs within 3 s per point, peers on (first scene).
-    /// The ladders start at 1e-3 so that the event solver has a point less accurate than
-    /// scipy's loosest (tol 1e-4): the ratio there is then measured, not only bounded.
-    ///
-    /// Every Moreau–Jean step divides the 0.01 s grid, so its trace samples are step values,
-    /// not interpolations between steps. The smallest step, 1e-5 (10⁷ steps, a few seconds),
-    /// is kept; the time budget makes it a single timed run.
+    /// The full benchmark: Table 1 and the Stribeck set at 1.5 V from rest over 100 s; every
+    /// solver over its own ladder (`SolverInfo::ladder`: event and switch at tol 1e-3 …
+    /// 1e-12, Moreau–Jean at h = 1e-2 … 1e-5), reference = event at tol 1e-13, median of up
+    /// to 15 runs within 3 s per point, peers on (first scene). The tolerance ladders start at
+    /// 1e-3 so that the event solver has a point less accurate than scipy's loosest (tol
+    /// 1e-4): the ratio there is then measured, not only bounded.
     fn default() -> Self {
         let root = workspace_root();
         BenchOptions {
@@ -123,16 +116,15 @@ impl Default for BenchOptions {
                 SceneSpec::table1_u15(&root, 100.0),
                 SceneSpec::stribeck_u15(&root, 100.0),
             ],
-            event_tols: decades(3, 12),
-            switch_tols: decades(3, 12),
-            moreau_hs: vec![1e-2, 5e-3, 2e-3, 1e-3, 5e-4, 2e-4, 1e-4, 1e-5],
+            ladders: SOLVERS
+                .iter()
+                .map(|k| (*k, k.info().ladder.to_vec()))
+                .collect(),
             reference_tol: 1e-13,
             reference_check_tol: 1e-14,
             repeats: 15,
             time_budget: 3.0,
             output_levels: true,
-            output_level_tol: 1e-10,
-            output_level_h: 1e-3,
             peers: PeerOptions {
                 scipy: true,
                 python: "python3".into(),
@@ -154,9 +146,11 @@ impl BenchOptions {
         let full = BenchOptions::default();
         BenchOptions {
             scenes: vec![SceneSpec::table1_u15(&root, 30.0)],
-            event_tols: vec![1e-4, 1e-6, 1e-8],
-            switch_tols: vec![1e-4, 1e-6, 1e-8],
-            moreau_hs: vec![1e-2, 5e-3, 1e-3],
+            ladders: vec![
+                (SolverKind::EVENT, vec![1e-4, 1e-6, 1e-8]),
+                (SolverKind::SWITCH, vec![1e-4, 1e-6, 1e-8]),
+                (SolverKind::MOREAU, vec![1e-2, 5e-3, 1e-3]),
+            ],
             reference_tol: 1e-12,
             reference_check_tol: 1e-13,
             repeats: 3,
@@ -168,16 +162,22 @@ impl BenchOptions {
                 scipy_tols: vec![1e-4, 1e-6, 1e-8],
                 ..full.peers
             },
-            ..full
         }
     }
 
-    /// The ladder of one solver.
+    /// The ladder of one solver (empty if it is not benchmarked).
     pub fn ladder(&self, kind: SolverKind) -> &[f64] {
-        match kind {
-            SolverKind::Event => &self.event_tols,
-            SolverKind::Switch => &self.switch_tols,
-            SolverKind::Moreau => &self.moreau_hs,
+        self.ladders
+            .iter()
+            .find(|(k, _)| *k == kind)
+            .map_or(&[], |(_, l)| l.as_slice())
+    }
+
+    /// Sets the ladder of one solver (adding the solver if it has none).
+    pub fn set_ladder(&mut self, kind: SolverKind, settings: Vec<f64>) {
+        match self.ladders.iter_mut().find(|(k, _)| *k == kind) {
+            Some(l) => l.1 = settings,
+            None => self.ladders.push((kind, settings)),
         }
     }
 }

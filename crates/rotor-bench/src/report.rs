@@ -1,5 +1,6 @@
 //! The report as a text table, JSON, CSV and a work-precision SVG.
 
+use rotor_compare::SOLVERS;
 use std::fmt::Write;
 
 use rotor_plot::{Panel, Series, render};
@@ -33,13 +34,12 @@ fn csv_text(s: &str) -> String {
     }
 }
 
+/// A solver's colour from its entry; the peers' own.
 fn color(name: &str) -> &'static str {
-    match name {
-        "event" => "#1f77b4",
-        "switch" => "#ff7f0e",
-        "moreau" => "#2ca02c",
-        "scipy" => "#d62728",
-        _ => "#9467bd",
+    match (SolverKind::by_name(name), name) {
+        (Some(k), _) => k.info().style.color,
+        (None, "scipy") => "#d62728",
+        (None, _) => "#2ca02c",
     }
 }
 
@@ -358,7 +358,7 @@ impl BenchReport {
         for (k, sc) in self.scenes.iter().enumerate() {
             for (what, y_label, pick) in kinds {
                 let mut series = Vec::new();
-                for kind in SolverKind::ALL {
+                for kind in SOLVERS {
                     let pts: Vec<(f64, f64)> = sc
                         .points
                         .iter()

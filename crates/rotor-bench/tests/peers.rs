@@ -3,7 +3,7 @@
 //! both). A peer that runs must compute the reference's answer, else
 //! its ratio is meaningless.
 
-use rotor_bench::{BenchOptions, peer_available, run};
+use rotor_bench::{BenchOptions, SolverKind, peer_available, run};
 
 /// Whether the peer can be tested; a missing peer fails when `ROTOR_REQUIRE_PEERS=1`.
 fn peer_present(python: &str, module: &str) -> bool {
@@ -21,9 +21,9 @@ fn peer_present(python: &str, module: &str) -> bool {
 
 fn options() -> BenchOptions {
     let mut o = BenchOptions::quick();
-    o.event_tols = vec![1e-6, 1e-8, 1e-10];
-    o.switch_tols = vec![1e-6];
-    o.moreau_hs = vec![1e-2];
+    o.set_ladder(SolverKind::EVENT, vec![1e-6, 1e-8, 1e-10]);
+    o.set_ladder(SolverKind::SWITCH, vec![1e-6]);
+    o.set_ladder(SolverKind::MOREAU, vec![1e-2]);
     o.output_levels = false;
     o.repeats = 1;
     o.time_budget = 0.0;

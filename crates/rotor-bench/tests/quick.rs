@@ -3,6 +3,7 @@
 //! No assertion here is about speed.
 
 use rotor_bench::{BenchOptions, BenchReport, SolverKind, run};
+use rotor_compare::SOLVERS;
 
 fn quick() -> BenchReport {
     let mut lines = Vec::new();
@@ -25,7 +26,7 @@ fn quick() -> BenchReport {
 fn errors_fall_as_the_setting_tightens() {
     let r = quick();
     let sc = &r.scenes[0];
-    for kind in SolverKind::ALL {
+    for kind in SOLVERS {
         let pts: Vec<_> = sc.points.iter().filter(|p| p.solver == kind).collect();
         assert_eq!(pts.len(), 3, "{kind:?}");
         for p in &pts {
@@ -46,7 +47,7 @@ fn errors_fall_as_the_setting_tightens() {
                 pts.iter().map(|p| p.stats.steps).collect::<Vec<_>>()
             );
         }
-        if kind == SolverKind::Moreau {
+        if kind == SolverKind::MOREAU {
             for p in &pts {
                 assert_eq!(p.stats.steps, (sc.t_end / p.setting).round() as u64);
             }
@@ -131,7 +132,7 @@ fn metrics_only_runs_keep_no_samples() {
         // 30 s from rest at 1.5 V: the cycle (4.6 s) has converged by ~15 s, leaving room to
         // skip; the answer passes the metrics-only gates of rotor-compare's property test.
         assert!(o.skipped_periods > 0, "{:?}", o.solver);
-        let gate = if o.solver == SolverKind::Moreau {
+        let gate = if o.solver == SolverKind::MOREAU {
             10.0 * o.setting * o.setting
         } else {
             1e-7
@@ -212,9 +213,9 @@ fn json_csv_and_svg_are_complete_and_refuse_a_non_finite_number() {
 #[test]
 fn a_missing_peer_is_skipped_with_its_reason() {
     let mut o = BenchOptions::quick();
-    o.event_tols = vec![1e-6];
-    o.switch_tols = vec![1e-6];
-    o.moreau_hs = vec![1e-2];
+    o.set_ladder(SolverKind::EVENT, vec![1e-6]);
+    o.set_ladder(SolverKind::SWITCH, vec![1e-6]);
+    o.set_ladder(SolverKind::MOREAU, vec![1e-2]);
     o.output_levels = false;
     o.peers.scipy = true;
     o.peers.python = "/nonexistent/python3".into();
@@ -236,9 +237,9 @@ fn a_missing_peer_is_skipped_with_its_reason() {
 #[test]
 fn bad_options_are_refused_with_the_field() {
     let mut o = BenchOptions::quick();
-    o.moreau_hs = vec![1e-2, -1.0];
+    o.set_ladder(SolverKind::MOREAU, vec![1e-2, -1.0]);
     let e = run(&o, |_| {}).unwrap_err().to_string();
-    assert!(e.contains("moreau_hs") && e.contains("-1"), "{e}");
+    assert!(e.contains("ladders[moreau]") && e.contains("-1"), "{e}");
     let mut o = BenchOptions::quick();
     o.scenes[0].transient = [0.0, 1e3];
     let e = run(&o, |_| {}).unwrap_err().to_string();

@@ -117,11 +117,11 @@ fn solver_by_name(name: &str) -> Result<Box<dyn Solver>> {
 }
 
 fn kind_by_name(name: &str) -> Result<SolverKind> {
-    match SolverKind::ALL.into_iter().find(|k| k.name() == name) {
+    match SolverKind::by_name(name) {
         Some(kind) => Ok(kind),
         None => bail!(
             "--solver {name:?}: unknown solver (expected one of: {})",
-            SolverKind::ALL.map(SolverKind::name).join(", ")
+            rotor_compare::SOLVERS.map(SolverKind::name).join(", ")
         ),
     }
 }
@@ -177,14 +177,14 @@ fn check(flag: &str, v: f64, ok: bool, what: &str) -> Result<()> {
 /// A flag the chosen solver has no use for is said so, not silently dropped: the adaptive
 /// solvers take no step size, Moreau–Jean no tolerance.
 fn warn_ignored(common: &Common) {
-    match common.solver.as_str() {
-        "moreau" if common.tol.is_some() => eprintln!(
-            "warning: --tol is ignored by moreau (fixed steps: its accuracy is set by --h)"
-        ),
-        s @ ("event" | "switch") if common.h.is_some() => eprintln!(
-            "warning: --h is ignored by {s} (adaptive steps: its accuracy is set by --tol)"
-        ),
-        _ => {}
+    let Some(kind) = SolverKind::by_name(&common.solver) else {
+        return;
+    };
+    let s = kind.name();
+    if kind.is_fixed_step() && common.tol.is_some() {
+        eprintln!("warning: --tol is ignored by {s} (fixed steps: its accuracy is set by --h)");
+    } else if !kind.is_fixed_step() && common.h.is_some() {
+        eprintln!("warning: --h is ignored by {s} (adaptive steps: its accuracy is set by --tol)");
     }
 }
 
@@ -502,7 +502,7 @@ fn compare(files: &[PathBuf], report: &Path, main_job: bool) -> Result<()> {
     };
     let scenarios = files
         .iter()
-        .map(|f| rotor_model::Scenario::from_file(f))
+        .map(|f| rotor_compare::load_scenario(f))
         .collect::<Result<Vec<_>, _>>()?;
     // Report files are named after the scenarios: two of one name would overwrite each other.
     for (i, a) in scenarios.iter().enumerate() {

@@ -12,7 +12,8 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
 use rotor_testkit::{
-    SCENARIO, TABLE1, bad_params_cases, bad_scenario_cases, edit, local_scenario, write_scenario,
+    SCENARIO, TABLE1, bad_pair_cases, bad_params_cases, bad_scenario_cases, edit, local_scenario,
+    write_scenario,
 };
 
 fn fixtures() -> PathBuf {
@@ -204,7 +205,10 @@ fn files_of(dir: &Path) -> Vec<(String, Vec<u8>)> {
 #[test]
 fn compare_with_a_bad_scenario_writes_no_report() {
     let s = local_scenario();
-    let cases = bad_scenario_cases();
+    let cases: Vec<_> = bad_scenario_cases()
+        .into_iter()
+        .chain(bad_pair_cases())
+        .collect();
     assert!(!cases.is_empty());
     for c in &cases {
         let what = c.name.as_str();

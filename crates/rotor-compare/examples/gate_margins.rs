@@ -33,7 +33,7 @@ fn main() {
         "scenario", "pair", "quantity", "measured", "gate", "margin", "rule"
     );
     for f in Scenario::list_dir(&dir).expect("fixtures/scenarios") {
-        let sc = Scenario::from_file(&f).unwrap_or_else(|e| panic!("{e}"));
+        let sc = rotor_compare::load_scenario(&f).unwrap_or_else(|e| panic!("{e}"));
         let r = run_scenario(&sc);
         for g in gate_scenario(&r).0 {
             for m in &g.measured {

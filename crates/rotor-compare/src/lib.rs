@@ -6,8 +6,12 @@ pub mod report;
 pub mod run;
 pub mod settle;
 pub mod snapshot;
+pub mod solvers;
 pub mod stress;
 
 pub use gate::{Failure, GateResult, Measured, check_pair};
-pub use run::{RunResult, ScenarioResult, SolverKind, run_scenario, solver_settings};
+pub use run::{RunResult, ScenarioResult, run_scenario, run_scenario_with, solver_settings};
 pub use settle::{SettleError, SettleOptions, Settled, settle};
+pub use solvers::{
+    Knob, SOLVERS, SolverInfo, SolverKind, load_scenario, load_scenario_for, pair_name, pairs,
+};

@@ -7,14 +7,9 @@ use std::path::Path;
 use rotor_model::{Disc, Friction, Model, Params, Scenario, SteadyState};
 
 use crate::gate::{Failure, GateResult, check_pair};
-use crate::run::{ScenarioResult, SolverKind, solver_settings};
+use crate::run::{ScenarioResult, solver_settings};
+use crate::solvers::{SolverKind, pair_name, pairs};
 use rotor_plot::{Panel, Series, render};
-
-/// The gated pairs: each solver against the event-driven reference.
-pub const PAIRS: [(SolverKind, SolverKind); 2] = [
-    (SolverKind::Event, SolverKind::Switch),
-    (SolverKind::Event, SolverKind::Moreau),
-];
 
 /// Gates every pair of one scenario. A solver error, or a pair without a tolerance in the
 /// scenario file, is a failure too.
@@ -33,8 +28,9 @@ pub fn gate_scenario(r: &ScenarioResult) -> (Vec<GateResult>, Vec<Failure>) {
             });
         }
     }
-    for (a, b) in PAIRS {
-        let pair = format!("{}-{}", a.name(), b.name());
+    let kinds: Vec<SolverKind> = r.runs.iter().map(|run| run.kind).collect();
+    for (a, b) in pairs(&kinds) {
+        let pair = pair_name(a, b);
         let Some(tol) = sc.tolerance.get(&pair) else {
             fails.push(Failure {
                 scenario: sc.name.clone(),
@@ -80,27 +76,19 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
     std::fs::rename(&tmp, path)
 }
 
-const COLORS: [(&str, Option<&str>, f64); 3] = [
-    ("#000000", None, 2.5),
-    ("#e66101", Some("6 3"), 1.5),
-    ("#5e3c99", Some("2 2"), 1.5),
-];
-
 fn label(kind: SolverKind, sc: &Scenario) -> String {
     let (tol, h) = solver_settings(kind, sc);
-    match kind {
-        SolverKind::Event => format!("event-driven (tol {tol:.0e})"),
-        SolverKind::Switch => format!("switch model (tol {tol:.0e})"),
-        SolverKind::Moreau => format!("Moreau-Jean (h {h:.0e})"),
-    }
+    kind.label_at(if kind.is_fixed_step() { h } else { tol })
 }
 
 /// Per-scenario CSV: `t` and ω_u, ω_l of each solver on the comparison grid (12 significant
 /// digits: far below every gate's tolerance).
 pub fn scenario_csv(r: &ScenarioResult) -> String {
     let mut s = String::from("t");
-    let kinds: Vec<SolverKind> = SolverKind::ALL
-        .into_iter()
+    let kinds: Vec<SolverKind> = r
+        .runs
+        .iter()
+        .map(|run| run.kind)
         .filter(|k| r.traj(*k).is_some())
         .collect();
     for k in &kinds {
@@ -124,14 +112,14 @@ pub fn scenario_csv(r: &ScenarioResult) -> String {
     s
 }
 
-/// Per-scenario SVG: ω_u and ω_l of the three solvers overlaid (the source's Figs. 4–7).
+/// Per-scenario SVG: ω_u and ω_l of every solver overlaid (the source's Figs. 4–7).
 pub fn scenario_svg(r: &ScenarioResult) -> String {
     let sc = &r.scenario;
     let t_max = sc
         .compare
         .transient
         .map_or(sc.t_end, |w| w[1].max(sc.t_end.min(60.0)));
-    let labels: Vec<String> = SolverKind::ALL.iter().map(|&k| label(k, sc)).collect();
+    let labels: Vec<String> = r.runs.iter().map(|run| label(run.kind, sc)).collect();
     let mk = |idx: usize, name: &'static str| {
         Panel::new(
             format!("{}: {} (u = {} V)", sc.name, name, sc.u),
@@ -141,17 +129,17 @@ pub fn scenario_svg(r: &ScenarioResult) -> String {
             } else {
                 "ω_l [rad/s]"
             },
-            SolverKind::ALL
+            r.runs
                 .iter()
                 .enumerate()
-                .filter_map(|(i, &k)| {
-                    let tr = r.traj(k)?;
-                    let (color, dash, width) = COLORS[i];
+                .filter_map(|(i, run)| {
+                    let tr = run.result.as_ref().ok()?;
+                    let style = run.kind.info().style;
                     Some(Series {
                         label: &labels[i],
-                        color,
-                        dash,
-                        width,
+                        color: style.color,
+                        dash: style.dash,
+                        width: style.width,
                         marker: None,
                         points: tr
                             .samples
@@ -166,6 +154,13 @@ pub fn scenario_svg(r: &ScenarioResult) -> String {
     };
     render(&[mk(1, "upper disc"), mk(2, "lower disc")], 900.0, 320.0)
 }
+
+/// Line styles of the parameter sets in the friction plot.
+const SET_STYLES: [(&str, Option<&str>); 3] = [
+    ("#000000", None),
+    ("#e66101", Some("6 3")),
+    ("#5e3c99", Some("2 2")),
+];
 
 /// The friction curves of both parameter sets (the source's Fig. 2).
 pub fn friction_svg(sets: &[(&str, Params)]) -> String {
@@ -190,7 +185,7 @@ pub fn friction_svg(sets: &[(&str, Params)]) -> String {
                 let mid = pts.iter().position(|p| p.0 > 0.0).unwrap_or(0);
                 pts.insert(mid, (0.0, hi));
                 pts.insert(mid, (0.0, lo));
-                let (color, dash, _) = COLORS[i];
+                let (color, dash) = SET_STYLES[i % SET_STYLES.len()];
                 Series {
                     label: set,
                     color,

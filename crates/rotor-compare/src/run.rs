@@ -2,65 +2,27 @@
 
 use std::time::Instant;
 
-use rotor_model::{Model, Output, Scenario, Scene, SolveError, Solver, Trajectory};
+use rotor_model::{Model, Output, Scenario, Scene, SolveError, Trajectory};
 
-/// The three solvers, in report order.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash, serde::Serialize)]
-#[serde(rename_all = "lowercase")]
-pub enum SolverKind {
-    /// `rotor-event`: event-driven Filippov (DOP853), the accuracy reference.
-    Event,
-    /// `rotor-switch`: Leine's switch model (DOPRI5).
-    Switch,
-    /// `rotor-moreau`: Moreau–Jean time-stepping.
-    Moreau,
-}
+use crate::solvers::{Knob, SOLVERS, SolverKind};
 
-impl SolverKind {
-    /// All solvers, in report order.
-    pub const ALL: [SolverKind; 3] = [SolverKind::Event, SolverKind::Switch, SolverKind::Moreau];
-
-    /// Name of the accuracy setting: `tol` for the adaptive solvers, `h` for Moreau–Jean.
-    pub fn setting_name(self) -> &'static str {
-        match self {
-            SolverKind::Moreau => "h",
-            _ => "tol",
-        }
-    }
-
-    /// Whether the accuracy knob is a fixed step h (else a tolerance).
-    pub fn is_fixed_step(self) -> bool {
-        self.setting_name() == "h"
-    }
-
-    /// Short name (as the CLI's `--solver`).
-    pub fn name(self) -> &'static str {
-        match self {
-            SolverKind::Event => "event",
-            SolverKind::Switch => "switch",
-            SolverKind::Moreau => "moreau",
-        }
-    }
-
-    /// The solver of this kind, with its default options.
-    pub fn solver(self) -> Box<dyn Solver> {
-        match self {
-            SolverKind::Event => Box::new(rotor_event::EventSolver::default()),
-            SolverKind::Switch => Box::new(rotor_switch::SwitchSolver::default()),
-            SolverKind::Moreau => Box::new(rotor_moreau::MoreauSolver::default()),
-        }
-    }
-}
-
-/// The accuracy setting of each solver in the comparison: the event-driven reference at
-/// tol 1e-12; the switch model at tol 1e-10 with its default band η = 1e-7; Moreau–Jean at
-/// h = 1e-3 (the step at which Siconos is benchmarked). A scenario file may override tol/h.
+/// The accuracy setting `(tol, h)` of a solver in the comparison of a scenario: the
+/// reference (the first of [`SOLVERS`]) at its comparison setting; every other solver at its
+/// comparison setting unless the scenario file sets `tol` or `h`.
 pub fn solver_settings(kind: SolverKind, sc: &Scenario) -> (f64, f64) {
     let d = Scene::default();
-    match kind {
-        SolverKind::Event => (1e-12, d.h),
-        SolverKind::Switch => (sc.tol.unwrap_or(1e-10), d.h),
-        SolverKind::Moreau => (d.tol, sc.h.unwrap_or(1e-3)),
+    let info = kind.info();
+    let set = if kind == SOLVERS[0] {
+        info.comparison
+    } else {
+        match info.knob {
+            Knob::Tolerance => sc.tol.unwrap_or(info.comparison),
+            Knob::Step => sc.h.unwrap_or(info.comparison),
+        }
+    };
+    match info.knob {
+        Knob::Tolerance => (set, d.h),
+        Knob::Step => (d.tol, set),
     }
 }
 
@@ -90,9 +52,14 @@ pub fn scene_for(kind: SolverKind, sc: &Scenario) -> Scene {
     }
 }
 
-/// Runs a scenario through every solver.
+/// Runs a scenario through every solver of [`SOLVERS`].
 pub fn run_scenario(sc: &Scenario) -> ScenarioResult {
-    let runs = SolverKind::ALL
+    run_scenario_with(sc, &SOLVERS)
+}
+
+/// Runs a scenario through each of `solvers` (the first is the reference).
+pub fn run_scenario_with(sc: &Scenario, solvers: &[SolverKind]) -> ScenarioResult {
+    let runs = solvers
         .iter()
         .map(|&kind| run_one(kind, &sc.model, &scene_for(kind, sc)))
         .collect();

@@ -11,7 +11,7 @@
 
 use rotor_model::{Model, Output, Scene, SolveError, Stats, SteadyState};
 
-use crate::run::SolverKind;
+use crate::solvers::SolverKind;
 
 /// Options of [`settle`].
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -129,9 +129,10 @@ pub fn settle(
     opts: &SettleOptions,
 ) -> Result<Settled, SettleError> {
     let solver = kind.solver();
-    let rel = match kind {
-        SolverKind::Moreau => opts.rel.max(opts.rel_per_h * base.h),
-        _ => opts.rel,
+    let rel = if kind.is_fixed_step() {
+        opts.rel.max(opts.rel_per_h * base.h)
+    } else {
+        opts.rel
     };
     let mut x = base.x0;
     let mut t = 0.0;
@@ -218,7 +219,7 @@ mod tests {
             .into_iter()
             .find(|e| m.equilibrium_is_stable(e))
             .expect("a stable slipping equilibrium below the Hopf point");
-        let one_run = SolverKind::Switch
+        let one_run = SolverKind::SWITCH
             .solver()
             .simulate(
                 &m,
@@ -231,7 +232,7 @@ mod tests {
             )
             .unwrap();
         assert_eq!(one_run.metrics.unwrap().kind(), "limit_cycle");
-        for kind in [SolverKind::Switch, SolverKind::Moreau] {
+        for kind in [SolverKind::SWITCH, SolverKind::MOREAU] {
             let s = settle(kind, &m, &base(u), &SettleOptions::default()).unwrap();
             let SteadyState::Equilibrium { omega_l, alpha, .. } = s.state else {
                 panic!("{kind:?}: {:?}", s.state);
@@ -257,7 +258,7 @@ mod tests {
             max_time: 1200.0,
             ..SettleOptions::default()
         };
-        let e = settle(SolverKind::Switch, &m, &base(0.383), &opts).unwrap_err();
+        let e = settle(SolverKind::SWITCH, &m, &base(0.383), &opts).unwrap_err();
         let msg = e.to_string();
         assert!(
             matches!(e, SettleError::NotSettled { t: 1200.0, .. }) && msg.contains("amplitude"),
@@ -275,7 +276,7 @@ mod tests {
         let m = Model::table1();
         for u in [0.383, 0.385, 4.7] {
             let ev = event_steady(&m, u);
-            let sw = settle(SolverKind::Switch, &m, &base(u), &SettleOptions::default()).unwrap();
+            let sw = settle(SolverKind::SWITCH, &m, &base(u), &SettleOptions::default()).unwrap();
             let (what, c) = change(&ev, &sw.state, 1e-8);
             assert!(
                 c <= 1e-5,
@@ -301,7 +302,7 @@ mod tests {
         let ev = event_steady(&m, 0.12);
         assert!(matches!(ev, SteadyState::Equilibrium { .. }), "{ev:?}");
         let opts = SettleOptions::default();
-        for kind in [SolverKind::Switch, SolverKind::Moreau] {
+        for kind in [SolverKind::SWITCH, SolverKind::MOREAU] {
             let s = settle(kind, &m, &base(0.12), &opts).unwrap();
             // The floor abs/rel makes a relative 1e-5 of it the absolute 1e-8.
             let (what, c) = change(&ev, &s.state, opts.abs / opts.rel);
@@ -319,7 +320,7 @@ mod tests {
     fn a_settled_cycle_agrees_with_the_refined_one() {
         let m = Model::table1();
         let reference = event_steady(&m, 1.5);
-        for (kind, gate) in [(SolverKind::Switch, 2e-6), (SolverKind::Moreau, 3e-6)] {
+        for (kind, gate) in [(SolverKind::SWITCH, 2e-6), (SolverKind::MOREAU, 3e-6)] {
             let s = settle(kind, &m, &base(1.5), &SettleOptions::default()).unwrap();
             let (what, c) = change(&reference, &s.state, 1e-8);
             assert!(c <= gate, "{kind:?}: {what} differs by {c:e}");

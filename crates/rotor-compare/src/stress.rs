@@ -39,7 +39,7 @@ use rotor_model::{
     State, Stats, SteadyState, Trajectory, UpperFriction,
 };
 
-use crate::run::SolverKind;
+use crate::solvers::{SOLVERS, SolverKind};
 
 /// The event-driven reference's tolerance (as in the comparison, `run.rs`).
 pub const REFERENCE_TOL: f64 = 1e-12;
@@ -168,7 +168,7 @@ impl Setting {
     /// The event-driven reference.
     pub fn reference() -> Setting {
         Setting {
-            kind: SolverKind::Event,
+            kind: SolverKind::EVENT,
             tol: REFERENCE_TOL,
             h: 1e-3,
             gate: Gate::Reference,
@@ -187,7 +187,7 @@ impl Setting {
 
     /// Every solver at the comparison-grade defaults (tol 1e-10, h = 1e-3), one gate.
     pub fn every_solver(gate: Gate) -> Vec<Setting> {
-        SolverKind::ALL
+        SOLVERS
             .iter()
             .map(|&kind| Setting {
                 kind,
@@ -201,7 +201,7 @@ impl Setting {
     /// Moreau–Jean at step `h` with a gate.
     pub fn moreau(h: f64, gate: Gate) -> Setting {
         Setting {
-            kind: SolverKind::Moreau,
+            kind: SolverKind::MOREAU,
             tol: 1e-10,
             h,
             gate,
@@ -209,10 +209,11 @@ impl Setting {
     }
 
     fn label(&self) -> String {
-        match self.kind {
-            SolverKind::Moreau => format!("h {:e}", self.h),
-            _ => format!("tol {:e}", self.tol),
-        }
+        self.kind.setting_label(if self.kind.is_fixed_step() {
+            self.h
+        } else {
+            self.tol
+        })
     }
 }
 
@@ -499,7 +500,7 @@ fn gate_value(
                     .iter()
                     .any(|e| matches!(e.kind, EventKind::StickStart(_)))
             });
-            let eta = if s.kind == SolverKind::Switch && sticks {
+            let eta = if s.kind == SolverKind::SWITCH && sticks {
                 rotor_switch::SwitchOptions::default().eta
             } else {
                 0.0
@@ -532,7 +533,7 @@ pub fn run_case(case: &StressCase) -> Vec<StressRow> {
         Measure::Transient { .. } | Measure::Period { .. } | Measure::Drift { .. } => {
             let s = Setting::reference();
             run(
-                SolverKind::Event,
+                SolverKind::EVENT,
                 &model,
                 &scene_of(case, &s, case.u, case.x0),
             )
@@ -729,7 +730,7 @@ fn three(switch: Gate, hs: &[f64]) -> Vec<Setting> {
         Setting::reference(),
         Setting {
             gate: switch,
-            ..Setting::adaptive(SolverKind::Switch, 1e-10)
+            ..Setting::adaptive(SolverKind::SWITCH, 1e-10)
         },
     ];
     v.extend(hs.iter().map(|&h| Setting::moreau(h, Gate::Trapezoid)));
@@ -852,7 +853,7 @@ pub fn cases(full: bool) -> Vec<StressCase> {
     let mut lin = three(Gate::Observed(pick(3.34e-10, 6.23e-9)), fine);
     lin[0] = Setting {
         gate: Gate::Observed(pick(6.66e-12, 2.40e-11)),
-        ..Setting::adaptive(SolverKind::Event, REFERENCE_TOL)
+        ..Setting::adaptive(SolverKind::EVENT, REFERENCE_TOL)
     };
     v.push(StressCase {
         name: "zero-friction",
@@ -906,9 +907,9 @@ pub fn cases(full: bool) -> Vec<StressCase> {
             t_end: pick(20.0, 100.0),
             measure: Measure::Mirror { dt: 0.01 },
             settings: vec![
-                exact(SolverKind::Event, REFERENCE_TOL, 1e-3),
-                exact(SolverKind::Switch, 1e-10, 1e-3),
-                exact(SolverKind::Moreau, 1e-10, 1e-3),
+                exact(SolverKind::EVENT, REFERENCE_TOL, 1e-3),
+                exact(SolverKind::SWITCH, 1e-10, 1e-3),
+                exact(SolverKind::MOREAU, 1e-10, 1e-3),
             ],
         });
     }
@@ -940,7 +941,7 @@ pub fn cases(full: bool) -> Vec<StressCase> {
             },
             Setting {
                 gate: Gate::Observed(pick(3.38e-11, 8.38e-11)),
-                ..Setting::adaptive(SolverKind::Switch, 1e-10)
+                ..Setting::adaptive(SolverKind::SWITCH, 1e-10)
             },
             Setting::moreau(1e-3, Gate::MoreauPeriod),
         ],
@@ -968,11 +969,11 @@ pub fn cases(full: bool) -> Vec<StressCase> {
                 [
                     Setting {
                         gate: event_gate,
-                        ..Setting::adaptive(SolverKind::Event, tol)
+                        ..Setting::adaptive(SolverKind::EVENT, tol)
                     },
                     Setting {
                         gate: Gate::Observed(switch),
-                        ..Setting::adaptive(SolverKind::Switch, tol)
+                        ..Setting::adaptive(SolverKind::SWITCH, tol)
                     },
                 ]
             })

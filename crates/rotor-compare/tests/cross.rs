@@ -36,8 +36,8 @@ fn a_reversal_without_sticking_matches_the_event_solver() {
             .map(|e| (e.t, e.kind))
             .collect()
     };
-    let event = lower(&run(SolverKind::Event, 1e-12, &scene));
-    let switch = lower(&run(SolverKind::Switch, 1e-10, &scene));
+    let event = lower(&run(SolverKind::EVENT, 1e-12, &scene));
+    let switch = lower(&run(SolverKind::SWITCH, 1e-10, &scene));
     assert_eq!(event.len(), 1, "{event:?}");
     assert_eq!(event[0].1, EventKind::Reversal(Disc::Lower));
     assert_eq!(switch.len(), 1, "{switch:?}");
@@ -46,7 +46,7 @@ fn a_reversal_without_sticking_matches_the_event_solver() {
     // for |ω_l| < η): |ω̇_l| ≈ (0.36 − 0.16)/0.0326 ≈ 6 rad/s² gives 1.7e-8 s; measured
     // 1.0e-8 s. Plus both solvers' location error (≤ 1e-12 s).
     let m = Model::table1();
-    let ev = run(SolverKind::Event, 1e-12, &scene);
+    let ev = run(SolverKind::EVENT, 1e-12, &scene);
     let x = ev
         .events
         .iter()
@@ -74,8 +74,8 @@ fn grid_samples_between_steps_match_the_event_solver() {
         output: Output::Grid { dt: 0.3 },
         ..Scene::default()
     };
-    let reference = run(SolverKind::Event, 1e-12, &scene);
-    for (kind, tol) in [(SolverKind::Switch, 1e-10), (SolverKind::Moreau, 1e-10)] {
+    let reference = run(SolverKind::EVENT, 1e-12, &scene);
+    for (kind, tol) in [(SolverKind::SWITCH, 1e-10), (SolverKind::MOREAU, 1e-10)] {
         let tr = run(kind, tol, &scene);
         let steps = run(
             kind,
@@ -112,7 +112,7 @@ fn grid_samples_between_steps_match_the_event_solver() {
         // Measured 4.8e-9 rad/s (switch: DOPRI5's dense output and its tol 1e-10) and
         // 1.5e-5 (Moreau–Jean: linear interpolation between steps, O(h²|ẍ|/8) with
         // |ẍ| ≲ 100 rad/s³, and its O(h²) scheme error); gates 4x.
-        let gate = if kind == SolverKind::Switch {
+        let gate = if kind == SolverKind::SWITCH {
             2e-8
         } else {
             6e-5

@@ -5,9 +5,9 @@ use std::path::Path;
 
 use std::sync::OnceLock;
 
-use rotor_compare::report::{PAIRS, gate_scenario};
+use rotor_compare::report::gate_scenario;
 use rotor_compare::snapshot::snapshot;
-use rotor_compare::{ScenarioResult, SolverKind, run_scenario};
+use rotor_compare::{SOLVERS, ScenarioResult, SolverKind, pair_name, pairs, run_scenario};
 use rotor_model::{Disc, Event, EventKind, Scenario, State, SteadyState, Trajectory};
 
 /// Every fixture through the three solvers, once per test binary (shared by the tests).
@@ -20,7 +20,7 @@ fn all() -> Vec<ScenarioResult> {
             assert!(files.len() >= 14);
             files
                 .par_iter()
-                .map(|f| run_scenario(&Scenario::from_file(f).unwrap()))
+                .map(|f| run_scenario(&rotor_compare::load_scenario(f).unwrap()))
                 .collect()
         })
         .clone()
@@ -79,7 +79,7 @@ fn every_fixture_agrees_across_the_three_solvers_and_a_perturbation_is_caught() 
         .find(|r| r.scenario.name == "t1-u1.5-rest")
         .unwrap();
     for run in &mut r.runs {
-        if run.kind == SolverKind::Switch {
+        if run.kind == SolverKind::SWITCH {
             let tr = run.result.as_mut().unwrap();
             for s in &mut tr.samples {
                 if s.t > 5.0 && s.t < 6.0 {
@@ -136,8 +136,8 @@ fn every_gate_of_every_fixture_fails_its_negative_control() {
     for r in &results {
         let sc = &r.scenario;
         let [t0, t1] = sc.compare.transient.unwrap();
-        for (a, b) in PAIRS {
-            let pair = format!("{}-{}", a.name(), b.name());
+        for (a, b) in pairs(&SOLVERS) {
+            let pair = pair_name(a, b);
             let tol = sc.tolerance[&pair];
             let base = gate_scenario(r)
                 .0

@@ -25,11 +25,6 @@ use crate::dynamics::{Model, State};
 use crate::params::{Params, ParamsError, one_line, shown, text_of};
 use crate::scene::{MAX_GRID_ROWS, MIN_TOL, Output, Scene};
 
-/// The solver pairs a `[tolerance.<pair>]` table may name: each solver against the
-/// event-driven reference (the pairs rotor-compare gates). Any other name is a typo that
-/// would leave a pair ungated, so it is rejected when the file is read.
-pub const TOLERANCE_PAIRS: [&str; 2] = ["event-switch", "event-moreau"];
-
 /// A scenario file could not be read or is not admissible.
 #[derive(Debug, Error, Clone, PartialEq)]
 pub enum ScenarioError {
@@ -444,11 +439,21 @@ impl Scenario {
             ));
         }
         for (pair, tol) in &raw.tolerance {
-            if !TOLERANCE_PAIRS.contains(&pair.as_str()) {
+            // Which solvers exist is the runner's knowledge (`check_pairs`); the form is
+            // checked here.
+            let part = |p: &str| {
+                !p.is_empty()
+                    && p.chars()
+                        .all(|c| c.is_ascii_lowercase() || c.is_ascii_digit() || c == '_')
+            };
+            if !pair
+                .split_once('-')
+                .is_some_and(|(a, b)| part(a) && part(b))
+            {
                 return Err(bad(
                     "tolerance",
                     format!("{pair:?}"),
-                    "unknown solver pair (expected \"event-switch\" or \"event-moreau\")",
+                    "a solver pair is named <reference>-<solver>, e.g. \"event-switch\"",
                 ));
             }
             // Non-negative: 0 is a gate of exact agreement (both discs stuck from rest, where
@@ -527,6 +532,27 @@ impl Scenario {
             compare: raw.compare,
             tolerance: raw.tolerance,
         })
+    }
+
+    /// Refuses `[tolerance.<pair>]` tables of pairs not in `known` (the pairs a runner gates):
+    /// a misspelt pair name would leave that pair ungated.
+    pub fn check_pairs(&self, known: &[String]) -> Result<(), ScenarioError> {
+        match self.tolerance.keys().find(|p| !known.contains(p)) {
+            None => Ok(()),
+            Some(pair) => Err(ScenarioError::Invalid {
+                path: self.path.clone(),
+                field: "tolerance".into(),
+                value: format!("{pair:?}"),
+                reason: format!(
+                    "unknown solver pair (expected one of {})",
+                    known
+                        .iter()
+                        .map(|k| format!("{k:?}"))
+                        .collect::<Vec<_>>()
+                        .join(", ")
+                ),
+            }),
+        }
     }
 
     /// All `*.toml` scenario files in a directory, sorted by file name.
