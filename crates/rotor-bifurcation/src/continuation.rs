@@ -321,7 +321,7 @@ impl Continuer<'_> {
         };
         let traj = rotor_event::EventSolver::default()
             .simulate(self.sh.model, &scene)
-            .map_err(|e| BifError::Solve(e.to_string()))?;
+            .map_err(BifError::Solve)?;
         let (wl_max, wl_min, stick_time) = match traj.metrics {
             Some(SteadyState::LimitCycle {
                 omega_l_max,

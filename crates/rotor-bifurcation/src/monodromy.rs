@@ -230,7 +230,7 @@ fn segment(
             break;
         }
     }
-    Err(BifError::Solve(format!(
+    Err(BifError::Degenerate(format!(
         "variational equations: step size collapsed at t = {t} of a {len} s segment (u = {u})"
     )))
 }

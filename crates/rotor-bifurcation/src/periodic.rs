@@ -58,7 +58,7 @@ pub struct Return {
 }
 
 fn err(e: SolveError) -> BifError {
-    BifError::Solve(e.to_string())
+    BifError::Solve(e)
 }
 
 impl Shooter<'_> {

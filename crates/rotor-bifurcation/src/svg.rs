@@ -14,7 +14,7 @@
 
 use rotor_plot::{Label, Panel, Series, render as plot};
 
-use crate::Diagram;
+use crate::{Diagram, EquilibriumKind, PointKind};
 
 const UNSTABLE_DASH: &str = "6 4";
 
@@ -45,11 +45,11 @@ fn split_runs(
 
 pub(crate) fn render(d: &Diagram, title: &str) -> String {
     let (mut eq_s, mut eq_u) = (Vec::new(), Vec::new());
-    let mut slip: Vec<_> = d.equilibria.iter().filter(|e| e.kind == "slip").collect();
+    let mut slip: Vec<_> = d.equilibria.iter().filter(|e| e.kind == EquilibriumKind::Slip).collect();
     slip.sort_by(|a, b| a.omega.total_cmp(&b.omega));
     let pts: Vec<_> = slip.iter().map(|e| ((e.u, e.omega), e.stable)).collect();
     split_runs(&pts, &mut eq_s, &mut eq_u);
-    let mut stuck: Vec<_> = d.equilibria.iter().filter(|e| e.kind == "stuck").collect();
+    let mut stuck: Vec<_> = d.equilibria.iter().filter(|e| e.kind == EquilibriumKind::Stuck).collect();
     stuck.sort_by(|a, b| a.u.total_cmp(&b.u));
     let pts: Vec<_> = stuck.iter().map(|e| ((e.u, 0.0), e.stable)).collect();
     split_runs(&pts, &mut eq_s, &mut eq_u);
@@ -72,7 +72,7 @@ pub(crate) fn render(d: &Diagram, title: &str) -> String {
     let n_disc = d
         .points
         .iter()
-        .filter(|p| p.kind == "fold" && p.discontinuous == Some(true))
+        .filter(|p| p.kind == PointKind::Fold && p.discontinuous == Some(true))
         .count();
     let mut order: Vec<_> = d.points.iter().collect();
     order.sort_by(|a, b| a.u.total_cmp(&b.u));
@@ -82,9 +82,9 @@ pub(crate) fn render(d: &Diagram, title: &str) -> String {
         let k = count.entry((p.kind, p.discontinuous)).or_insert(0);
         *k += 1;
         let (y, text) = match (p.kind, p.discontinuous) {
-            ("hopf", _) => (p.omega, format!("H{k} Hopf {:.4}", p.u)),
-            ("grazing", _) => (Some(0.0), format!("G{k} grazing {:.4}", p.u)),
-            ("fold", Some(true)) => (
+            (PointKind::Hopf, _) => (p.omega, format!("H{k} Hopf {:.4}", p.u)),
+            (PointKind::Grazing, _) => (Some(0.0), format!("G{k} grazing {:.4}", p.u)),
+            (PointKind::Fold, Some(true)) => (
                 p.omega_l_max,
                 format!(
                     "{} fold (discontinuous) {:.4}",
@@ -96,7 +96,7 @@ pub(crate) fn render(d: &Diagram, title: &str) -> String {
                     p.u
                 ),
             ),
-            ("fold", _) => (p.omega_l_max, format!("F{k} fold {:.4}", p.u)),
+            (PointKind::Fold, _) => (p.omega_l_max, format!("F{k} fold {:.4}", p.u)),
             _ => (None, String::new()),
         };
         if let Some(y) = y

@@ -181,7 +181,7 @@ fn table1_diagram_structure() {
         assert!((p.u - u).abs() < 0.02 && p.stick_slip, "{u}: {p:?}");
     }
     // The equilibrium table: unstable between the Hopf points, stable outside.
-    for e in d.equilibria.iter().filter(|e| e.kind == "slip") {
+    for e in d.equilibria.iter().filter(|e| e.kind.as_str() == "slip") {
         let inside = hopf[0].u < e.u && e.u < hopf[1].u;
         assert_eq!(e.stable, !inside, "{e:?}");
     }
@@ -204,7 +204,7 @@ fn the_widest_range_finds_the_same_special_points() {
     let m = model("table1");
     let d = t1_diagram();
     let kinds = |d: &Diagram| {
-        let mut v: Vec<(&str, f64)> = d.points.iter().map(|p| (p.kind, p.u)).collect();
+        let mut v: Vec<(&str, f64)> = d.points.iter().map(|p| (p.kind.as_str(), p.u)).collect();
         v.sort_by(|a, b| a.0.cmp(b.0).then(a.1.total_cmp(&b.1)));
         v
     };
@@ -258,7 +258,7 @@ fn stribeck_diagram_structure() {
         .unwrap();
     assert!(st.stick_slip && (st.u - 1.5).abs() < 0.05);
     // Both discs stuck at small u (the equilibrium set).
-    assert!(d.equilibria.iter().any(|e| e.kind == "stuck" && e.u < 0.1));
+    assert!(d.equilibria.iter().any(|e| e.kind.as_str() == "stuck" && e.u < 0.1));
 }
 
 #[test]

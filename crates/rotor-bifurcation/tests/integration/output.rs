@@ -62,7 +62,7 @@ fn json_follows_the_cli_contract() {
         assert_eq!(pts.len(), d.points.len());
         for (p, row) in pts.iter().zip(&d.points) {
             let kind = p["kind"].as_str().unwrap();
-            assert_eq!(kind, row.kind);
+            assert_eq!(kind, row.kind.as_str());
             assert!(
                 [
                     "hopf",
@@ -215,7 +215,7 @@ fn svg_is_well_formed_labelled_and_dashed_where_unstable() {
         }
         // Every Hopf point, grazing point and fold is labelled with its u.
         for p in &d.points {
-            let text = match (p.kind, p.discontinuous) {
+            let text = match (p.kind.as_str(), p.discontinuous) {
                 ("hopf", _) => format!("Hopf {:.4}", p.u),
                 ("grazing", _) => format!("grazing {:.4}", p.u),
                 ("fold", Some(true)) => format!("fold (discontinuous) {:.4}", p.u),
@@ -341,7 +341,7 @@ fn a_window_above_the_start_voltage_still_finds_its_branch() {
     let fold = |d: &Diagram| {
         d.points
             .iter()
-            .find(|p| p.kind == "fold" && p.discontinuous == Some(false))
+            .find(|p| p.kind.as_str() == "fold" && p.discontinuous == Some(false))
             .map(|p| p.u)
     };
     let (a, b) = (fold(&d).unwrap(), fold(t1_diagram()).unwrap());

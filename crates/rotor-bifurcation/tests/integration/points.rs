@@ -261,7 +261,7 @@ fn special_points_are_pinned_to_1e8_volt() {
             .points
             .iter()
             .map(|p| Pinned {
-                kind: p.kind,
+                kind: p.kind.as_str(),
                 u: format!("{:.8}", p.u),
                 discontinuous: p.discontinuous,
             })

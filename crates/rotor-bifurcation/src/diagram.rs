@@ -1,0 +1,469 @@
+//! The diagram: the equilibrium table, the periodic branches from the attractor reached from
+//! rest and from each Hopf point, and their special points.
+
+use rotor_event::{StopAt, flow};
+use rotor_model::{Model, State};
+use serde::Serialize;
+
+use crate::continuation::{self, ContOptions, Continuer, End, Node};
+use crate::periodic::Shooter;
+use crate::points::{HOPF_CONDITION, PointKind, SpecialPoint, special_points, stuck_end_points};
+use crate::{BifError, equilibria};
+
+/// Largest admissible `u_max` \[V\]: the Hopf search samples the slipping branch up to
+/// ω = 1e4 rad/s (`equilibria::omega_reaching`), which Table 1 reaches well above 1000 V (at
+/// 1e4 V both Hopf points were lost); 1000 V is 140 times the source's range.
+pub const U_MAX: f64 = 1000.0;
+
+/// Largest arclength step of the periodic branches: the default range's (7 V / 200).
+const H_MAX: f64 = 7.0 / 200.0;
+
+/// What [`diagram`] computes.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct DiagramOptions {
+    /// Lower end of the input range \[V\].
+    pub u_min: f64,
+    /// Upper end of the input range \[V\].
+    pub u_max: f64,
+    /// Number of u values of the equilibrium table; the periodic branch gets at least this
+    /// many points over the range it spans (arclength step ≤ (u_max − u_min)/n).
+    pub n: usize,
+    /// Integration tolerance of the flow along the branches.
+    pub tol: f64,
+    /// Integration tolerance when a special point (grazing orbit) is located.
+    pub point_tol: f64,
+    /// Where the first periodic branch is started (the attractor reached from rest there);
+    /// outside `[u_min, u_max]` the middle of the range is used, and if no cycle is reached
+    /// from rest the branches start from the Hopf points only.
+    pub u_start: f64,
+    /// ω_l amplitude at which the branch is stopped near a Hopf point \[rad/s\].
+    pub amp_stop: f64,
+}
+
+impl Default for DiagramOptions {
+    fn default() -> Self {
+        DiagramOptions {
+            u_min: 0.0,
+            u_max: 7.0,
+            n: 200,
+            tol: 1e-11,
+            point_tol: 1e-12,
+            u_start: 1.5,
+            amp_stop: 0.02,
+        }
+    }
+}
+
+impl DiagramOptions {
+    /// Checks every field; the error names the first bad one and its value.
+    pub fn validate(&self) -> Result<(), BifError> {
+        let bad = |field, value, reason| {
+            Err(BifError::InvalidOption {
+                field,
+                value,
+                reason,
+            })
+        };
+        if !self.u_min.is_finite() {
+            return bad("u_min", self.u_min, "must be finite");
+        }
+        if !self.u_max.is_finite() {
+            return bad("u_max", self.u_max, "must be finite");
+        }
+        if self.u_max <= self.u_min {
+            return bad("u_max", self.u_max, "must be greater than u_min");
+        }
+        // The branches are traced with the lower disc driven upward (its stick exits and
+        // sections are upward); for a law odd in ω the u < 0 half is the mirror image.
+        if self.u_min < 0.0 {
+            return bad(
+                "u_min",
+                self.u_min,
+                "must be >= 0: the diagram covers u >= 0 (for a law odd in omega, u < 0 is its mirror image)",
+            );
+        }
+        if self.u_max > U_MAX {
+            return bad(
+                "u_max",
+                self.u_max,
+                "must be <= 1000 V: the Hopf search samples omega up to 1e4 rad/s",
+            );
+        }
+        if self.n < 2 {
+            return bad("n", self.n as f64, "must be at least 2");
+        }
+        // DOP853 cannot resolve below ~1e-14 relative in double precision; above 1e-6 the
+        // located points would not reach the promised 1e-8 V.
+        for (field, v) in [("tol", self.tol), ("point_tol", self.point_tol)] {
+            if !(1e-14..=1e-6).contains(&v) {
+                return bad(field, v, "must lie in [1e-14, 1e-6]");
+            }
+        }
+        if !self.u_start.is_finite() {
+            return bad("u_start", self.u_start, "must be finite");
+        }
+        if !(self.amp_stop.is_finite() && self.amp_stop > 0.0) {
+            return bad("amp_stop", self.amp_stop, "must be positive and finite");
+        }
+        Ok(())
+    }
+}
+
+/// An equilibrium of the table (its JSON `kind`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum EquilibriumKind {
+    /// Both discs at ω ≠ 0.
+    Slip,
+    /// Both at rest: `alpha` is the lower end of the stuck set and `alpha_max` the upper end.
+    Stuck,
+}
+
+impl EquilibriumKind {
+    /// The JSON and CSV name.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            EquilibriumKind::Slip => "slip",
+            EquilibriumKind::Stuck => "stuck",
+        }
+    }
+}
+
+/// One equilibrium of the table.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct EquilibriumRow {
+    pub u: f64,
+    pub omega: f64,
+    pub alpha: f64,
+    pub stable: bool,
+    pub kind: EquilibriumKind,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub alpha_max: Option<f64>,
+}
+
+/// One periodic orbit of the branch (in branch order).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct PeriodicRow {
+    /// Index of the branch (0: the one started from a steady orbit; then one per Hopf point
+    /// the first does not reach, started from the Hopf eigenvector).
+    pub branch: usize,
+    pub u: f64,
+    pub period: f64,
+    pub omega_l_max: f64,
+    pub omega_l_min: f64,
+    pub stable: bool,
+    /// Floquet multipliers `[re, im]`, eigenvalues of the saltation monodromy matrix: the
+    /// trivial one (≈ 1) first, then by decreasing modulus (`[≈1, λ, 0]` with a stick phase).
+    pub multipliers: Vec<[f64; 2]>,
+    pub stick_slip: bool,
+    pub stick_time: f64,
+    /// The orbit's state `[α, ω_u, ω_l]` on the section `ω_l = ω*(u)` (a restart point).
+    pub section_state: [f64; 3],
+}
+
+/// The bifurcation diagram (DESIGN.md §4).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Diagram {
+    pub equilibria: Vec<EquilibriumRow>,
+    pub periodic: Vec<PeriodicRow>,
+    pub points: Vec<SpecialPoint>,
+}
+
+impl PeriodicRow {
+    fn of(n: &Node, branch: usize) -> PeriodicRow {
+        PeriodicRow {
+            branch,
+            u: n.y[0],
+            period: n.info.period,
+            omega_l_max: n.info.omega_l_max,
+            omega_l_min: n.info.omega_l_min,
+            stable: n.info.stable,
+            multipliers: n.info.multipliers.iter().map(|l| [l.re, l.im]).collect(),
+            stick_slip: n.info.stick_slip,
+            stick_time: n.info.stick_time,
+            section_state: [n.y[1], n.y[2], n.c],
+        }
+    }
+}
+
+/// The equilibrium table at `n` values of u, and the Hopf and stick-limit points.
+pub fn equilibrium_part(
+    model: &Model,
+    opts: &DiagramOptions,
+) -> (Vec<EquilibriumRow>, Vec<SpecialPoint>) {
+    let mut rows = Vec::new();
+    for i in 0..opts.n {
+        let u = opts.u_min + (opts.u_max - opts.u_min) * i as f64 / (opts.n.max(2) - 1) as f64;
+        if let Some(s) = model.stuck_equilibria(u) {
+            rows.push(EquilibriumRow {
+                u,
+                omega: 0.0,
+                alpha: s.alpha_min,
+                stable: true,
+                kind: EquilibriumKind::Stuck,
+                alpha_max: Some(s.alpha_max),
+            });
+        }
+        for e in model
+            .slip_equilibria(u)
+            .into_iter()
+            .filter(|e| e.omega > 0.0)
+        {
+            rows.push(EquilibriumRow {
+                u,
+                omega: e.omega,
+                alpha: e.alpha,
+                stable: model.equilibrium_is_stable(&e),
+                kind: EquilibriumKind::Slip,
+                alpha_max: None,
+            });
+        }
+    }
+    let mut points = Vec::new();
+    let u0 = model.slip_equilibrium_at(f64::MIN_POSITIVE).u;
+    if (opts.u_min..=opts.u_max).contains(&u0) {
+        let mut p = SpecialPoint::new(
+            PointKind::StickLimit,
+            u0,
+            "slipping branch meets the stuck set (omega -> 0+)".into(),
+        );
+        p.omega = Some(0.0);
+        points.push(p);
+    }
+    if let Some(wmax) = equilibria::omega_reaching(model, opts.u_max) {
+        for h in equilibria::hopf_points(model, wmax) {
+            if !(opts.u_min..=opts.u_max).contains(&h.equilibrium.u) {
+                continue;
+            }
+            let mut p = SpecialPoint::new(
+                PointKind::Hopf,
+                h.equilibrium.u,
+                format!(
+                    "equilibrium {} stability with increasing u",
+                    if h.stabilizing { "gains" } else { "loses" },
+                ),
+            );
+            p.omega = Some(h.equilibrium.omega);
+            p.frequency = Some(h.frequency);
+            p.period = Some(2.0 * std::f64::consts::PI / h.frequency);
+            p.residual = Some(h.re);
+            p.condition = Some(HOPF_CONDITION);
+            points.push(p);
+        }
+    }
+    (rows, points)
+}
+
+/// A point on the section `ω_l = ω*(u)` near the attractor reached from rest at `u`.
+pub fn start_point(sh: &Shooter, u: f64) -> Result<([f64; 2], f64), BifError> {
+    let model = sh.model;
+    let x0 = State::zeros();
+    let e = BifError::Solve;
+    let settled = flow(
+        model,
+        u,
+        sh.tol.max(1e-9),
+        x0,
+        model.mode_at(&x0, u),
+        400.0,
+        StopAt::Time,
+    )
+    .map_err(e)?;
+    let c = sh.section_level(u)?;
+    let on = flow(
+        model,
+        u,
+        sh.tol,
+        settled.x,
+        settled.mode,
+        1000.0,
+        StopAt::Section(c),
+    )
+    .map_err(e)?;
+    if !on.reached {
+        return Err(BifError::NoReturn { u });
+    }
+    Ok(([on.x[0], on.x[1]], c))
+}
+
+/// The bifurcation diagram over `[u_min, u_max]` (see the crate docs).
+///
+/// ```no_run
+/// use rotor_bifurcation::{DiagramOptions, diagram};
+/// let model = rotor_model::Model::table1();
+/// let d = diagram(&model, &DiagramOptions { u_min: 0.0, u_max: 7.0, ..Default::default() })?;
+/// std::fs::write("diagram.json", d.to_json()?).unwrap();
+/// std::fs::write("diagram.svg", d.to_svg("Table 1")).unwrap();
+/// # Ok::<(), rotor_bifurcation::BifError>(())
+/// ```
+pub fn diagram(model: &Model, opts: &DiagramOptions) -> Result<Diagram, BifError> {
+    opts.validate()?;
+    let (equilibria, mut points) = equilibrium_part(model, opts);
+    let sh = Shooter {
+        model,
+        tol: opts.tol,
+    };
+    // The arclength step shrinks with the range but never grows past the default's (7 V over
+    // 200): a coarser step walks past the grazing point near the lower Hopf point (at 0.6 V,
+    // 0.22 V above it), which a 1.5 V step over [0, 300] V did.
+    let h_max = ((opts.u_max - opts.u_min) / opts.n as f64).min(H_MAX);
+    let cont = Continuer {
+        sh,
+        opts: ContOptions {
+            u_min: opts.u_min,
+            u_max: opts.u_max,
+            h_max,
+            h_min: 1e-9,
+            newton_tol: 1e-9,
+            amp_stop: opts.amp_stop,
+            max_nodes: 20 * opts.n,
+            fd_step: 1e-6,
+            multipliers: continuation::Multipliers::Saltation,
+        },
+    };
+    let mut branches = Vec::new();
+    let u_start = if (opts.u_min..=opts.u_max).contains(&opts.u_start) {
+        opts.u_start
+    } else {
+        0.5 * (opts.u_min + opts.u_max)
+    };
+    // The branch through the attractor reached from rest, if that is a cycle (a damped
+    // approach to a stable equilibrium also crosses the section: its "fixed point" is the
+    // equilibrium, of zero amplitude).
+    let started = start_point(&sh, u_start).and_then(|(z0, c)| {
+        let z = sh.section_fixed_point(u_start, c, z0, 1e-10)?;
+        cont.node([u_start, z[0], z[1]], &[1.0, 0.0, 0.0], 0.0)
+    });
+    if let Ok(start) = started
+        && start.info.omega_l_max - start.info.omega_l_min >= opts.amp_stop
+    {
+        let (down, end_down) = cont.follow(&start, &[-1.0, 0.0, 0.0]);
+        let (up, end_up) = cont.follow(&start, &[1.0, 0.0, 0.0]);
+        let mut nodes: Vec<Node> = down.into_iter().rev().collect();
+        nodes.push(start);
+        nodes.extend(up);
+        branches.push(Branch {
+            nodes,
+            ends: [end_down, end_up],
+        });
+    }
+    // Branches born at Hopf points that the first branch does not reach.
+    let hopfs = equilibria::omega_reaching(model, opts.u_max)
+        .map(|w| equilibria::hopf_points(model, w))
+        .unwrap_or_default();
+    let hopfs: Vec<_> = hopfs
+        .into_iter()
+        .filter(|h| (opts.u_min..=opts.u_max).contains(&h.equilibrium.u))
+        .collect();
+    for h in &hopfs {
+        if nearest_hopf_end(&branches, &hopfs, h).is_some() {
+            continue;
+        }
+        let eps = 2.0 * opts.amp_stop;
+        let (Ok(y1), Ok(y2)) = (
+            cont.hopf_cycle(h.equilibrium.omega, eps),
+            cont.hopf_cycle(h.equilibrium.omega, 1.5 * eps),
+        ) else {
+            continue;
+        };
+        let along = [y2[0] - y1[0], y2[1] - y1[1], y2[2] - y1[2]];
+        let Ok(first) = cont.node(y1, &along, 0.0) else {
+            continue;
+        };
+        let (rest, end) = cont.follow(&first, &along);
+        let mut nodes = vec![first];
+        nodes.extend(rest);
+        branches.push(Branch {
+            nodes,
+            ends: [End::Small, end],
+        });
+    }
+    for b in &mut branches {
+        orient(&mut b.nodes);
+        points.extend(special_points(&cont, &b.nodes, opts.point_tol));
+    }
+    // Criticality of each Hopf point: from the stability of the cycles at the branch end
+    // next to it.
+    for p in points.iter_mut().filter(|p| p.kind == PointKind::Hopf) {
+        if let Some(h) = hopfs.iter().find(|h| h.equilibrium.u == p.u)
+            && let Some(n) = nearest_hopf_end(&branches, &hopfs, h)
+        {
+            p.detail = format!(
+                "{}; {} (cycles of amplitude {:.3} rad/s at u = {} are {})",
+                if n.info.stable {
+                    "supercritical"
+                } else {
+                    "subcritical"
+                },
+                p.detail,
+                n.info.omega_l_max - n.info.omega_l_min,
+                n.y[0],
+                if n.info.stable { "stable" } else { "unstable" }
+            );
+        }
+    }
+    points.extend(stuck_end_points(model, &branches, opts.point_tol));
+    let periodic = branches
+        .iter()
+        .enumerate()
+        .flat_map(|(k, b)| b.nodes.iter().map(move |n| PeriodicRow::of(n, k)))
+        .collect();
+    Ok(Diagram {
+        equilibria,
+        periodic,
+        points,
+    })
+}
+
+/// A followed branch and why each of its ends ended.
+pub(crate) struct Branch {
+    pub(crate) nodes: Vec<Node>,
+    pub(crate) ends: [End; 2],
+}
+
+/// Orients every tangent along the branch order.
+fn orient(nodes: &mut [Node]) {
+    if nodes.len() >= 2 {
+        let (a, b) = (&nodes[0].y, &nodes[1].y);
+        let t = nodes[0].tangent;
+        if (0..3).map(|k| (b[k] - a[k]) * t[k]).sum::<f64>() < 0.0 {
+            nodes[0].tangent = t.map(|v| -v);
+        }
+    }
+    for i in 1..nodes.len() {
+        let prev = nodes[i - 1].tangent;
+        let t = &mut nodes[i].tangent;
+        if t[0] * prev[0] + t[1] * prev[1] + t[2] * prev[2] < 0.0 {
+            *t = t.map(|v| -v);
+        }
+    }
+}
+
+/// The branch end (stopped for small amplitude) whose nearest Hopf point is `h`, if any.
+fn nearest_hopf_end<'a>(
+    branches: &'a [Branch],
+    hopfs: &[equilibria::HopfPoint],
+    h: &equilibria::HopfPoint,
+) -> Option<&'a Node> {
+    let nearest = |u: f64| {
+        hopfs
+            .iter()
+            .min_by(|a, b| {
+                (a.equilibrium.u - u)
+                    .abs()
+                    .total_cmp(&(b.equilibrium.u - u).abs())
+            })
+            .map(|x| x.equilibrium.u)
+    };
+    branches.iter().find_map(|b| {
+        let cands = [
+            (b.ends[0] == End::Small).then(|| b.nodes.first()).flatten(),
+            (b.ends[1] == End::Small).then(|| b.nodes.last()).flatten(),
+        ];
+        cands
+            .into_iter()
+            .flatten()
+            .find(|n| nearest(n.y[0]) == Some(h.equilibrium.u))
+    })
+}
+
