@@ -4,9 +4,13 @@
 use std::path::Path;
 use std::process::Command;
 
-use serde::Deserialize;
+use rotor_model::{PairTolerance, State};
+use serde::{Deserialize, Serialize};
 
 use crate::BenchError;
+use crate::ladder::{LadderPoint, Loaded};
+use crate::measure::{Errors, Timing, run_point, scene_at, time_at_error};
+use crate::options::{BenchOptions, SolverKind};
 
 /// What a peer script prints.
 #[derive(Debug, Clone, Deserialize)]
@@ -195,5 +199,426 @@ mod tests {
             let e = o.validate().unwrap_err();
             assert!(e.contains(needle), "{e} lacks {needle}");
         }
+    }
+}
+
+/// Whether a peer ran.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum PeerStatus {
+    Ran,
+    /// Not installed, or turned off.
+    Skipped,
+    Failed,
+}
+
+impl PeerStatus {
+    /// `"ran"`, `"skipped"` or `"failed"`.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            PeerStatus::Ran => "ran",
+            PeerStatus::Skipped => "skipped",
+            PeerStatus::Failed => "failed",
+        }
+    }
+}
+
+/// A peer: what it computed, whether it agrees, and how it compares.
+#[derive(Debug, Clone, Serialize)]
+pub struct PeerReport {
+    /// `"scipy"` or `"siconos"`.
+    pub name: String,
+    pub status: PeerStatus,
+    /// Why it was skipped or failed.
+    pub reason: Option<String>,
+    pub version: Option<String>,
+    pub method: Option<String>,
+    /// `"tol"` (rtol = atol) or `"h"`.
+    pub setting_name: &'static str,
+    pub points: Vec<PeerPoint>,
+    /// Agreement of the peer's most accurate run with the reference.
+    pub agreement: Option<Agreement>,
+    /// Run time at equal error vs a Rust solver (scipy vs event).
+    pub ratios: Vec<Ratio>,
+    /// Time per step at equal h vs rotor-moreau (Siconos).
+    pub per_step: Vec<PerStep>,
+}
+
+/// One setting of a peer.
+#[derive(Debug, Clone, Serialize)]
+pub struct PeerPoint {
+    pub setting: f64,
+    pub timing: Option<Timing>,
+    pub errors: Errors,
+    pub steps: Option<u64>,
+    pub rhs_evals: Option<u64>,
+    pub failure: Option<String>,
+}
+
+/// Whether a peer computes the same answer as the reference.
+#[derive(Debug, Clone, Serialize)]
+pub struct Agreement {
+    /// The peer setting checked (its most accurate one).
+    pub setting: f64,
+    pub period_rel: Option<f64>,
+    pub omega_l_max_rel: Option<f64>,
+    pub transient_max: Option<f64>,
+    /// Gates, from the scenario file's tolerance table.
+    pub gate_period_rel: f64,
+    pub gate_omega_l_rel: f64,
+    pub gate_transient_max: f64,
+    /// Which table entry the gates come from.
+    pub gate_origin: String,
+    pub agrees: bool,
+}
+
+/// Peer time / Rust time at the peer's error.
+#[derive(Debug, Clone, Serialize)]
+pub struct Ratio {
+    pub against: SolverKind,
+    /// `"steady_rel"` or `"transient_max"`.
+    pub error_kind: &'static str,
+    pub peer_setting: f64,
+    pub error: f64,
+    pub peer_seconds: f64,
+    /// The Rust solver's time at that error (interpolated on its work-precision front).
+    pub rust_seconds: f64,
+    /// The Rust solver's fastest point is already more accurate: `rust_seconds` is an upper
+    /// bound, the ratio a lower bound.
+    pub rust_is_bound: bool,
+    /// peer_seconds / rust_seconds (medians).
+    pub ratio: f64,
+    /// The same from the fastest runs of each (less sensitive to other load on the machine).
+    pub ratio_of_minima: Option<f64>,
+}
+
+/// Time per step of Siconos vs rotor-moreau at one h.
+#[derive(Debug, Clone, Serialize)]
+pub struct PerStep {
+    pub h: f64,
+    pub peer_s_per_step: f64,
+    pub moreau_s_per_step: f64,
+    /// peer / moreau time per step (medians).
+    pub ratio: f64,
+    /// The same from the fastest runs of each.
+    pub ratio_of_minima: f64,
+    pub peer_errors: Errors,
+    pub moreau_errors: Errors,
+}
+
+fn x0_arg(x: &State) -> String {
+    format!("{:e},{:e},{:e}", x[0], x[1], x[2])
+}
+
+/// Common command-line arguments of the peer scripts.
+fn peer_args(l: &Loaded, repeats: usize, budget: f64) -> Vec<String> {
+    let s = &l.spec;
+    vec![
+        "--params".into(),
+        l.scenario.params_path.display().to_string(),
+        "--u".into(),
+        format!("{:e}", l.scenario.u),
+        "--x0".into(),
+        x0_arg(&l.scenario.x0),
+        "--t-end".into(),
+        format!("{:e}", s.t_end),
+        "--metrics-from".into(),
+        format!("{:e}", s.metrics_from),
+        "--transient".into(),
+        format!("{:e},{:e}", s.transient[0], s.transient[1]),
+        "--dt".into(),
+        format!("{:e}", s.dt),
+        "--repeat".into(),
+        repeats.to_string(),
+        "--time-budget".into(),
+        format!("{budget:e}"),
+    ]
+}
+
+fn peer_points(l: &Loaded, out: &PeerOutput) -> Vec<PeerPoint> {
+    out.runs
+        .iter()
+        .map(|r| {
+            let samples: Vec<(f64, f64)> =
+                r.t.iter().copied().zip(r.omega_l.iter().copied()).collect();
+            let ok = r.failure.is_none() && !r.seconds.is_empty();
+            PeerPoint {
+                setting: r.setting,
+                timing: ok.then(|| Timing::of(r.seconds.clone())),
+                errors: if ok {
+                    l.refd
+                        .errors(r.metrics.map(|m| (m.period, m.omega_l_max)), &samples)
+                } else {
+                    Errors::default()
+                },
+                steps: r.steps,
+                rhs_evals: r.rhs_evals,
+                failure: r.failure.clone(),
+            }
+        })
+        .collect()
+}
+
+fn agreement(points: &[PeerPoint], gate: Option<(&str, PairTolerance)>) -> Option<Agreement> {
+    let best = points
+        .iter()
+        .filter(|p| p.timing.is_some())
+        .min_by(|a, b| a.setting.total_cmp(&b.setting))?;
+    let (origin, tol) = gate?;
+    let gp = tol.period_rel?;
+    let gw = tol.omega_l_rel?;
+    let gt = tol.transient_max?;
+    let e = &best.errors;
+    let agrees = e.period_rel.is_some_and(|e| e <= gp)
+        && e.omega_l_max_rel.is_some_and(|e| e <= gw)
+        && e.transient_max.is_some_and(|e| e <= gt);
+    Some(Agreement {
+        setting: best.setting,
+        period_rel: e.period_rel,
+        omega_l_max_rel: e.omega_l_max_rel,
+        transient_max: e.transient_max,
+        gate_period_rel: gp,
+        gate_omega_l_rel: gw,
+        gate_transient_max: gt,
+        gate_origin: origin.to_string(),
+        agrees,
+    })
+}
+
+fn skipped(
+    name: &str,
+    setting_name: &'static str,
+    status: PeerStatus,
+    reason: String,
+) -> PeerReport {
+    PeerReport {
+        name: name.into(),
+        status,
+        reason: Some(reason),
+        version: None,
+        method: None,
+        setting_name,
+        points: Vec::new(),
+        agreement: None,
+        ratios: Vec::new(),
+        per_step: Vec::new(),
+    }
+}
+
+/// One peer script to launch: whether it is on, its interpreter and the module that must
+/// import, its script and ladder flag, and the scenario's tolerance pair it must agree within.
+struct PeerLaunch<'a> {
+    name: &'static str,
+    setting_name: &'static str,
+    enabled: bool,
+    python: &'a str,
+    module: &'static str,
+    script: &'static str,
+    flag: &'static str,
+    settings: &'a [f64],
+    pair: &'static str,
+}
+
+/// What a peer that ran gave: its output, the points measured against the reference, and
+/// its agreement with the reference within the scenario's gate.
+struct Launched {
+    out: PeerOutput,
+    points: Vec<PeerPoint>,
+    agreement: Option<Agreement>,
+}
+
+/// Runs a peer script if it is turned on and its interpreter has the module; `Err` is the
+/// report of a peer that was skipped or failed.
+fn launch_peer(
+    pl: &PeerLaunch,
+    opts: &BenchOptions,
+    l: &Loaded,
+    progress: &mut impl FnMut(&str),
+) -> Result<Launched, Box<PeerReport>> {
+    let (name, setting) = (pl.name, pl.setting_name);
+    if !pl.enabled {
+        return Err(Box::new(skipped(
+            name,
+            setting,
+            PeerStatus::Skipped,
+            "turned off in the options".into(),
+        )));
+    }
+    if let Err(why) = available(pl.python, pl.module) {
+        progress(&format!("{name} peer skipped: {why}"));
+        return Err(Box::new(skipped(name, setting, PeerStatus::Skipped, why)));
+    }
+    let list = list(pl.settings);
+    progress(&format!(
+        "{}: {name} peer, {setting} = {list}",
+        l.scenario.name
+    ));
+    let mut args = peer_args(l, opts.repeats, opts.time_budget);
+    args.extend([pl.flag.to_string(), list]);
+    let out = run_script(pl.python, &opts.peers.dir.join(pl.script), &args)
+        .map_err(|e| Box::new(skipped(name, setting, PeerStatus::Failed, e.to_string())))?;
+    let points = peer_points(l, &out);
+    let origin = format!("scenario [tolerance.{}]", pl.pair);
+    let gate = l
+        .scenario
+        .tolerance
+        .get(pl.pair)
+        .map(|t| (origin.as_str(), *t));
+    let agreement = agreement(&points, gate);
+    Ok(Launched {
+        out,
+        points,
+        agreement,
+    })
+}
+
+pub(crate) fn scipy_peer(
+    opts: &BenchOptions,
+    l: &Loaded,
+    points: &[LadderPoint],
+    progress: &mut impl FnMut(&str),
+) -> PeerReport {
+    let p = &opts.peers;
+    let launch = PeerLaunch {
+        name: "scipy",
+        setting_name: "tol",
+        enabled: p.scipy,
+        python: &p.python,
+        module: "scipy",
+        script: "scipy_rotor.py",
+        flag: "--tol",
+        settings: &p.scipy_tols,
+        pair: "event-switch",
+    };
+    let Launched {
+        out,
+        points: pts,
+        agreement,
+    } = match launch_peer(&launch, opts, l, progress) {
+        Ok(x) => x,
+        Err(report) => return *report,
+    };
+    let mut ratios = Vec::new();
+    if agreement.as_ref().is_some_and(|a| a.agrees) {
+        for (kind_name, pick) in [
+            (
+                "steady_rel",
+                (|e: &Errors| e.steady_rel) as fn(&Errors) -> Option<f64>,
+            ),
+            ("transient_max", |e: &Errors| e.transient_max),
+        ] {
+            let curve = |min: bool| -> Vec<(f64, f64)> {
+                points
+                    .iter()
+                    .filter(|q| q.solver == SolverKind::EVENT)
+                    .filter_map(|q| {
+                        let t = q.timing?;
+                        Some((pick(&q.errors)?, if min { t.min_s } else { t.median_s }))
+                    })
+                    .collect()
+            };
+            let (median_curve, min_curve) = (curve(false), curve(true));
+            for pp in &pts {
+                let (Some(e), Some(t)) = (pick(&pp.errors), pp.timing) else {
+                    continue;
+                };
+                if let Some((rt, bound)) = time_at_error(&median_curve, e) {
+                    ratios.push(Ratio {
+                        against: SolverKind::EVENT,
+                        error_kind: kind_name,
+                        peer_setting: pp.setting,
+                        error: e,
+                        peer_seconds: t.median_s,
+                        rust_seconds: rt,
+                        rust_is_bound: bound,
+                        ratio: t.median_s / rt,
+                        ratio_of_minima: time_at_error(&min_curve, e).map(|(rm, _)| t.min_s / rm),
+                    });
+                }
+            }
+        }
+    }
+    PeerReport {
+        name: "scipy".into(),
+        status: PeerStatus::Ran,
+        reason: None,
+        version: Some(out.version),
+        method: Some(out.method),
+        setting_name: "tol",
+        points: pts,
+        agreement,
+        ratios,
+        per_step: Vec::new(),
+    }
+}
+
+pub(crate) fn siconos_peer(
+    opts: &BenchOptions,
+    l: &Loaded,
+    progress: &mut impl FnMut(&str),
+) -> PeerReport {
+    let p = &opts.peers;
+    let launch = PeerLaunch {
+        name: "siconos",
+        setting_name: "h",
+        enabled: p.siconos,
+        python: &p.siconos_python,
+        module: "siconos.kernel",
+        script: "siconos_rotor.py",
+        flag: "--h",
+        settings: &p.siconos_hs,
+        pair: "event-moreau",
+    };
+    let Launched {
+        out,
+        points: pts,
+        agreement,
+    } = match launch_peer(&launch, opts, l, progress) {
+        Ok(x) => x,
+        Err(report) => return *report,
+    };
+    let mut per_step = Vec::new();
+    for pp in &pts {
+        let (Some(t), Some(steps)) = (pp.timing, pp.steps) else {
+            continue;
+        };
+        progress(&format!(
+            "{}: moreau at the siconos step h = {:e}",
+            l.scenario.name, pp.setting
+        ));
+        let scene = scene_at(&l.base, SolverKind::MOREAU, pp.setting, l.base.output);
+        if let Ok((tr, mt, me)) = run_point(
+            SolverKind::MOREAU,
+            &scene,
+            &l.scenario.model,
+            &l.refd,
+            l.spec.transient,
+            opts.repeats,
+            opts.time_budget,
+        ) {
+            let peer_s = t.median_s / steps as f64;
+            let ours = mt.median_s / tr.stats.steps as f64;
+            per_step.push(PerStep {
+                h: pp.setting,
+                peer_s_per_step: peer_s,
+                moreau_s_per_step: ours,
+                ratio: peer_s / ours,
+                ratio_of_minima: (t.min_s / steps as f64) / (mt.min_s / tr.stats.steps as f64),
+                peer_errors: pp.errors,
+                moreau_errors: me,
+            });
+        }
+    }
+    PeerReport {
+        name: "siconos".into(),
+        status: PeerStatus::Ran,
+        reason: None,
+        version: Some(out.version),
+        method: Some(out.method),
+        setting_name: "h",
+        points: pts,
+        agreement,
+        ratios: Vec::new(),
+        per_step,
     }
 }

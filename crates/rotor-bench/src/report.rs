@@ -426,7 +426,7 @@ fn first_non_finite(v: &toml::Value, path: String) -> Option<(String, f64)> {
 }
 
 fn peer_table(s: &mut String, p: &PeerReport) {
-    let _ = write!(s, "peer {}: {}", p.name, p.status);
+    let _ = write!(s, "peer {}: {}", p.name, p.status.as_str());
     if let Some(r) = &p.reason {
         let _ = write!(s, " ({r})");
     }

@@ -51,7 +51,7 @@ fn scipy_peer_agrees_with_the_reference() {
     let r = run(&o, |m| eprintln!("{m}")).unwrap();
     let p = &r.peers[0];
     assert_eq!(p.name, "scipy");
-    assert_eq!(p.status, "ran", "{:?}", p.reason);
+    assert_eq!(p.status.as_str(), "ran", "{:?}", p.reason);
     assert_eq!(p.points.len(), 2);
     let a = p.agreement.as_ref().expect("the scenario has gates");
     assert!(a.agrees, "{a:?}");
@@ -90,7 +90,7 @@ fn siconos_peer_agrees_with_the_reference() {
     let r = run(&o, |m| eprintln!("{m}")).unwrap();
     let p = &r.peers[1];
     assert_eq!(p.name, "siconos");
-    assert_eq!(p.status, "ran", "{:?}", p.reason);
+    assert_eq!(p.status.as_str(), "ran", "{:?}", p.reason);
     let a = p.agreement.as_ref().expect("the scenario has gates");
     assert!(a.agrees, "{a:?}");
     assert_eq!(p.per_step.len(), 1);

@@ -223,7 +223,7 @@ fn a_missing_peer_is_skipped_with_its_reason() {
     o.peers.siconos_python = "/nonexistent/python3".into();
     let r = run(&o, |_| {}).unwrap();
     for p in &r.peers {
-        assert_eq!(p.status, "skipped");
+        assert_eq!(p.status.as_str(), "skipped");
         assert!(
             p.reason
                 .as_deref()

@@ -466,4 +466,3 @@ fn nearest_hopf_end<'a>(
             .find(|n| nearest(n.y[0]) == Some(h.equilibrium.u))
     })
 }
-

@@ -30,8 +30,8 @@
 //! (criterion medians, `cargo bench -p rotor-bifurcation`, benches/diagram.rs; release build,
 //! one thread, on a 2-core machine shared with other jobs while measured).
 
-mod diagram;
 pub mod continuation;
+mod diagram;
 pub mod equilibria;
 pub mod grazing;
 pub mod monodromy;
@@ -77,4 +77,3 @@ pub enum BifError {
     #[error("write failed: {0}")]
     Io(String),
 }
-

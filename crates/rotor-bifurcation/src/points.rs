@@ -158,7 +158,11 @@ fn discontinuous_fold(g: &grazing::GrazingOrbit, a: &Node, b: &Node, side_u: f64
 }
 
 /// Folds, grazing points and other stability changes along an ordered branch.
-pub(crate) fn special_points(cont: &Continuer, branch: &[Node], point_tol: f64) -> Vec<SpecialPoint> {
+pub(crate) fn special_points(
+    cont: &Continuer,
+    branch: &[Node],
+    point_tol: f64,
+) -> Vec<SpecialPoint> {
     let model = cont.sh.model;
     let mut out = Vec::new();
     for w in branch.windows(2) {
@@ -273,7 +277,11 @@ pub(crate) fn special_points(cont: &Continuer, branch: &[Node], point_tol: f64) 
 
 /// Branch ends at a collapsed step: a non-smooth turning point at a grazing orbit. Each is
 /// located as a grazing orbit; two ends at the same grazing orbit form a discontinuous fold.
-pub(crate) fn stuck_end_points(model: &Model, branches: &[Branch], point_tol: f64) -> Vec<SpecialPoint> {
+pub(crate) fn stuck_end_points(
+    model: &Model,
+    branches: &[Branch],
+    point_tol: f64,
+) -> Vec<SpecialPoint> {
     // Each stuck end with the node 10 steps back (its side of the end in u).
     let ends: Vec<(&Node, &Node)> = branches
         .iter()
@@ -338,4 +346,3 @@ fn point_at(kind: PointKind, n: &Node, detail: String) -> SpecialPoint {
     p.omega_l_min = Some(n.info.omega_l_min);
     p
 }
-

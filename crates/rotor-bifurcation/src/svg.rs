@@ -45,11 +45,19 @@ fn split_runs(
 
 pub(crate) fn render(d: &Diagram, title: &str) -> String {
     let (mut eq_s, mut eq_u) = (Vec::new(), Vec::new());
-    let mut slip: Vec<_> = d.equilibria.iter().filter(|e| e.kind == EquilibriumKind::Slip).collect();
+    let mut slip: Vec<_> = d
+        .equilibria
+        .iter()
+        .filter(|e| e.kind == EquilibriumKind::Slip)
+        .collect();
     slip.sort_by(|a, b| a.omega.total_cmp(&b.omega));
     let pts: Vec<_> = slip.iter().map(|e| ((e.u, e.omega), e.stable)).collect();
     split_runs(&pts, &mut eq_s, &mut eq_u);
-    let mut stuck: Vec<_> = d.equilibria.iter().filter(|e| e.kind == EquilibriumKind::Stuck).collect();
+    let mut stuck: Vec<_> = d
+        .equilibria
+        .iter()
+        .filter(|e| e.kind == EquilibriumKind::Stuck)
+        .collect();
     stuck.sort_by(|a, b| a.u.total_cmp(&b.u));
     let pts: Vec<_> = stuck.iter().map(|e| ((e.u, 0.0), e.stable)).collect();
     split_runs(&pts, &mut eq_s, &mut eq_u);

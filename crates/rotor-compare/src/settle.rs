@@ -231,7 +231,10 @@ mod tests {
                 },
             )
             .unwrap();
-        assert_eq!(one_run.metrics.unwrap().kind(), "limit_cycle");
+        assert_eq!(
+            one_run.metrics.unwrap().kind(),
+            rotor_model::SteadyKind::LimitCycle
+        );
         for kind in [SolverKind::SWITCH, SolverKind::MOREAU] {
             let s = settle(kind, &m, &base(u), &SettleOptions::default()).unwrap();
             let SteadyState::Equilibrium { omega_l, alpha, .. } = s.state else {

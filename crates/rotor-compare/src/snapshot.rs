@@ -185,7 +185,7 @@ pub fn snapshot(r: &ScenarioResult) -> ScenarioSnapshot {
                     }
                     SolverSnapshot {
                         solver: run.kind.name(),
-                        steady: t.metrics.map_or("none", |m| m.kind()).to_owned(),
+                        steady: t.metrics.map_or("none", |m| m.kind().as_str()).to_owned(),
                         metrics,
                         digits,
                         counters: Counters::new(

@@ -32,4 +32,4 @@ pub use scene::{
     Event, EventKind, Output, OutputGrid, Sample, Scene, SolveError, Solver, Stats, Trajectory,
     check_finite,
 };
-pub use steady::{MetricsAccumulator, SteadyState};
+pub use steady::{MetricsAccumulator, SteadyKind, SteadyState};

@@ -58,12 +58,36 @@ impl SteadyState {
         }
     }
 
-    /// `"equilibrium"` or `"limit_cycle"`.
-    pub fn kind(&self) -> &'static str {
+    /// An equilibrium or a limit cycle.
+    pub fn kind(&self) -> SteadyKind {
         match self {
-            SteadyState::Equilibrium { .. } => "equilibrium",
-            SteadyState::LimitCycle { .. } => "limit_cycle",
+            SteadyState::Equilibrium { .. } => SteadyKind::Equilibrium,
+            SteadyState::LimitCycle { .. } => SteadyKind::LimitCycle,
         }
+    }
+}
+
+/// What a steady state is (`"equilibrium"` or `"limit_cycle"` in JSON and reports).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum SteadyKind {
+    Equilibrium,
+    LimitCycle,
+}
+
+impl SteadyKind {
+    /// `"equilibrium"` or `"limit_cycle"`.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            SteadyKind::Equilibrium => "equilibrium",
+            SteadyKind::LimitCycle => "limit_cycle",
+        }
+    }
+}
+
+impl std::fmt::Display for SteadyKind {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.as_str())
     }
 }
 

@@ -45,7 +45,11 @@ pub fn st_diagram() -> &'static Diagram {
 
 /// The special points of one kind, by increasing u.
 pub fn points<'a>(d: &'a Diagram, kind: &str) -> Vec<&'a SpecialPoint> {
-    let mut v: Vec<_> = d.points.iter().filter(|p| p.kind.as_str() == kind).collect();
+    let mut v: Vec<_> = d
+        .points
+        .iter()
+        .filter(|p| p.kind.as_str() == kind)
+        .collect();
     v.sort_by(|a, b| a.u.total_cmp(&b.u));
     v
 }

@@ -258,7 +258,11 @@ fn stribeck_diagram_structure() {
         .unwrap();
     assert!(st.stick_slip && (st.u - 1.5).abs() < 0.05);
     // Both discs stuck at small u (the equilibrium set).
-    assert!(d.equilibria.iter().any(|e| e.kind.as_str() == "stuck" && e.u < 0.1));
+    assert!(
+        d.equilibria
+            .iter()
+            .any(|e| e.kind.as_str() == "stuck" && e.u < 0.1)
+    );
 }
 
 #[test]

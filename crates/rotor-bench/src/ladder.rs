@@ -1,0 +1,195 @@
+//! The reference run of a scene and each solver's ladder of settings, every point timed and
+//! measured against the reference.
+
+use rotor_model::{Output, Scenario, Scene, Stats};
+use serde::Serialize;
+
+use crate::BenchError;
+use crate::measure::{
+    Errors, RefData, Timing, cycle_metrics, run_point, scene_at, solver, timed, window,
+};
+use crate::options::{BenchOptions, SceneSpec, SolverKind};
+
+/// One scene: its reference and every ladder point.
+#[derive(Debug, Clone, Serialize)]
+pub struct SceneReport {
+    pub name: String,
+    pub description: String,
+    pub u: f64,
+    pub x0: [f64; 3],
+    pub t_end: f64,
+    pub metrics_from: f64,
+    pub transient: [f64; 2],
+    pub dt: f64,
+    pub reference: ReferenceReport,
+    pub points: Vec<LadderPoint>,
+}
+
+/// The reference run and the estimate of its own error.
+#[derive(Debug, Clone, Serialize)]
+pub struct ReferenceReport {
+    pub solver: SolverKind,
+    pub tol: f64,
+    /// Period of the last complete cycle (s).
+    pub period: f64,
+    /// Max ω_l over that cycle (rad/s).
+    pub omega_l_max: f64,
+    /// One untimed run (s).
+    pub seconds: f64,
+    pub stats: Stats,
+    /// Tolerance of the check run.
+    pub check_tol: f64,
+    /// Errors of the reference measured against the check run (swapped roles: the
+    /// difference between the two, an estimate of the reference's own error).
+    pub check: Option<Errors>,
+    /// Why the check run failed, if it did.
+    pub check_failure: Option<String>,
+}
+
+/// One solver at one accuracy setting.
+#[derive(Debug, Clone, Serialize)]
+pub struct LadderPoint {
+    pub solver: SolverKind,
+    /// `tol` or `h`.
+    pub setting_name: &'static str,
+    pub setting: f64,
+    /// `None` if the run failed.
+    pub timing: Option<Timing>,
+    pub errors: Errors,
+    pub stats: Stats,
+    /// Why the run failed, if it did.
+    pub failure: Option<String>,
+}
+
+/// A loaded scene with its reference.
+pub(crate) struct Loaded {
+    pub(crate) scenario: Scenario,
+    pub(crate) spec: SceneSpec,
+    pub(crate) base: Scene,
+    pub(crate) refd: RefData,
+}
+
+pub(crate) fn load(
+    opts: &BenchOptions,
+    spec: &SceneSpec,
+    progress: &mut impl FnMut(&str),
+) -> Result<(Loaded, ReferenceReport), BenchError> {
+    let scenario = rotor_compare::load_scenario(&spec.scenario)?;
+    let base = Scene {
+        u: scenario.u,
+        x0: scenario.x0,
+        t_end: spec.t_end,
+        tol: opts.reference_tol,
+        h: Scene::default().h,
+        output: Output::Grid { dt: spec.dt },
+        metrics_from: Some(spec.metrics_from),
+    };
+    progress(&format!(
+        "{}: reference (event, tol {:e})",
+        scenario.name, opts.reference_tol
+    ));
+    let ev = solver(SolverKind::EVENT);
+    let (tr, timing) = timed(1, 0.0, || ev.simulate(&scenario.model, &base)).map_err(|source| {
+        BenchError::Reference {
+            scene: scenario.name.clone(),
+            tol: opts.reference_tol,
+            source,
+        }
+    })?;
+    let refd =
+        RefData::new(&tr, spec.transient, spec.dt).ok_or_else(|| BenchError::NoReferenceCycle {
+            scene: scenario.name.clone(),
+        })?;
+    progress(&format!(
+        "{}: reference check (event, tol {:e})",
+        scenario.name, opts.reference_check_tol
+    ));
+    let check_scene = Scene {
+        tol: opts.reference_check_tol,
+        ..base.clone()
+    };
+    let (check, check_failure) = match ev.simulate(&scenario.model, &check_scene) {
+        Ok(c) => match RefData::new(&c, spec.transient, spec.dt) {
+            // The reference measured against the tighter run.
+            Some(cd) => (
+                Some(cd.errors(
+                    cycle_metrics(tr.metrics.as_ref()),
+                    &window(&tr, spec.transient, spec.dt),
+                )),
+                None,
+            ),
+            None => (None, Some("the check run gives no cycle".into())),
+        },
+        Err(e) => (None, Some(e.to_string())),
+    };
+    let reference = ReferenceReport {
+        solver: SolverKind::EVENT,
+        tol: opts.reference_tol,
+        period: refd.period,
+        omega_l_max: refd.omega_l_max,
+        seconds: timing.median_s,
+        stats: tr.stats,
+        check_tol: opts.reference_check_tol,
+        check,
+        check_failure,
+    };
+    Ok((
+        Loaded {
+            scenario,
+            spec: spec.clone(),
+            base,
+            refd,
+        },
+        reference,
+    ))
+}
+
+pub(crate) fn ladders(
+    opts: &BenchOptions,
+    l: &Loaded,
+    progress: &mut impl FnMut(&str),
+) -> Vec<LadderPoint> {
+    let mut points = Vec::new();
+    for (kind, ladder) in &opts.ladders {
+        let kind = *kind;
+        for &setting in ladder {
+            progress(&format!(
+                "{}: {} {} = {setting:e}",
+                l.scenario.name,
+                kind.name(),
+                kind.setting_name()
+            ));
+            let scene = scene_at(&l.base, kind, setting, l.base.output);
+            let point = match run_point(
+                kind,
+                &scene,
+                &l.scenario.model,
+                &l.refd,
+                l.spec.transient,
+                opts.repeats,
+                opts.time_budget,
+            ) {
+                Ok((tr, timing, errors)) => LadderPoint {
+                    solver: kind,
+                    setting_name: kind.setting_name(),
+                    setting,
+                    timing: Some(timing),
+                    errors,
+                    stats: tr.stats,
+                    failure: None,
+                },
+                Err(e) => LadderPoint {
+                    solver: kind,
+                    setting_name: kind.setting_name(),
+                    setting,
+                    timing: None,
+                    errors: Errors::default(),
+                    stats: Stats::default(),
+                    failure: Some(e.to_string()),
+                },
+            };
+            points.push(point);
+        }
+    }
+    points
+}
