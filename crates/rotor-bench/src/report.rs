@@ -17,20 +17,60 @@ fn ms(s: f64) -> String {
     format!("{:.3}", 1e3 * s)
 }
 
-fn csv_num(v: Option<f64>) -> String {
-    v.map_or(String::new(), |x| format!("{x:e}"))
+/// One row of the benchmark's CSV (an empty field where a value does not apply).
+#[derive(serde::Serialize)]
+struct CsvRow<'a> {
+    scene: &'a str,
+    source: &'a str,
+    setting_name: &'a str,
+    setting: f64,
+    median_s: Option<f64>,
+    min_s: Option<f64>,
+    repeats: Option<usize>,
+    err_period_s: Option<f64>,
+    err_omega_l_max: Option<f64>,
+    err_steady_rel: Option<f64>,
+    err_transient_max: Option<f64>,
+    steps: Option<u64>,
+    rejected: Option<u64>,
+    rhs_evals: Option<u64>,
+    events: Option<u64>,
+    lcp_solves: Option<u64>,
+    newton_iters: Option<u64>,
+    failure: &'a str,
 }
 
-fn csv_int(v: Option<u64>) -> String {
-    v.map_or(String::new(), |x| x.to_string())
-}
-
-/// A CSV field: quoted when it holds a comma, a quote or a line break.
-fn csv_text(s: &str) -> String {
-    if s.contains([',', '"', '\n']) {
-        format!("\"{}\"", s.replace('"', "\"\""))
-    } else {
-        s.to_string()
+impl<'a> CsvRow<'a> {
+    fn new(
+        scene: &'a str,
+        source: &'a str,
+        setting_name: &'a str,
+        setting: f64,
+        t: Option<crate::Timing>,
+        er: &Errors,
+        c: [Option<u64>; 6],
+        failure: Option<&'a str>,
+    ) -> CsvRow<'a> {
+        CsvRow {
+            scene,
+            source,
+            setting_name,
+            setting,
+            median_s: t.map(|t| t.median_s),
+            min_s: t.map(|t| t.min_s),
+            repeats: t.map(|t| t.repeats),
+            err_period_s: er.period,
+            err_omega_l_max: er.omega_l_max,
+            err_steady_rel: er.steady_rel,
+            err_transient_max: er.transient_max,
+            steps: c[0],
+            rejected: c[1],
+            rhs_evals: c[2],
+            events: c[3],
+            lcp_solves: c[4],
+            newton_iters: c[5],
+            failure: failure.unwrap_or(""),
+        }
     }
 }
 
@@ -253,76 +293,36 @@ impl BenchReport {
     /// Every point (ladders and peers) as CSV rows (a non-finite number is an error).
     pub fn to_csv(&self) -> Result<String, BenchError> {
         self.check_finite()?;
-        let mut s = String::from(
-            "scene,source,setting_name,setting,median_s,min_s,repeats,err_period_s,\
-             err_omega_l_max,err_steady_rel,err_transient_max,steps,rejected,rhs_evals,events,\
-             lcp_solves,newton_iters,failure\n",
-        );
-        let row = |s: &mut String,
-                   scene: &str,
-                   source: &str,
-                   setting_name: &str,
-                   setting: f64,
-                   t: Option<crate::Timing>,
-                   er: &Errors,
-                   counts: [Option<u64>; 6],
-                   failure: Option<&str>| {
-            let _ = writeln!(
-                s,
-                "{},{},{},{:e},{},{},{},{},{},{},{},{},{},{},{},{},{},{}",
-                csv_text(scene),
-                source,
-                setting_name,
-                setting,
-                csv_num(t.map(|t| t.median_s)),
-                csv_num(t.map(|t| t.min_s)),
-                t.map_or(String::new(), |t| t.repeats.to_string()),
-                csv_num(er.period),
-                csv_num(er.omega_l_max),
-                csv_num(er.steady_rel),
-                csv_num(er.transient_max),
-                csv_int(counts[0]),
-                csv_int(counts[1]),
-                csv_int(counts[2]),
-                csv_int(counts[3]),
-                csv_int(counts[4]),
-                csv_int(counts[5]),
-                csv_text(failure.unwrap_or(""))
-            );
+        let mut w = csv::Writer::from_writer(Vec::new());
+        let counts = |st: &rotor_model::Stats| {
+            [
+                Some(st.steps),
+                Some(st.rejected),
+                Some(st.rhs_evals),
+                Some(st.events),
+                Some(st.lcp_solves),
+                Some(st.newton_iters),
+            ]
         };
+        let mut rows = Vec::new();
         for sc in &self.scenes {
             for p in &sc.points {
-                let st = &p.stats;
-                let counts = if p.timing.is_some() {
-                    [
-                        Some(st.steps),
-                        Some(st.rejected),
-                        Some(st.rhs_evals),
-                        Some(st.events),
-                        Some(st.lcp_solves),
-                        Some(st.newton_iters),
-                    ]
-                } else {
-                    [None; 6]
-                };
-                row(
-                    &mut s,
+                rows.push(CsvRow::new(
                     &sc.name,
                     p.solver.name(),
                     p.setting_name,
                     p.setting,
                     p.timing,
                     &p.errors,
-                    counts,
+                    p.timing.map_or([None; 6], |_| counts(&p.stats)),
                     p.failure.as_deref(),
-                );
+                ));
             }
         }
         if let Some(sc) = self.scenes.first() {
             for peer in &self.peers {
                 for p in &peer.points {
-                    row(
-                        &mut s,
+                    rows.push(CsvRow::new(
                         &sc.name,
                         &peer.name,
                         peer.setting_name,
@@ -331,11 +331,18 @@ impl BenchReport {
                         &p.errors,
                         [p.steps, None, p.rhs_evals, None, None, None],
                         p.failure.as_deref(),
-                    );
+                    ));
                 }
             }
         }
-        Ok(s)
+        let ser = |e: csv::Error| BenchError::Serialise(e.to_string());
+        for r in &rows {
+            w.serialize(r).map_err(ser)?;
+        }
+        let bytes = w
+            .into_inner()
+            .map_err(|e| BenchError::Serialise(e.to_string()))?;
+        String::from_utf8(bytes).map_err(|e| BenchError::Serialise(e.to_string()))
     }
 
     /// Work-precision plot: per scene, steady-state error and transient error against run

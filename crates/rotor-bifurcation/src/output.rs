@@ -4,6 +4,11 @@
 use std::io::Write;
 
 use crate::svg;
+
+/// A float as the csv writer prints it (the shortest form that reads back the same).
+fn num(v: f64) -> String {
+    ryu::Buffer::new().format(v).to_owned()
+}
 use crate::{BifError, Diagram};
 
 /// Every number of the diagram, named, for the finiteness check.
@@ -76,57 +81,79 @@ impl Diagram {
     /// an error, and nothing is written then.
     pub fn write_csv(&self, w: &mut impl Write) -> Result<(), BifError> {
         self.check_finite()?;
-        self.write_csv_io(w)
+        self.write_csv_rows(w)
             .map_err(|e| BifError::Io(e.to_string()))
     }
 
-    fn write_csv_io(&self, w: &mut impl Write) -> std::io::Result<()> {
-        writeln!(w, "table,u,omega,alpha,stable,kind")?;
+    fn write_csv_rows(&self, w: &mut impl Write) -> csv::Result<()> {
+        // Three tables of different widths in one file.
+        let mut c = csv::WriterBuilder::new().flexible(true).from_writer(w);
+        c.write_record(["table", "u", "omega", "alpha", "stable", "kind"])?;
         for e in &self.equilibria {
-            writeln!(
-                w,
-                "equilibrium,{},{},{},{},{}",
+            c.serialize((
+                "equilibrium",
                 e.u,
                 e.omega,
                 e.alpha,
                 e.stable,
-                e.kind.as_str()
-            )?;
+                e.kind.as_str(),
+            ))?;
         }
-        writeln!(
-            w,
-            "table,u,period,omega_l_max,omega_l_min,stable,stick_slip,stick_time,mult1_re,mult1_im,mult2_re,mult2_im,mult3_re,mult3_im"
-        )?;
+        c.write_record([
+            "table",
+            "u",
+            "period",
+            "omega_l_max",
+            "omega_l_min",
+            "stable",
+            "stick_slip",
+            "stick_time",
+            "mult1_re",
+            "mult1_im",
+            "mult2_re",
+            "mult2_im",
+            "mult3_re",
+            "mult3_im",
+        ])?;
         for p in &self.periodic {
-            write!(
-                w,
-                "periodic,{},{},{},{},{},{},{}",
-                p.u, p.period, p.omega_l_max, p.omega_l_min, p.stable, p.stick_slip, p.stick_time
-            )?;
-            for m in &p.multipliers {
-                write!(w, ",{},{}", m[0], m[1])?;
-            }
-            writeln!(w)?;
+            let mut row = vec![
+                "periodic".to_string(),
+                num(p.u),
+                num(p.period),
+                num(p.omega_l_max),
+                num(p.omega_l_min),
+                p.stable.to_string(),
+                p.stick_slip.to_string(),
+                num(p.stick_time),
+            ];
+            row.extend(p.multipliers.iter().flat_map(|m| [num(m[0]), num(m[1])]));
+            c.write_record(&row)?;
         }
-        writeln!(
-            w,
-            "table,kind,u,discontinuous,omega,frequency,period,residual,detail"
-        )?;
-        let opt = |v: Option<f64>| v.map(|x| x.to_string()).unwrap_or_default();
+        c.write_record([
+            "table",
+            "kind",
+            "u",
+            "discontinuous",
+            "omega",
+            "frequency",
+            "period",
+            "residual",
+            "detail",
+        ])?;
         for p in &self.points {
-            writeln!(
-                w,
-                "point,{},{},{},{},{},{},{},\"{}\"",
-                p.kind,
+            c.serialize((
+                "point",
+                p.kind.as_str(),
                 p.u,
-                p.discontinuous.map(|b| b.to_string()).unwrap_or_default(),
-                opt(p.omega),
-                opt(p.frequency),
-                opt(p.period),
-                opt(p.residual),
-                p.detail.replace('"', "'")
-            )?;
+                p.discontinuous,
+                p.omega,
+                p.frequency,
+                p.period,
+                p.residual,
+                &p.detail,
+            ))?;
         }
+        c.flush()?;
         Ok(())
     }
 

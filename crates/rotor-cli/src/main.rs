@@ -1,6 +1,5 @@
 //! `rotor`: the command-line front end (contract: DESIGN.md §4).
 
-use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
@@ -29,7 +28,7 @@ enum Command {
         /// Output interval [s] (rows at 0, dt, 2dt, ..., t_end).
         #[arg(long, default_value_t = 0.01, allow_hyphen_values = true)]
         dt: f64,
-        /// Output CSV file.
+        /// Output CSV file (`-`: standard output).
         #[arg(long)]
         csv: PathBuf,
     },
@@ -50,13 +49,14 @@ enum Command {
         /// Upper end of the input range [V] (at most 1000).
         #[arg(long, default_value_t = 7.0, allow_hyphen_values = true)]
         u_max: f64,
-        /// Output JSON file (equilibria, periodic, points).
+        /// Output JSON file (equilibria, periodic, points; `-`: standard output).
         #[arg(long)]
         json: PathBuf,
-        /// Output SVG figure (max/min of omega_l against u, like the source's Figure 3).
+        /// Output SVG figure (max/min of omega_l against u, like the source's Figure 3;
+        /// `-`: standard output).
         #[arg(long)]
         svg: Option<PathBuf>,
-        /// Output CSV of every branch point.
+        /// Output CSV of every branch point (`-`: standard output).
         #[arg(long)]
         csv: Option<PathBuf>,
     },
@@ -64,13 +64,13 @@ enum Command {
     /// against a tight reference, median run time, counters; peers (scipy, Siconos) side by
     /// side when installed. Prints a table.
     Bench {
-        /// Output JSON file.
+        /// Output JSON file (`-`: standard output).
         #[arg(long)]
         json: Option<PathBuf>,
-        /// Output SVG work-precision plot (error against run time, log-log).
+        /// Output SVG work-precision plot (error against run time, log-log; `-`: stdout).
         #[arg(long)]
         svg: Option<PathBuf>,
-        /// Output CSV file.
+        /// Output CSV file (`-`: standard output).
         #[arg(long)]
         csv: Option<PathBuf>,
         /// A short ladder over a 30 s horizon without peers (seconds instead of a minute).
@@ -123,6 +123,16 @@ fn kind_by_name(name: &str) -> Result<SolverKind> {
             "--solver {name:?}: unknown solver (expected one of: {})",
             rotor_compare::SOLVERS.map(SolverKind::name).join(", ")
         ),
+    }
+}
+
+/// Prints a command's summary: on standard output, unless one of its outputs goes there
+/// (`-`), then on standard error.
+fn say<const N: usize>(text: &str, outputs: [Option<&Path>; N]) {
+    if outputs.iter().flatten().any(|p| p.as_os_str() == "-") {
+        eprint!("{text}");
+    } else {
+        print!("{text}");
     }
 }
 
@@ -226,33 +236,11 @@ fn simulate(common: &Common, t_end: f64, dt: f64, csv_path: &Path) -> Result<()>
         .simulate_finite(&model, &scene)
         .with_context(|| format!("solver {}", solver.name()))?;
     warn_inexact(&traj.stats);
-    let mut buf = Vec::with_capacity(traj.samples.len() * 64);
-    writeln!(buf, "t,alpha,omega_u,omega_l")?;
-    let digits = time_digits(dt);
-    for s in &traj.samples {
-        let t = round_to(s.t, digits);
-        writeln!(buf, "{t},{},{},{}", s.x[0], s.x[1], s.x[2])?;
-    }
-    rotor_compare::report::write_atomic(csv_path, &buf)
-        .with_context(|| format!("{}: cannot write", csv_path.display()))?;
+    rotor_compare::report::write_output_with(csv_path, |w| {
+        rotor_compare::trace::write_trace_to(w, &traj.samples, dt)
+    })
+    .with_context(|| format!("{}: cannot write", csv_path.display()))?;
     Ok(())
-}
-
-/// Decimals that print a grid time `k·dt` without its binary noise: six past the first
-/// significant digit of dt (the grid's times are k·dt within an ulp, so the printed time is
-/// within 1e-6 dt of the time the state was taken at).
-fn time_digits(dt: f64) -> i32 {
-    (6.0 - dt.log10().floor()).clamp(0.0, 300.0) as i32
-}
-
-/// `t` rounded to `digits` decimals: `3 × 0.3 = 0.8999999999999999` prints as `0.9`.
-/// (Division of an integer-valued float by a power of ten is correctly rounded, so the
-/// result is the float nearest the decimal, which prints as that decimal. Where t·10^digits
-/// exceeds 2^53 the value is already an integer multiple of the spacing and stays.)
-fn round_to(t: f64, digits: i32) -> f64 {
-    let scale = 10f64.powi(digits);
-    let r = (t * scale).round() / scale;
-    if r.is_finite() { r } else { t }
 }
 
 fn steady(common: &Common) -> Result<()> {
@@ -303,7 +291,7 @@ fn bifurcation(
     svg: Option<&Path>,
     csv: Option<&Path>,
 ) -> Result<()> {
-    use rotor_compare::report::write_atomic;
+    use rotor_compare::report::write_output;
     let model = load_model(params)?;
     let opts = rotor_bifurcation::DiagramOptions {
         u_min,
@@ -320,30 +308,31 @@ fn bifurcation(
         )
     })?;
     let d = rotor_bifurcation::diagram(&model, &opts)?;
-    write_atomic(json, d.to_json()?.as_bytes())
+    write_output(json, d.to_json()?.as_bytes())
         .with_context(|| format!("{}: cannot write", json.display()))?;
     if let Some(path) = csv {
         let mut buf = Vec::new();
         d.write_csv(&mut buf)?;
-        write_atomic(path, &buf).with_context(|| format!("{}: cannot write", path.display()))?;
+        write_output(path, &buf).with_context(|| format!("{}: cannot write", path.display()))?;
     }
     if let Some(path) = svg {
         let name = params.map_or("Table 1".to_owned(), |p| p.display().to_string());
-        write_atomic(
+        write_output(
             path,
             d.to_svg(&format!("Bifurcation diagram: {name}")).as_bytes(),
         )
         .with_context(|| format!("{}: cannot write", path.display()))?;
     }
-    println!(
-        "{} equilibria, {} periodic orbits, {} special points",
+    let mut summary = format!(
+        "{} equilibria, {} periodic orbits, {} special points\n",
         d.equilibria.len(),
         d.periodic.len(),
         d.points.len()
     );
     for p in &d.points {
-        println!("  {}", serde_json::to_string(p)?);
+        summary += &format!("  {}\n", serde_json::to_string(p)?);
     }
+    say(&summary, [Some(json), csv, svg]);
     Ok(())
 }
 
@@ -354,7 +343,7 @@ fn bench(
     quick: bool,
     no_peers: bool,
 ) -> Result<()> {
-    use rotor_compare::report::write_atomic;
+    use rotor_compare::report::write_output;
     let mut opts = if quick {
         rotor_bench::BenchOptions::quick()
     } else {
@@ -365,14 +354,14 @@ fn bench(
         opts.peers.siconos = false;
     }
     let report = rotor_bench::run(&opts, |m| eprintln!("{m}"))?;
-    print!("{}", report.table());
+    say(&report.table(), [json, svg, csv]);
     for (path, text) in [
         (json, report.to_json()?),
         (svg, report.to_svg()?),
         (csv, report.to_csv()?),
     ] {
         if let Some(path) = path {
-            write_atomic(path, text.as_bytes())
+            write_output(path, text.as_bytes())
                 .with_context(|| format!("{}: cannot write", path.display()))?;
         }
     }

@@ -36,8 +36,8 @@ fn simulate_writes_the_contract_csv() {
         assert_eq!(lines[0], "t,alpha,omega_u,omega_l");
         // 0, 0.01, ..., 2.0: 201 rows plus the header.
         assert_eq!(lines.len(), 202, "{solver}");
-        assert!(lines[1].starts_with("0,"));
-        assert!(lines[201].starts_with("2,"));
+        assert!(lines[1].starts_with("0.0,"));
+        assert!(lines[201].starts_with("2.0,"));
         // Every time prints as the decimal k/100 (k·0.01 is 0.35000000000000003 at k = 35,
         // and 24 of the 201 grid times carry such noise).
         for (k, l) in lines[1..].iter().enumerate() {
@@ -45,7 +45,14 @@ fn simulate_writes_the_contract_csv() {
             assert_eq!(t.parse::<f64>().unwrap(), k as f64 / 100.0, "{l}");
             assert!(t.len() <= 4, "{l}");
         }
+        // `--csv -` writes the same bytes to standard output.
+        let o = rotor(&[
+            "simulate", "--solver", solver, "--u", "1.5", "--t-end", "2", "--csv", "-",
+        ]);
+        assert!(o.status.success());
+        assert_eq!(String::from_utf8(o.stdout).unwrap(), text, "{solver}");
     }
+    assert!(!std::path::Path::new("-").exists(), "no file named '-'");
 }
 
 /// A flag the solver does not use is a warning on stderr, and the run goes on.

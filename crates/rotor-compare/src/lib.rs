@@ -8,6 +8,7 @@ pub mod settle;
 pub mod snapshot;
 pub mod solvers;
 pub mod stress;
+pub mod trace;
 
 pub use gate::{Failure, GateResult, Measured, check_pair};
 pub use run::{RunResult, ScenarioResult, run_scenario, run_scenario_with, solver_settings};

@@ -8,6 +8,7 @@ use rotor_model::{Disc, Friction, Model, Params, Scenario, SteadyState};
 
 use crate::gate::{Failure, GateResult, check_pair};
 use crate::run::{ScenarioResult, solver_settings};
+use crate::snapshot::round_sig;
 use crate::solvers::{SolverKind, pair_name, pairs};
 use rotor_plot::{Panel, Series, render};
 
@@ -51,9 +52,37 @@ pub fn gate_scenario(r: &ScenarioResult) -> (Vec<GateResult>, Vec<Failure>) {
     (gates, fails)
 }
 
-/// Writes `bytes` to `path` through a temporary file and a rename, so an interrupted run
+/// Writes `bytes` to `path`, or to standard output if `path` is `-` (as Unix tools do);
+/// a file through [`write_atomic`].
+pub fn write_output(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
+    write_output_with(path, |w| w.write_all(bytes))
+}
+
+/// Writes what `fill` writes to `path`, or to standard output if `path` is `-`; a file
+/// atomically ([`write_atomic`]'s temporary file and rename), so that a failed `fill`
 /// leaves the previous file intact.
-pub fn write_atomic(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
+pub fn write_output_with(
+    path: &Path,
+    fill: impl FnOnce(&mut dyn std::io::Write) -> std::io::Result<()>,
+) -> std::io::Result<()> {
+    if path.as_os_str() == "-" {
+        let mut out = std::io::stdout().lock();
+        fill(&mut out)?;
+        return out.flush();
+    }
+    let tmp = temporary_for(path)?;
+    let res = std::fs::File::create(&tmp).and_then(|mut f| fill(&mut f));
+    match res {
+        Ok(()) => std::fs::rename(&tmp, path),
+        Err(e) => {
+            let _ = std::fs::remove_file(&tmp);
+            Err(e)
+        }
+    }
+}
+
+/// The temporary file next to `path` that [`write_atomic`] renames onto it.
+fn temporary_for(path: &Path) -> std::io::Result<std::path::PathBuf> {
     let dir = match path.parent() {
         Some(d) if !d.as_os_str().is_empty() => d,
         _ => Path::new("."),
@@ -64,14 +93,21 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
             format!("{}: not a file path", path.display()),
         )
     })?;
-    let tmp = dir.join(format!(
+    Ok(dir.join(format!(
         ".{}.tmp{}",
         name.to_string_lossy(),
         std::process::id()
-    ));
+    )))
+}
+
+/// Writes `bytes` to `path` through a temporary file and a rename, so an interrupted run
+/// leaves the previous file intact: a reader sees the old file or the whole new one, never a
+/// part. (Not `fsync`ed: the guarantee is against an interrupted or failed run, not a power
+/// cut, and a sync costs about a millisecond per file here, more than a whole solve.)
+pub fn write_atomic(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
+    let tmp = temporary_for(path)?;
     let mut f = std::fs::File::create(&tmp)?;
     f.write_all(bytes)?;
-    f.sync_all()?;
     drop(f);
     std::fs::rename(&tmp, path)
 }
@@ -81,35 +117,43 @@ fn label(kind: SolverKind, sc: &Scenario) -> String {
     kind.label_at(if kind.is_fixed_step() { h } else { tol })
 }
 
-/// Per-scenario CSV: `t` and ω_u, ω_l of each solver on the comparison grid (12 significant
-/// digits: far below every gate's tolerance).
+/// Per-scenario CSV: `t` and ω_u, ω_l of each solver on the comparison grid, each value to
+/// 12 significant digits (far below every gate's tolerance, so the committed report moves
+/// only where an answer does).
 pub fn scenario_csv(r: &ScenarioResult) -> String {
-    let mut s = String::from("t");
     let kinds: Vec<SolverKind> = r
         .runs
         .iter()
         .map(|run| run.kind)
         .filter(|k| r.traj(*k).is_some())
         .collect();
+    let mut w = csv::Writer::from_writer(Vec::new());
+    let mut header = vec!["t".to_string()];
     for k in &kinds {
-        let _ = write!(s, ",omega_u_{0},omega_l_{0}", k.name());
+        header.push(format!("omega_u_{}", k.name()));
+        header.push(format!("omega_l_{}", k.name()));
     }
-    s.push('\n');
+    // Writing to memory cannot fail.
+    w.write_record(&header).expect("in memory");
     let n = kinds
         .iter()
         .map(|k| r.traj(*k).map_or(0, |t| t.samples.len()))
         .min()
         .unwrap_or(0);
+    let digits = crate::trace::time_digits(r.scenario.compare.dt);
+    let mut row: Vec<f64> = Vec::with_capacity(1 + 2 * kinds.len());
     for i in 0..n {
+        row.clear();
         let t = r.traj(kinds[0]).map_or(0.0, |tr| tr.samples[i].t);
-        let _ = write!(s, "{t}");
+        row.push(crate::trace::round_to(t, digits));
         for k in &kinds {
             let x = r.traj(*k).map(|tr| tr.samples[i].x).unwrap_or_default();
-            let _ = write!(s, ",{:.12e},{:.12e}", x[1], x[2]);
+            row.push(round_sig(x[1], 12, 0.0));
+            row.push(round_sig(x[2], 12, 0.0));
         }
-        s.push('\n');
+        w.serialize(&row).expect("in memory");
     }
-    s
+    String::from_utf8(w.into_inner().expect("in memory")).expect("ASCII")
 }
 
 /// Per-scenario SVG: ω_u and ω_l of every solver overlaid (the source's Figs. 4–7).

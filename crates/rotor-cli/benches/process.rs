@@ -1,0 +1,91 @@
+//! The whole `rotor simulate` process against its in-process solve, side by side in one run
+//! (a benchmark, not a test: these machines' timings move by ±15 %).
+//!
+//! ```sh
+//! cargo bench -p rotor-cli --bench process
+//! ```
+//!
+//! Scene: Table 1, u = 1.5 V from rest, 100 s, event-driven solver at tol 1e-12, the 0.01 s
+//! trace (10 001 rows) written as CSV. Medians of 41 runs each:
+//! * the solve in process (`EventSolver::simulate_finite`, the trace kept);
+//! * the solve plus writing the CSV file in process (what the process does besides starting);
+//! * the whole process, `rotor simulate ... --csv FILE`, spawned and waited for;
+//! * an empty process, `rotor --version`: start-up and exit alone.
+
+use std::path::Path;
+use std::process::{Command, Stdio};
+use std::time::Instant;
+
+use rotor_model::{Model, Output, Scene, Solver};
+
+fn median(mut v: Vec<f64>) -> f64 {
+    v.sort_by(f64::total_cmp);
+    v[v.len() / 2]
+}
+
+fn time(n: usize, mut f: impl FnMut()) -> f64 {
+    f();
+    median(
+        (0..n)
+            .map(|_| {
+                let t0 = Instant::now();
+                f();
+                t0.elapsed().as_secs_f64()
+            })
+            .collect(),
+    )
+}
+
+fn main() {
+    let n = 41;
+    let dir = std::env::temp_dir().join(format!("rotor-process-bench-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let csv = dir.join("x.csv");
+    let model = Model::table1();
+    let scene = Scene {
+        u: 1.5,
+        t_end: 100.0,
+        tol: 1e-12,
+        output: Output::Grid { dt: 0.01 },
+        ..Scene::default()
+    };
+    let solver = rotor_event::EventSolver::default();
+    let solve = time(n, || {
+        std::hint::black_box(solver.simulate_finite(&model, &scene).unwrap());
+    });
+    let solve_write = time(n, || {
+        let tr = solver.simulate_finite(&model, &scene).unwrap();
+        rotor_compare::report::write_output_with(&csv, |w| {
+            rotor_compare::trace::write_trace_to(w, &tr.samples, 0.01)
+        })
+        .unwrap();
+    });
+    let bin = Path::new(env!("CARGO_BIN_EXE_rotor"));
+    let run = |args: &[&str]| {
+        let st = Command::new(bin)
+            .args(args)
+            .stdout(Stdio::null())
+            .status()
+            .unwrap();
+        assert!(st.success());
+    };
+    let c = csv.to_str().unwrap();
+    let args = [
+        "simulate", "--solver", "event", "--u", "1.5", "--t-end", "100", "--tol", "1e-12", "--csv",
+        c,
+    ];
+    let whole = time(n, || run(&args));
+    let empty = time(n, || run(&["--version"]));
+    let ms = |s: f64| s * 1e3;
+    println!("rotor simulate --solver event --u 1.5 --t-end 100 --tol 1e-12 --csv FILE");
+    println!("  in-process solve             {:7.3} ms", ms(solve));
+    println!("  in-process solve + CSV file  {:7.3} ms", ms(solve_write));
+    println!("  whole process                {:7.3} ms", ms(whole));
+    println!("  empty process (--version)    {:7.3} ms", ms(empty));
+    println!("  whole / solve                {:7.2}", whole / solve);
+    println!(
+        "  (whole - empty) / solve      {:7.2}",
+        (whole - empty) / solve
+    );
+    std::fs::remove_dir_all(&dir).ok();
+}
