@@ -1,4 +1,4 @@
-//! Work-precision benchmark of the three rotor solvers (issue #7).
+//! Work-precision benchmark of the rotor solvers.
 //!
 //! [`run`] takes [`BenchOptions`] and returns a [`BenchReport`]:
 //!

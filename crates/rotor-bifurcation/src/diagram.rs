@@ -161,7 +161,7 @@ pub struct PeriodicRow {
     pub section_state: [f64; 3],
 }
 
-/// The bifurcation diagram (DESIGN.md §4).
+/// The bifurcation diagram (the JSON of `rotor bifurcation`, docs/design.md).
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Diagram {
     pub equilibria: Vec<EquilibriumRow>,

@@ -19,16 +19,10 @@
 //!   orbits (`min ω_l = 0` of the slipping cycle, a 2×2 Newton solve, [`grazing`]) and
 //!   discontinuous folds (a grazing orbit where the branch turns back in u: point E).
 //!
-//! [`diagram`] assembles everything into a [`Diagram`], which writes JSON (the CLI contract,
-//! the CLI contract), CSV and an SVG figure ([`Diagram::to_svg`]).
+//! [`diagram`] assembles everything into a [`Diagram`], which writes JSON (the CLI's contract), CSV and an SVG figure ([`Diagram::to_svg`]).
 //!
-//! # Cost
-//!
-//! The whole diagram over 0–7 V with the default options (200 equilibria; each periodic
-//! branch at arclength steps ≤ 7/200, about 500 orbits with their monodromy matrices; every
-//! special point located) takes 1.1 s for the Table 1 set and 1.6 s for the Stribeck set
-//! (criterion medians, `cargo bench -p rotor-bifurcation`, benches/diagram.rs; release build,
-//! one thread, on a 2-core machine shared with other jobs while measured).
+//! Its cost is benchmarked by `cargo bench -p rotor-bifurcation` (`benches/diagram.rs`);
+//! the measurements are in `reports/measurements.md`.
 
 pub mod continuation;
 mod diagram;

@@ -67,7 +67,7 @@ impl Diagram {
         }
     }
 
-    /// The diagram as pretty JSON (DESIGN.md §4): `{"equilibria": [{"u", "omega", "alpha",
+    /// The diagram as pretty JSON (the CLI contract, docs/design.md): `{"equilibria": [{"u", "omega", "alpha",
     /// "stable", ...}], "periodic": [{"u", "period", "omega_l_max", "omega_l_min", "stable",
     /// "multipliers": [[re, im]...], ...}], "points": [{"kind", "u", ...}]}`. A non-finite
     /// number is an error (JSON has none; serde would write `null`).

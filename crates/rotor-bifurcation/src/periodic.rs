@@ -9,11 +9,14 @@
 //! * **Stick exit** of the lower disc: there `ω_l = 0` and `k_θ α = T_sl` (the upper end of
 //!   the stick interval) exactly, so the map is 1-D in ω_u: `w ↦ P(w)`, ω_u at the next exit.
 //!
-//! Floquet multipliers. For a stick-slip cycle the 3-D monodromy has one multiplier exactly 0
-//! (the stick phase collapses α and ω_l onto the exit point) and one exactly 1 (time
-//! shift); the third is `λ = P'(w*)`, taken by a central difference
-//! `(P(w*+h) − P(w*−h)) / 2h`. For a slipping cycle the multipliers are `1` and the two
-//! eigenvalues of `DP_c(z*)`, also by central differences.
+//! Floquet multipliers come from the monodromy matrix of the variational equations with a
+//! saltation matrix at every switching event ([`crate::monodromy`]; the continuation's
+//! default). For a stick-slip cycle the 3-D monodromy has one multiplier exactly 0 (the
+//! stick phase collapses α and ω_l onto the exit point) and one exactly 1 (time shift); the
+//! third is `λ = P'(w*)`. For a slipping cycle the multipliers are `1` and the two
+//! eigenvalues of `DP_c(z*)`. Central differences of the return maps (`(P(w*+h) −
+//! P(w*−h)) / 2h`) remain as an independent check
+//! ([`crate::continuation::Multipliers::FiniteDifference`]).
 
 use nalgebra::{Complex, Matrix2, Matrix3, Vector2, Vector3};
 use rotor_event::{FlowEnd, StopAt, flow};

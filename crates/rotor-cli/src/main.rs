@@ -1,4 +1,4 @@
-//! `rotor`: the command-line front end (contract: DESIGN.md §4).
+//! `rotor`: the command-line front end (its contract: docs/design.md, "The CLI").
 
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -391,9 +391,9 @@ fn bifurcation_section(sets: &[(&str, &str, Params)]) -> Result<rotor_compare::r
         })
         .collect::<Vec<_>>();
     let mut sec = rotor_compare::report::Section::default();
-    let md = &mut sec.markdown;
-    md.push_str("## Bifurcation diagrams (the source's Figure 3)\n\n");
-    md.push_str(
+    sec.markdown
+        .push_str("## Bifurcation diagrams (the source's Figure 3)\n\n");
+    sec.markdown.push_str(
         "Computed by `rotor bifurcation` (crate `rotor-bifurcation`): the equilibrium branch with \
          its eigenvalues, periodic orbits by shooting with the exact Filippov flow, Floquet \
          multipliers from the monodromy matrix with saltation matrices, pseudo-arclength \
@@ -403,9 +403,14 @@ fn bifurcation_section(sets: &[(&str, &str, Params)]) -> Result<rotor_compare::r
     for ((name, slug, _), (d, secs)) in sets.iter().zip(diagrams) {
         let d = d.with_context(|| format!("bifurcation diagram of the {name} set"))?;
         let _ = write!(
+            sec.timings,
+            "\n## Bifurcation diagram, {name}\n\nComputed in {secs:.2} s.\n"
+        );
+        let md = &mut sec.markdown;
+        let _ = write!(
             md,
             "\n### {name}\n\n![bifurcation diagram, {name}](bifurcation-{slug}.svg)\n\n\
-             {} equilibria, {} periodic orbits, computed in {secs:.1} s \
+             {} equilibria, {} periodic orbits \
              ([JSON](bifurcation-{slug}.json), [CSV](bifurcation-{slug}.csv)).\n\n\
              | point | u [V] | residual | detail |\n|---|---|---|---|\n",
             d.equilibria.len(),
@@ -462,6 +467,10 @@ fn stress_section() -> rotor_compare::report::Section {
             stress::stress_table_markdown(&rows)
         ),
         files: Vec::new(),
+        timings: format!(
+            "\n## Numerical stress (fast form)\n\n{}",
+            stress::stress_timings_markdown(&rows)
+        ),
         failures: rows
             .iter()
             .filter(|r| !r.passes())
@@ -571,8 +580,9 @@ fn compare(files: &[PathBuf], report: &Path, main_job: bool) -> Result<()> {
         }
     }
     println!(
-        "{} scenarios, 3 solvers, {:.2} s wall; report in {}",
+        "{} scenarios, {} solvers, {:.2} s wall; report in {}",
         results.len(),
+        rotor_compare::SOLVERS.len(),
         wall,
         report.display()
     );

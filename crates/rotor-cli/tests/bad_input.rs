@@ -1,4 +1,4 @@
-//! Bad input through the `rotor` binary (issue #8): bad parameter files, bad scenario files
+//! Bad input through the `rotor` binary: bad parameter files, bad scenario files
 //! and bad flags each give an error on stderr that names the file or flag, the field and the
 //! value, with a non-zero exit code that is not a panic's (101) nor a signal's (an abort on a
 //! failed allocation); `rotor compare --report DIR` with a bad scenario writes nothing into

@@ -1,4 +1,4 @@
-//! The CLI contract of DESIGN.md §4: CSV format, steady JSON, and clear errors (never a panic).
+//! The CLI contract (docs/design.md): CSV format, steady JSON, and clear errors (never a panic).
 
 use std::process::Command;
 
@@ -187,4 +187,66 @@ fn bench_quick_prints_the_table_and_writes_the_plot() {
     assert!(v.is_object());
     let figure = std::fs::read_to_string(&svg).unwrap();
     assert!(figure.starts_with("<svg") && !figure.contains("NaN"));
+}
+
+/// The report of a run is the same bytes every time (its run times go to the uncommitted
+/// `timings.md`): the main job leaves `git status` clean unless a result changed.
+#[test]
+fn a_report_written_twice_is_the_same_bytes() {
+    let fixtures =
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../fixtures/scenarios");
+    let base = std::env::temp_dir().join(format!("rotor-cli-report-twice-{}", std::process::id()));
+    let read = |dir: &std::path::Path| {
+        let mut v: Vec<(String, Vec<u8>)> = std::fs::read_dir(dir)
+            .unwrap()
+            .map(|e| e.unwrap())
+            .map(|e| {
+                (
+                    e.file_name().into_string().unwrap(),
+                    std::fs::read(e.path()).unwrap(),
+                )
+            })
+            .collect();
+        v.sort();
+        v
+    };
+    let mut runs = Vec::new();
+    for k in 0..2 {
+        let dir = base.join(k.to_string());
+        let o = rotor(&[
+            "compare",
+            fixtures.join("t1-u1.5-rest.toml").to_str().unwrap(),
+            fixtures.join("st-u0.05-rest.toml").to_str().unwrap(),
+            "--report",
+            dir.to_str().unwrap(),
+        ]);
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        runs.push(read(&dir));
+    }
+    let names: Vec<&str> = runs[0].iter().map(|(n, _)| n.as_str()).collect();
+    assert!(
+        names.contains(&"README.md") && names.contains(&"timings.md"),
+        "{names:?}"
+    );
+    assert!(names.contains(&"t1-u1.5-rest.csv") && names.contains(&"t1-u1.5-rest.svg"));
+    for ((na, a), (nb, b)) in runs[0].iter().zip(&runs[1]) {
+        assert_eq!(na, nb);
+        if na != "timings.md" {
+            assert!(a == b, "{na} differs between two runs");
+        }
+    }
+    let readme = String::from_utf8(
+        runs[0]
+            .iter()
+            .find(|f| f.0 == "README.md")
+            .unwrap()
+            .1
+            .clone(),
+    )
+    .unwrap();
+    assert!(
+        !readme.contains("[ms]"),
+        "no run times in the committed report"
+    );
+    std::fs::remove_dir_all(&base).ok();
 }

@@ -295,7 +295,13 @@ pub struct Section {
     /// The section's own failed checks, one line each (the run fails after the report is
     /// written, as it does for a failed agreement gate).
     pub failures: Vec<String>,
+    /// Its run times, markdown for `timings.md` (which is not committed: times change from
+    /// run to run, and the committed report must change only when a result does).
+    pub timings: String,
 }
+
+/// The file that holds the run's times beside the report (ignored by git).
+pub const TIMINGS_FILE: &str = "timings.md";
 
 /// Writes the whole report into `dir` and returns the failures.
 pub fn write_report(
@@ -309,8 +315,13 @@ pub fn write_report(
     let mut md = String::new();
     let mut all_fails = Vec::new();
     md.push_str(include_str!("report_intro.md"));
-    md.push_str("\n## Agreement and run time per scenario\n\n");
-    md.push_str("| scenario | solver | steady state (second half of the run) | steps | rejected | RHS evals | events | LCP solves / skipped | time [ms] |\n|---|---|---|---|---|---|---|---|---|\n");
+    md.push_str("\n## Agreement and work per scenario\n\n");
+    md.push_str("| scenario | solver | steady state (second half of the run) | steps | rejected | RHS evals | events | LCP solves / skipped |\n|---|---|---|---|---|---|---|---|\n");
+    let mut times = String::from(
+        "# Run times of the last report\n\nWritten by the run that wrote the report beside it, \
+         not committed (times move by ±15 % from run to run on this machine).\n\n\
+         ## Solver runs per scenario\n\n| scenario | solver | time [ms] |\n|---|---|---|\n",
+    );
     for r in results {
         for run in &r.runs {
             let (st, stats) = match &run.result {
@@ -319,7 +330,7 @@ pub fn write_report(
             };
             let _ = writeln!(
                 md,
-                "| [{}]({}.svg) | {} | {} | {} | {} | {} | {} | {} / {} | {:.1} |",
+                "| [{}]({}.svg) | {} | {} | {} | {} | {} | {} | {} / {} |",
                 r.scenario.name,
                 r.scenario.name,
                 run.kind.name(),
@@ -330,6 +341,12 @@ pub fn write_report(
                 stats.events,
                 stats.lcp_solves,
                 stats.lcp_skipped,
+            );
+            let _ = writeln!(
+                times,
+                "| {} | {} | {:.1} |",
+                r.scenario.name,
+                run.kind.name(),
                 run.seconds * 1e3
             );
         }
@@ -388,11 +405,13 @@ pub fn write_report(
     for sec in sections {
         md.push('\n');
         md.push_str(&sec.markdown);
+        times.push_str(&sec.timings);
         for (name, bytes) in &sec.files {
             write_atomic(&dir.join(name), bytes)?;
         }
     }
     write_atomic(&dir.join("README.md"), md.as_bytes())?;
+    write_atomic(&dir.join(TIMINGS_FILE), times.as_bytes())?;
     Ok(all_fails)
 }
 

@@ -1,4 +1,4 @@
-//! Numerical stress (issue #8): the three solvers on parameter sets, inputs, horizons and
+//! Numerical stress: the three solvers on parameter sets, inputs, horizons and
 //! accuracy settings far from the fixtures.
 //!
 //! Each [`StressCase`] says what it stresses, how answers are compared ([`Measure`]) and, per
@@ -21,14 +21,7 @@
 //! [`cases`] has a fast form (short horizons, about a second in all, run by CI) and a full form
 //! (`ROTOR_STRESS=full`: the 1e5 s horizon and the whole tolerance and step ladders).
 //!
-//! **What the cases show** (full form): every run finishes with finite states; the mirror
-//! symmetry `x(−u, −x0) = −x(u, x0)` holds bit for bit in all three solvers (from rest too);
-//! over 1e5 s the period does not drift (event-driven: 3e-11 relative) and every period has
-//! the same 5 events. Two limits of Moreau–Jean: (a) it is first order across a velocity
-//! *reversal* (a spurious one-step stick: `far-from-rest`, errors 2.2e-4, 1.9e-5, 3.8e-6 at
-//! h = 1e-3, 1e-4, 1e-5), not second order as on stick-slip cycles; (b) the comparison's
-//! h = 1e-3 does not resolve a light lower disc (`J_l/b_l` = 0.3 ms): 91 % scaled difference,
-//! with 8 steps flagged in `Stats::inexact_steps`.
+//! What the cases show (both forms) is summarised in `reports/measurements.md`.
 
 use std::fmt::Write as _;
 use std::time::Instant;
@@ -639,12 +632,28 @@ impl StressRow {
     }
 }
 
+/// The run time of every row, as a Markdown table (for the uncommitted timings file).
+pub fn stress_timings_markdown(rows: &[StressRow]) -> String {
+    let mut s = String::from("| case | solver | setting | time [ms] |\n|---|---|---|---|\n");
+    for r in rows {
+        let _ = writeln!(
+            s,
+            "| {} | {} | {} | {:.1} |",
+            r.case,
+            r.solver.name(),
+            r.setting,
+            r.seconds * 1e3
+        );
+    }
+    s
+}
+
 /// The rows as a Markdown table (for the report): case, solver, setting, outcome, measured
-/// agreement against its gate and the gate's origin, run time.
+/// agreement against its gate and the gate's origin.
 pub fn stress_table_markdown(rows: &[StressRow]) -> String {
     let mut s = String::from(
-        "| case | what | solver | setting | outcome | measure | agreement | gate | margin | gate origin | | time [ms] |\n\
-         |---|---|---|---|---|---|---|---|---|---|---|---|\n",
+        "| case | what | solver | setting | outcome | measure | agreement | gate | margin | gate origin | |\n\
+         |---|---|---|---|---|---|---|---|---|---|---|\n",
     );
     let mut last_case = "";
     for r in rows {
@@ -672,7 +681,7 @@ pub fn stress_table_markdown(rows: &[StressRow]) -> String {
         let verdict = if r.passes() { "ok" } else { "**FAIL**" };
         let _ = writeln!(
             s,
-            "| {case} | {what} | {} | {} | {outcome} | {} | {} | {} | {} | {} | {verdict} | {:.1} |",
+            "| {case} | {what} | {} | {} | {outcome} | {} | {} | {} | {} | {} | {verdict} |",
             r.solver.name(),
             r.setting,
             r.measure,
@@ -690,7 +699,6 @@ pub fn stress_table_markdown(rows: &[StressRow]) -> String {
                 None => "".into(),
             },
             gate_origin(r.gate_kind),
-            r.seconds * 1e3
         );
     }
     s

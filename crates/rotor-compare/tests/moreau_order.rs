@@ -129,7 +129,7 @@ fn orders(options: MoreauOptions, label: &str) -> [(f64, f64); 2] {
 fn moreau_theta_half_implicit_level_converges_at_second_order_to_the_event_solver() {
     let r = orders(MoreauOptions::default(), "theta=1/2 implicit");
     for (p, c) in r {
-        // The bar (Siconos' MoreauJeanOSI reaches ≈ 2 here): a fitted slope ≥ 1.8
+        // The bar (Siconos' MoreauJeanOSI reaches ≈ 2 here): a fitted slope ≥ 1.8
         // over two decades excludes any first-order scheme.
         assert!(p >= 1.8, "order {p}");
         // The fixtures' event–moreau steady_rel = 3e-6 at h = 1e-3 allows C·h² ≤ 3e-6 × (period

@@ -1,4 +1,4 @@
-//! Numerical stress (issue #8). Every test name contains `stress`, so
+//! Numerical stress. Every test name contains `stress`, so
 //! `cargo test --release -p rotor-compare stress` runs them; `ROTOR_STRESS=full` selects the
 //! full form of the case list (`just stress`).
 //!

@@ -181,7 +181,7 @@ mod tests {
 
     #[test]
     fn table1_is_unstable_at_2_5_and_stable_at_6() {
-        // MODEL.md: with Table 1 the 2.5 V equilibrium is unstable (a cycle surrounds it),
+        // docs/model.md: with Table 1 the 2.5 V equilibrium is unstable (a cycle surrounds it),
         // 6 V lies above the subcritical Hopf point (stable).
         let m = Model::table1();
         let e = m.slip_equilibria(2.5);

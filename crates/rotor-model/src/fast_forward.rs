@@ -25,9 +25,8 @@
 //! solver goes back to the return it jumped from and integrates the skipped periods after all
 //! ([`Verdict::Undo`]), watching the returns again: at most [`MAX_JUMPS`] jumps per run. A
 //! false convergence (a ratio estimated from a transient cycle, a spiralling approach) costs
-//! time, never accuracy. On 213 random parameter sets near Table 1 (the generator of
-//! rotor-compare's metrics-only property test), 5 event-solver runs and 2 switch-model runs
-//! undid their first jump; none of Moreau–Jean's.
+//! time, never accuracy. How often it undoes is in
+//! `reports/measurements.md`.
 //!
 //! **What it changes.** The metrics (period, extremes, stick time) are invariant under the
 //! shift; the skip moves them by the convergence bound, ≤ one tolerance, and the integration

@@ -1,6 +1,6 @@
 //! The two-disc rotor benchmark model (drill-string set-up) with set-valued friction.
 //!
-//! See `../shared/MODEL.md`: state `x = [α, ω_u, ω_l]`, equations
+//! See docs/model.md: state `x = [α, ω_u, ω_l]`, equations
 //! `α̇ = ω_u − ω_l`, `J_u ω̇_u = k_m u − k_θ α − T_fu(ω_u)`, `J_l ω̇_l = k_θ α − T_fl(ω_l)`.
 //!
 //! This crate is shared by all solvers and holds no integration code.

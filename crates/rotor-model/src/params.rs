@@ -67,7 +67,7 @@ pub struct UpperFriction {
     pub db: f64,
 }
 
-/// Friction law of the lower disc: one of the two families of MODEL.md.
+/// Friction law of the lower disc: one of the two families of docs/model.md.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 #[serde(tag = "family", rename_all = "lowercase")]
 pub enum LowerFriction {

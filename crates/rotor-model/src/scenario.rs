@@ -1,4 +1,4 @@
-//! Scenario files: one scene, run by all three solvers (DESIGN.md §3).
+//! Scenario files: one scene, run by every solver (docs/design.md, "Fixtures").
 //!
 //! ```toml
 //! name = "t1-u1.5-rest"

@@ -10,7 +10,7 @@ use serde::Serialize;
 use crate::dynamics::{Disc, OMEGA_L, OMEGA_U, State};
 use crate::scene::{Event, EventKind};
 
-/// The steady state as `rotor steady` prints it (DESIGN.md §4).
+/// The steady state as `rotor steady` prints it (docs/design.md, "The CLI").
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 #[serde(tag = "kind", rename_all = "snake_case")]
 pub enum SteadyState {

@@ -1,4 +1,4 @@
-//! Bad parameter and scenario files (issue #8): every kind of bad input is an error, never a
+//! Bad parameter and scenario files: every kind of bad input is an error, never a
 //! panic, and its message is one line that names the file, the field and the offending value.
 //!
 //! Each case is a mutation of a real fixture file, written to a temporary directory and read

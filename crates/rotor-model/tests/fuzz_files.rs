@@ -1,4 +1,4 @@
-//! Malformed and random fixture text (issue #8): mutations of the real parameter and scenario
+//! Malformed and random fixture text: mutations of the real parameter and scenario
 //! files (deleted, duplicated and swapped lines, swapped values, random TOML values, random
 //! bytes, truncation). Reading a mutant never panics; it gives either an admissible parameter
 //! set / scenario, or an error whose message is one line and names the file.

@@ -68,36 +68,17 @@
 //! (a failed check falls back to the enumeration). Counted in [`Stats::lcp_skipped`]
 //! (vs [`Stats::lcp_solves`]).
 //!
-//! # Orders measured (`rotor-compare/tests/moreau_order.rs`)
+//! # Order
 //!
-//! Against the event-driven solver (tol = 1e-13, its own error ≤ 1e-11) on Table 1,
-//! u = 1.5 V from rest, 60 s, metrics over [30, 60] s (period 4.5778 s, max ω_l 6.3361 rad/s):
-//! the errors `e(h) = |m(h) − m_event|` for h = 1e-2, 3e-3, 1e-3, 3e-4, 1e-4, fitted as
-//! `e ≈ C·h^p`:
-//!
-//! | scheme | period: p, C (s) | max ω_l: p, C (rad/s) | period e(1e-2), e(1e-3), e(1e-4) |
-//! |---|---|---|---|
-//! | θ = 1/2, implicit level (default) | 1.99, 0.57 | 2.01, 0.65 | 6.2e-5, 5.7e-7, 6.3e-9 |
-//! | θ = 1/2, explicit level | 1.00, 0.62 | 1.00, 0.65 | 6.2e-3, 6.1e-4, 6.1e-5 |
-//! | θ = 1, implicit level | 1.00, 3.3 | 1.00, 7.3 | 3.4e-2, 3.4e-3, 3.4e-4 |
-//!
-//! Pointwise, `e/h²` of the default's period lies in 0.57–0.64. Below h = 1e-4 the error
-//! meets the scheme's rounding noise: at h = 1e-5 (6·10⁶ steps, e ≈ 6e-11) two runs whose
-//! steps differ by one part in 10⁹ differ in the metrics by up to 5e-11, so h = 1e-5 is no
-//! fit point.
-//!
-//! The default matches the second-order behaviour measured with Siconos 4.4's
-//! `MoreauJeanOSI` on this model (6e-5, 8e-7, 1e-8). Friction events keep the velocity
-//! continuous (no impacts), so the O(h²) local error of a step containing a stick onset or
-//! exit does not spoil the global order. **Not across a velocity reversal:** a disc whose
-//! velocity passes through zero without sticking is held at rest for the one step that
-//! contains the reversal (reported as a Reversal, see below), a local
-//! error O(h) that makes the global error first order (measured by rotor-compare's stress
-//! case "far from rest": 2.2e-4, 1.9e-5, 3.8e-6 rad/s at h = 1e-3, 1e-4, 1e-5). No fixture
-//! scenario has a reversal; the second order above holds on stick-slip and slipping cycles.
-//! Cost: about 0.14 µs per step (h = 1e-3, 100 s: 1e5 steps in 13.6 ms on one core,
-//! `rotor bench`), ≈ 1.8 Newton iterations and 1.8 evaluations of the lower disc's friction
-//! law per step, and about 80 % of the steps skip the enumeration.
+//! With the default (θ = 1/2, implicit level) the scheme is second order on stick-slip and
+//! slipping cycles: friction events keep the velocity continuous (no impacts), so the O(h²)
+//! local error of a step containing a stick onset or exit does not spoil the global order.
+//! The explicit level and θ = 1 are first order. **Not across a velocity reversal:** a disc
+//! whose velocity passes through zero without sticking is held at rest for the one step that
+//! contains the reversal (reported as a Reversal, see below), a local error O(h) that makes
+//! the global error first order. The measured orders and constants, and the cost per step,
+//! are in `reports/measurements.md` (measured by `rotor-compare/tests/moreau_order.rs` and
+//! the stress case "far from rest").
 //!
 //! **Very large steps.** Up to h = 0.25 s every step problem of the fixtures is solved
 //! exactly. At h = 0.5 s a level falling faster than `M̂` can absorb (`θh|N'| > J_l`) makes
@@ -118,8 +99,9 @@
 //!   leaves the cone — by linear interpolation (or extrapolation, by at most one step) of the
 //!   excess between the two step ends: O(h²).
 //! * `StickStart(d)`: a slipping disc ends the step stuck. Located at the zero of the
-//!   velocity's first-order Taylor expansion from the last slipping step end, with the
-//!   model's acceleration there ([`rotor_model::Model::disc_accel`]), clamped to the step: O(h²).
+//!   velocity's second-order Taylor expansion `ω + aΔ + ½jΔ²` from the last slipping step
+//!   end, with the acceleration `a` and its rate `j = ω̈` from the model's vector field and
+//!   Jacobian in the slipping mode, clamped to the step: O(h²) or better.
 //! * `Reversal(d)`: the velocity changes sign without sticking; linear interpolation: O(h²).
 //!   A disc held at rest for exactly one step between slips of opposite sign also reverses
 //!   (at the scheme's resolution): its stick onset is withdrawn and a Reversal is reported at

@@ -1,7 +1,7 @@
 //! Dormand–Prince 5(4) with Hairer's step-size control and Shampine's dense output.
 //!
 //! Written after the description of `dopri5.f` in Hairer, Nørsett & Wanner, *Solving
-//! Ordinary Differential Equations I*, 2nd ed., §II.4–II.6 (see `ECOSYSTEM.md` §2a for why we
+//! Ordinary Differential Equations I*, 2nd ed., §II.4–II.6 (see docs/design.md, "Independent solvers", for why we
 //! do not use a crate). One step from `(t, y)` with step `h`:
 //!
 //! ```text

@@ -1,4 +1,4 @@
-//! Leine's switch-model solver for the two-disc rotor (`../shared/METHODS.md` §1.1;
+//! Leine's switch-model solver for the two-disc rotor (docs/methods.md;
 //! Leine, van Campen, de Kraker & van den Steen, *Nonlinear Dyn.* 16 (1998);
 //! Leine & Nijmeijer, LNACM 18 (2004)).
 //!

@@ -18,14 +18,11 @@ const EXTREMUM_RESOLUTION: f64 = 10.0;
 pub struct SwitchOptions {
     /// Half-width η of the stick band `|ω| ≤ η` [rad/s]; 0 gives the exact Filippov solution.
     ///
-    /// Default `1e-7`, from the η study in this crate's tests (`tests/switch.rs`,
-    /// `eta_convergence_study` and `default_eta_meets_the_metric_target`): on Table 1 at
-    /// u = 1.5 V from rest, tol = 1e-10, the steady-state metrics differ from the η = 0 run
-    /// (exact Filippov solution) by: stick time ≈ 0.22·η relative (order 1.00: the stick onset
-    /// is located at ω_l = η, η/|ω̇_l| early), ω_l max ≈ 1e-3·η^1.5 (order 1.50), period
-    /// ≤ 8e-6·η. The worst case seen is the short stick phase at u = 4.5 V (≈ 5·η relative).
-    /// `1e-7` keeps every metric within ≈ 5e-7 relative, 20× inside the 1e-5 target, at no
-    /// measurable cost (the band only moves the located switches).
+    /// Default `1e-7`: the stick onset is located at `ω_l = η`, `η/|ω̇_l|` early, so the
+    /// metrics differ from the exact Filippov solution (η = 0) by O(η) (stick time) or less;
+    /// 1e-7 keeps every steady metric within ≈ 5e-7 relative at no measurable cost. The η
+    /// study is `tests/switch.rs` (`eta_convergence_study`); its numbers are in
+    /// `reports/measurements.md`.
     pub eta: f64,
     /// Largest number of step attempts.
     pub max_steps: u64,

@@ -1,4 +1,4 @@
-//! Test support for the bad-input tests (issue #8) of `rotor-model` (through `from_file`) and
+//! Test support for the bad-input tests of `rotor-model` (through `from_file`) and
 //! `rotor-cli` (through the `rotor` binary).
 //!
 //! Both test the same bad files; this crate holds them once, so that the library and the

@@ -32,7 +32,7 @@ fn hopf_points_are_roots_and_bracketed_by_simulation() {
         let r = complex_pair(&m, w + 1e-9).unwrap().re;
         assert!(l * r < 0.0, "{l:e} {r:e}");
     }
-    // Independently simulated facts (rotor-event, MODEL.md): stable equilibrium at 0.3 V,
+    // Independently simulated facts (rotor-event; docs/model.md): stable equilibrium at 0.3 V,
     // slipping cycle at 0.5 V; equilibrium unstable at 2.5 V and stable at 4.5 V (bistable)
     // and 6.0 V. So the second (subcritical) Hopf point lies in (2.5, 4.5); what lies in
     // (4.5, 6.0) is the fold E (checked in `table1_diagram_structure`).

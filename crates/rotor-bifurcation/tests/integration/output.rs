@@ -1,4 +1,4 @@
-//! What the CLI writes: the JSON contract (DESIGN.md §4), the CSV, the SVG figure, and the
+//! What the CLI writes: the JSON contract (docs/design.md), the CSV, the SVG figure, and the
 //! option checks.
 
 use rotor_bifurcation::{BifError, Diagram, DiagramOptions, diagram};

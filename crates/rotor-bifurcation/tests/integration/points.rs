@@ -12,7 +12,7 @@ use rotor_model::Model;
 
 use crate::common::{cont_options, model, points, st_diagram, t1_diagram};
 
-/// The goal of the issue: every special point to 1e-8 V.
+/// The accuracy asked of every special point: 1e-8 V.
 const GOAL: f64 = 1e-8;
 
 #[test]
