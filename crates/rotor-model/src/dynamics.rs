@@ -120,8 +120,8 @@ impl Model {
     pub fn new(params: Params) -> Model {
         Model {
             params,
-            upper: Friction::Upper(params.upper),
-            lower: Friction::Lower(params.lower),
+            upper: Friction::upper(params.upper),
+            lower: Friction::lower(params.lower),
         }
     }
 

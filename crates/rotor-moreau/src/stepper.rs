@@ -178,18 +178,14 @@ impl Stepper {
     /// [`rotor_model::Lagrangian`].
     pub fn new(model: &Model, u: f64, options: &MoreauOptions) -> Stepper {
         let l = rotor_model::Lagrangian::new(model);
-        let db_u = match model.friction(Disc::Upper) {
-            Friction::Upper(p) => p.db,
-            Friction::Lower(_) => 0.0,
-        };
+        let db_u = model.friction(Disc::Upper).as_upper().map_or(0.0, |p| p.db);
         Stepper {
             theta: options.theta,
             level: options.friction_level,
             max_newton: options.max_newton,
             skip_free: options.skip_free_steps,
             estimate_stop: options.newton_estimate_stop,
-            affine_law: [Disc::Upper, Disc::Lower]
-                .map(|d| matches!(model.friction(d), Friction::Upper(_))),
+            affine_law: [Disc::Upper, Disc::Lower].map(|d| model.friction(d).as_upper().is_some()),
             j: [l.m[(0, 0)], l.m[(1, 1)]],
             c: [l.c[(0, 0)], l.c[(1, 1)]],
             k: l.k[(0, 0)],
