@@ -1,8 +1,8 @@
 #!/usr/bin/env python3
-"""The rotorbench rotor model in plain scipy: a peer for `rotor-bench` (issue #7).
+"""The rotorbench rotor model in plain scipy: a peer for `rotor-bench`.
 
 What a careful scipy user would write for the two-disc rotor with set-valued friction
-(../shared/MODEL.md): state x = [alpha, omega_u, omega_l],
+(docs/model.md): state x = [alpha, omega_u, omega_l],
 
     alpha'         = omega_u - omega_l
     J_u omega_u'   = k_m u - k_theta alpha - T_fu(omega_u)
@@ -13,7 +13,7 @@ events, switching vector fields at the events (Filippov's solution for this one 
 surface):
 
 * slip on branch s = +1 / -1 (sign of omega_l): the friction law of the branch,
-  T_fl = b_l omega + s N(s omega), with N the friction level of MODEL.md continued
+  T_fl = b_l omega + s N(s omega), with N the friction level of docs/model.md continued
   smoothly past omega = 0 so that the event function is smooth across its root;
   terminal event omega_l = 0 (direction -s);
 * at omega_l = 0: stick if |k_theta alpha| <= N(0) = T_sl (the spring torque is inside the
@@ -25,7 +25,7 @@ surface):
 
 The upper disc must be smooth (Table 1: T_su = dT_su = db_u = 0, so T_fu = b_u omega_u);
 a parameter file with upper static friction is refused (it needs a second switching surface).
-The lower disc may use either family of MODEL.md (exponential: Table 1; stribeck).
+The lower disc may use either family of docs/model.md (exponential: Table 1; stribeck).
 
 Steady-state metrics as rotor-model's MetricsAccumulator defines them: the last complete
 cycle between two successive stick exits in [metrics_from, t_end] (between omega_l maxima if
@@ -88,7 +88,7 @@ class Rotor:
     def level(self, x):
         """Friction level N(x) of the lower disc, x = s*omega (x >= 0 on the branch).
 
-        Exponential (MODEL.md): T_sl + T_1 (1 - 2/(1 + e^{w_1 x})) + T_2 (1 - 2/(1 + e^{w_2 x})),
+        Exponential (docs/model.md): T_sl + T_1 (1 - 2/(1 + e^{w_1 x})) + T_2 (1 - 2/(1 + e^{w_2 x})),
         written with 1 - 2/(1 + e^y) = tanh(y/2), which is odd in x: a smooth continuation.
         Stribeck: T_cl + (T_sl - T_cl) exp(-|x/omega_s|^delta) (even in x).
         """

@@ -1,7 +1,7 @@
 #!/usr/bin/python3
-"""The rotorbench rotor model in Siconos (MoreauJeanOSI): a peer for `rotor-bench` (issue #7).
+"""The rotorbench rotor model in Siconos (MoreauJeanOSI): a peer for `rotor-bench`.
 
-The Lagrangian form of section 3 of the source (../shared/MODEL.md; rotor-model's
+The Lagrangian form of section 3 of the source (docs/model.md; rotor-model's
 lagrangian.rs), as a Siconos user would set it up:
 
     M q'' + F_int(q, q') = F_ext + r,      q = [theta_u, theta_l, x_u, x_l]
@@ -18,7 +18,7 @@ lagrangian.rs), as a Siconos user would set it up:
   friction;
 * `MoreauJeanOSI(theta = 1/2)`, `TimeStepping` with its Newton loop (the friction level is
   implicit, inside the Newton iterations, as in rotor-moreau's default), one-step problem
-  `FrictionContact(2)` solved by `SICONOS_FRICTION_2D_LEMKE` (METHODS.md: Lemke was the clean
+  `FrictionContact(2)` solved by `SICONOS_FRICTION_2D_LEMKE` (Lemke was the clean
   one-step solver on this model; NSGS printed warnings, the 2-D enumeration gave wrong
   dynamics).
 

@@ -1,5 +1,5 @@
 /* Siconos plugin for bench/peers/siconos_rotor.py: the internal forces of the rotor's
- * Lagrangian form (../../../shared/MODEL.md, section "Lagrangian form"; rotor-model's
+ * Lagrangian form (docs/model.md, "Lagrangian form"; rotor-model's
  * lagrangian.rs) and their Jacobians, in Siconos' FPtr6 signature
  *   (time, size of q, q, v, out, size of z, z)
  * with matrices column-major. q = [theta_u, theta_l, x_u, x_l].
