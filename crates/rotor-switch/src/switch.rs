@@ -502,7 +502,9 @@ impl Run<'_> {
                 for (j, t) in sample_times(t0, t1, m).enumerate() {
                     vals[j] = (t, f.guard_value(k, g, &xs[j]));
                 }
-                let root = first_crossing(&vals[..=m], |tt| f.guard_value(k, g, &integ.dense(tt)));
+                let guard = |tt: f64| f.guard_value(k, g, &integ.dense(tt));
+                let root =
+                    first_crossing(&vals[..=m], guard).or_else(|| self.dip(k, g, &vals[..=m]));
                 if let Some(tr) = root
                     && hit.is_none_or(|h| tr < h.0)
                 {
@@ -511,6 +513,40 @@ impl Run<'_> {
             }
         }
         hit
+    }
+
+    /// A velocity guard (`s·ω − η` or `s·ω`) that dips below 0 and back between two samples,
+    /// as an orbit does that grazes the band. Without this check a tangential approach that
+    /// spends less than a sample interval inside the band (1.6e-4 s near the grazing orbit at
+    /// 4.6153 V, Table 1) passes through it unseen, with ω_l below 0 and no stick.
+    ///
+    /// Where the slope of `s·ω` on the dense output turns from negative to positive between
+    /// two samples, its minimum is located (Illinois on the slope) and the guard evaluated
+    /// there; if it is negative, its root before the minimum is the crossing. The slope is
+    /// the interpolant's derivative ([`Dopri5::dense_slope`]): no field evaluation.
+    fn dip(&self, k: usize, g: Guard, vals: &[(f64, f64)]) -> Option<f64> {
+        let s = match g {
+            Guard::BandEntry(s) | Guard::Zero(s) => s,
+            _ => return None,
+        };
+        let (f, integ) = (&self.field, &self.integ);
+        let idx = f.laws[k].idx;
+        let slope = |t: f64| s * integ.dense_slope(t)[idx];
+        let mut prev = slope(vals[0].0);
+        for j in 1..vals.len() {
+            let cur = slope(vals[j].0);
+            if prev < 0.0 && cur > 0.0 && vals[j - 1].1 > 0.0 {
+                let (ta, tb) = (vals[j - 1].0, vals[j].0);
+                let (tm, _) = illinois(slope, ta, prev, tb, cur);
+                let gm = f.guard_value(k, g, &integ.dense(tm));
+                if gm < 0.0 {
+                    let guard = |tt: f64| f.guard_value(k, g, &integ.dense(tt));
+                    return Some(illinois(guard, ta, vals[j - 1].1, tm, gm).0);
+                }
+            }
+            prev = cur;
+        }
+        None
     }
 
     /// Markers in `(t0, te]` (reversals inside the band, extrema of ω when metrics are asked),

@@ -444,3 +444,55 @@ fn band_edge_sliver_is_held_not_chattered() {
         );
     }
 }
+
+/// Just below the grazing end of the stick-slip branch (4.6153 V, Table 1; its exact value,
+/// 4.61527687505 V, from the bifurcation diagram) the cycle touches ω_l = 0 tangentially and
+/// sticks for well under a millisecond each period. The orbit spends ~1e-4 s inside the band
+/// |ω_l| ≤ η, less than one guard-sample interval: before the band entry was also checked at
+/// the slope's turning point, most periods passed through the band unseen (ω_l down to
+/// −6.7e-8 with no stick) and the steady state came out as a period-2 or period-3 cycle.
+/// Now every period sticks, as the Filippov solution does (the event-driven solver sticks
+/// every period at both voltages), and ω_l never goes below −η.
+#[test]
+fn a_grazing_approach_inside_one_sample_interval_still_enters_the_band() {
+    let m = Model::table1();
+    let eta = SwitchOptions::default().eta;
+    for u in [4.615_276_8, 4.615_276_875_05 - 1e-6] {
+        let settled = run(
+            eta,
+            &m,
+            &Scene {
+                u,
+                t_end: 900.0,
+                output: Output::Final,
+                ..Scene::default()
+            },
+        );
+        let t = run(
+            eta,
+            &m,
+            &Scene {
+                u,
+                x0: settled.x_final,
+                t_end: 42.0,
+                output: Output::Events,
+                metrics_from: Some(0.0),
+                ..Scene::default()
+            },
+        );
+        let count = |k: EventKind| t.events.iter().filter(|e| e.kind == k).count();
+        let maxima = count(EventKind::Max(Disc::Lower));
+        let sticks = count(EventKind::StickStart(Disc::Lower));
+        assert!(maxima >= 9, "{u} V: {maxima} maxima of omega_l in 42 s");
+        assert!(
+            sticks.abs_diff(maxima) <= 1,
+            "{u} V: {sticks} sticks for {maxima} periods"
+        );
+        let lowest = t
+            .events
+            .iter()
+            .map(|e| e.x[OMEGA_L])
+            .fold(f64::INFINITY, f64::min);
+        assert!(lowest >= -eta, "{u} V: omega_l reached {lowest:e}");
+    }
+}
