@@ -94,7 +94,8 @@ fn the_reference_is_tight_enough() {
         &rotor_event::SteadyOptions::default(),
         &rotor_event::EventOptions::default(),
     )
-    .unwrap();
+    .unwrap()
+    .state;
     let rotor_model::SteadyState::LimitCycle {
         period,
         omega_l_max,

@@ -245,41 +245,17 @@ fn simulate(common: &Common, t_end: f64, dt: f64, csv_path: &Path) -> Result<()>
 
 fn steady(common: &Common) -> Result<()> {
     let model = load_model(common.params.as_deref())?;
-    let st = match common.solver.as_str() {
-        "event" => {
-            let mut opts = rotor_event::SteadyOptions::default();
-            if let Some(tol) = common.tol {
-                check("tol", tol, tol > 0.0 && tol < 1.0, "must lie in (0, 1)")?;
-                opts.tol = tol;
-            }
-            let scene = scene_from(common, opts.settle, Output::Final)?;
-            scene.validate()?;
-            rotor_event::steady_state(
-                &model,
-                scene.u,
-                scene.x0,
-                &opts,
-                &rotor_event::EventOptions::default(),
-            )?
-        }
-        other => {
-            // From the simulated orbit, once its metrics stop changing (a slow transient is
-            // an error, not a limit cycle).
-            let kind = kind_by_name(other)?;
-            let opts = rotor_compare::SettleOptions::default();
-            let scene = scene_from(common, opts.chunk, Output::Final)?;
-            let s = rotor_compare::settle(kind, &model, &scene, &opts)
-                .with_context(|| format!("solver {other}"))?;
-            warn_inexact(&s.stats);
-            s.state
-        }
-    };
-    for (name, v) in st.values() {
-        if !v.is_finite() {
-            bail!("steady state has a non-finite {name}: {v}");
-        }
+    let kind = kind_by_name(&common.solver)?;
+    let mut opts = rotor_compare::SteadyOptions::default();
+    if let Some(tol) = common.tol {
+        check("tol", tol, tol > 0.0 && tol < 1.0, "must lie in (0, 1)")?;
+        opts.event.tol = tol;
     }
-    println!("{}", steady_json(&st));
+    let scene = scene_from(common, opts.settle.chunk, Output::Final)?;
+    let answer = rotor_compare::steady(kind, &model, &scene, &opts)
+        .with_context(|| format!("solver {}", kind.name()))?;
+    warn_inexact(&answer.stats);
+    println!("{}", steady_json(&answer));
     Ok(())
 }
 
@@ -379,7 +355,12 @@ fn fixtures_dir() -> PathBuf {
 
 /// The report section with the bifurcation diagrams of both parameter sets (the source's
 /// Figure 3): SVG, JSON and CSV per set, and a table of the special points.
-fn bifurcation_section(sets: &[(&str, &str, Params)]) -> Result<rotor_compare::report::Section> {
+fn bifurcation_section(
+    sets: &[(&str, &str, Params)],
+) -> Result<(
+    rotor_compare::report::Section,
+    Vec<rotor_bifurcation::Diagram>,
+)> {
     use rayon::prelude::*;
     use std::fmt::Write as _;
     let diagrams = sets
@@ -391,6 +372,7 @@ fn bifurcation_section(sets: &[(&str, &str, Params)]) -> Result<rotor_compare::r
         })
         .collect::<Vec<_>>();
     let mut sec = rotor_compare::report::Section::default();
+    let mut out = Vec::new();
     sec.markdown
         .push_str("## Bifurcation diagrams (the source's Figure 3)\n\n");
     sec.markdown.push_str(
@@ -440,8 +422,78 @@ fn bifurcation_section(sets: &[(&str, &str, Params)]) -> Result<rotor_compare::r
             d.to_json()?.into_bytes(),
         ));
         sec.files.push((format!("bifurcation-{slug}.csv"), csv));
+        out.push(d);
     }
-    Ok(sec)
+    Ok((sec, out))
+}
+
+/// The report section with the steady states probed next to every special point of both
+/// diagrams (`rotor_compare::probes`, all solvers, all offsets, both starts).
+fn probe_section(
+    sets: &[(&str, &str, Params)],
+    diagrams: &[rotor_bifurcation::Diagram],
+) -> rotor_compare::report::Section {
+    use rayon::prelude::*;
+    use rotor_compare::probes;
+    let mut rows = Vec::new();
+    for ((_, slug, p), d) in sets.iter().zip(diagrams) {
+        let m = Model::new(*p);
+        let selected = probes::selection(d, true);
+        rows.extend(probes::run_set(slug, &m, d, &selected, |jobs, f| {
+            jobs.par_iter().map(f).collect()
+        }));
+    }
+    let count =
+        |f: &dyn Fn(&probes::Verdict) -> bool| rows.iter().filter(|r| f(&r.verdict)).count();
+    let agree = count(&|v| matches!(v, probes::Verdict::Agrees { .. }));
+    let refused = count(&|v| matches!(v, probes::Verdict::Refused { .. }));
+    let bad: Vec<String> = rows
+        .iter()
+        .filter(|r| !r.verdict.acceptable())
+        .map(|r| {
+            format!(
+                "steady near {} of {} ({:+e} V, from {}): {} {:?}",
+                r.probe.point.label,
+                r.set,
+                r.probe.offset,
+                r.probe.start.as_str(),
+                r.probe.kind.name(),
+                r.verdict
+            )
+        })
+        .collect();
+    let slowest = rows.iter().map(|r| r.seconds).fold(0.0, f64::max);
+    let total: f64 = rows.iter().map(|r| r.seconds).sum();
+    rotor_compare::report::Section {
+        markdown: format!(
+            "## Steady states near special points\n\n\
+             `rotor steady` at ±1e-3, ±1e-4 and ±1e-6 V from every special point of both \
+             diagrams, from rest and from the equilibrium perturbed by 1e-3 rad/s, for every \
+             solver (crate `rotor-compare`, module `probes`). Each answer is checked against \
+             what the continuation says is stable at that input (the stable equilibria, the \
+             stuck set, the stable cycles found by Newton's method from the branch and from \
+             the Hopf eigenvector): it must be one of them in kind, period and ω_l extremes \
+             (within 1e-6 for the event-driven solver, 1e-5 for the switch model, 1e-4 for \
+             Moreau–Jean, each well inside the distance to the nearest other cycle), or a \
+             refusal that names its cause: a transient that decays or grows too slowly to \
+             settle within 20 000 s (next to a Hopf point), a stick phase shorter than ten \
+             steps (Moreau–Jean next to a grazing orbit), no cycle next to a weakly unstable \
+             equilibrium, or a stability the tolerance cannot decide. {} probes: {agree} \
+             answers agree, {refused} refusals, {} wrong or failed.\n\n{}\n\
+             Each probe:\n\n{}",
+            rows.len(),
+            bad.len(),
+            probes::probe_summary_markdown(&rows, &rotor_compare::SOLVERS),
+            probes::probe_table_markdown(&rows, &rotor_compare::SOLVERS)
+        ),
+        files: Vec::new(),
+        timings: format!(
+            "\n## Steady states near special points\n\n{} probes, {total:.1} s of solver \
+             time in all, the slowest {slowest:.2} s.\n",
+            rows.len()
+        ),
+        failures: bad,
+    }
 }
 
 /// The report section with the numerical stress cases in their fast form (the full form:
@@ -535,8 +587,15 @@ fn compare(files: &[PathBuf], report: &Path, main_job: bool) -> Result<()> {
         },
         || -> Result<Vec<rotor_compare::report::Section>> {
             if main_job {
-                let (bif, stress) = rayon::join(|| bifurcation_section(&sets), stress_section);
-                Ok(vec![bif?, stress])
+                let (bif, stress) = rayon::join(
+                    || {
+                        let (sec, diagrams) = bifurcation_section(&sets)?;
+                        Ok::<_, anyhow::Error>((sec, probe_section(&sets, &diagrams)))
+                    },
+                    stress_section,
+                );
+                let (bif, probes) = bif?;
+                Ok(vec![bif, stress, probes])
             } else {
                 Ok(Vec::new())
             }
@@ -620,7 +679,7 @@ fn progress_bar(len: u64, what: &str) -> indicatif::ProgressBar {
     bar
 }
 
-fn steady_json(st: &SteadyState) -> String {
+fn steady_json(st: &rotor_compare::SteadyAnswer) -> String {
     serde_json::to_string(st).expect("plain floats and strings serialize")
 }
 

@@ -91,6 +91,37 @@ fn steady_prints_one_json_object() {
     assert!(o.status.success());
     let out = String::from_utf8(o.stdout).unwrap();
     assert!(out.trim().starts_with("{\"kind\":\"equilibrium\""), "{out}");
+    // A refined cycle: the contract's fields, then how it was obtained and its Floquet
+    // multipliers (the trivial one first).
+    let o = rotor(&["steady", "--solver", "event", "--u", "1.5"]);
+    assert!(o.status.success());
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    for key in [
+        "period",
+        "omega_l_max",
+        "omega_l_min",
+        "omega_u_max",
+        "omega_u_min",
+        "stick_time",
+    ] {
+        assert!(v[key].is_f64(), "{key}: {v}");
+    }
+    assert_eq!(v["method"], "refined");
+    assert_eq!(v["multipliers"].as_array().map(Vec::len), Some(3), "{v}");
+}
+
+/// A steady state a solver cannot resolve is an error that names the cause, with a non-zero
+/// exit, not an answer: Moreau–Jean at h = 1e-3 on a cycle whose stick phase is shorter than
+/// ten steps (1e-4 V below the grazing end of Table 1's stick-slip branch).
+#[test]
+fn steady_refuses_what_the_solver_cannot_resolve() {
+    let o = rotor(&["steady", "--solver", "moreau", "--u", "4.61517687505"]);
+    assert!(!o.status.success() && o.stdout.is_empty());
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        err.contains("grazes omega_l = 0") && err.contains("h = 0.001"),
+        "{err}"
+    );
 }
 
 #[test]

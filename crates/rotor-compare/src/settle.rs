@@ -58,14 +58,109 @@ pub enum SettleError {
     /// The metrics still changed between the last two chunks at `max_time`.
     #[error(
         "not settled after {t} s: {what} still changes by {change:e} (relative) from one {chunk} s \
-         chunk to the next; a slow transient (e.g. a focus near a Hopf point), not a steady state"
+         chunk to the next; {cause}"
     )]
     NotSettled {
         t: f64,
         chunk: f64,
         what: String,
         change: f64,
+        cause: Unsettled,
     },
+}
+
+/// Why a run did not settle, as far as its last two chunks tell.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Unsettled {
+    /// A transient that decays or grows slowly: a focus next to a Hopf point, an orbit
+    /// passing a fold of cycles.
+    SlowTransient,
+    /// A change that falls geometrically, by `per_chunk` per chunk, too slowly to settle
+    /// before `max_time`: it would at about `needs` seconds.
+    SlowDecay {
+        per_chunk: f64,
+        needs: f64,
+        max_time: f64,
+    },
+    /// An oscillation growing geometrically, by `per_chunk` per chunk, from a weakly
+    /// unstable equilibrium: it would leave the equilibrium's neighbourhood (1 % of the mean
+    /// velocity) only at about `needs` seconds.
+    SlowGrowth {
+        per_chunk: f64,
+        needs: f64,
+        max_time: f64,
+    },
+    /// A fixed-step solver on a cycle that grazes ω_l = 0: its stick phase (`stick_time` per
+    /// period, 0 if it only touches) is shorter than 10 steps of `h`, so whether and how long
+    /// the disc sticks changes from period to period with where the steps fall.
+    GrazingBelowStep { stick_time: f64, h: f64 },
+}
+
+impl std::fmt::Display for Unsettled {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match *self {
+            Unsettled::SlowTransient => f.write_str(
+                "a slow transient (e.g. a focus near a Hopf point, or a passage near a fold of \
+                 cycles), not a steady state",
+            ),
+            Unsettled::SlowDecay {
+                per_chunk,
+                needs,
+                max_time,
+            } => write!(
+                f,
+                "the change falls geometrically, by a factor {per_chunk:.4} per chunk, and at that \
+                 rate the run would settle after about {needs:.1e} s, beyond the {max_time} s \
+                 limit: a slowly decaying transient (e.g. a focus or cycle with a multiplier near \
+                 1, next to a Hopf point or a fold), not yet a steady state"
+            ),
+            Unsettled::SlowGrowth {
+                per_chunk,
+                needs,
+                max_time,
+            } => write!(
+                f,
+                "the orbit leaves a weakly unstable equilibrium, its amplitude growing by a factor \
+                 {per_chunk:.4} per chunk: it would reach 1 % of its mean velocity only after \
+                 about {needs:.1e} s, beyond the {max_time} s limit (the input is next to a Hopf \
+                 point)"
+            ),
+            Unsettled::GrazingBelowStep { stick_time, h } if stick_time > 0.0 => write!(
+                f,
+                "the cycle grazes omega_l = 0 with a stick phase of {stick_time:.2e} s per \
+                 period, shorter than 10 steps of h = {h} s, so where the steps fall changes it \
+                 from period to period: use h of a tenth of the stick phase or less, or the \
+                 event-driven solver (exact sliding)"
+            ),
+            Unsettled::GrazingBelowStep { h, .. } => write!(
+                f,
+                "the cycle grazes omega_l = 0 (its minimum is within 1e-3 of its range from 0), \
+                 and whether a step of h = {h} s lands the disc in stick changes from period to \
+                 period: use a smaller h, or the event-driven solver (exact sliding)"
+            ),
+        }
+    }
+}
+
+/// The cause of a run that has not settled, from its last chunk's metrics.
+fn unsettled(fixed_step: bool, h: f64, last: &SteadyState) -> Unsettled {
+    if let SteadyState::LimitCycle {
+        omega_l_max,
+        omega_l_min,
+        stick_time,
+        ..
+    } = *last
+    {
+        // Touching: a stick phase under 10 steps, or a minimum of ω_l within 1e-3 of the
+        // cycle's range from 0 (a step changes ω_l near its minimum by ~ω̈h²/2, 2e-5 rad/s
+        // at h = 1e-3 on Table 1's cycles: a grazing minimum is not resolved below that).
+        let touching =
+            stick_time < 10.0 * h && omega_l_min.abs() <= 1e-3 * (omega_l_max - omega_l_min).abs();
+        if fixed_step && touching {
+            return Unsettled::GrazingBelowStep { stick_time, h };
+        }
+    }
+    Unsettled::SlowTransient
 }
 
 /// The largest relative change between two steady states' metrics, and its name (an
@@ -139,6 +234,12 @@ pub fn settle(
     let mut stats = Stats::default();
     let mut prev: Option<SteadyState> = None;
     let mut prev_change = f64::INFINITY;
+    // The last three ratios of consecutive changes (q), and of consecutive ω_l ranges (r).
+    let mut qs = [f64::NAN; 3];
+    let mut rs = [f64::NAN; 3];
+    let mut prev_range = f64::NAN;
+    // Every chunk's change, for the jitter test below.
+    let mut changes: Vec<f64> = Vec::new();
     loop {
         let scene = Scene {
             x0: x,
@@ -168,12 +269,111 @@ pub fn settle(
             if settled {
                 return Ok(Settled { state: st, stats });
             }
-            if t >= opts.max_time {
+            // A change falling geometrically (three consecutive ratios q ≤ 0.99 within 10 % of
+            // 1 − q of each other) settles after n more chunks, c·qⁿ/(1 − q) = rel. An amplitude
+            // falling geometrically, by r per chunk (a focus decaying), changes by the same
+            // fraction 1 − r every chunk relative to itself; the run settles once it is below
+            // the amplitude that reads as an equilibrium, after ln(a_eq/a)/ln r chunks and two
+            // more to confirm. If either is past `max_time`, say so now rather than after
+            // simulating up to it. (Three ratios, not two: a passage near the ghost of a fold
+            // slows down and then speeds up again.)
+            let range = match st {
+                SteadyState::LimitCycle {
+                    omega_l_max,
+                    omega_l_min,
+                    ..
+                } => omega_l_max - omega_l_min,
+                SteadyState::Equilibrium { .. } => f64::NAN,
+            };
+            qs = [qs[1], qs[2], q];
+            rs = [rs[1], rs[2], range / prev_range];
+            prev_range = range;
+            // A ratio above 0.99 is a plateau rather than a decay that can be extrapolated
+            // (the passage near a fold's ghost changes by a nearly constant amount).
+            let steady_ratio = |v: &[f64; 3]| {
+                let x = v[2];
+                x > 0.0 && x <= 0.99 && v.iter().all(|y| (y - x).abs() <= 0.1 * (1.0 - x))
+            };
+            let (geometric, decaying) = (steady_ratio(&qs), steady_ratio(&rs));
+            let r = rs[2];
+            // An amplitude growing geometrically, by r ≥ 1.01 per chunk, while still below 1 %
+            // of the mean velocity: the orbit is leaving a weakly unstable equilibrium. It
+            // cannot settle before its amplitude has grown to that 1 % at least.
+            let growing = r >= 1.01
+                && rs.iter().all(|y| (y - r).abs() <= 0.1 * (r - 1.0))
+                && if let SteadyState::LimitCycle {
+                    omega_l_max,
+                    omega_l_min,
+                    ..
+                } = st
+                {
+                    range < 0.01 * (0.5 * (omega_l_max + omega_l_min)).abs().max(1.0)
+                } else {
+                    false
+                };
+            if growing {
+                let mean = match st {
+                    SteadyState::LimitCycle {
+                        omega_l_max,
+                        omega_l_min,
+                        ..
+                    } => (0.5 * (omega_l_max + omega_l_min)).abs().max(1.0),
+                    SteadyState::Equilibrium { .. } => 1.0,
+                };
+                let n = (0.01 * mean / range).ln() / r.ln();
+                if t + n * opts.chunk > opts.max_time {
+                    return Err(SettleError::NotSettled {
+                        t,
+                        chunk: opts.chunk,
+                        what,
+                        change: c,
+                        cause: Unsettled::SlowGrowth {
+                            per_chunk: r,
+                            needs: t + n * opts.chunk,
+                            max_time: opts.max_time,
+                        },
+                    });
+                }
+            }
+            let projection = if geometric {
+                Some((q, ((rel * (1.0 - q) / c).ln() / q.ln()).ceil()))
+            } else if decaying {
+                let a_eq = rotor_model::steady::EQUILIBRIUM_AMPLITUDE;
+                Some((r, (a_eq / range).ln() / r.ln() + 2.0))
+            } else {
+                None
+            };
+            if let Some((q, n)) = projection {
+                let needs = t + n * opts.chunk;
+                if needs > opts.max_time {
+                    return Err(SettleError::NotSettled {
+                        t,
+                        chunk: opts.chunk,
+                        what,
+                        change: c,
+                        cause: Unsettled::SlowDecay {
+                            per_chunk: q,
+                            needs,
+                            max_time: opts.max_time,
+                        },
+                    });
+                }
+            }
+            // A fixed-step solver on a grazing cycle jitters from period to period with where
+            // its steps fall: a change that has not halved over the last five chunks (ten
+            // chunks into the run) will not fall below `rel` later either.
+            changes.push(c);
+            let cause = unsettled(kind.is_fixed_step(), base.h, &st);
+            let jitter = matches!(cause, Unsettled::GrazingBelowStep { .. })
+                && changes.len() >= 10
+                && c >= 0.5 * changes[changes.len() - 6];
+            if jitter || t >= opts.max_time {
                 return Err(SettleError::NotSettled {
                     t,
                     chunk: opts.chunk,
                     what,
                     change: c,
+                    cause,
                 });
             }
         }
@@ -204,6 +404,7 @@ mod tests {
             &rotor_event::EventOptions::default(),
         )
         .unwrap()
+        .state
     }
 
     /// Just below the first Hopf point (0.3835 V, Table 1) the equilibrium is a stable focus
@@ -328,5 +529,89 @@ mod tests {
             let (what, c) = change(&reference, &s.state, 1e-8);
             assert!(c <= gate, "{kind:?}: {what} differs by {c:e}");
         }
+    }
+
+    /// Table 1's first Hopf point (supercritical) at full precision.
+    fn hopf(m: &Model, i: usize) -> f64 {
+        rotor_bifurcation::equilibria::hopf_points(m, 20.0)[i]
+            .equilibrium
+            .u
+    }
+
+    /// 1e-4 V below the first Hopf point the focus decays by a factor ≈ 0.9 per 300 s chunk
+    /// (Re λ ≈ −3.3e-4 /s): settling would take ~4e4 s. The run says so as soon as three
+    /// chunks show the geometric decay, long before the 20 000 s limit, and names it.
+    #[test]
+    fn a_slow_geometric_decay_is_refused_early_with_its_projection() {
+        let m = Model::table1();
+        let opts = SettleOptions::default();
+        let e = settle(SolverKind::SWITCH, &m, &base(hopf(&m, 0) - 1e-4), &opts).unwrap_err();
+        let SettleError::NotSettled { t, cause, .. } = e else {
+            panic!("{e}")
+        };
+        let Unsettled::SlowDecay {
+            per_chunk, needs, ..
+        } = cause
+        else {
+            panic!("{cause:?}")
+        };
+        assert!(t < 0.25 * opts.max_time, "refused only at {t} s");
+        assert!(per_chunk < 0.99 && needs > opts.max_time, "{cause:?}");
+    }
+
+    /// 1e-3 V below the second Hopf point (subcritical) the equilibrium repels at
+    /// Re λ ≈ 7.7e-5 /s: from 1e-3 rad/s off it the oscillation grows by ≈ 2 % per chunk and
+    /// would need ~5e4 s to leave the equilibrium's neighbourhood. Refused early, by name.
+    #[test]
+    fn a_slow_growth_from_an_unstable_equilibrium_is_refused_early() {
+        let m = Model::table1();
+        let u = hopf(&m, 1) - 1e-3;
+        let eq = m.slip_equilibria(u)[0];
+        let scene = Scene {
+            x0: eq.state() + State::new(0.0, 0.0, 1e-3),
+            ..base(u)
+        };
+        let opts = SettleOptions::default();
+        let e = settle(SolverKind::SWITCH, &m, &scene, &opts).unwrap_err();
+        let msg = e.to_string();
+        let SettleError::NotSettled { t, cause, .. } = e else {
+            panic!("{msg}")
+        };
+        assert!(
+            matches!(cause, Unsettled::SlowGrowth { per_chunk, .. } if per_chunk > 1.01),
+            "{msg}"
+        );
+        assert!(
+            t < 0.25 * opts.max_time && msg.contains("unstable equilibrium"),
+            "{msg}"
+        );
+    }
+
+    /// 1e-4 V below the grazing end of the stick-slip branch (4.6153 V) the stick phase lasts
+    /// 2.8 ms, under three Moreau–Jean steps at h = 1e-3: where the steps fall changes it from
+    /// period to period by ~7e-4, above the settling agreement. The refusal names the step
+    /// and what resolves it.
+    #[test]
+    fn moreau_on_a_cycle_grazing_below_its_step_says_so() {
+        let m = Model::table1();
+        let e = settle(
+            SolverKind::MOREAU,
+            &m,
+            &base(4.615_276_875_05 - 1e-4),
+            &SettleOptions::default(),
+        )
+        .unwrap_err();
+        let msg = e.to_string();
+        assert!(
+            matches!(
+                e,
+                SettleError::NotSettled {
+                    cause: Unsettled::GrazingBelowStep { h: 1e-3, .. },
+                    ..
+                }
+            ) && msg.contains("h = 0.001")
+                && msg.contains("event-driven"),
+            "{msg}"
+        );
     }
 }

@@ -14,4 +14,4 @@ pub mod tableau;
 pub use filippov::EventOptions;
 pub use flow::{FlowEnd, StopAt, flow};
 pub use solver::EventSolver;
-pub use steady::{SteadyOptions, steady_state};
+pub use steady::{Method, Steady, SteadyOptions, steady_state};

@@ -14,13 +14,57 @@
 //!    two-dimensional map in (α, ω_u), by Newton with a finite-difference Jacobian.
 //!
 //! The metrics are then measured over exactly one period from the fixed point.
+//!
+//! A fixed point is accepted only if it is stable: its nontrivial Floquet multipliers, the
+//! eigenvalues of the return map's derivative at the fixed point (central differences), lie
+//! inside the unit circle. A steady state reached from an initial state is an attractor, and
+//! near a fold of cycles Newton's method converges to whichever of the stable and the
+//! unstable cycle is nearer. When the refined cycle is unstable the settling run goes on (to a
+//! cycle-to-cycle drift of 1e-10) and the refinement is tried again from there; if it still
+//! finds only an unstable cycle, the settled run's own last cycle is the answer
+//! ([`Method::Settled`]).
 
 use rotor_model::{
-    Disc, DiscMode, Event, EventKind, MetricsAccumulator, Mode, Model, SolveError, State,
-    SteadyState,
+    Disc, DiscMode, Event, EventKind, MetricsAccumulator, Mode, Model, SlipEquilibrium, SolveError,
+    State, SteadyState,
 };
 
+use nalgebra::Complex;
+
 use crate::filippov::{EventOptions, Integrator, RunEnd, Sink};
+
+/// How a steady state was obtained.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Method {
+    /// An equilibrium from the equilibrium equations, the stuck set or its boundary.
+    Equilibrium,
+    /// A cycle refined as a stable fixed point of a return map.
+    Refined,
+    /// A cycle read off a run that settled to a cycle-to-cycle drift of 1e-10, where the
+    /// refinement found no stable fixed point.
+    Settled,
+}
+
+/// A refined steady state.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Steady {
+    pub state: SteadyState,
+    pub method: Method,
+    /// A state on the cycle (at the fixed point of the return map, or the settled run's
+    /// final state); `None` for an equilibrium.
+    pub on_cycle: Option<State>,
+    /// The nontrivial Floquet multipliers of a refined cycle from central differences of its
+    /// return map: `P'(w*)` of the stick-exit map (one), or the eigenvalues of `DP(z*)` of
+    /// the section map (two). Empty otherwise.
+    pub multipliers: Vec<Complex<f64>>,
+}
+
+impl Steady {
+    /// Whether every multiplier lies inside the unit circle.
+    pub fn is_stable(&self) -> bool {
+        self.multipliers.iter().all(|m| m.norm() < 1.0)
+    }
+}
 
 /// Options of the steady-state refinement.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -34,6 +78,10 @@ pub struct SteadyOptions {
     pub max_settle: f64,
     /// Newton/secant stopping tolerance on the fixed-point residual (rad/s).
     pub fixed_point_tol: f64,
+    /// The section Newton iteration also stops only once its step is below this, relative
+    /// to `1 + |z|`: next to a Hopf point the map is nearly the identity and a residual below
+    /// `fixed_point_tol` can still be far from a fixed point.
+    pub fixed_point_step: f64,
 }
 
 impl Default for SteadyOptions {
@@ -43,6 +91,7 @@ impl Default for SteadyOptions {
             settle: 300.0,
             max_settle: 20_000.0,
             fixed_point_tol: 1e-11,
+            fixed_point_step: 1e-7,
         }
     }
 }
@@ -148,7 +197,7 @@ pub fn steady_state(
     x0: State,
     opts: &SteadyOptions,
     ev: &EventOptions,
-) -> Result<SteadyState, SolveError> {
+) -> Result<Steady, SolveError> {
     let flow = Flow {
         model,
         u,
@@ -163,46 +212,147 @@ pub fn steady_state(
         mode: model.mode_at(&x0, u),
         elapsed: 0.0,
     };
-    let (rough, last_exit, settled) = run.until(1e-6)?;
-    let x = run.x;
-    match rough {
-        SteadyState::Equilibrium { .. } => Ok(refine_equilibrium(model, u, &x)),
-        SteadyState::LimitCycle {
-            stick_time,
-            omega_l_max,
-            omega_l_min,
-            ..
-        } => {
-            let refined = if let (Some(exit), true) = (last_exit, stick_time > 0.0) {
-                refine_stick_slip(&flow, &exit, opts)
-            } else {
-                refine_slipping(&flow, &x, 0.5 * (omega_l_max + omega_l_min), opts)
-            };
-            match refined {
-                Ok(st) => Ok(st),
-                // Near a Hopf point or a fold of cycles the section map's fixed point is
-                // ill-conditioned (a multiplier near 1) and Newton may fail, or step out of
-                // the cycle's basin in a bistable window. A run that has settled still
-                // answers: it goes on until period and amplitude are steady to 1e-10 from one
-                // cycle to the next, and the metrics of its last cycle are the answer.
-                Err(_) if settled => match run.until(1e-10)? {
-                    (st, _, true) => Ok(st),
-                    (_, _, false) => Err(SolveError::NoConvergence {
-                        detail: format!(
-                            "the refinement failed and the run still drifts after {} s",
-                            run.elapsed
-                        ),
-                    }),
-                },
-                Err(e) => Err(SolveError::NoConvergence {
-                    detail: format!(
-                        "not settled after {} s (period or amplitude still drifting), and the \
-                         refinement failed: {e}",
-                        run.elapsed
-                    ),
-                }),
+    let (rough, last_exit, _) = run.until(1e-6)?;
+    if let SteadyState::Equilibrium { .. } = rough {
+        return Ok(equilibrium(model, u, &run.x));
+    }
+    // 2. Refine; accept only a stable cycle.
+    let first = match refine_cycle(&flow, &run, &rough, last_exit, opts) {
+        Ok(Refined::Cycle(c)) if c.is_stable() => return Ok(c),
+        Ok(Refined::Cycle(c)) => format!(
+            "it converged to an unstable cycle (multipliers {})",
+            list(&c.multipliers)
+        ),
+        Ok(Refined::Collapsed(e)) => match collapsed(model, &e) {
+            Some(st) => return Ok(st),
+            None => {
+                let growth = model
+                    .equilibrium_eigenvalues(&e)
+                    .iter()
+                    .map(|l| l.re)
+                    .fold(f64::NEG_INFINITY, f64::max);
+                format!(
+                    "there is no cycle near the orbit: it circles the slipping equilibrium at \
+                     omega = {:.6} rad/s, which is unstable but repels it only at Re lambda = \
+                     {growth:.2e} /s (the input is next to a Hopf point)",
+                    e.omega
+                )
+            }
+        },
+        Err(e) => e.to_string(),
+    };
+    // 3. Near a Hopf point or a fold of cycles the fixed point is ill-conditioned (a
+    // multiplier near 1): Newton may fail, step out of the cycle's basin, or converge to the
+    // unstable cycle nearby. The run goes on until period and amplitude are steady to 1e-10
+    // from one cycle to the next, and the refinement is tried again from there.
+    let (rough, last_exit, settled) = run.until(1e-10)?;
+    if let SteadyState::Equilibrium { .. } = rough {
+        return Ok(equilibrium(model, u, &run.x));
+    }
+    match refine_cycle(&flow, &run, &rough, last_exit, opts) {
+        Ok(Refined::Cycle(c)) if c.is_stable() => return Ok(c),
+        Ok(Refined::Collapsed(e)) => {
+            if let Some(st) = collapsed(model, &e) {
+                return Ok(st);
             }
         }
+        _ => {}
+    }
+    if settled {
+        return Ok(Steady {
+            state: rough,
+            method: Method::Settled,
+            on_cycle: Some(run.x),
+            multipliers: Vec::new(),
+        });
+    }
+    Err(SolveError::NoConvergence {
+        detail: format!(
+            "the refinement failed ({first}) and the run still drifts after {} s",
+            run.elapsed
+        ),
+    })
+}
+
+/// The steady state when Newton's method shrinks the orbit onto a slipping equilibrium: that
+/// equilibrium if it is stable (a focus the orbit spirals into, too slowly to have settled:
+/// next to a Hopf point the decay rate Re λ is proportional to the distance in u), else none.
+fn collapsed(model: &Model, e: &SlipEquilibrium) -> Option<Steady> {
+    model.equilibrium_is_stable(e).then(|| Steady {
+        state: SteadyState::Equilibrium {
+            omega_u: e.omega,
+            omega_l: e.omega,
+            alpha: e.alpha,
+        },
+        method: Method::Equilibrium,
+        on_cycle: None,
+        multipliers: Vec::new(),
+    })
+}
+
+/// `(a+bi, …)` for messages.
+fn list(m: &[Complex<f64>]) -> String {
+    m.iter()
+        .map(|z| {
+            if z.im == 0.0 {
+                format!("{:.6}", z.re)
+            } else {
+                format!("{:.6}{:+.6}i", z.re, z.im)
+            }
+        })
+        .collect::<Vec<_>>()
+        .join(", ")
+}
+
+/// What the refinement of a cycle found.
+enum Refined {
+    /// A fixed point of the return map (stable or not).
+    Cycle(Steady),
+    /// No cycle: Newton's method shrank the orbit onto this slipping equilibrium (a focus
+    /// next to a Hopf point, around which the orbit decays or grows slowly).
+    Collapsed(SlipEquilibrium),
+}
+
+/// The refined cycle through the settling run's orbit: the stick-exit map if the lower disc
+/// sticks on it, else the section map on `ω_l = ω*` (the slipping equilibrium's velocity, if
+/// it lies inside the orbit's range of ω_l, as in the bifurcation analysis) or on the middle
+/// of that range.
+fn refine_cycle(
+    flow: &Flow,
+    run: &Settling,
+    rough: &SteadyState,
+    last_exit: Option<(Event, DiscMode)>,
+    opts: &SteadyOptions,
+) -> Result<Refined, SolveError> {
+    let SteadyState::LimitCycle {
+        stick_time,
+        omega_l_max,
+        omega_l_min,
+        ..
+    } = *rough
+    else {
+        unreachable!("only cycles are refined")
+    };
+    match last_exit {
+        Some(exit) if stick_time > 0.0 => refine_stick_slip(flow, &exit, opts).map(Refined::Cycle),
+        _ => {
+            let center = flow
+                .model
+                .slip_equilibria(flow.u)
+                .into_iter()
+                .find(|e| omega_l_min < e.omega && e.omega < omega_l_max);
+            let c = center.map_or(0.5 * (omega_l_max + omega_l_min), |e| e.omega);
+            refine_slipping(flow, (&run.x, run.mode), (c, center), opts)
+        }
+    }
+}
+
+fn equilibrium(model: &Model, u: f64, x: &State) -> Steady {
+    Steady {
+        state: refine_equilibrium(model, u, x),
+        method: Method::Equilibrium,
+        on_cycle: None,
+        multipliers: Vec::new(),
     }
 }
 
@@ -333,7 +483,7 @@ fn refine_stick_slip(
     flow: &Flow,
     exit: &(Event, DiscMode),
     opts: &SteadyOptions,
-) -> Result<SteadyState, SolveError> {
+) -> Result<Steady, SolveError> {
     let (e, upper) = *exit;
     let alpha = e.x[0];
     let mut w = e.x[1];
@@ -373,6 +523,17 @@ fn refine_stick_slip(
         w = w0;
         upper_mode = DiscMode::slip_of(w);
     }
+    // The multiplier: P'(w*) by central differences (the map is smooth in w); with the upper
+    // disc stuck at the exit the map is 0-dimensional, every orbit leaves from the same
+    // state, and the multiplier is 0.
+    let multiplier = if upper_mode == DiscMode::Stick {
+        0.0
+    } else {
+        let h = 1e-6 * w.abs().max(1.0);
+        let hi = flow.stick_exit_map(alpha, w + h, upper_mode)?;
+        let lo = flow.stick_exit_map(alpha, w - h, upper_mode)?;
+        (hi.x[1] - lo.x[1]) / (2.0 * h)
+    };
     // One period from the fixed point, with extrema, into a fresh accumulator.
     let (x, mode) = flow.exit_state(alpha, w, upper_mode);
     let mut acc = MetricsAccumulator::new(0.0);
@@ -382,31 +543,35 @@ fn refine_stick_slip(
         kind: EventKind::StickEnd(Disc::Lower),
     });
     let (end, sink) = flow.run(x, mode, 1e4, Stop::LowerStickExit, true, None, Some(acc))?;
-    Ok(sink.acc.expect("accumulator was given").finish(&end.x))
+    Ok(Steady {
+        state: sink.acc.expect("accumulator was given").finish(&end.x),
+        method: Method::Refined,
+        on_cycle: Some(x),
+        multipliers: vec![Complex::new(multiplier, 0.0)],
+    })
 }
 
 fn refine_slipping(
     flow: &Flow,
-    x: &State,
-    c: f64,
+    (x, mode): (&State, Mode),
+    (c, center): (f64, Option<SlipEquilibrium>),
     opts: &SteadyOptions,
-) -> Result<SteadyState, SolveError> {
-    // A point on the section near the settled orbit.
-    let start = flow.section_map([x[0], x[1]], c).or_else(|_| {
-        let mode = flow.model.mode_at(x, flow.u);
-        let (end, _) = flow.run(*x, mode, 1e4, Stop::Section, false, Some(c), None)?;
-        Ok::<_, SolveError>([end.x[0], end.x[1]])
-    })?;
-    let mut z = start;
+) -> Result<Refined, SolveError> {
+    // The start: where the settled orbit itself next crosses the section (not the state's
+    // (α, ω_u) moved onto the section: near a fold of cycles that point can lie beyond the
+    // unstable cycle, and Newton converges to it).
+    let (end, _) = flow.run(*x, mode, 1e4, Stop::Section, false, Some(c), None)?;
+    if end.t >= 1e4 {
+        return Err(SolveError::NoConvergence {
+            detail: format!("the orbit does not reach the section omega_l = {c}"),
+        });
+    }
+    let mut z = [end.x[0], end.x[1]];
     let mut converged = false;
-    for _ in 0..30 {
+    for _ in 0..40 {
         let p = flow.section_map(z, c)?;
         let r = [p[0] - z[0], p[1] - z[1]];
-        if r[0].abs().max(r[1].abs()) <= opts.fixed_point_tol {
-            converged = true;
-            break;
-        }
-        // Finite-difference Jacobian of P − I (step √tol-scaled: the map is smooth).
+        // Forward-difference Jacobian of P − I (step 1e-6 relative: the map is smooth).
         let mut j = [[0.0; 2]; 2];
         for k in 0..2 {
             let dz = 1e-6 * z[k].abs().max(1.0);
@@ -421,9 +586,30 @@ fn refine_slipping(
         if det == 0.0 || !det.is_finite() {
             break;
         }
-        let d0 = (-r[0] * j[1][1] + r[1] * j[0][1]) / det;
-        let d1 = (-r[1] * j[0][0] + r[0] * j[1][0]) / det;
-        z = [z[0] + d0, z[1] + d1];
+        let d = [
+            (-r[0] * j[1][1] + r[1] * j[0][1]) / det,
+            (-r[1] * j[0][0] + r[0] * j[1][0]) / det,
+        ];
+        let next = [z[0] + d[0], z[1] + d[1]];
+        let tol_step = opts.fixed_point_step * (1.0 + z[0].abs().max(z[1].abs()));
+        // No cycle around a focus: Newton shrinks the orbit onto the equilibrium. A "cycle"
+        // within 100 steps' tolerance of it is that collapse, not a cycle it can resolve.
+        if let Some(e) = center
+            && (next[0] - e.alpha).abs().max((next[1] - e.omega).abs()) <= 100.0 * tol_step
+        {
+            return Ok(Refined::Collapsed(e));
+        }
+        // Where the map is nearly the identity (a multiplier near 1: next to a Hopf point) a
+        // small residual does not mean a nearby fixed point: the Newton step says how far it
+        // is. Converged when both the residual and the step are small.
+        if r[0].abs().max(r[1].abs()) <= opts.fixed_point_tol
+            && d[0].abs().max(d[1].abs()) <= tol_step
+        {
+            converged = true;
+            z = next;
+            break;
+        }
+        z = next;
     }
     if !converged {
         return Err(SolveError::NoConvergence {
@@ -444,7 +630,34 @@ fn refine_slipping(
         stop_at: 2,
     };
     let end = integ.run(0.0, x0, mode, 1e4, &mut sink)?;
-    Ok(sink.acc.finish(&end.x))
+    Ok(Refined::Cycle(Steady {
+        state: sink.acc.finish(&end.x),
+        method: Method::Refined,
+        on_cycle: Some(x0),
+        multipliers: section_multipliers(flow, z, c)?.to_vec(),
+    }))
+}
+
+/// Eigenvalues of `DP(z)` of the section map, `DP` by central differences (step 1e-6
+/// relative: the map is smooth on a slipping cycle).
+fn section_multipliers(flow: &Flow, z: [f64; 2], c: f64) -> Result<[Complex<f64>; 2], SolveError> {
+    let mut j = [[0.0; 2]; 2];
+    for k in 0..2 {
+        let dz = 1e-6 * z[k].abs().max(1.0);
+        let (mut zp, mut zm) = (z, z);
+        zp[k] += dz;
+        zm[k] -= dz;
+        let (pp, pm) = (flow.section_map(zp, c)?, flow.section_map(zm, c)?);
+        for i in 0..2 {
+            j[i][k] = (pp[i] - pm[i]) / (2.0 * dz);
+        }
+    }
+    // λ = tr/2 ± √(tr²/4 − det).
+    let tr = j[0][0] + j[1][1];
+    let det = j[0][0] * j[1][1] - j[0][1] * j[1][0];
+    let root = Complex::new(0.25 * tr * tr - det, 0.0).sqrt();
+    let half = Complex::new(0.5 * tr, 0.0);
+    Ok([half + root, half - root])
 }
 
 struct CountSections {

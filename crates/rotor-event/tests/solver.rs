@@ -219,7 +219,11 @@ fn steady_state_converges_in_tolerance_and_matches_long_run() {
             tol,
             ..SteadyOptions::default()
         };
-        cycle(steady_state(&m, 1.5, State::zeros(), &o, &ev).unwrap())
+        cycle(
+            steady_state(&m, 1.5, State::zeros(), &o, &ev)
+                .unwrap()
+                .state,
+        )
     };
     let r13 = refined(1e-13);
     let mut prev = f64::INFINITY;
@@ -298,6 +302,7 @@ fn steady_state_mirrors_under_u_to_minus_u() {
             &EventOptions::default(),
         )
         .unwrap()
+        .state
     };
     // Stick-slip: mirror images computed by the same operations with signs flipped, the same
     // to rounding (measured: identical digits), 1e-12 relative. The slipping cycle's section
@@ -383,7 +388,8 @@ fn creeping_onto_the_stick_boundary_settles_on_it() {
             &SteadyOptions::default(),
             &EventOptions::default(),
         )
-        .unwrap();
+        .unwrap()
+        .state;
         let alpha = (p.k_m * u - (p.upper.t_s + p.upper.dt_s)) / p.k_theta;
         let SteadyState::Equilibrium {
             omega_u,
@@ -574,4 +580,76 @@ fn a_reversal_whose_excursion_returns_within_one_sample_ends_in_stick() {
         assert_eq!(a.kind, b.kind);
         assert!((a.t - b.t).abs() < 1e-11, "{a:?} vs {b:?}");
     }
+}
+
+/// Only a stable fixed point is a steady state. 2e-4 V below the fold of cycles E of Table 1
+/// (4.8430 V) Newton's method on the section map could converge to the unstable cycle nearby
+/// (ω_l max 16.761 instead of 16.801); the refined cycle must now be stable by its own
+/// return-map multipliers, and be the cycle a long plain run settles on (within 1e-5: the
+/// long run's own drift after 3000 s at a multiplier of 0.97).
+#[test]
+fn steady_state_accepts_only_a_stable_cycle_near_a_fold() {
+    let m = Model::table1();
+    let u = 4.8428;
+    let st = steady_state(
+        &m,
+        u,
+        State::zeros(),
+        &SteadyOptions::default(),
+        &EventOptions::default(),
+    )
+    .unwrap();
+    assert_eq!(st.method, rotor_event::Method::Refined);
+    assert!(st.is_stable(), "{:?}", st.multipliers);
+    let run = EventSolver::default()
+        .simulate(
+            &m,
+            &Scene {
+                u,
+                t_end: 3000.0,
+                tol: 1e-12,
+                output: Output::Final,
+                metrics_from: Some(2900.0),
+                ..Scene::default()
+            },
+        )
+        .unwrap();
+    let (
+        SteadyState::LimitCycle { omega_l_max: a, .. },
+        Some(SteadyState::LimitCycle { omega_l_max: b, .. }),
+    ) = (st.state, run.metrics)
+    else {
+        panic!("{:?} / {:?}", st.state, run.metrics)
+    };
+    assert!(((a - b) / b).abs() < 1e-5, "refined {a} vs run {b}");
+}
+
+/// 1e-6 V below a supercritical Hopf point there is no cycle: the orbit spirals into the
+/// stable focus at Re λ ≈ −3e-6 /s, far too slowly to settle in any run. Newton's method on
+/// the section map shrinks the orbit onto the equilibrium, and that equilibrium is the answer
+/// (a small residual of the nearly-identity map is not taken for a fixed point).
+#[test]
+fn steady_state_next_to_a_hopf_point_answers_the_focus() {
+    let m = Model::table1();
+    let hopf = 0.383_547_060_287_328_4; // Table 1's first Hopf point (rotor-bifurcation)
+    let u = hopf - 1e-6;
+    let st = steady_state(
+        &m,
+        u,
+        State::zeros(),
+        &SteadyOptions::default(),
+        &EventOptions::default(),
+    )
+    .unwrap();
+    let eq = m.slip_equilibria(u)[0];
+    assert!(m.equilibrium_is_stable(&eq));
+    assert_eq!(st.method, rotor_event::Method::Equilibrium);
+    assert_eq!(
+        st.state,
+        SteadyState::Equilibrium {
+            omega_u: eq.omega,
+            omega_l: eq.omega,
+            alpha: eq.alpha
+        }
+    );
 }

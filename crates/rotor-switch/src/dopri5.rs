@@ -592,7 +592,10 @@ mod tests {
         // 100·tol: the derivative of an interpolant with error ~tol over steps of ~0.1 s
         // (measured 1.1e-7).
         assert!(worst < 100.0 * tol, "slope error {worst:e}");
-        assert!(worst_fd < 1e-9, "slope vs difference of dense: {worst_fd:e}");
+        assert!(
+            worst_fd < 1e-9,
+            "slope vs difference of dense: {worst_fd:e}"
+        );
     }
 
     #[test]

@@ -100,7 +100,8 @@ fn branch_period_matches_steady_state_refinement() {
         &SteadyOptions::default(),
         &EventOptions::default(),
     )
-    .unwrap();
+    .unwrap()
+    .state;
     let SteadyState::LimitCycle {
         period,
         omega_l_max,

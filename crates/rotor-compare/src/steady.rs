@@ -1,0 +1,379 @@
+//! The steady state reached from an initial state, by any solver, with what stands behind
+//! it: `rotor steady` (and the Python package's `steady`).
+//!
+//! * The event-driven solver refines: a settling run, then the fixed point of a return map,
+//!   accepted only if stable ([`rotor_event::steady_state`]). Its Floquet multipliers are then
+//!   computed independently, from the monodromy matrix of the variational equations with
+//!   saltation matrices ([`rotor_bifurcation::monodromy`]), and must agree that the cycle is
+//!   stable.
+//! * Every other solver simulates until its metrics stop changing ([`crate::settle`]).
+//!
+//! Each answer says how it was obtained ([`SteadyMethod`]). A solver that cannot resolve the
+//! steady state at its setting says so and why ([`SteadyError`]) rather than answering with a
+//! different cycle.
+
+use nalgebra::Complex;
+use rotor_bifurcation::continuation::{ContOptions, Continuer, Multipliers};
+use rotor_bifurcation::periodic::{Shooter, T_RETURN};
+use rotor_model::{Model, Scene, SolveError, State, Stats, SteadyState};
+use serde::Serialize;
+
+use crate::settle::{SettleError, SettleOptions, settle};
+use crate::solvers::SolverKind;
+
+/// How a steady state was obtained.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum SteadyMethod {
+    /// From the equilibrium equations (or the stuck set), after a settling run.
+    Equilibrium,
+    /// A stable fixed point of a return map (event-driven solver).
+    Refined,
+    /// The last cycle of a run that settled to a cycle-to-cycle drift of 1e-10, where the
+    /// refinement found no stable fixed point (event-driven solver).
+    Settled,
+    /// The metrics of a simulation once they stopped changing (see [`crate::settle`]).
+    Simulated,
+}
+
+/// Settings of [`steady`].
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct SteadyOptions {
+    /// The event-driven solver's refinement (its `tol` is the integration tolerance).
+    pub event: rotor_event::SteadyOptions,
+    /// The other solvers' settling runs.
+    pub settle: SettleOptions,
+}
+
+/// A steady state as `rotor steady` prints it: the metrics, how they were obtained and, for a
+/// refined cycle, its Floquet multipliers.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct SteadyAnswer {
+    #[serde(flatten)]
+    pub state: SteadyState,
+    pub method: SteadyMethod,
+    /// Floquet multipliers `[re, im]` of a refined cycle, the trivial one (≈ 1) first, then by
+    /// decreasing modulus: `[1, λ, 0]` with a stick phase, `[1, λ1, λ2]` without; `None` for an
+    /// equilibrium and for a simulated cycle.
+    #[serde(serialize_with = "complex_list")]
+    pub multipliers: Option<Vec<Complex<f64>>>,
+    #[serde(skip)]
+    pub stats: Stats,
+}
+
+fn complex_list<S: serde::Serializer>(
+    m: &Option<Vec<Complex<f64>>>,
+    s: S,
+) -> Result<S::Ok, S::Error> {
+    match m {
+        Some(v) => s.collect_seq(v.iter().map(|z| [z.re, z.im])),
+        None => s.serialize_none(),
+    }
+}
+
+/// Why there is no steady state to report.
+#[derive(Debug, thiserror::Error)]
+pub enum SteadyError {
+    #[error(transparent)]
+    Solve(#[from] SolveError),
+    #[error(transparent)]
+    Settle(#[from] SettleError),
+    /// The refined cycle's saltation multipliers put it outside the unit circle although the
+    /// return map's differences did not: its stability is not decided at this tolerance.
+    #[error(
+        "the refined cycle's stability is undecided: its Floquet multipliers from the \
+         monodromy matrix are {multipliers}, the return map's differences gave {estimate}; \
+         the input is too close to a bifurcation of the cycle for this tolerance"
+    )]
+    Undecided {
+        multipliers: String,
+        estimate: String,
+    },
+    /// A value of the answer is not finite.
+    #[error("the steady state has a non-finite {name}: {value}")]
+    NonFinite { name: &'static str, value: f64 },
+}
+
+/// The steady state that `kind` reaches from `scene.x0` at `scene.u` (the scene's `tol` or
+/// `h` is the solver's setting; its `t_end`, `output` and `metrics_from` are not used).
+/// For the event-driven solver the integration tolerance is `opts.event.tol`.
+pub fn steady(
+    kind: SolverKind,
+    model: &Model,
+    scene: &Scene,
+    opts: &SteadyOptions,
+) -> Result<SteadyAnswer, SteadyError> {
+    scene.validate()?;
+    let answer = if kind == SolverKind::EVENT {
+        refined(model, scene.u, scene.x0, opts)?
+    } else {
+        let s = settle(kind, model, scene, &opts.settle)?;
+        SteadyAnswer {
+            state: s.state,
+            method: SteadyMethod::Simulated,
+            multipliers: None,
+            stats: s.stats,
+        }
+    };
+    for (name, value) in answer.state.values() {
+        if !value.is_finite() {
+            return Err(SteadyError::NonFinite { name, value });
+        }
+    }
+    Ok(answer)
+}
+
+/// The event-driven solver's refined steady state, with the saltation multipliers of a
+/// refined cycle.
+fn refined(
+    model: &Model,
+    u: f64,
+    x0: State,
+    opts: &SteadyOptions,
+) -> Result<SteadyAnswer, SteadyError> {
+    let st = rotor_event::steady_state(
+        model,
+        u,
+        x0,
+        &opts.event,
+        &rotor_event::EventOptions::default(),
+    )?;
+    let mut answer = SteadyAnswer {
+        state: st.state,
+        method: match st.method {
+            rotor_event::Method::Equilibrium => SteadyMethod::Equilibrium,
+            rotor_event::Method::Refined => SteadyMethod::Refined,
+            rotor_event::Method::Settled => SteadyMethod::Settled,
+        },
+        multipliers: None,
+        stats: Stats::default(),
+    };
+    let (rotor_event::Method::Refined, Some(x)) = (st.method, st.on_cycle) else {
+        return Ok(answer);
+    };
+    let one = Complex::new(1.0, 0.0);
+    // The difference estimate, completed with the trivial multiplier (and the 0 of a stick
+    // phase): the answer when the monodromy matrix is not available (no section level, i.e.
+    // no slipping equilibrium with ω > 0, as for u < 0).
+    let mut estimate = vec![one];
+    estimate.extend(&st.multipliers);
+    if estimate.len() == 2 {
+        estimate.push(Complex::new(0.0, 0.0));
+    }
+    match saltation_multipliers(model, u, x, opts.event.tol) {
+        Some((m, true)) => answer.multipliers = Some(m),
+        Some((m, false)) => {
+            return Err(SteadyError::Undecided {
+                multipliers: list(&m),
+                estimate: list(&st.multipliers),
+            });
+        }
+        None => answer.multipliers = Some(estimate),
+    }
+    Ok(answer)
+}
+
+/// The Floquet multipliers of the cycle through `x` from the monodromy matrix with saltation
+/// matrices, on the section `ω_l = ω*(u)` as the bifurcation diagram computes them, and
+/// whether the cycle is stable. `None` when the section or the monodromy is not available.
+fn saltation_multipliers(
+    model: &Model,
+    u: f64,
+    x: State,
+    tol: f64,
+) -> Option<(Vec<Complex<f64>>, bool)> {
+    let sh = Shooter { model, tol };
+    let c = sh.section_level(u).ok()?;
+    let to_section = rotor_event::flow(
+        model,
+        u,
+        tol,
+        x,
+        model.mode_at(&x, u),
+        T_RETURN,
+        rotor_event::StopAt::Section(c),
+    )
+    .ok()?;
+    if !to_section.reached {
+        return None;
+    }
+    let cont = Continuer {
+        sh,
+        opts: ContOptions {
+            u_min: u,
+            u_max: u,
+            h_max: 0.0,
+            h_min: 0.0,
+            newton_tol: 0.0,
+            amp_stop: 0.0,
+            max_nodes: 0,
+            fd_step: 0.0,
+            multipliers: Multipliers::Saltation,
+        },
+    };
+    let info = cont
+        .describe(u, c, [to_section.x[0], to_section.x[1]])
+        .ok()?;
+    Some((info.multipliers, info.stable))
+}
+
+fn list(m: &[Complex<f64>]) -> String {
+    m.iter()
+        .map(|z| format!("{:.6}{:+.6}i", z.re, z.im))
+        .collect::<Vec<_>>()
+        .join(", ")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::probes::{Attractor, expected};
+    use rotor_model::SteadyKind;
+
+    fn scene(u: f64) -> Scene {
+        Scene {
+            u,
+            ..Scene::default()
+        }
+    }
+
+    fn answer(kind: SolverKind, m: &Model, u: f64) -> SteadyAnswer {
+        steady(kind, m, &scene(u), &SteadyOptions::default())
+            .unwrap_or_else(|e| panic!("{} at {u} V: {e}", kind.name()))
+    }
+
+    fn cycle(st: &SteadyState) -> [f64; 3] {
+        match *st {
+            SteadyState::LimitCycle {
+                period,
+                omega_l_max,
+                omega_l_min,
+                ..
+            } => [period, omega_l_max, omega_l_min],
+            _ => panic!("not a cycle: {st:?}"),
+        }
+    }
+
+    /// Largest difference of period and ω_l extremes, relative with a floor of 1.
+    fn diff(a: [f64; 3], b: [f64; 3]) -> f64 {
+        a.iter()
+            .zip(&b)
+            .map(|(x, y)| (x - y).abs() / x.abs().max(y.abs()).max(1.0))
+            .fold(0.0, f64::max)
+    }
+
+    /// The first Hopf point of Table 1 (supercritical) at full precision.
+    fn hopf1(m: &Model) -> f64 {
+        rotor_bifurcation::equilibria::hopf_points(m, 20.0)[0]
+            .equilibrium
+            .u
+    }
+
+    /// 2e-4 V below the fold of cycles E (4.8430 V) the stable and the unstable cycle lie
+    /// close together; the return-map Newton once converged to the unstable one (ω_l in
+    /// [0.519, 16.761]) while the switch model and Moreau–Jean, which only simulate, reached
+    /// [0.478, 16.801]. The refined answer is now the stable cycle: it agrees with the switch
+    /// model's settled run within the switch model's probe agreement, 1e-5 (the wrong cycle
+    /// is 2.4e-3 away), and its saltation multipliers lie inside the unit circle.
+    #[test]
+    fn below_the_fold_of_cycles_the_event_solver_answers_the_stable_cycle() {
+        let m = Model::table1();
+        let ev = answer(SolverKind::EVENT, &m, 4.8428);
+        let sw = answer(SolverKind::SWITCH, &m, 4.8428);
+        assert_eq!(ev.method, SteadyMethod::Refined);
+        let d = diff(cycle(&ev.state), cycle(&sw.state));
+        assert!(
+            d <= 1e-5,
+            "event {:?} vs switch {:?}: {d:e}",
+            ev.state,
+            sw.state
+        );
+        let mu = ev
+            .multipliers
+            .as_ref()
+            .expect("a refined cycle has multipliers");
+        assert_eq!(mu.len(), 3);
+        // The trivial multiplier 1 (to the monodromy's accuracy, 1e-9 here) and the others
+        // inside the unit circle.
+        assert!(
+            (mu[0].re - 1.0).abs() < 1e-9 && mu[0].im.abs() < 1e-9,
+            "{mu:?}"
+        );
+        assert!(mu[1..].iter().all(|z| z.norm() < 1.0), "{mu:?}");
+    }
+
+    /// Just below the grazing end of the stick-slip branch (4.6153 V) the switch model once
+    /// answered a period-2 or period-3 cycle (period 8.43 or 12.64 s). Its answer is now the
+    /// one-period cycle of the event-driven solver: period and ω_l extremes within the switch
+    /// model's probe agreement, 1e-5 (a period-2 cycle is 100 % away).
+    #[test]
+    fn below_the_grazing_end_the_switch_model_answers_the_one_period_cycle() {
+        let m = Model::table1();
+        for u in [4.615_276_8, 4.615_276_875_05 - 1e-6] {
+            let ev = answer(SolverKind::EVENT, &m, u);
+            let sw = answer(SolverKind::SWITCH, &m, u);
+            let d = diff(cycle(&ev.state), cycle(&sw.state));
+            assert!(
+                d <= 1e-5,
+                "{u} V: event {:?} vs switch {:?}",
+                ev.state,
+                sw.state
+            );
+        }
+    }
+
+    /// At 1e-4 V above the first Hopf point every solver gave up after 20 000 s (the small
+    /// cycle grows at a rate proportional to u − u_H). The event-driven solver now answers
+    /// it: the stable cycle of the continuation at that input (Newton from the Hopf
+    /// eigenvector), within 1e-6 (its probe agreement); just below the Hopf point (1e-6 V) it
+    /// answers the equilibrium the orbit spirals into, which no run settles on in 20 000 s.
+    #[test]
+    fn next_to_the_first_hopf_point_the_event_solver_answers() {
+        let m = Model::table1();
+        let uh = hopf1(&m);
+        let d =
+            rotor_bifurcation::diagram(&m, &rotor_bifurcation::DiagramOptions::default()).unwrap();
+        let above = uh + 1e-4;
+        let ev = answer(SolverKind::EVENT, &m, above);
+        let cycles: Vec<[f64; 3]> = expected(&m, &d, above)
+            .into_iter()
+            .filter_map(|a| match a {
+                Attractor::Cycle {
+                    period,
+                    omega_l_max,
+                    omega_l_min,
+                    ..
+                } => Some([period, omega_l_max, omega_l_min]),
+                _ => None,
+            })
+            .collect();
+        assert_eq!(cycles.len(), 1, "one stable cycle at {above} V");
+        let dd = diff(cycle(&ev.state), cycles[0]);
+        assert!(dd <= 1e-6, "{:?} vs {:?}: {dd:e}", ev.state, cycles[0]);
+        assert!(ev.multipliers.unwrap()[1..].iter().all(|z| z.norm() < 1.0));
+
+        let below = uh - 1e-6;
+        let ev = answer(SolverKind::EVENT, &m, below);
+        assert_eq!(ev.state.kind(), SteadyKind::Equilibrium, "{:?}", ev.state);
+        let eq = m.slip_equilibria(below)[0];
+        assert!(m.equilibrium_is_stable(&eq));
+        let SteadyState::Equilibrium { omega_l, alpha, .. } = ev.state else {
+            unreachable!()
+        };
+        assert_eq!((omega_l, alpha), (eq.omega, eq.alpha));
+    }
+
+    /// The JSON of `rotor steady`: the metrics, then how they were obtained, then the
+    /// multipliers (`null` for a simulated answer).
+    #[test]
+    fn the_answer_serializes_with_method_and_multipliers() {
+        let m = Model::table1();
+        let ev = serde_json::to_value(answer(SolverKind::EVENT, &m, 1.5)).unwrap();
+        assert_eq!(ev["kind"], "limit_cycle");
+        assert_eq!(ev["method"], "refined");
+        assert_eq!(ev["multipliers"].as_array().unwrap().len(), 3);
+        let sw = serde_json::to_value(answer(SolverKind::SWITCH, &m, 1.5)).unwrap();
+        assert_eq!(sw["method"], "simulated");
+        assert!(sw["multipliers"].is_null());
+    }
+}
