@@ -3,6 +3,8 @@
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
+mod open;
+
 use anyhow::{Context, Result, anyhow, bail};
 use clap::{Parser, Subcommand};
 use rotor_compare::SolverKind;
@@ -79,6 +81,32 @@ enum Command {
         /// Skip the peers even when python3 with scipy / Siconos is installed.
         #[arg(long)]
         no_peers: bool,
+    },
+    /// Write the benchmark's reference data for every scenario: trace, events and steady
+    /// state of the event-driven solver, with their stated errors.
+    Reference {
+        /// Output directory (default: fixtures/reference).
+        #[arg(long)]
+        out: Option<PathBuf>,
+    },
+    /// Grade one trace (CSV t,alpha,omega_u,omega_l on the scenario's grid) against the
+    /// reference with the scenario's own gates. Exit 0: every gate passes; 1: a gate fails;
+    /// 2: the input is unusable.
+    Check {
+        /// Scenario file (its reference is read from fixtures/reference beside it).
+        scenario: PathBuf,
+        /// The trace to grade.
+        #[arg(long)]
+        trace: PathBuf,
+        /// The trace's events (CSV t,disc,kind), to grade the event times.
+        #[arg(long)]
+        events: Option<PathBuf>,
+        /// strict (the event-switch tolerances) or loose (event-moreau).
+        #[arg(long, default_value = "loose")]
+        gate: String,
+        /// Write the verdict as JSON (`-`: standard output).
+        #[arg(long)]
+        json: Option<PathBuf>,
     },
     /// Run scenarios through the three solvers, gate their agreement, write the report.
     Compare {
@@ -722,6 +750,20 @@ fn main() -> ExitCode {
             *no_peers,
         ),
         Some(Command::Compare { scenarios, report }) => compare(scenarios, report, false),
+        Some(Command::Reference { out }) => {
+            let fixtures = fixtures_dir();
+            let out = out.clone().unwrap_or_else(|| open::default_out(&fixtures));
+            open::write_reference(&fixtures.join("scenarios"), &out)
+        }
+        Some(Command::Check {
+            scenario,
+            trace,
+            events,
+            gate,
+            json,
+        }) => {
+            return open::check_trace(scenario, trace, events.as_deref(), gate, json.as_deref());
+        }
         None => compare(&[], Path::new("reports"), true),
     };
     match res {

@@ -281,3 +281,60 @@ fn a_report_written_twice_is_the_same_bytes() {
     );
     std::fs::remove_dir_all(&base).ok();
 }
+
+/// `rotor check`: exit 0 for the reference's own trace, 1 with the failing quantity named
+/// for a trace moved beyond a gate, 2 with the line named for a malformed one; `--json`
+/// writes the contract's fields.
+#[test]
+fn check_grades_with_exit_codes_0_1_2() {
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
+    let scenario = root.join("fixtures/scenarios/t1-u0.02-rest.toml");
+    let good = root.join("fixtures/reference/t1-u0.02-rest.csv");
+    let dir = std::env::temp_dir().join(format!("rotor-cli-check-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let run = |trace: &std::path::Path, extra: &[&str]| {
+        let mut args = vec![
+            "check",
+            scenario.to_str().unwrap(),
+            "--trace",
+            trace.to_str().unwrap(),
+        ];
+        args.extend_from_slice(extra);
+        rotor(&args)
+    };
+    let o = run(&good, &["--gate", "strict", "--json", "-"]);
+    assert_eq!(
+        o.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert_eq!(v["scenario"], "t1-u0.02-rest");
+    assert_eq!(v["passed"], true);
+    assert_eq!(v["gate"], "strict");
+    for key in ["name", "difference", "tolerance", "passed", "digits"] {
+        assert!(v["quantities"][0].get(key).is_some(), "{key}: {v}");
+    }
+    let text = std::fs::read_to_string(&good).unwrap();
+    let mut lines: Vec<String> = text.lines().map(str::to_owned).collect();
+    // ω_l at t = 1 s moved by 1 rad/s: far beyond the transient gate.
+    let mut f: Vec<String> = lines[101].split(',').map(str::to_owned).collect();
+    f[3] = (f[3].parse::<f64>().unwrap() + 1.0).to_string();
+    lines[101] = f.join(",");
+    let bad = dir.join("bad.csv");
+    std::fs::write(&bad, lines.join("\n") + "\n").unwrap();
+    let o = run(&bad, &[]);
+    assert_eq!(o.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("failing: transient_omega_l"));
+    lines.remove(50);
+    let broken = dir.join("broken.csv");
+    std::fs::write(&broken, lines.join("\n") + "\n").unwrap();
+    let o = run(&broken, &[]);
+    assert_eq!(o.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(err.contains("broken.csv: line 51"), "{err}");
+    let o = run(&good, &["--gate", "lax"]);
+    assert_eq!(o.status.code(), Some(2));
+    std::fs::remove_dir_all(&dir).ok();
+}

@@ -1,8 +1,11 @@
 //! Cross-validation: identical scenarios through the three independent solvers, agreement
 //! gates on θ̇_u and θ̇_l, and the report.
 
+pub mod check;
 pub mod gate;
+pub mod gridmetrics;
 pub mod probes;
+pub mod reference;
 pub mod report;
 pub mod run;
 pub mod settle;

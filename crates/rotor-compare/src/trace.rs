@@ -5,10 +5,13 @@
 //! Reading is strict, because a trace graded against the reference must be what it claims:
 //! a wrong header, a field that is not a finite number, a row of the wrong length or an empty
 //! file is an error naming the file, the line and the column.
+//!
+//! The events file of the benchmark (`t,disc,kind`, disc `upper|lower`, kind
+//! `stick_start|stick_end|reversal`) is written and read here as well.
 
 use std::path::{Path, PathBuf};
 
-use rotor_model::{Sample, State};
+use rotor_model::{Disc, Event, EventKind, Sample, State};
 use thiserror::Error;
 
 /// The header of a trace file.
@@ -80,11 +83,12 @@ pub enum TraceError {
     Io { path: PathBuf, message: String },
     #[error("{}: the file is empty (expected the header t,alpha,omega_u,omega_l)", .path.display())]
     Empty { path: PathBuf },
-    #[error("{}: line {line}: the header is {found:?}, expected \"t,alpha,omega_u,omega_l\"", .path.display())]
+    #[error("{}: line {line}: the header is {found:?}, expected {expected:?}", .path.display())]
     Header {
         path: PathBuf,
         line: u64,
         found: String,
+        expected: &'static str,
     },
     #[error("{}: line {line}, column {column} ({name}): {value:?} is not a finite number", .path.display())]
     Value {
@@ -94,11 +98,21 @@ pub enum TraceError {
         name: &'static str,
         value: String,
     },
-    #[error("{}: line {line}: {found} fields, expected 4 (t,alpha,omega_u,omega_l)", .path.display())]
+    #[error("{}: line {line}, column {column} ({name}): {value:?} is not one of {expected}", .path.display())]
+    Word {
+        path: PathBuf,
+        line: u64,
+        column: usize,
+        name: &'static str,
+        value: String,
+        expected: &'static str,
+    },
+    #[error("{}: line {line}: {found} fields, expected {expected}", .path.display())]
     Fields {
         path: PathBuf,
         line: u64,
         found: usize,
+        expected: &'static str,
     },
     #[error("{}: line {line}: {message}", .path.display())]
     Csv {
@@ -155,6 +169,7 @@ pub fn parse_trace(bytes: &[u8], path: &Path) -> Result<Trace, TraceError> {
             path: p(),
             line: line_of(&header),
             found: header.iter().collect::<Vec<_>>().join(","),
+            expected: "t,alpha,omega_u,omega_l",
         });
     }
     let mut samples = Vec::new();
@@ -171,6 +186,7 @@ pub fn parse_trace(bytes: &[u8], path: &Path) -> Result<Trace, TraceError> {
                 path: p(),
                 line,
                 found: rec.len(),
+                expected: "4 (t,alpha,omega_u,omega_l)",
             });
         }
         let mut v = [0.0; 4];
@@ -200,6 +216,156 @@ pub fn parse_trace(bytes: &[u8], path: &Path) -> Result<Trace, TraceError> {
     Ok(Trace {
         path: path.to_owned(),
         samples,
+        lines,
+    })
+}
+
+/// The header of an events file.
+pub const EVENTS_HEADER: [&str; 3] = ["t", "disc", "kind"];
+
+/// `upper` or `lower`.
+pub fn disc_name(d: Disc) -> &'static str {
+    match d {
+        Disc::Upper => "upper",
+        Disc::Lower => "lower",
+    }
+}
+
+/// The disc and the events-file name of a mode-switch event (`None` for extrema, which the
+/// file does not hold).
+pub fn event_row(kind: EventKind) -> Option<(Disc, &'static str)> {
+    match kind {
+        EventKind::StickStart(d) => Some((d, "stick_start")),
+        EventKind::StickEnd(d) => Some((d, "stick_end")),
+        EventKind::Reversal(d) => Some((d, "reversal")),
+        EventKind::Max(_) | EventKind::Min(_) => None,
+    }
+}
+
+/// The events file of a run: one row per stick onset, stick exit and reversal of either disc,
+/// in time order (extrema are left out), times in the shortest round-trip form.
+pub fn write_events(events: &[Event]) -> Vec<u8> {
+    let mut out = String::from("t,disc,kind\n");
+    let mut b = ryu::Buffer::new();
+    for e in events {
+        if let Some((d, k)) = event_row(e.kind) {
+            out.push_str(b.format(e.t));
+            out.push(',');
+            out.push_str(disc_name(d));
+            out.push(',');
+            out.push_str(k);
+            out.push('\n');
+        }
+    }
+    out.into_bytes()
+}
+
+/// An events file as read: the events with the line each came from.
+#[derive(Debug, Clone, PartialEq)]
+pub struct EventsFile {
+    pub path: PathBuf,
+    pub events: Vec<Event>,
+    /// The file line of each event (1-based; the header is line 1).
+    pub lines: Vec<u64>,
+}
+
+/// Reads an events file.
+pub fn read_events(path: &Path) -> Result<EventsFile, TraceError> {
+    let bytes = std::fs::read(path).map_err(|e| TraceError::Io {
+        path: path.to_owned(),
+        message: e.to_string(),
+    })?;
+    parse_events(&bytes, path)
+}
+
+/// Parses an events file (the events' states are not in the file: they are zero). An empty
+/// list of events after the header is valid (a run without a stick or a reversal).
+pub fn parse_events(bytes: &[u8], path: &Path) -> Result<EventsFile, TraceError> {
+    let p = || path.to_owned();
+    if bytes.iter().all(|b| b.is_ascii_whitespace()) {
+        return Err(TraceError::Empty { path: p() });
+    }
+    let mut r = csv::ReaderBuilder::new()
+        .has_headers(false)
+        .flexible(true)
+        .trim(csv::Trim::All)
+        .from_reader(bytes);
+    let mut records = r.records();
+    let line_of = |rec: &csv::StringRecord| rec.position().map_or(0, |pos| pos.line());
+    let csv_err = |e: csv::Error| TraceError::Csv {
+        path: p(),
+        line: e.position().map_or(0, |pos| pos.line()),
+        message: e.to_string(),
+    };
+    let header = records
+        .next()
+        .ok_or_else(|| TraceError::Empty { path: p() })?
+        .map_err(csv_err)?;
+    if header.iter().collect::<Vec<_>>() != EVENTS_HEADER {
+        return Err(TraceError::Header {
+            path: p(),
+            line: line_of(&header),
+            found: header.iter().collect::<Vec<_>>().join(","),
+            expected: "t,disc,kind",
+        });
+    }
+    let mut out = Vec::new();
+    let mut lines = Vec::new();
+    for rec in records {
+        let rec = rec.map_err(csv_err)?;
+        let line = line_of(&rec);
+        if rec.len() == 1 && rec[0].is_empty() {
+            continue;
+        }
+        if rec.len() != 3 {
+            return Err(TraceError::Fields {
+                path: p(),
+                line,
+                found: rec.len(),
+                expected: "3 (t,disc,kind)",
+            });
+        }
+        let t = match rec[0].parse::<f64>() {
+            Ok(x) if x.is_finite() => x,
+            _ => {
+                return Err(TraceError::Value {
+                    path: p(),
+                    line,
+                    column: 1,
+                    name: "t",
+                    value: rec[0].to_owned(),
+                });
+            }
+        };
+        let word = |column: usize, name: &'static str, expected: &'static str| TraceError::Word {
+            path: p(),
+            line,
+            column,
+            name,
+            value: rec[column - 1].to_owned(),
+            expected,
+        };
+        let disc = match &rec[1] {
+            "upper" => Disc::Upper,
+            "lower" => Disc::Lower,
+            _ => return Err(word(2, "disc", "upper, lower")),
+        };
+        let kind = match &rec[2] {
+            "stick_start" => EventKind::StickStart(disc),
+            "stick_end" => EventKind::StickEnd(disc),
+            "reversal" => EventKind::Reversal(disc),
+            _ => return Err(word(3, "kind", "stick_start, stick_end, reversal")),
+        };
+        out.push(Event {
+            t,
+            x: State::zeros(),
+            kind,
+        });
+        lines.push(line);
+    }
+    Ok(EventsFile {
+        path: path.to_owned(),
+        events: out,
         lines,
     })
 }
@@ -284,5 +450,58 @@ mod tests {
         assert!(e.contains("line 2: 5 fields"), "{e}");
         let e = err("t,alpha,omega_u,omega_l\n0,0,0,\n");
         assert!(e.contains("line 2, column 4"), "{e}");
+    }
+
+    #[test]
+    fn events_files_round_trip_and_name_bad_fields() {
+        let ev = |t: f64, kind: EventKind| Event {
+            t,
+            x: State::zeros(),
+            kind,
+        };
+        let events = vec![
+            ev(0.5, EventKind::StickStart(Disc::Lower)),
+            ev(0.75, EventKind::Max(Disc::Lower)),
+            ev(1.0 / 3.0, EventKind::StickEnd(Disc::Lower)),
+            ev(2.0, EventKind::Reversal(Disc::Upper)),
+        ];
+        let bytes = write_events(&events);
+        let text = String::from_utf8(bytes.clone()).unwrap();
+        assert_eq!(
+            text,
+            "t,disc,kind\n0.5,lower,stick_start\n0.3333333333333333,lower,stick_end\n\
+             2.0,upper,reversal\n"
+        );
+        let back = parse_events(&bytes, Path::new("e.csv")).unwrap();
+        assert_eq!(back.lines, [2, 3, 4]);
+        let kinds: Vec<(f64, EventKind)> = back.events.iter().map(|e| (e.t, e.kind)).collect();
+        assert_eq!(
+            kinds,
+            [
+                (0.5, EventKind::StickStart(Disc::Lower)),
+                (1.0 / 3.0, EventKind::StickEnd(Disc::Lower)),
+                (2.0, EventKind::Reversal(Disc::Upper)),
+            ]
+        );
+        assert!(
+            parse_events(b"t,disc,kind\n", Path::new("e.csv"))
+                .unwrap()
+                .events
+                .is_empty()
+        );
+        let err = |text: &str| {
+            parse_events(text.as_bytes(), Path::new("e.csv"))
+                .unwrap_err()
+                .to_string()
+        };
+        assert!(err("t,d,kind\n").contains("line 1: the header"));
+        let e = err("t,disc,kind\n1,middle,stick_start\n");
+        assert!(e.contains("line 2, column 2 (disc): \"middle\""), "{e}");
+        let e = err("t,disc,kind\n1,lower,stop\n");
+        assert!(e.contains("line 2, column 3 (kind)"), "{e}");
+        let e = err("t,disc,kind\nx,lower,stick_end\n");
+        assert!(e.contains("line 2, column 1 (t)"), "{e}");
+        let e = err("t,disc,kind\n1,lower\n");
+        assert!(e.contains("line 2: 2 fields, expected 3"), "{e}");
     }
 }

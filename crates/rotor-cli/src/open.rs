@@ -1,0 +1,108 @@
+//! The open benchmark's commands: `rotor reference` and `rotor check`.
+
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+
+use anyhow::{Context, Result};
+use rayon::prelude::*;
+use rotor_compare::check::{CheckError, Strictness, check};
+use rotor_compare::reference;
+
+/// `rotor reference [--out DIR]`: the reference files of every scenario.
+pub fn write_reference(scenarios_dir: &Path, out: &Path) -> Result<()> {
+    let files = rotor_model::Scenario::list_dir(scenarios_dir)
+        .with_context(|| format!("{}: cannot list scenarios", scenarios_dir.display()))?;
+    let scenarios = files
+        .iter()
+        .map(|f| rotor_compare::load_scenario(f))
+        .collect::<Result<Vec<_>, _>>()?;
+    std::fs::create_dir_all(out).with_context(|| format!("{}: cannot create", out.display()))?;
+    let refs = scenarios
+        .par_iter()
+        .map(reference::compute)
+        .collect::<Result<Vec<_>, _>>()?;
+    for r in &refs {
+        let name = &r.json.scenario;
+        for (path, bytes) in reference::paths(out, name)
+            .iter()
+            .zip(reference::to_files(r))
+        {
+            rotor_compare::report::write_atomic(path, &bytes)
+                .with_context(|| format!("{}: cannot write", path.display()))?;
+        }
+        let worst = |n: &str| r.error(n);
+        println!(
+            "{name}: {} samples, {} events, {} significant digits; stated error omega_l {:.1e} \
+             rad/s, event times {:.1e} s",
+            r.samples.len(),
+            r.events.len(),
+            r.json.trace_digits,
+            worst("omega_l"),
+            worst("event_time"),
+        );
+    }
+    println!("{} references in {}", refs.len(), out.display());
+    Ok(())
+}
+
+/// `rotor check`: 0 when every gate passes, 1 when one fails, 2 when the input is unusable.
+pub fn check_trace(
+    scenario: &Path,
+    trace: &Path,
+    events: Option<&Path>,
+    gate: &str,
+    json: Option<&Path>,
+) -> ExitCode {
+    match grade(scenario, trace, events, gate, json) {
+        Ok(true) => ExitCode::SUCCESS,
+        Ok(false) => ExitCode::from(1),
+        Err(e) => {
+            eprintln!("error: {e:#}");
+            ExitCode::from(2)
+        }
+    }
+}
+
+/// The verdict (`Ok(passed)`), or why the input cannot be graded.
+fn grade(
+    scenario: &Path,
+    trace: &Path,
+    events: Option<&Path>,
+    gate: &str,
+    json: Option<&Path>,
+) -> Result<bool> {
+    let strictness = Strictness::by_name(gate).ok_or_else(|| {
+        anyhow::anyhow!(
+            "--gate {gate:?}: expected strict (event-switch tolerances) or loose (event-moreau)"
+        )
+    })?;
+    let sc = rotor_compare::load_scenario(scenario)?;
+    let dir = reference::dir_for(scenario);
+    let r = reference::read(&dir, &sc.name)?;
+    let t = rotor_compare::trace::read_trace(trace).map_err(CheckError::from)?;
+    let ev = events
+        .map(rotor_compare::trace::read_events)
+        .transpose()
+        .map_err(CheckError::from)?;
+    let report = check(&sc, &r, &t, ev.as_ref(), strictness)?;
+    if let Some(path) = json {
+        let text = serde_json::to_string_pretty(&report)? + "\n";
+        rotor_compare::report::write_output(path, text.as_bytes())
+            .with_context(|| format!("{}: cannot write", path.display()))?;
+    }
+    let table = report.table();
+    if json.is_some_and(|p| p.as_os_str() == "-") {
+        eprint!("{table}");
+    } else {
+        print!("{table}");
+    }
+    if !report.passed {
+        eprintln!("failing: {}", report.failing().join(", "));
+    }
+    Ok(report.passed)
+}
+
+/// The default reference directory.
+pub fn default_out(fixtures: &Path) -> PathBuf {
+    fixtures.join("reference")
+}

@@ -1,0 +1,501 @@
+//! The benchmark's reference data (`rotor reference`, `fixtures/reference/`): for every
+//! scenario the event-driven solver's trace on the scenario's grid, its events, and its steady
+//! state, each with the reference's own error estimate and how it was obtained.
+//!
+//! * **Trace** `<name>.csv` (`t,alpha,omega_u,omega_l`, every `dt` over `[0, t_end]`) and
+//!   **events** `<name>.events.csv` (`t,disc,kind`): the event-driven solver at
+//!   [`REFERENCE_TOL`]. Values are rounded to the significant digits that the error estimate
+//!   justifies (half a unit of the last digit is at most a tenth of the estimate).
+//! * **Steady state** `<name>.json`: the metrics of the last complete cycle in
+//!   `[steady_from, t_end]` as `rotor steady` prints them, with `error` (per quantity), how
+//!   it was estimated, and the cross-check against the switch model and Moreau–Jean.
+//!
+//! The error estimate of each quantity is its difference from the same solver at the tighter
+//! [`CHECK_TOL`], times [`ERROR_MARGIN`] (the tighter run is itself not exact), with a floor of
+//! what double precision resolves on it. The cross-check is reported, not folded in: the
+//! other two solvers are less accurate than the reference by design.
+
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+
+use rotor_model::{Event, Output, Sample, Scenario, Scene, SolveError, SteadyState};
+use serde::{Deserialize, Serialize};
+
+use crate::solvers::SolverKind;
+use crate::trace::{TraceError, parse_events, parse_trace, write_events};
+
+/// Tolerance of the reference run.
+pub const REFERENCE_TOL: f64 = 1e-12;
+/// Tolerance of the run the reference's error is estimated against.
+pub const CHECK_TOL: f64 = 1e-13;
+/// The difference to the tighter run times this is the stated error: the tighter run errs
+/// by about a tenth of the reference's (the event-driven solver's error is proportional to its
+/// tolerance: `crates/rotor-event/tests/solver.rs`), so the difference is within 10 % of the
+/// reference's true error, and 2 covers that with room.
+pub const ERROR_MARGIN: f64 = 2.0;
+/// Smallest stated error, relative to the quantity's scale: a few units of double rounding.
+const FLOOR_REL: f64 = 1e-14;
+
+/// The `<name>.json` of a reference.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ReferenceJson {
+    pub scenario: String,
+    /// The steady state as `rotor steady` prints it (`kind` and its metrics), over the
+    /// scenario's `[steady_from, t_end]`; absent when the scenario compares no steady state.
+    #[serde(flatten)]
+    pub steady: Option<SteadyJson>,
+    /// How the reference was computed.
+    pub solver: String,
+    pub tol: f64,
+    pub dt: f64,
+    pub t_end: f64,
+    pub steady_from: Option<f64>,
+    pub transient: Option<[f64; 2]>,
+    /// Significant digits of the values in the trace file.
+    pub trace_digits: u32,
+    /// The stated error of each quantity (same units as the quantity): `alpha`, `omega_u`,
+    /// `omega_l` (the trace, largest over the run), `event_time` (largest over the events),
+    /// and each steady metric by its name.
+    pub error: BTreeMap<String, f64>,
+    pub error_method: String,
+    /// Differences of the switch model and Moreau–Jean (at the scenario's settings) from the
+    /// reference, per quantity as in `error`: the same answer from two independent methods.
+    /// `null` where they cannot be compared (a different number of events or another kind of
+    /// steady state).
+    pub cross_check: BTreeMap<String, CrossCheck>,
+}
+
+/// A steady state's fields, as in `rotor steady`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "kind", rename_all = "snake_case")]
+pub enum SteadyJson {
+    Equilibrium {
+        omega_u: f64,
+        omega_l: f64,
+        alpha: f64,
+    },
+    LimitCycle {
+        period: f64,
+        omega_l_max: f64,
+        omega_l_min: f64,
+        omega_u_max: f64,
+        omega_u_min: f64,
+        stick_time: f64,
+    },
+}
+
+impl From<SteadyState> for SteadyJson {
+    fn from(s: SteadyState) -> SteadyJson {
+        match s {
+            SteadyState::Equilibrium {
+                omega_u,
+                omega_l,
+                alpha,
+            } => SteadyJson::Equilibrium {
+                omega_u,
+                omega_l,
+                alpha,
+            },
+            SteadyState::LimitCycle {
+                period,
+                omega_l_max,
+                omega_l_min,
+                omega_u_max,
+                omega_u_min,
+                stick_time,
+            } => SteadyJson::LimitCycle {
+                period,
+                omega_l_max,
+                omega_l_min,
+                omega_u_max,
+                omega_u_min,
+                stick_time,
+            },
+        }
+    }
+}
+
+impl From<&SteadyJson> for SteadyState {
+    fn from(s: &SteadyJson) -> SteadyState {
+        match *s {
+            SteadyJson::Equilibrium {
+                omega_u,
+                omega_l,
+                alpha,
+            } => SteadyState::Equilibrium {
+                omega_u,
+                omega_l,
+                alpha,
+            },
+            SteadyJson::LimitCycle {
+                period,
+                omega_l_max,
+                omega_l_min,
+                omega_u_max,
+                omega_u_min,
+                stick_time,
+            } => SteadyState::LimitCycle {
+                period,
+                omega_l_max,
+                omega_l_min,
+                omega_u_max,
+                omega_u_min,
+                stick_time,
+            },
+        }
+    }
+}
+
+/// One solver's differences from the reference.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct CrossCheck {
+    /// `tol 1e-10` or `h 1e-3`.
+    pub setting: String,
+    pub differences: BTreeMap<String, Option<f64>>,
+}
+
+/// A reference: what the three files hold.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Reference {
+    pub samples: Vec<Sample>,
+    pub events: Vec<Event>,
+    pub json: ReferenceJson,
+}
+
+/// Why a reference cannot be computed or read.
+#[derive(Debug, thiserror::Error)]
+pub enum ReferenceError {
+    #[error("scenario {scenario}: {source}")]
+    Solve {
+        scenario: String,
+        #[source]
+        source: SolveError,
+    },
+    #[error(transparent)]
+    Trace(#[from] TraceError),
+    #[error("{}: {message}", .path.display())]
+    File { path: PathBuf, message: String },
+}
+
+impl Reference {
+    /// The stated error of a quantity (0 if not stated).
+    pub fn error(&self, name: &str) -> f64 {
+        self.json.error.get(name).copied().unwrap_or(0.0)
+    }
+
+    /// The steady state, if the scenario compares one.
+    pub fn steady(&self) -> Option<SteadyState> {
+        self.json.steady.as_ref().map(SteadyState::from)
+    }
+}
+
+/// The reference run of a scenario at tolerance `tol`: grid samples, events, metrics.
+fn event_run(sc: &Scenario, tol: f64) -> Result<rotor_model::Trajectory, ReferenceError> {
+    let scene = Scene {
+        tol,
+        ..sc.scene(Output::Grid { dt: sc.compare.dt })
+    };
+    SolverKind::EVENT
+        .solver()
+        .simulate_finite(&sc.model, &scene)
+        .map_err(|source| ReferenceError::Solve {
+            scenario: sc.name.clone(),
+            source,
+        })
+}
+
+/// Mode-switch events (no extrema), as the events file holds them.
+fn switches(events: &[Event]) -> Vec<Event> {
+    events
+        .iter()
+        .filter(|e| crate::trace::event_row(e.kind).is_some())
+        .copied()
+        .collect()
+}
+
+/// Largest |a − b| of each state component over two runs on the same grid (∞ if the grids
+/// differ).
+fn trace_differences(a: &[Sample], b: &[Sample]) -> [f64; 3] {
+    if a.len() != b.len() {
+        return [f64::INFINITY; 3];
+    }
+    let mut d = [0.0f64; 3];
+    for (x, y) in a.iter().zip(b) {
+        for (i, di) in d.iter_mut().enumerate() {
+            *di = di.max((x.x[i] - y.x[i]).abs());
+        }
+    }
+    d
+}
+
+/// Largest |Δt| of the events matched in order (∞ if their sequences differ).
+fn event_difference(a: &[Event], b: &[Event]) -> f64 {
+    if a.len() != b.len() || a.iter().zip(b).any(|(x, y)| x.kind != y.kind) {
+        return f64::INFINITY;
+    }
+    a.iter()
+        .zip(b)
+        .map(|(x, y)| (x.t - y.t).abs())
+        .fold(0.0, f64::max)
+}
+
+/// The differences of a run from the reference, per quantity (∞ where not comparable).
+fn differences(
+    r: &rotor_model::Trajectory,
+    reference: &rotor_model::Trajectory,
+) -> BTreeMap<String, f64> {
+    let d = trace_differences(&r.samples, &reference.samples);
+    let mut out: BTreeMap<String, f64> = ["alpha", "omega_u", "omega_l"]
+        .iter()
+        .zip(d)
+        .map(|(n, e)| ((*n).to_owned(), e))
+        .collect();
+    out.insert(
+        "event_time".into(),
+        event_difference(&switches(&r.events), &switches(&reference.events)),
+    );
+    if let (Some(a), Some(b)) = (r.metrics, reference.metrics) {
+        if a.kind() == b.kind() {
+            for ((name, va), (_, vb)) in a.values().into_iter().zip(b.values()) {
+                out.insert(name.into(), (va - vb).abs());
+            }
+        } else {
+            out.insert("steady_kind".into(), f64::INFINITY);
+        }
+    }
+    out
+}
+
+/// `x` rounded to `digits` significant digits.
+pub fn round_sig(x: f64, digits: u32) -> f64 {
+    if x == 0.0 || !x.is_finite() {
+        return x;
+    }
+    let e = x.abs().log10().floor() as i32;
+    let scale = 10f64.powi(digits as i32 - 1 - e);
+    let r = (x * scale).round() / scale;
+    if r.is_finite() { r } else { x }
+}
+
+/// `x ≥ 0` rounded up to `digits` significant digits (a stated error never shrinks): the
+/// decimal `⌈x·10^k⌉/10^k`, nudged up by an ulp if its nearest double lies below `x`.
+fn round_up_sig(x: f64, digits: u32) -> f64 {
+    if x == 0.0 || !x.is_finite() {
+        return x;
+    }
+    let e = x.abs().log10().floor() as i32;
+    let scale = 10f64.powi(digits as i32 - 1 - e);
+    let r = (x * scale).ceil() / scale;
+    if r >= x { r } else { r.next_up() }
+}
+
+/// Computes the reference of a scenario (three event-driven runs: the reference, the tighter
+/// one, and the cross-check runs of the other two solvers).
+pub fn compute(sc: &Scenario) -> Result<Reference, ReferenceError> {
+    let r = event_run(sc, REFERENCE_TOL)?;
+    let tight = event_run(sc, CHECK_TOL)?;
+    // The stated error: the difference to the tighter run, with a margin and a floor.
+    let scale_of = |name: &str| -> f64 {
+        let comp = match name {
+            "alpha" => Some(0),
+            "omega_u" => Some(1),
+            "omega_l" => Some(2),
+            _ => None,
+        };
+        match comp {
+            Some(i) => r.samples.iter().map(|s| s.x[i].abs()).fold(1.0, f64::max),
+            None if name == "event_time" => sc.t_end,
+            None => r
+                .metrics
+                .map(|m| {
+                    m.values()
+                        .into_iter()
+                        .find(|(n, _)| *n == name)
+                        .map_or(1.0, |(_, v)| v.abs().max(1.0))
+                })
+                .unwrap_or(1.0),
+        }
+    };
+    let error: BTreeMap<String, f64> = differences(&r, &tight)
+        .into_iter()
+        .map(|(name, e)| {
+            let stated = (ERROR_MARGIN * e).max(FLOOR_REL * scale_of(&name));
+            (name, stated)
+        })
+        .collect();
+    if let Some((name, _)) = error.iter().find(|(_, e)| !e.is_finite()) {
+        return Err(ReferenceError::Solve {
+            scenario: sc.name.clone(),
+            source: SolveError::NoConvergence {
+                detail: format!(
+                    "the reference and the run at tol {CHECK_TOL:e} differ in {name} (another \
+                     event sequence or steady kind): no error can be stated"
+                ),
+            },
+        });
+    }
+    // Trace digits: half a unit of the last digit ≤ a tenth of the smallest relative error
+    // of the three components.
+    let rel = ["alpha", "omega_u", "omega_l"]
+        .iter()
+        .map(|n| error.get(*n).map_or(f64::INFINITY, |e| e / scale_of(n)))
+        .fold(f64::INFINITY, f64::min);
+    let trace_digits = ((0.5 / (0.1 * rel)).log10().ceil() as u32 + 1).clamp(6, 17);
+    let samples: Vec<Sample> = r
+        .samples
+        .iter()
+        .map(|s| Sample {
+            t: s.t,
+            x: s.x.map(|v| round_sig(v, trace_digits)),
+        })
+        .collect();
+    let mut cross_check = BTreeMap::new();
+    for kind in [SolverKind::SWITCH, SolverKind::MOREAU] {
+        let scene = crate::run::scene_for(kind, sc);
+        let run = kind
+            .solver()
+            .simulate_finite(&sc.model, &scene)
+            .map_err(|source| ReferenceError::Solve {
+                scenario: format!("{} ({})", sc.name, kind.name()),
+                source,
+            })?;
+        let (tol, h) = crate::run::solver_settings(kind, sc);
+        cross_check.insert(
+            kind.name().to_owned(),
+            CrossCheck {
+                setting: kind.setting_label(if kind.is_fixed_step() { h } else { tol }),
+                differences: differences(&run, &r)
+                    .into_iter()
+                    .map(|(n, d)| (n, d.is_finite().then_some(d)))
+                    .collect(),
+            },
+        );
+    }
+    // Metrics to the digits their error justifies (as the trace), errors and differences to
+    // two: the file changes only when a result does, not with the last bits of a machine.
+    let steady = sc.compare.steady_from.and(r.metrics).map(|m| {
+        let rounded = |name: &str, v: f64| {
+            let e = error.get(name).copied().unwrap_or(0.0);
+            let d = if v == 0.0 || e == 0.0 {
+                17
+            } else {
+                ((v.abs() / (0.1 * e)).log10().ceil() as u32 + 1).clamp(2, 17)
+            };
+            round_sig(v, d)
+        };
+        let mut m = m;
+        match &mut m {
+            SteadyState::Equilibrium {
+                omega_u,
+                omega_l,
+                alpha,
+            } => {
+                *omega_u = rounded("omega_u", *omega_u);
+                *omega_l = rounded("omega_l", *omega_l);
+                *alpha = rounded("alpha", *alpha);
+            }
+            SteadyState::LimitCycle {
+                period,
+                omega_l_max,
+                omega_l_min,
+                omega_u_max,
+                omega_u_min,
+                stick_time,
+            } => {
+                *period = rounded("period", *period);
+                *omega_l_max = rounded("omega_l_max", *omega_l_max);
+                *omega_l_min = rounded("omega_l_min", *omega_l_min);
+                *omega_u_max = rounded("omega_u_max", *omega_u_max);
+                *omega_u_min = rounded("omega_u_min", *omega_u_min);
+                *stick_time = rounded("stick_time", *stick_time);
+            }
+        }
+        SteadyJson::from(m)
+    });
+    let error = error
+        .into_iter()
+        .map(|(n, e)| (n, round_up_sig(e, 2)))
+        .collect();
+    for c in cross_check.values_mut() {
+        for d in c.differences.values_mut() {
+            *d = d.map(|x| round_sig(x, 2));
+        }
+    }
+    let json = ReferenceJson {
+        scenario: sc.name.clone(),
+        steady,
+        solver: "event".into(),
+        tol: REFERENCE_TOL,
+        dt: sc.compare.dt,
+        t_end: sc.t_end,
+        steady_from: sc.compare.steady_from,
+        transient: sc.compare.transient,
+        trace_digits,
+        error,
+        error_method: format!(
+            "{ERROR_MARGIN} x the largest difference from the event-driven solver at tol \
+             {CHECK_TOL:e} (trace: over every sample of the run; event_time: over the matched \
+             events; steady metrics: the last complete cycle in [steady_from, t_end]), at \
+             least {FLOOR_REL:e} of the quantity's scale; the trace is rounded to \
+             {trace_digits} significant digits"
+        ),
+        cross_check,
+    };
+    Ok(Reference {
+        samples,
+        events: switches(&r.events),
+        json,
+    })
+}
+
+/// The three file names of a scenario's reference in `dir`.
+pub fn paths(dir: &Path, name: &str) -> [PathBuf; 3] {
+    [
+        dir.join(format!("{name}.csv")),
+        dir.join(format!("{name}.events.csv")),
+        dir.join(format!("{name}.json")),
+    ]
+}
+
+/// The reference's files as bytes (trace, events, JSON).
+pub fn to_files(r: &Reference) -> [Vec<u8>; 3] {
+    let json = serde_json::to_string_pretty(&r.json).expect("plain numbers and strings") + "\n";
+    [
+        crate::trace::write_trace(&r.samples, r.json.dt),
+        write_events(&r.events),
+        json.into_bytes(),
+    ]
+}
+
+/// Reads a scenario's reference from `dir`.
+pub fn read(dir: &Path, name: &str) -> Result<Reference, ReferenceError> {
+    let [trace, events, json] = paths(dir, name);
+    let read = |p: &Path| {
+        std::fs::read(p).map_err(|e| ReferenceError::File {
+            path: p.to_owned(),
+            message: format!("cannot read the reference ({e}); `rotor reference` writes it"),
+        })
+    };
+    let samples = parse_trace(&read(&trace)?, &trace)?.samples;
+    let events = parse_events(&read(&events)?, &events)?.events;
+    let json: ReferenceJson =
+        serde_json::from_slice(&read(&json)?).map_err(|e| ReferenceError::File {
+            path: json.clone(),
+            message: format!("not a reference JSON: {e}"),
+        })?;
+    Ok(Reference {
+        samples,
+        events,
+        json,
+    })
+}
+
+/// The reference directory of a scenario file: `fixtures/reference/` beside its
+/// `fixtures/scenarios/`.
+pub fn dir_for(scenario_path: &Path) -> PathBuf {
+    scenario_path
+        .parent()
+        .and_then(Path::parent)
+        .unwrap_or(Path::new("."))
+        .join("reference")
+}
