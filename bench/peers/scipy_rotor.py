@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""The rotorbench rotor model in plain scipy: a peer for `rotor-bench`.
+"""The rotorbench rotor model in plain scipy: a peer client of `rotor bench` (BENCHMARK.md).
 
 What a careful scipy user would write for the two-disc rotor with set-valued friction
 (docs/model.md): state x = [alpha, omega_u, omega_l],
@@ -27,16 +27,11 @@ The upper disc must be smooth (Table 1: T_su = dT_su = db_u = 0, so T_fu = b_u o
 a parameter file with upper static friction is refused (it needs a second switching surface).
 The lower disc may use either family of docs/model.md (exponential: Table 1; stribeck).
 
-Steady-state metrics as rotor-model's MetricsAccumulator defines them: the last complete
-cycle between two successive stick exits in [metrics_from, t_end] (between omega_l maxima if
-the orbit never sticks); period = its length, omega_l_max = the largest located maximum in it.
-
-Prints one JSON object on stdout. Run times are measured in-process with
-time.perf_counter() around the whole simulation (all segments, the 0.01 s trace and the
-metrics), after one untimed warm-up run; interpreter start-up and imports are excluded.
-
-    python3 scipy_rotor.py --params ../../fixtures/params/table1.toml --u 1.5 --x0 0,0,0 \
-        --t-end 100 --metrics-from 50 --transient 0,20 --dt 0.01 --tol 1e-6,1e-9 --repeat 3
+A client of the benchmark's job-file protocol: `python3 scipy_rotor.py JOB.json` integrates
+the job's scene at rtol = atol = the job's tol, writes the trace (alpha, omega_u, omega_l on
+the grid) and the events it locates (stick onsets and exits, reversals of the lower disc),
+and prints {"solve_seconds": S, ...}: time.perf_counter() around the simulation alone
+(interpreter start-up, imports, reading the job and writing the files excluded).
 """
 
 import math
@@ -153,22 +148,25 @@ def stick_events(rotor):
     return [exit_hi, exit_lo]
 
 
+def initial_mode(rotor, x):
+    """As rotor-model's Model::mode_at: slip by the sign of omega_l, else stick if the spring
+    torque is inside the stick interval, else slip the way it pushes."""
+    if x[2] > 0.0:
+        return 1.0
+    if x[2] < 0.0:
+        return -1.0
+    torque = rotor.k_theta * x[0]
+    return 0.0 if abs(torque) <= rotor.t_sl else math.copysign(1.0, torque)
+
+
 def simulate(rotor, x0, t_end, grid, tol, method):
-    """One run: returns (grid samples of omega_l, exit times, maxima, rhs evaluations)."""
+    """One run: returns (the 3 x len(grid) solution on the grid, events, rhs evaluations)."""
     t = 0.0
     x = list(x0)
-    # Initial mode: as rotor-model's Model::mode_at.
-    if x[2] > 0.0:
-        mode = 1.0
-    elif x[2] < 0.0:
-        mode = -1.0
-    else:
-        torque = rotor.k_theta * x[0]
-        mode = 0.0 if abs(torque) <= rotor.t_sl else math.copysign(1.0, torque)
-    omega_l = np.empty(len(grid))
+    mode = initial_mode(rotor, x)
+    y = np.empty((3, len(grid)))
     i = 0  # next grid sample
-    exits = []  # stick exit times
-    maxima = []  # (t, omega_l) at omega_l maxima
+    events = []  # (t, disc, kind)
     nfev = 0
     segments = 0
     while t < t_end:
@@ -176,16 +174,16 @@ def simulate(rotor, x0, t_end, grid, tol, method):
         if segments > 100_000:
             raise RuntimeError(f"more than 100000 segments by t = {t}: Zeno-like switching")
         if mode == 0.0:
-            fun, events = rotor.stick, stick_events(rotor)
+            fun, evs = rotor.stick, stick_events(rotor)
         else:
-            fun, events = rotor.slip(mode), slip_events(rotor, mode)
+            fun, evs = rotor.slip(mode), slip_events(rotor, mode)
         sol = solve_ivp(
             fun,
             (t, t_end),
             x,
             method=method,
             t_eval=grid[i:],
-            events=events,
+            events=evs,
             rtol=tol,
             atol=tol,
         )
@@ -193,54 +191,53 @@ def simulate(rotor, x0, t_end, grid, tol, method):
             raise RuntimeError(f"solve_ivp failed at t = {t}: {sol.message}")
         nfev += sol.nfev
         n = len(sol.t)
-        omega_l[i : i + n] = sol.y[2]
+        y[:, i : i + n] = sol.y
+        if mode == 0.0:
+            y[2, i : i + n] = 0.0
         i += n
-        if mode != 0.0:
-            maxima.extend((te, ye[2]) for te, ye in zip(sol.t_events[1], sol.y_events[1]))
         if sol.status == 0:  # reached t_end
             break
         # A terminal event ended the segment.
-        hit = [k for k, te in enumerate(sol.t_events) if events[k].terminal and len(te)]
+        hit = [k for k, te in enumerate(sol.t_events) if evs[k].terminal and len(te)]
         k = hit[0]
         t = float(sol.t_events[k][-1])
         x = [float(v) for v in sol.y_events[k][-1]]
         x[2] = 0.0
         if mode == 0.0:
-            exits.append(t)
+            events.append((t, "lower", "stick_end"))
             mode = 1.0 if k == 0 else -1.0
         else:
             torque = rotor.k_theta * x[0]
-            mode = 0.0 if abs(torque) <= rotor.t_sl else math.copysign(1.0, torque)
+            if abs(torque) <= rotor.t_sl:
+                events.append((t, "lower", "stick_start"))
+                mode = 0.0
+            else:
+                events.append((t, "lower", "reversal"))
+                mode = math.copysign(1.0, torque)
     if i < len(grid):
         raise RuntimeError(f"{len(grid) - i} grid samples missing at the end")
-    return omega_l, exits, maxima, nfev
-
-
-def run_setting(rotor, args, grid, window, tol):
-    """Time one tolerance and return its entry of "runs" (a failed run's reason if it raised)."""
-    try:
-        (omega_l, exits, maxima, nfev), seconds = common.time_runs(
-            lambda: simulate(rotor, args.x0, args.t_end, grid, tol, args.method),
-            args.repeat,
-            args.time_budget,
-        )
-    except (RuntimeError, ValueError, FloatingPointError) as e:
-        return common.failed_record(tol, str(e))
-    metrics = common.cycle_metrics(exits, maxima, args.metrics_from, maxima_fallback=True)
-    return common.run_record(tol, seconds, metrics, grid, omega_l, window, rhs_evals=int(nfev))
+    return y, events, nfev
 
 
 def main():
-    ap = common.make_parser(
-        __doc__.splitlines()[0], "--tol", "rtol = atol ladder, comma-separated", repeat_default=5
-    )
-    ap.add_argument("--method", default="DOP853", help="solve_ivp method")
-    args = common.parse_args(ap)
-    rotor = common.load_model(args, Rotor)
-    grid = common.grid_times(args.dt, args.t_end)
-    window = common.trace_window(grid, args.transient, args.dt)
-    runs = [run_setting(rotor, args, grid, window, tol) for tol in args.tol]
-    common.emit("scipy", scipy.__version__, f"solve_ivp {args.method}", runs)
+    job = common.read_job(sys.argv)
+    tol = job.get("tol")
+    if tol is None or not (math.isfinite(tol) and tol > 0.0):
+        print(f"the job's tol = {tol} must be positive (this client has a tolerance)", file=sys.stderr)
+        sys.exit(2)
+    rotor = common.build_model(job, Rotor)
+    grid = common.grid_times(job["dt"], job["t_end"])
+    method = "DOP853"
+    try:
+        (y, events, nfev), seconds = common.timed(
+            lambda: simulate(rotor, job["x0"], job["t_end"], grid, tol, method)
+        )
+    except (RuntimeError, ValueError, FloatingPointError) as e:
+        print(f"the integration failed: {e}", file=sys.stderr)
+        sys.exit(1)
+    common.write_trace(job["trace"], grid, y)
+    common.write_events(job["events"], events)
+    common.report(seconds, scipy.__version__, f"solve_ivp {method}", rhs_evals=int(nfev))
 
 
 if __name__ == "__main__":

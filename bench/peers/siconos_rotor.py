@@ -29,14 +29,15 @@ vertex of the parabola through three slipping steps. Metrics of the last complet
 between two stick exits in [metrics_from, t_end]. The 0.01 s trace is the linear
 interpolation of the step ends.
 
-Prints one JSON object on stdout with each setting's run times (time.perf_counter() around
-model construction and the whole time loop, after one untimed warm-up; plugin compilation
-and interpreter start-up excluded) and its number of steps.
-
-    /usr/bin/python3 siconos_rotor.py --params ../../fixtures/params/table1.toml --u 1.5 \
-        --x0 0,0,0 --t-end 100 --metrics-from 50 --transient 0,20 --dt 0.01 --h 1e-2,1e-3
+A client of the benchmark's job-file protocol: `/usr/bin/python3 siconos_rotor.py JOB.json`
+runs the job's scene at the job's step h, writes the trace (alpha = theta_u - theta_l,
+omega_u, omega_l at the grid times, linear between step ends; no events file: a step end is
+no event time) and prints {"solve_seconds": S, "steps": N, ...}: time.perf_counter() around
+model construction and the time loop (plugin compilation, interpreter start-up, reading the
+job and writing the trace excluded).
 """
 
+import math
 import os
 import shutil
 import subprocess
@@ -104,7 +105,7 @@ class Params:
 
 
 def simulate(p, plugin, x0, t_end, h, grid):
-    """One run. Returns (omega_l on the grid, exit times, maxima, steps)."""
+    """One run. Returns (the 3 x len(grid) solution on the grid, steps)."""
     alpha0, wu0, wl0 = x0
     q0 = np.array([alpha0, 0.0, 0.0, 0.0])
     v0 = np.array([wu0, wl0, 0.0, 0.0])
@@ -135,90 +136,59 @@ def simulate(p, plugin, x0, t_end, h, grid):
 
     q = ds.q()
     v = ds.velocity()
-    kt, bound = p.k_theta, p.t_sl
-    omega_l = np.empty(len(grid))
+    y = np.empty((3, len(grid)))
     i = 0
     while i < len(grid) and grid[i] <= 0.0:
-        omega_l[i] = wl0
+        y[:, i] = (alpha0, wu0, wl0)
         i += 1
-    # Previous two step ends: (t, omega_l, spring torque excess).
-    t_a, w_a, g_a = 0.0, wl0, kt * alpha0 - bound
-    prev = None  # the step end before (t_a, w_a)
-    exits, maxima = [], []
+    # The previous step end: (t, alpha, omega_u, omega_l).
+    t_a, a_a = 0.0, np.array([alpha0, wu0, wl0])
     steps = 0
     while sim.hasNextEvent():
         sim.computeOneStep()
         steps += 1
         t_b = sim.nextTime()
-        w_b = v[1]
-        g_b = kt * (q[0] - q[1]) - bound
+        a_b = np.array([q[0] - q[1], v[0], v[1]])
+        if abs(a_b[2]) <= STICK_V:
+            a_b[2] = 0.0
         while i < len(grid) and grid[i] <= t_b + 1e-12 * h:
             s = (grid[i] - t_a) / (t_b - t_a)
-            omega_l[i] = w_a + s * (w_b - w_a)
+            y[:, i] = a_a + s * (a_b - a_a)
             i += 1
-        stuck_a, stuck_b = abs(w_a) <= STICK_V, abs(w_b) <= STICK_V
-        if stuck_a and not stuck_b and w_b > 0.0:
-            # Leaves stick upward: zero of the torque excess on the line through the two ends.
-            if g_b > g_a:
-                t_x = t_a - g_a * (t_b - t_a) / (g_b - g_a)
-                t_x = min(max(t_x, prev[0] if prev else t_a), t_b)
-            else:
-                t_x = t_a + 0.5 * (t_b - t_a)
-            exits.append(t_x)
-        if prev is not None and not stuck_a and not stuck_b and abs(prev[1]) > STICK_V:
-            t_0, w_0 = prev[0], prev[1]
-            d1, d2 = w_a - w_0, w_b - w_a
-            if d1 > 0.0 and d2 <= 0.0:
-                # Vertex of the parabola through the three step ends.
-                ha, hb = t_a - t_0, t_b - t_a
-                s1, s2 = d1 / ha, d2 / hb
-                curv = (s2 - s1) / (0.5 * (ha + hb))
-                tm = t_0 + 0.5 * ha - s1 / curv if curv != 0.0 else t_a
-                tm = min(max(tm, t_0), t_b)
-                la = (tm - t_a) * (tm - t_b) / ((t_0 - t_a) * (t_0 - t_b))
-                lb = (tm - t_0) * (tm - t_b) / ((t_a - t_0) * (t_a - t_b))
-                lc = (tm - t_0) * (tm - t_a) / ((t_b - t_0) * (t_b - t_a))
-                maxima.append((tm, w_0 * la + w_a * lb + w_b * lc))
-        prev = (t_a, w_a)
-        t_a, w_a, g_a = t_b, w_b, g_b
+        t_a, a_a = t_b, a_b
         sim.nextStep()
     while i < len(grid):
-        omega_l[i] = w_a
+        y[:, i] = a_a
         i += 1
-    return omega_l, exits, maxima, steps
-
-
-def run_setting(p, plugin, args, grid, window, h):
-    """Time one step size and return its entry of "runs" (a failed run's reason if it raised)."""
-    try:
-        (omega_l, exits, maxima, steps), seconds = common.time_runs(
-            lambda: simulate(p, plugin, args.x0, args.t_end, h, grid),
-            args.repeat,
-            args.time_budget,
-        )
-    except Exception as e:  # Siconos raises its own exception types through SWIG
-        return common.failed_record(h, f"{type(e).__name__}: {e}")
-    metrics = common.cycle_metrics(exits, maxima, args.metrics_from)
-    return common.run_record(h, seconds, metrics, grid, omega_l, window, steps=steps)
+    return y, steps
 
 
 def main():
-    ap = common.make_parser(
-        __doc__.splitlines()[0], "--h", "step sizes, comma-separated", repeat_default=3
-    )
-    args = common.parse_args(ap)
-    p = common.load_model(args, Params)
+    job = common.read_job(sys.argv)
+    h = job.get("h")
+    if h is None or not (math.isfinite(h) and h > 0.0):
+        print(f"the job's h = {h} must be positive (this client has a step)", file=sys.stderr)
+        sys.exit(2)
+    p = common.build_model(job, Params)
     sn.numerics_set_verbose(0)
-    grid = common.grid_times(args.dt, args.t_end)
-    window = common.trace_window(grid, args.transient, args.dt)
+    grid = common.grid_times(job["dt"], job["t_end"])
     with tempfile.TemporaryDirectory() as workdir:
         plugin = build_plugin(workdir)
-        runs = [run_setting(p, plugin, args, grid, window, h) for h in args.h]
+        try:
+            (y, steps), seconds = common.timed(
+                lambda: simulate(p, plugin, job["x0"], job["t_end"], h, grid)
+            )
+        except Exception as e:  # Siconos raises its own exception types through SWIG
+            print(f"the simulation failed: {type(e).__name__}: {e}", file=sys.stderr)
+            sys.exit(1)
+    common.write_trace(job["trace"], grid, y)
     try:
         version = metadata.version("siconos")
     except metadata.PackageNotFoundError:
         version = "unknown"
-    common.emit("siconos", version, "MoreauJeanOSI theta=1/2, FrictionContact(2) Lemke", runs)
+    common.report(
+        seconds, version, "MoreauJeanOSI theta=1/2, FrictionContact(2) Lemke", steps=steps
+    )
 
 
 if __name__ == "__main__":

@@ -1,7 +1,10 @@
 //! The reference run of a scene and each solver's ladder of settings, every point timed and
 //! measured against the reference.
 
-use rotor_model::{Output, Scenario, Scene, Stats};
+use rotor_compare::check::{Strictness, check};
+use rotor_compare::gridmetrics::{StickExit, grid_metrics};
+use rotor_compare::reference::Reference;
+use rotor_model::{Output, Scenario, Scene, Stats, SteadyState};
 use serde::Serialize;
 
 use crate::BenchError;
@@ -59,6 +62,9 @@ pub struct LadderPoint {
     pub stats: Stats,
     /// Why the run failed, if it did.
     pub failure: Option<String>,
+    /// Whether its trace passes the scenario's loose gate, graded as an external trace is
+    /// (`rotor check`): the "solved" of the performance profile.
+    pub passes_loose: Option<bool>,
 }
 
 /// A loaded scene with its reference.
@@ -67,6 +73,13 @@ pub(crate) struct Loaded {
     pub(crate) spec: SceneSpec,
     pub(crate) base: Scene,
     pub(crate) refd: RefData,
+    /// The reference's metrics read off its grid as a trace's are
+    /// ([`rotor_compare::gridmetrics`]): what a trace-only client's errors are measured
+    /// against, so that the reconstruction's own error cancels.
+    pub(crate) grid_refd: RefData,
+    /// The scene as a scenario (its horizon and windows) and the reference run as a
+    /// reference, for grading traces as `rotor check` does.
+    pub(crate) view: (Scenario, Reference),
 }
 
 pub(crate) fn load(
@@ -122,6 +135,34 @@ pub(crate) fn load(
         },
         Err(e) => (None, Some(e.to_string())),
     };
+    let mut view_sc = scenario.clone();
+    view_sc.t_end = spec.t_end;
+    view_sc.compare = rotor_model::CompareSpec {
+        transient: Some(spec.transient),
+        dt: spec.dt,
+        steady_from: Some(spec.metrics_from),
+    };
+    let view_ref = Reference::in_memory(&view_sc, &tr, opts.reference_tol);
+    let exit = StickExit {
+        model: &scenario.model,
+        u: scenario.u,
+    };
+    let grid_refd = match grid_metrics(&tr.samples, spec.metrics_from, exit) {
+        Ok(SteadyState::LimitCycle {
+            period,
+            omega_l_max,
+            ..
+        }) => RefData {
+            period,
+            omega_l_max,
+            ..refd.clone()
+        },
+        _ => {
+            return Err(BenchError::NoReferenceCycle {
+                scene: scenario.name.clone(),
+            });
+        }
+    };
     let reference = ReferenceReport {
         solver: SolverKind::EVENT,
         tol: opts.reference_tol,
@@ -139,6 +180,8 @@ pub(crate) fn load(
             spec: spec.clone(),
             base,
             refd,
+            grid_refd,
+            view: (view_sc, view_ref),
         },
         reference,
     ))
@@ -177,6 +220,7 @@ pub(crate) fn ladders(
                     errors,
                     stats: tr.stats,
                     failure: None,
+                    passes_loose: Some(passes_loose(l, &tr)),
                 },
                 Err(e) => LadderPoint {
                     solver: kind,
@@ -186,10 +230,28 @@ pub(crate) fn ladders(
                     errors: Errors::default(),
                     stats: Stats::default(),
                     failure: Some(e.to_string()),
+                    passes_loose: None,
                 },
             };
             points.push(point);
         }
     }
     points
+}
+
+/// Whether a run's trace and events pass the scene's loose gate, graded as `rotor check`
+/// grades an external trace.
+fn passes_loose(l: &Loaded, tr: &rotor_model::Trajectory) -> bool {
+    let (sc, r) = &l.view;
+    let trace = rotor_compare::trace::Trace {
+        path: "run".into(),
+        samples: tr.samples.clone(),
+        lines: (2..tr.samples.len() as u64 + 2).collect(),
+    };
+    let events = rotor_compare::trace::EventsFile {
+        path: "run".into(),
+        events: tr.events.clone(),
+        lines: (2..tr.events.len() as u64 + 2).collect(),
+    };
+    check(sc, r, &trace, Some(&events), Strictness::Loose).is_ok_and(|c| c.passed)
 }

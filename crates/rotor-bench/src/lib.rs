@@ -16,37 +16,47 @@
 //! * **Output levels**: per solver, metrics-only (`Output::Metrics`, which skips the periods
 //!   of a converged cycle), final-only (`Output::Final`) and the full trace
 //!   (`Output::Grid { dt: 0.01 }`), all with metrics, timed in turn.
-//! * **Peers**, run as subprocesses in the same run: a plain scipy `solve_ivp` implementation
-//!   (`bench/peers/scipy_rotor.py`) compared at equal error, and Siconos' `MoreauJeanOSI`
-//!   (`bench/peers/siconos_rotor.py`) compared per step at equal h. A peer whose answer does
-//!   not agree with the reference within the scenario's agreement gate gets no ratio.
-//!   A peer that is not installed is skipped with the reason.
+//! * **Clients**: external solvers through the job-file protocol ([`protocol`]; BENCHMARK.md),
+//!   each run in its own process with a timeout, over its ladder on every scene, graded as
+//!   `rotor check` grades a trace, placed beside the three solvers, with time ratios at equal
+//!   error (in-process and whole-process) and, for a fixed-step client that reports its
+//!   steps, time per step against rotor-moreau. The repository's peers, a plain scipy
+//!   `solve_ivp` (`bench/peers/scipy_rotor.py`) and Siconos' `MoreauJeanOSI`
+//!   (`bench/peers/siconos_rotor.py`), are clients of the same protocol, run when installed.
+//!   A failure (crash, non-zero exit, timeout, unusable trace, a trace failing the loose
+//!   gate) is recorded with its reason; the bench goes on.
+//! * **Performance profile** ([`profile`]) of the solvers and clients over the scenes.
 //!
 //! Nothing here asserts a speed: ratios are measured side by side and reported.
 
+mod clients;
 mod ladder;
 mod levels;
 mod measure;
 mod options;
 mod peers;
+pub mod profile;
+pub mod protocol;
 mod report;
 
 use rotor_model::{Model, Output, ScenarioError, Scene, SolveError};
 use serde::Serialize;
 use thiserror::Error;
 
+pub use clients::{
+    ClientPoint, ClientReport, ClientScene, ClientStatus, Failure, FailureKind, Overhead, PerStep,
+    Ratio,
+};
 pub use ladder::{LadderPoint, ReferenceReport, SceneReport};
 pub use levels::OutputLevel;
 pub use measure::{Errors, RefData, Timing, solver, time_at_error, timed};
 pub use options::{BenchOptions, PeerOptions, SceneSpec, SolverKind, workspace_root};
-pub use peers::{
-    Agreement, PeerMetrics, PeerOutput, PeerPoint, PeerReport, PeerRun, PerStep, Ratio,
-    available as peer_available,
-};
+pub use peers::available as peer_available;
+pub use profile::Profile;
+pub use protocol::ClientSpec;
 
 use ladder::{Loaded, ladders, load};
 use levels::output_levels;
-use peers::{scipy_peer, siconos_peer};
 
 /// Why the benchmark could not run.
 #[derive(Debug, Error)]
@@ -81,9 +91,9 @@ pub enum BenchError {
         #[source]
         source: SolveError,
     },
-    /// A peer script failed (recorded in the report, not returned by [`run`]).
-    #[error("peer {peer}: {detail}")]
-    Peer { peer: String, detail: String },
+    /// The clients' working directory cannot be made.
+    #[error("{0}")]
+    Work(String),
     /// The report holds a non-finite number (a bug): nothing is written.
     #[error("the benchmark report holds {path} = {value}: not written (JSON has no NaN)")]
     NonFinite { path: String, value: f64 },
@@ -99,8 +109,10 @@ pub struct BenchReport {
     pub scenes: Vec<SceneReport>,
     /// Metrics-only vs full-trace run time per solver (first scene).
     pub output_levels: Vec<OutputLevel>,
-    /// Peers (first scene).
-    pub peers: Vec<PeerReport>,
+    /// The peers and the external clients, over every scene.
+    pub clients: Vec<ClientReport>,
+    /// The performance profile of solvers and clients over the scenes.
+    pub profile: Profile,
     /// Where and how it was measured.
     pub environment: Environment,
 }
@@ -161,6 +173,8 @@ fn validate(opts: &BenchOptions) -> Result<(), BenchError> {
     let peers = [
         ("peers.scipy_tols".to_string(), &opts.peers.scipy_tols),
         ("peers.siconos_hs".to_string(), &opts.peers.siconos_hs),
+        ("client_tols".to_string(), &opts.client_tols),
+        ("client_hs".to_string(), &opts.client_hs),
     ];
     for (name, v) in ladders.chain(peers) {
         if let Some(x) = v.iter().find(|x| !(**x > 0.0 && x.is_finite())) {
@@ -173,6 +187,19 @@ fn validate(opts: &BenchOptions) -> Result<(), BenchError> {
     if opts.repeats == 0 {
         return bad("repeats must be at least 1".into());
     }
+    if !(opts.timeout > 0.0 && opts.timeout.is_finite()) {
+        return bad(format!(
+            "timeout = {}: must be positive and finite",
+            opts.timeout
+        ));
+    }
+    let mut names: Vec<&str> = opts.clients.iter().map(|c| c.name.as_str()).collect();
+    names.extend(["scipy", "siconos"]);
+    names.extend(rotor_compare::SOLVERS.map(SolverKind::name));
+    names.sort_unstable();
+    if let Some(w) = names.windows(2).find(|w| w[0] == w[1]) {
+        return bad(format!("two solvers or clients named {:?}", w[0]));
+    }
     Ok(())
 }
 
@@ -182,7 +209,7 @@ pub fn run(opts: &BenchOptions, mut progress: impl FnMut(&str)) -> Result<BenchR
     validate(opts)?;
     let load_start = load_average();
     let mut scenes = Vec::new();
-    let mut first: Option<(Loaded, Vec<LadderPoint>)> = None;
+    let mut loaded: Vec<(Loaded, Vec<LadderPoint>)> = Vec::new();
     for spec in &opts.scenes {
         let (l, reference) = load(opts, spec, &mut progress)?;
         let points = ladders(opts, &l, &mut progress);
@@ -198,24 +225,51 @@ pub fn run(opts: &BenchOptions, mut progress: impl FnMut(&str)) -> Result<BenchR
             reference,
             points: points.clone(),
         });
-        if first.is_none() {
-            first = Some((l, points));
-        }
+        loaded.push((l, points));
     }
-    let (l, points) = first.ok_or_else(|| BenchError::Options("no scene".into()))?;
+    let (l, _) = loaded
+        .first()
+        .ok_or_else(|| BenchError::Options("no scene".into()))?;
     let output_levels = if opts.output_levels {
-        output_levels(opts, &l, &mut progress)?
+        output_levels(opts, l, &mut progress)?
     } else {
         Vec::new()
     };
-    let peers = vec![
-        scipy_peer(opts, &l, &points, &mut progress),
-        siconos_peer(opts, &l, &mut progress),
-    ];
+    // One directory per run (runs may share a process: tests run in parallel).
+    static RUNS: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
+    let n = RUNS.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+    let work = std::env::temp_dir().join(format!("rotor-bench-{}-{n}", std::process::id()));
+    std::fs::create_dir_all(&work)
+        .map_err(|e| BenchError::Work(format!("{}: cannot create: {e}", work.display())))?;
+    let mut clients = Vec::new();
+    for launch in peers::peers(opts, &mut progress) {
+        clients.push(match launch {
+            Ok((spec, ladder)) => clients::run(&spec, &ladder, opts, &loaded, &work, &mut progress),
+            Err(skipped) => *skipped,
+        });
+    }
+    for spec in &opts.clients {
+        let ladder = if spec.fixed_step {
+            &opts.client_hs
+        } else {
+            &opts.client_tols
+        };
+        clients.push(clients::run(
+            spec,
+            ladder,
+            opts,
+            &loaded,
+            &work,
+            &mut progress,
+        ));
+    }
+    let _ = std::fs::remove_dir_all(&work);
+    let profile = profile::profile(&scenes, &clients);
     Ok(BenchReport {
         scenes,
         output_levels,
-        peers,
+        clients,
+        profile,
         environment: Environment {
             cores: std::thread::available_parallelism().map_or(1, |n| n.get()),
             debug_build: cfg!(debug_assertions),

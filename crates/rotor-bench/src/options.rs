@@ -33,6 +33,27 @@ impl SceneSpec {
         }
     }
 
+    /// A scenario file as it stands: its horizon, its steady window and transient window,
+    /// its grid. The error names the file when it compares no transient or no steady state
+    /// (the benchmark measures both).
+    pub fn from_scenario(path: &Path) -> Result<SceneSpec, crate::BenchError> {
+        let sc = rotor_compare::load_scenario(path)?;
+        let (Some(transient), Some(metrics_from)) = (sc.compare.transient, sc.compare.steady_from)
+        else {
+            return Err(crate::BenchError::Options(format!(
+                "{}: the benchmark needs [compare] transient and steady_from",
+                path.display()
+            )));
+        };
+        Ok(SceneSpec {
+            scenario: path.to_owned(),
+            t_end: sc.t_end,
+            metrics_from,
+            transient,
+            dt: sc.compare.dt,
+        })
+    }
+
     /// The Stribeck set at u = 1.5 V from rest over `t_end` seconds: both discs start stuck
     /// (the upper disc has static friction and breaks away first), then a stick-slip cycle.
     /// Windows as [`SceneSpec::table1_u15`].
@@ -86,6 +107,14 @@ pub struct BenchOptions {
     pub output_levels: bool,
     /// Peers.
     pub peers: PeerOptions,
+    /// External solvers (`rotor bench --external NAME=COMMAND`).
+    pub clients: Vec<crate::protocol::ClientSpec>,
+    /// A client's run past this many seconds is killed, its process group with it.
+    pub timeout: f64,
+    /// The ladder of an external client with a tolerance (1e-3 … 1e-12).
+    pub client_tols: Vec<f64>,
+    /// The ladder of an external client with a step h (1e-2 … 1e-4).
+    pub client_hs: Vec<f64>,
 }
 
 /// The workspace root: the current directory if it holds `fixtures/`, else the checkout
@@ -134,6 +163,10 @@ impl Default for BenchOptions {
                 siconos_hs: vec![1e-2, 1e-3],
                 dir: root.join("bench/peers"),
             },
+            clients: Vec::new(),
+            timeout: 60.0,
+            client_tols: decades(3, 12),
+            client_hs: vec![1e-2, 3e-3, 1e-3, 3e-4, 1e-4],
         }
     }
 }
@@ -160,8 +193,11 @@ impl BenchOptions {
                 scipy: false,
                 siconos: false,
                 scipy_tols: vec![1e-4, 1e-6, 1e-8],
-                ..full.peers
+                ..full.peers.clone()
             },
+            client_tols: vec![1e-4, 1e-6, 1e-8],
+            client_hs: vec![1e-2, 1e-3],
+            ..full
         }
     }
 

@@ -5,9 +5,10 @@ use std::fmt::Write;
 
 use rotor_plot::{Panel, Series, render};
 
+use crate::clients::{ClientReport, FailureKind};
 use crate::measure::Errors;
 use crate::options::SolverKind;
-use crate::{BenchError, BenchReport, PeerReport};
+use crate::{BenchError, BenchReport};
 
 fn e(v: Option<f64>) -> String {
     v.map_or("-".into(), |x| format!("{x:.1e}"))
@@ -75,11 +76,16 @@ impl<'a> CsvRow<'a> {
 }
 
 /// A solver's colour from its entry; the peers' own.
-fn color(name: &str) -> &'static str {
+pub(crate) fn color(name: &str) -> &'static str {
+    const OTHERS: [&str; 7] = [
+        "#2ca02c", "#9467bd", "#8c564b", "#e377c2", "#7f7f7f", "#bcbd22", "#17becf",
+    ];
     match (SolverKind::by_name(name), name) {
         (Some(k), _) => k.info().style.color,
         (None, "scipy") => "#d62728",
-        (None, _) => "#2ca02c",
+        (None, "siconos") => "#2ca02c",
+        // Any other client: a colour fixed by its name (a sum of its bytes).
+        (None, _) => OTHERS[name.bytes().map(usize::from).sum::<usize>() % OTHERS.len()],
     }
 }
 
@@ -248,8 +254,26 @@ impl BenchReport {
                  trace's metrics and final state)\n"
             );
         }
-        for p in &self.peers {
-            peer_table(&mut s, p);
+        for p in &self.clients {
+            client_table(&mut s, p);
+        }
+        if !self.profile.entries.is_empty() {
+            let _ = writeln!(
+                s,
+                "performance profile over {} scene(s) (solved: {}); time / best time per scene:",
+                self.profile.scenes.len(),
+                self.profile.criterion
+            );
+            let _ = writeln!(s, "{:<10} {}", "", self.profile.scenes.join("  "));
+            for en in &self.profile.entries {
+                let cells: Vec<String> = en
+                    .ratios
+                    .iter()
+                    .map(|r| r.map_or("unsolved".into(), |r| format!("{r:.2}")))
+                    .collect();
+                let _ = writeln!(s, "{:<10} {}", en.name, cells.join("  "));
+            }
+            let _ = writeln!(s);
         }
         let env = &self.environment;
         let load =
@@ -319,18 +343,18 @@ impl BenchReport {
                 ));
             }
         }
-        if let Some(sc) = self.scenes.first() {
-            for peer in &self.peers {
-                for p in &peer.points {
+        for c in &self.clients {
+            for cs in &c.scenes {
+                for p in &cs.points {
                     rows.push(CsvRow::new(
-                        &sc.name,
-                        &peer.name,
-                        peer.setting_name,
+                        &cs.scene,
+                        &c.name,
+                        c.setting_name,
                         p.setting,
-                        p.timing,
+                        p.time(),
                         &p.errors,
                         [p.steps, None, p.rhs_evals, None, None, None],
-                        p.failure.as_deref(),
+                        p.failure.as_ref().map(|f| f.detail.as_str()),
                     ));
                 }
             }
@@ -362,7 +386,7 @@ impl BenchReport {
                 e.transient_max
             }),
         ];
-        for (k, sc) in self.scenes.iter().enumerate() {
+        for sc in &self.scenes {
             for (what, y_label, pick) in kinds {
                 let mut series = Vec::new();
                 for kind in SOLVERS {
@@ -377,22 +401,27 @@ impl BenchReport {
                         ..Series::line(kind.name(), color(kind.name()), pts)
                     });
                 }
-                if k == 0 {
-                    for peer in self.peers.iter().filter(|p| !p.points.is_empty()) {
-                        let pts: Vec<(f64, f64)> = peer
-                            .points
-                            .iter()
-                            .filter_map(|p| Some((p.timing?.median_s, pick(&p.errors)?)))
-                            .collect();
-                        series.push(Series {
-                            label: &peer.name,
-                            color: color(&peer.name),
-                            dash: Some("6 4"),
-                            width: 1.5,
-                            marker: Some(3.0),
-                            points: pts,
-                        });
+                for c in &self.clients {
+                    let Some(cs) = c.scenes.iter().find(|s| s.scene == sc.name) else {
+                        continue;
+                    };
+                    let pts: Vec<(f64, f64)> = cs
+                        .points
+                        .iter()
+                        .filter(|p| placed(p.failure.as_ref()))
+                        .filter_map(|p| Some((p.time()?.median_s, pick(&p.errors)?)))
+                        .collect();
+                    if pts.is_empty() {
+                        continue;
                     }
+                    series.push(Series {
+                        label: &c.name,
+                        color: color(&c.name),
+                        dash: Some("6 4"),
+                        width: 1.5,
+                        marker: Some(3.0),
+                        points: pts,
+                    });
                 }
                 let mut panel = Panel::new(
                     format!(
@@ -407,6 +436,9 @@ impl BenchReport {
                 panel.y_log = true;
                 panels.push(panel);
             }
+        }
+        if self.profile.entries.len() > 1 {
+            panels.push(self.profile.panel());
         }
         Ok(render(&panels, 760.0, 420.0))
     }
@@ -432,126 +464,135 @@ fn first_non_finite(v: &toml::Value, path: String) -> Option<(String, f64)> {
     }
 }
 
-fn peer_table(s: &mut String, p: &PeerReport) {
-    let _ = write!(s, "peer {}: {}", p.name, p.status.as_str());
+fn client_table(s: &mut String, p: &ClientReport) {
+    let _ = write!(
+        s,
+        "{} {}: {}",
+        if p.peer { "peer" } else { "client" },
+        p.name,
+        p.status.as_str()
+    );
     if let Some(r) = &p.reason {
         let _ = write!(s, " ({r})");
     }
     if let (Some(v), Some(m)) = (&p.version, &p.method) {
         let _ = write!(s, ", version {v}, {m}");
     }
-    let _ = writeln!(s);
-    if p.points.is_empty() {
-        let _ = writeln!(s);
-        return;
-    }
-    if let Some(a) = &p.agreement {
+    let _ = writeln!(s, "\n  command: {} <job.json>", p.command);
+    if let Some(o) = p.overhead {
         let _ = writeln!(
             s,
-            "agreement at {} {:e}: period {} (gate {:.0e}), max omega_l {} (gate {:.0e}), \
-             transient {} (gate {:.0e}) from {}: {}",
-            p.setting_name,
-            a.setting,
-            e(a.period_rel),
-            a.gate_period_rel,
-            e(a.omega_l_max_rel),
-            a.gate_omega_l_rel,
-            e(a.transient_max),
-            a.gate_transient_max,
-            a.gate_origin,
-            if a.agrees {
-                "agrees"
-            } else {
-                "DOES NOT AGREE (no ratio)"
-            }
+            "  protocol overhead per run: {} ms (job file, reading and grading the trace); \
+             process beyond the solve: {}",
+            ms(o.protocol_s),
+            o.process_s
+                .map_or("- (no solve_seconds)".into(), |x| format!("{} ms", ms(x)))
         );
     }
-    let _ = writeln!(
-        s,
-        "{:>11} {:>11} {:>4} {:>10} {:>10} {:>9} {:>9}",
-        "setting", "time [ms]", "runs", "steady rel", "transient", "steps", "rhs"
-    );
-    for q in &p.points {
-        match q.timing {
-            Some(t) => {
+    for sc in &p.scenes {
+        let _ = writeln!(s, "  scene {}:", sc.scene);
+        let _ = writeln!(
+            s,
+            "{:>11} {:>10} {:>10} {:>4} {:>10} {:>10} {:>9} {:>9}  failure",
+            "setting", "solve ms", "wall ms", "runs", "steady rel", "transient", "steps", "gates"
+        );
+        for q in &sc.points {
+            let gates = match (q.passes_strict, q.passes_loose) {
+                (Some(true), _) => "strict",
+                (_, Some(true)) => "loose",
+                (Some(false), Some(false)) => "none",
+                _ => "-",
+            };
+            let _ = writeln!(
+                s,
+                "{:>11} {:>10} {:>10} {:>4} {:>10} {:>10} {:>9} {:>9}  {}",
+                format!("{} {:.0e}", p.setting_name, q.setting),
+                q.solve.map_or("-".into(), |t| ms(t.median_s)),
+                q.wall.map_or("-".into(), |t| ms(t.median_s)),
+                q.wall.map_or(0, |t| t.repeats),
+                e(q.errors.steady_rel),
+                e(q.errors.transient_max),
+                q.steps.map_or("-".into(), |v| v.to_string()),
+                gates,
+                q.failure.as_ref().map_or(String::new(), |f| {
+                    let kind = serde_json::to_value(f.kind)
+                        .ok()
+                        .and_then(|v| v.as_str().map(str::to_owned))
+                        .unwrap_or_default();
+                    format!("{kind}: {}", f.detail)
+                })
+            );
+        }
+        if !sc.ratios.is_empty() {
+            let _ = writeln!(
+                s,
+                "  time ratio {} / {} at equal error (Rust time interpolated on its \
+                 work-precision front; '>=' where the Rust solver's fastest point is already \
+                 more accurate):",
+                p.name,
+                sc.ratios[0].against.name()
+            );
+            let _ = writeln!(
+                s,
+                "{:>14} {:>14} {:>11} {:>9} {:>11} {:>11} {:>9} {:>9}",
+                "error kind",
+                "time",
+                "setting",
+                "error",
+                "client ms",
+                "rust ms",
+                "ratio",
+                "of minima"
+            );
+            for r in &sc.ratios {
+                let ge = if r.rust_is_bound { ">=" } else { "" };
                 let _ = writeln!(
                     s,
-                    "{:>11} {:>11} {:>4} {:>10} {:>10} {:>9} {:>9}",
-                    format!("{} {:.0e}", p.setting_name, q.setting),
-                    ms(t.median_s),
-                    t.repeats,
-                    e(q.errors.steady_rel),
-                    e(q.errors.transient_max),
-                    q.steps.map_or("-".into(), |v| v.to_string()),
-                    q.rhs_evals.map_or("-".into(), |v| v.to_string())
-                );
-            }
-            None => {
-                let _ = writeln!(
-                    s,
-                    "{:>11} failed: {}",
-                    format!("{} {:.0e}", p.setting_name, q.setting),
-                    q.failure.as_deref().unwrap_or("?")
+                    "{:>14} {:>14} {:>11} {:>9} {:>11} {:>11} {:>9} {:>9}",
+                    r.error_kind,
+                    r.time,
+                    format!("{} {:.0e}", p.setting_name, r.setting),
+                    format!("{:.1e}", r.error),
+                    ms(r.client_seconds),
+                    ms(r.rust_seconds),
+                    format!("{ge}{:.0}", r.ratio),
+                    r.ratio_of_minima
+                        .map_or("-".into(), |m| format!("{ge}{m:.0}"))
                 );
             }
         }
-    }
-    if !p.ratios.is_empty() {
-        let _ = writeln!(
-            s,
-            "time ratio {} / {} at equal error (Rust time interpolated on its work-precision \
-             front; '>=' where the Rust solver's fastest point is already more accurate):",
-            p.name,
-            p.ratios[0].against.name()
-        );
-        let _ = writeln!(
-            s,
-            "{:>14} {:>11} {:>9} {:>11} {:>11} {:>9} {:>9}",
-            "error kind", "peer", "error", "peer ms", "rust ms", "ratio", "of minima"
-        );
-        for r in &p.ratios {
+        if !sc.per_step.is_empty() {
+            let _ = writeln!(s, "  time per step {} / moreau at equal h:", p.name);
             let _ = writeln!(
                 s,
-                "{:>14} {:>11} {:>9} {:>11} {:>11} {:>9} {:>9}",
-                r.error_kind,
-                format!("{} {:.0e}", p.setting_name, r.peer_setting),
-                format!("{:.1e}", r.error),
-                ms(r.peer_seconds),
-                ms(r.rust_seconds),
-                format!("{}{:.0}", if r.rust_is_bound { ">=" } else { "" }, r.ratio),
-                r.ratio_of_minima.map_or("-".into(), |m| format!(
-                    "{}{m:.0}",
-                    if r.rust_is_bound { ">=" } else { "" }
-                ))
+                "{:>9} {:>15} {:>15} {:>8} {:>10} {:>13} {:>14}",
+                "h",
+                "client us/step",
+                "moreau us/step",
+                "ratio",
+                "of minima",
+                "client steady",
+                "moreau steady"
             );
-        }
-    }
-    if !p.per_step.is_empty() {
-        let _ = writeln!(s, "time per step {} / moreau at equal h:", p.name);
-        let _ = writeln!(
-            s,
-            "{:>9} {:>13} {:>15} {:>8} {:>10} {:>12} {:>14}",
-            "h",
-            "peer us/step",
-            "moreau us/step",
-            "ratio",
-            "of minima",
-            "peer steady",
-            "moreau steady"
-        );
-        for q in &p.per_step {
-            let _ = writeln!(
-                s,
-                "{:>9} {:>13.3} {:>15.4} {:>8.0} {:>10.0} {:>12} {:>14}",
-                format!("{:.0e}", q.h),
-                1e6 * q.peer_s_per_step,
-                1e6 * q.moreau_s_per_step,
-                q.ratio,
-                q.ratio_of_minima,
-                e(q.peer_errors.steady_rel),
-                e(q.moreau_errors.steady_rel)
-            );
+            for q in &sc.per_step {
+                let _ = writeln!(
+                    s,
+                    "{:>9} {:>15.3} {:>15.4} {:>8.0} {:>10.0} {:>13} {:>14}",
+                    format!("{:.0e}", q.h),
+                    1e6 * q.client_s_per_step,
+                    1e6 * q.moreau_s_per_step,
+                    q.ratio,
+                    q.ratio_of_minima,
+                    e(q.client_errors.steady_rel),
+                    e(q.moreau_errors.steady_rel)
+                );
+            }
         }
     }
     let _ = writeln!(s);
+}
+
+/// Whether a point is placed on the plots: it ran and gave a usable trace.
+fn placed(f: Option<&crate::clients::Failure>) -> bool {
+    f.is_none_or(|f| f.kind == FailureKind::FailsGate)
 }

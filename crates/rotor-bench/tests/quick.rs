@@ -153,7 +153,12 @@ fn json_csv_and_svg_are_complete_and_refuse_a_non_finite_number() {
     let json = r.to_json().unwrap();
     let v: serde_json::Value = serde_json::from_str(&json).unwrap();
     assert_eq!(v["scenes"][0]["points"].as_array().unwrap().len(), 9);
-    assert_eq!(v["peers"][0]["status"], "skipped");
+    assert_eq!(v["clients"][0]["status"], "skipped");
+    assert!(
+        v["profile"]["entries"]
+            .as_array()
+            .is_some_and(|e| e.len() == 3)
+    );
 
     let svg = r.to_svg().unwrap();
     assert!(svg.starts_with("<svg") && svg.trim_end().ends_with("</svg>"));
@@ -223,7 +228,8 @@ fn a_missing_peer_is_skipped_with_its_reason() {
     o.peers.siconos = true;
     o.peers.siconos_python = "/nonexistent/python3".into();
     let r = run(&o, |_| {}).unwrap();
-    for p in &r.peers {
+    assert_eq!(r.clients.len(), 2);
+    for p in &r.clients {
         assert_eq!(p.status.as_str(), "skipped");
         assert!(
             p.reason
@@ -231,7 +237,7 @@ fn a_missing_peer_is_skipped_with_its_reason() {
                 .unwrap()
                 .contains("/nonexistent/python3")
         );
-        assert!(p.ratios.is_empty() && p.per_step.is_empty());
+        assert!(p.scenes.is_empty());
     }
 }
 

@@ -81,6 +81,21 @@ enum Command {
         /// Skip the peers even when python3 with scipy / Siconos is installed.
         #[arg(long)]
         no_peers: bool,
+        /// An external solver, NAME=COMMAND (split as a shell splits words; no shell is
+        /// run), started once per scene and setting with a job file's path appended
+        /// (BENCHMARK.md). Repeatable.
+        #[arg(long = "external", value_name = "NAME=COMMAND")]
+        external: Vec<String>,
+        /// Treat the external solver NAME as fixed-step (ladder of h instead of tol).
+        #[arg(long = "fixed-step", value_name = "NAME")]
+        fixed_step: Vec<String>,
+        /// Seconds after which a client's run is killed (with its process group).
+        #[arg(long, default_value_t = 60.0, allow_hyphen_values = true)]
+        timeout: f64,
+        /// Benchmark these scenarios (their horizon, windows and grid) instead of the default
+        /// scenes. Repeatable.
+        #[arg(long = "scenario", value_name = "SCENARIO.toml")]
+        scenario: Vec<PathBuf>,
     },
     /// Write the benchmark's reference data for every scenario: trace, events and steady
     /// state of the event-driven solver, with their stated errors.
@@ -340,12 +355,19 @@ fn bifurcation(
     Ok(())
 }
 
+/// `rotor bench`'s external clients and scenes.
+struct BenchClients<'a> {
+    external: &'a [String],
+    fixed_step: &'a [String],
+    timeout: f64,
+    scenarios: &'a [PathBuf],
+}
+
 fn bench(
-    json: Option<&Path>,
-    svg: Option<&Path>,
-    csv: Option<&Path>,
+    [json, svg, csv]: [Option<&Path>; 3],
     quick: bool,
     no_peers: bool,
+    clients: BenchClients,
 ) -> Result<()> {
     use rotor_compare::report::write_output;
     let mut opts = if quick {
@@ -356,6 +378,29 @@ fn bench(
     if no_peers {
         opts.peers.scipy = false;
         opts.peers.siconos = false;
+    }
+    check(
+        "timeout",
+        clients.timeout,
+        clients.timeout > 0.0,
+        "must be positive and finite",
+    )?;
+    opts.timeout = clients.timeout;
+    for e in clients.external {
+        opts.clients
+            .push(rotor_bench::ClientSpec::parse(e, clients.fixed_step).map_err(|m| anyhow!(m))?);
+    }
+    for name in clients.fixed_step {
+        if !opts.clients.iter().any(|c| &c.name == name) {
+            bail!("--fixed-step {name:?}: no --external client of that name");
+        }
+    }
+    if !clients.scenarios.is_empty() {
+        opts.scenes = clients
+            .scenarios
+            .iter()
+            .map(|p| rotor_bench::SceneSpec::from_scenario(p))
+            .collect::<Result<_, _>>()?;
     }
     let report = rotor_bench::run(&opts, |m| eprintln!("{m}"))?;
     say(&report.table(), [json, svg, csv]);
@@ -742,12 +787,20 @@ fn main() -> ExitCode {
             csv,
             quick,
             no_peers,
+            external,
+            fixed_step,
+            timeout,
+            scenario,
         }) => bench(
-            json.as_deref(),
-            svg.as_deref(),
-            csv.as_deref(),
+            [json.as_deref(), svg.as_deref(), csv.as_deref()],
             *quick,
             *no_peers,
+            BenchClients {
+                external,
+                fixed_step,
+                timeout: *timeout,
+                scenarios: scenario,
+            },
         ),
         Some(Command::Compare { scenarios, report }) => compare(scenarios, report, false),
         Some(Command::Reference { out }) => {

@@ -338,3 +338,78 @@ fn check_grades_with_exit_codes_0_1_2() {
     assert_eq!(o.status.code(), Some(2));
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// BENCHMARK.md's minimal client, copied out of the page as it is written and run on its
+/// job, passes `rotor check` at the strict gate; and it is the file bench/clients/minimal.py
+/// (the two cannot drift apart). Needs python3 with scipy: skipped with a note where it is
+/// missing, unless `ROTOR_REQUIRE_PEERS=1` (as in .ci/run, which installs scipy).
+#[test]
+fn the_minimal_client_of_benchmark_md_passes_check() {
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
+    let page = std::fs::read_to_string(root.join("BENCHMARK.md")).unwrap();
+    let block = page
+        .split("<!-- minimal client begin -->\n```python\n")
+        .nth(1)
+        .and_then(|rest| rest.split("```\n<!-- minimal client end -->").next())
+        .expect("BENCHMARK.md holds the minimal client between its markers");
+    assert!(
+        block.lines().count() < 60,
+        "the minimal client must stay under 60 lines"
+    );
+    let file = std::fs::read_to_string(root.join("bench/clients/minimal.py")).unwrap();
+    assert_eq!(
+        block, file,
+        "BENCHMARK.md and bench/clients/minimal.py differ"
+    );
+    let has_scipy = std::process::Command::new("python3")
+        .args(["-c", "import scipy"])
+        .status()
+        .is_ok_and(|s| s.success());
+    if !has_scipy {
+        assert!(
+            std::env::var("ROTOR_REQUIRE_PEERS").as_deref() != Ok("1"),
+            "ROTOR_REQUIRE_PEERS=1 but python3 cannot import scipy"
+        );
+        eprintln!("minimal client not run: python3 cannot import scipy");
+        return;
+    }
+    let dir = std::env::temp_dir().join(format!("rotor-cli-minimal-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let client = dir.join("client.py");
+    std::fs::write(&client, block).unwrap();
+    let params = rotor_model::Params::from_file(&root.join("fixtures/params/table1.toml")).unwrap();
+    let job = serde_json::json!({
+        "scenario": "t1-u1.5-rest", "params": params, "u": 1.5, "x0": [0.0, 0.0, 0.0],
+        "t_end": 200.0, "dt": 0.01, "tol": 1e-10, "h": null,
+        "trace": dir.join("trace.csv"), "events": dir.join("events.csv"),
+    });
+    std::fs::write(dir.join("job.json"), job.to_string()).unwrap();
+    let o = std::process::Command::new("python3")
+        .arg(&client)
+        .arg(dir.join("job.json"))
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let said: serde_json::Value =
+        serde_json::from_str(String::from_utf8_lossy(&o.stdout).trim()).unwrap();
+    assert!(said["solve_seconds"].as_f64().is_some_and(|s| s > 0.0));
+    let scenario = root.join("fixtures/scenarios/t1-u1.5-rest.toml");
+    let o = rotor(&[
+        "check",
+        scenario.to_str().unwrap(),
+        "--trace",
+        dir.join("trace.csv").to_str().unwrap(),
+        "--events",
+        dir.join("events.csv").to_str().unwrap(),
+        "--gate",
+        "strict",
+    ]);
+    assert_eq!(
+        o.status.code(),
+        Some(0),
+        "{}{}",
+        String::from_utf8_lossy(&o.stdout),
+        String::from_utf8_lossy(&o.stderr)
+    );
+    std::fs::remove_dir_all(&dir).ok();
+}

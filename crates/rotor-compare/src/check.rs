@@ -226,7 +226,7 @@ fn digits(diff: f64, scale: f64) -> f64 {
         return 16.0;
     }
     let d = -(diff / scale.abs().max(f64::MIN_POSITIVE)).log10();
-    (d.clamp(0.0, 16.0) * 10.0).floor() / 10.0
+    (d.clamp(0.0, 16.0) * 10.0).floor() / 10.0 + 0.0
 }
 
 fn graded(name: &str, difference: f64, tolerance: f64, scale: f64) -> Graded {

@@ -178,6 +178,30 @@ pub enum ReferenceError {
 }
 
 impl Reference {
+    /// A reference held in memory only (the benchmark's own reference run on its scene):
+    /// the run's grid samples and mode-switch events, and the steady state it reached; no
+    /// error is stated.
+    pub fn in_memory(sc: &Scenario, tr: &rotor_model::Trajectory, tol: f64) -> Reference {
+        Reference {
+            samples: tr.samples.clone(),
+            events: switches(&tr.events),
+            json: ReferenceJson {
+                scenario: sc.name.clone(),
+                steady: sc.compare.steady_from.and(tr.metrics).map(SteadyJson::from),
+                solver: "event".into(),
+                tol,
+                dt: sc.compare.dt,
+                t_end: sc.t_end,
+                steady_from: sc.compare.steady_from,
+                transient: sc.compare.transient,
+                trace_digits: 17,
+                error: BTreeMap::new(),
+                error_method: "not estimated (in memory)".into(),
+                cross_check: BTreeMap::new(),
+            },
+        }
+    }
+
     /// The stated error of a quantity (0 if not stated).
     pub fn error(&self, name: &str) -> f64 {
         self.json.error.get(name).copied().unwrap_or(0.0)

@@ -1,0 +1,604 @@
+//! External solvers (and the repository's peers) through the job-file protocol
+//! ([`crate::protocol`]): each over its ladder on each scene, graded as `rotor check` grades a
+//! trace, placed beside the three solvers, with the ratios at equal error.
+
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use rotor_compare::check::{Strictness, check};
+use rotor_compare::gridmetrics::{StickExit, grid_metrics};
+use rotor_compare::trace::{read_events, read_trace};
+use rotor_model::SteadyState;
+use serde::Serialize;
+
+use crate::ladder::{LadderPoint, Loaded};
+use crate::measure::{Errors, Timing, run_point, scene_at, time_at_error};
+use crate::options::{BenchOptions, SolverKind};
+use crate::protocol::{ClientSays, ClientSpec, Ended, Job, RunOutput, run_client, tail};
+
+/// Why a run gave no usable point.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum FailureKind {
+    /// The command could not be started.
+    Spawn,
+    /// It was killed by a signal.
+    Crash,
+    /// It exited non-zero.
+    Exit,
+    /// It ran past the timeout.
+    Timeout,
+    /// Its trace (or events file) cannot be graded: missing, malformed, off the grid.
+    Unusable,
+    /// Its trace fails the scenario's loose gate (the point is still placed).
+    FailsGate,
+    /// Not run: an earlier setting of the same client on this scene timed out.
+    Skipped,
+}
+
+/// A run's failure with its reason.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Failure {
+    pub kind: FailureKind,
+    pub detail: String,
+}
+
+/// One setting of a client on one scene.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct ClientPoint {
+    pub setting: f64,
+    /// Wall time of the whole process (from the spawn to the exit).
+    pub wall: Option<Timing>,
+    /// The client's own in-process time (`solve_seconds`), when every timed run gave one.
+    pub solve: Option<Timing>,
+    pub errors: Errors,
+    pub steps: Option<u64>,
+    pub rhs_evals: Option<u64>,
+    /// Whether the trace passes the scenario's strict and loose gates (as `rotor check`).
+    pub passes_strict: Option<bool>,
+    pub passes_loose: Option<bool>,
+    /// The quantities failing the loose gate.
+    pub failing: Vec<String>,
+    pub failure: Option<Failure>,
+    /// The protocol's own cost of this run, not the client's: writing the job file, and
+    /// reading and grading the trace [s].
+    pub protocol_s: Option<f64>,
+}
+
+impl ClientPoint {
+    /// The point's time for ratios and profiles: in-process if the client reports it,
+    /// else the whole process.
+    pub fn time(&self) -> Option<Timing> {
+        self.solve.or(self.wall)
+    }
+}
+
+/// Client time / Rust time at the client's error.
+#[derive(Debug, Clone, Serialize)]
+pub struct Ratio {
+    pub against: SolverKind,
+    /// `"steady_rel"` or `"transient_max"`.
+    pub error_kind: &'static str,
+    /// `"in_process"` (the client's `solve_seconds`) or `"whole_process"` (its wall time).
+    pub time: &'static str,
+    pub setting: f64,
+    pub error: f64,
+    pub client_seconds: f64,
+    /// The Rust solver's time at that error (interpolated on its work-precision front).
+    pub rust_seconds: f64,
+    /// The Rust solver's fastest point is already more accurate: `rust_seconds` is an upper
+    /// bound, the ratio a lower bound.
+    pub rust_is_bound: bool,
+    /// client_seconds / rust_seconds (medians).
+    pub ratio: f64,
+    /// The same from the fastest runs of each.
+    pub ratio_of_minima: Option<f64>,
+}
+
+/// Time per step of a fixed-step client vs rotor-moreau at one h.
+#[derive(Debug, Clone, Serialize)]
+pub struct PerStep {
+    pub h: f64,
+    pub client_s_per_step: f64,
+    pub moreau_s_per_step: f64,
+    /// client / moreau time per step (medians, the client's in-process time).
+    pub ratio: f64,
+    /// The same from the fastest runs of each.
+    pub ratio_of_minima: f64,
+    pub client_errors: Errors,
+    pub moreau_errors: Errors,
+}
+
+/// A client on one scene.
+#[derive(Debug, Clone, Serialize)]
+pub struct ClientScene {
+    pub scene: String,
+    pub points: Vec<ClientPoint>,
+    pub ratios: Vec<Ratio>,
+    pub per_step: Vec<PerStep>,
+}
+
+/// Whether a client ran.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum ClientStatus {
+    /// At least one point was placed.
+    Ran,
+    /// A peer that is not installed, or turned off.
+    Skipped,
+    /// No run gave a usable trace.
+    Failed,
+}
+
+impl ClientStatus {
+    pub fn as_str(self) -> &'static str {
+        match self {
+            ClientStatus::Ran => "ran",
+            ClientStatus::Skipped => "skipped",
+            ClientStatus::Failed => "failed",
+        }
+    }
+}
+
+/// The protocol's overhead for one client, medians over its runs [s].
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct Overhead {
+    /// Writing the job file, reading and grading the trace.
+    pub protocol_s: f64,
+    /// The process beyond the client's own solve: start-up, reading the job, writing the
+    /// trace (wall − solve_seconds); `None` if the client reports no solve time.
+    pub process_s: Option<f64>,
+}
+
+/// One client over every scene.
+#[derive(Debug, Clone, Serialize)]
+pub struct ClientReport {
+    pub name: String,
+    pub command: String,
+    pub peer: bool,
+    pub fixed_step: bool,
+    /// `"tol"` or `"h"`.
+    pub setting_name: &'static str,
+    pub status: ClientStatus,
+    /// Why it was skipped or failed.
+    pub reason: Option<String>,
+    pub version: Option<String>,
+    pub method: Option<String>,
+    pub scenes: Vec<ClientScene>,
+    pub overhead: Option<Overhead>,
+}
+
+impl ClientReport {
+    /// A client that did not run.
+    pub fn skipped(spec: &ClientSpec, status: ClientStatus, reason: String) -> ClientReport {
+        ClientReport {
+            name: spec.name.clone(),
+            command: spec.command_line(),
+            peer: spec.peer,
+            fixed_step: spec.fixed_step,
+            setting_name: if spec.fixed_step { "h" } else { "tol" },
+            status,
+            reason: Some(reason),
+            version: None,
+            method: None,
+            scenes: Vec::new(),
+            overhead: None,
+        }
+    }
+}
+
+/// Where a client's runs write their files.
+fn run_dir(work: &Path, client: &str, scene: &str, k: usize) -> PathBuf {
+    work.join(client).join(scene).join(format!("run{k}"))
+}
+
+/// The job of one run.
+fn job_for(l: &Loaded, spec: &ClientSpec, setting: f64, dir: &Path) -> Job {
+    let sc = &l.scenario;
+    Job {
+        scenario: sc.name.clone(),
+        params: serde_json::to_value(sc.model.params).expect("plain numbers and strings"),
+        u: sc.u,
+        x0: [sc.x0[0], sc.x0[1], sc.x0[2]],
+        t_end: l.spec.t_end,
+        dt: l.spec.dt,
+        tol: (!spec.fixed_step).then_some(setting),
+        h: spec.fixed_step.then_some(setting),
+        trace: dir.join("trace.csv"),
+        events: dir.join("events.csv"),
+    }
+}
+
+/// Runs once: writes the job, starts the client. `Err` is the failure of the run.
+fn run_once(
+    spec: &ClientSpec,
+    job: &Job,
+    dir: &Path,
+    timeout: f64,
+) -> Result<(RunOutput, f64), Failure> {
+    let t0 = Instant::now();
+    let fail = |kind, detail: String| Failure { kind, detail };
+    std::fs::create_dir_all(dir)
+        .map_err(|e| fail(FailureKind::Spawn, format!("{}: {e}", dir.display())))?;
+    for p in [&job.trace, &job.events] {
+        let _ = std::fs::remove_file(p);
+    }
+    let path = dir.join("job.json");
+    let text = serde_json::to_string_pretty(job).expect("plain numbers and strings");
+    std::fs::write(&path, text)
+        .map_err(|e| fail(FailureKind::Spawn, format!("{}: {e}", path.display())))?;
+    let write_s = t0.elapsed().as_secs_f64();
+    let out = run_client(&spec.argv, &path, timeout).map_err(|e| fail(FailureKind::Spawn, e))?;
+    match &out.ended {
+        Ended::TimedOut => Err(fail(
+            FailureKind::Timeout,
+            format!("killed after the {timeout} s timeout"),
+        )),
+        Ended::Exited(st) if !st.success() => {
+            let why = tail(&out.stderr, 3);
+            match st.code() {
+                Some(code) => Err(fail(
+                    FailureKind::Exit,
+                    format!("exit status {code}: {why}"),
+                )),
+                None => Err(fail(
+                    FailureKind::Crash,
+                    format!("killed by a signal ({st}): {why}"),
+                )),
+            }
+        }
+        Ended::Exited(_) => Ok((out, write_s)),
+    }
+}
+
+/// Grades a run's files: the errors against the reference (as the Rust points), the gates
+/// (as `rotor check`), and the seconds it took.
+fn grade(l: &Loaded, job: &Job) -> Result<(Errors, bool, bool, Vec<String>, f64), Failure> {
+    let t0 = Instant::now();
+    let unusable = |detail: String| Failure {
+        kind: FailureKind::Unusable,
+        detail,
+    };
+    let trace = read_trace(&job.trace).map_err(|e| unusable(e.to_string()))?;
+    let events = if job.events.exists() {
+        Some(read_events(&job.events).map_err(|e| unusable(e.to_string()))?)
+    } else {
+        None
+    };
+    let (sc, r) = &l.view;
+    let verdict = |gate| check(sc, r, &trace, events.as_ref(), gate);
+    let loose = verdict(Strictness::Loose).map_err(|e| unusable(e.to_string()))?;
+    let strict = verdict(Strictness::Strict).map_err(|e| unusable(e.to_string()))?;
+    let exit = StickExit {
+        model: &sc.model,
+        u: sc.u,
+    };
+    let cycle = |m: Result<SteadyState, _>| match m {
+        Ok(SteadyState::LimitCycle {
+            period,
+            omega_l_max,
+            ..
+        }) => Some((period, omega_l_max)),
+        _ => None,
+    };
+    let metrics = cycle(grid_metrics(&trace.samples, l.spec.metrics_from, exit));
+    let window: Vec<(f64, f64)> = trace
+        .samples
+        .iter()
+        .filter(|s| {
+            s.t >= l.spec.transient[0] - 1e-9 * l.spec.dt
+                && s.t <= l.spec.transient[1] + 1e-9 * l.spec.dt
+        })
+        .map(|s| (s.t, s.x[2]))
+        .collect();
+    let errors = l.grid_refd.errors(metrics, &window);
+    let failing = loose.failing().iter().map(|s| s.to_string()).collect();
+    Ok((
+        errors,
+        strict.passed,
+        loose.passed,
+        failing,
+        t0.elapsed().as_secs_f64(),
+    ))
+}
+
+/// One setting: the first run graded, then timed runs within the budget.
+fn point(
+    spec: &ClientSpec,
+    opts: &BenchOptions,
+    l: &Loaded,
+    setting: f64,
+    dir: &Path,
+    says: &mut ClientSays,
+) -> ClientPoint {
+    let job = job_for(l, spec, setting, dir);
+    let mut p = ClientPoint {
+        setting,
+        wall: None,
+        solve: None,
+        errors: Errors::default(),
+        steps: None,
+        rhs_evals: None,
+        passes_strict: None,
+        passes_loose: None,
+        failing: Vec::new(),
+        failure: None,
+        protocol_s: None,
+    };
+    let (first, write_s) = match run_once(spec, &job, dir, opts.timeout) {
+        Ok(x) => x,
+        Err(f) => {
+            p.failure = Some(f);
+            return p;
+        }
+    };
+    let (errors, strict, loose, failing, grade_s) = match grade(l, &job) {
+        Ok(g) => g,
+        Err(f) => {
+            p.failure = Some(f);
+            return p;
+        }
+    };
+    let first_says = ClientSays::from_stdout(&first.stdout);
+    p.errors = errors;
+    p.passes_strict = Some(strict);
+    p.passes_loose = Some(loose);
+    p.protocol_s = Some(write_s + grade_s);
+    p.steps = first_says.steps;
+    p.rhs_evals = first_says.rhs_evals;
+    if says.version.is_none() {
+        says.version.clone_from(&first_says.version);
+        says.method.clone_from(&first_says.method);
+    }
+    if !loose {
+        p.failure = Some(Failure {
+            kind: FailureKind::FailsGate,
+            detail: format!("fails the loose gate in {}", failing.join(", ")),
+        });
+    }
+    p.failing = failing;
+    // Timed runs: as many as the budget allows after the first (which is not timed: a cold
+    // start of an interpreter is not the client's speed), at least one.
+    let n = ((opts.time_budget / first.wall_s.max(1e-9)).floor() as usize).clamp(1, opts.repeats);
+    let (mut walls, mut solves) = (Vec::new(), Vec::new());
+    for _ in 0..n {
+        match run_once(spec, &job, dir, opts.timeout) {
+            Ok((out, _)) => {
+                walls.push(out.wall_s);
+                if let Some(s) = ClientSays::from_stdout(&out.stdout).solve_seconds {
+                    solves.push(s);
+                }
+            }
+            Err(f) => {
+                p.failure = Some(f);
+                return p;
+            }
+        }
+    }
+    p.wall = Some(Timing::of(walls.clone()));
+    if solves.len() == walls.len() {
+        p.solve = Some(Timing::of(solves));
+    }
+    p
+}
+
+/// The ratios of a client's points (those passing the loose gate) to the Rust solver of its
+/// class (event-driven for a tolerance, Moreau–Jean for a step), at equal error, for the
+/// in-process and the whole-process time.
+fn ratios(points: &[ClientPoint], rust: &[LadderPoint], fixed_step: bool) -> Vec<Ratio> {
+    let against = if fixed_step {
+        SolverKind::MOREAU
+    } else {
+        SolverKind::EVENT
+    };
+    type Pick = fn(&Errors) -> Option<f64>;
+    let kinds: [(&'static str, Pick); 2] = [
+        ("steady_rel", |e| e.steady_rel),
+        ("transient_max", |e| e.transient_max),
+    ];
+    let mut out = Vec::new();
+    for (error_kind, pick) in kinds {
+        let curve = |min: bool| -> Vec<(f64, f64)> {
+            rust.iter()
+                .filter(|q| q.solver == against)
+                .filter_map(|q| {
+                    let t = q.timing?;
+                    Some((pick(&q.errors)?, if min { t.min_s } else { t.median_s }))
+                })
+                .collect()
+        };
+        let (median_curve, min_curve) = (curve(false), curve(true));
+        for time in ["in_process", "whole_process"] {
+            for p in points.iter().filter(|p| p.passes_loose == Some(true)) {
+                let t = if time == "in_process" {
+                    p.solve
+                } else {
+                    p.wall
+                };
+                let (Some(e), Some(t)) = (pick(&p.errors), t) else {
+                    continue;
+                };
+                if let Some((rt, bound)) = time_at_error(&median_curve, e) {
+                    out.push(Ratio {
+                        against,
+                        error_kind,
+                        time,
+                        setting: p.setting,
+                        error: e,
+                        client_seconds: t.median_s,
+                        rust_seconds: rt,
+                        rust_is_bound: bound,
+                        ratio: t.median_s / rt,
+                        ratio_of_minima: time_at_error(&min_curve, e).map(|(rm, _)| t.min_s / rm),
+                    });
+                }
+            }
+        }
+    }
+    out
+}
+
+/// For a fixed-step client that reports its steps: rotor-moreau at the same h, time per
+/// step side by side.
+fn per_step(
+    points: &[ClientPoint],
+    opts: &BenchOptions,
+    l: &Loaded,
+    progress: &mut impl FnMut(&str),
+) -> Vec<PerStep> {
+    let mut out = Vec::new();
+    for p in points {
+        let (Some(t), Some(steps)) = (p.solve, p.steps) else {
+            continue;
+        };
+        progress(&format!(
+            "{}: moreau at the client's step h = {:e}",
+            l.scenario.name, p.setting
+        ));
+        let scene = scene_at(&l.base, SolverKind::MOREAU, p.setting, l.base.output);
+        if let Ok((tr, mt, me)) = run_point(
+            SolverKind::MOREAU,
+            &scene,
+            &l.scenario.model,
+            &l.refd,
+            l.spec.transient,
+            opts.repeats,
+            opts.time_budget,
+        ) {
+            let client = t.median_s / steps as f64;
+            let ours = mt.median_s / tr.stats.steps as f64;
+            out.push(PerStep {
+                h: p.setting,
+                client_s_per_step: client,
+                moreau_s_per_step: ours,
+                ratio: client / ours,
+                ratio_of_minima: (t.min_s / steps as f64) / (mt.min_s / tr.stats.steps as f64),
+                client_errors: p.errors,
+                moreau_errors: me,
+            });
+        }
+    }
+    out
+}
+
+/// Runs one client over its ladder on every scene.
+pub(crate) fn run(
+    spec: &ClientSpec,
+    ladder: &[f64],
+    opts: &BenchOptions,
+    scenes: &[(Loaded, Vec<LadderPoint>)],
+    work: &Path,
+    progress: &mut impl FnMut(&str),
+) -> ClientReport {
+    let mut says = ClientSays::default();
+    let mut out = Vec::new();
+    for (l, rust) in scenes {
+        let mut points: Vec<ClientPoint> = Vec::new();
+        let mut stop: Option<&'static str> = None;
+        for (k, &setting) in ladder.iter().enumerate() {
+            let setting_name = if spec.fixed_step { "h" } else { "tol" };
+            if let Some(why) = stop {
+                points.push(ClientPoint {
+                    failure: Some(Failure {
+                        kind: FailureKind::Skipped,
+                        detail: why.into(),
+                    }),
+                    ..skipped_point(setting)
+                });
+                continue;
+            }
+            progress(&format!(
+                "{}: {} {setting_name} = {setting:e}",
+                l.scenario.name, spec.name
+            ));
+            let dir = run_dir(work, &spec.name, &l.scenario.name, k);
+            let p = point(spec, opts, l, setting, &dir, &mut says);
+            // A timeout: the tighter settings would take longer still. The same failure at
+            // two settings in a row (a client refusing the scene's parameters, say): the
+            // rest would repeat it.
+            let same_twice = |a: &ClientPoint, b: &ClientPoint| match (&a.failure, &b.failure) {
+                (Some(x), Some(y)) => {
+                    x == y && matches!(x.kind, FailureKind::Exit | FailureKind::Crash)
+                }
+                _ => false,
+            };
+            if p.failure
+                .as_ref()
+                .is_some_and(|f| f.kind == FailureKind::Timeout)
+            {
+                stop = Some("not run: a looser setting timed out");
+            } else if points.last().is_some_and(|q| same_twice(q, &p)) {
+                stop = Some("not run: the same failure at the two settings before");
+            }
+            points.push(p);
+        }
+        let ratios = ratios(&points, rust, spec.fixed_step);
+        let per_step = if spec.fixed_step {
+            per_step(&points, opts, l, progress)
+        } else {
+            Vec::new()
+        };
+        out.push(ClientScene {
+            scene: l.scenario.name.clone(),
+            points,
+            ratios,
+            per_step,
+        });
+    }
+    let all: Vec<&ClientPoint> = out.iter().flat_map(|s| &s.points).collect();
+    let placed = all.iter().any(|p| p.wall.is_some());
+    let median = |mut v: Vec<f64>| -> Option<f64> {
+        if v.is_empty() {
+            return None;
+        }
+        v.sort_by(f64::total_cmp);
+        Some(v[v.len() / 2])
+    };
+    let overhead =
+        median(all.iter().filter_map(|p| p.protocol_s).collect()).map(|protocol_s| Overhead {
+            protocol_s,
+            process_s: median(
+                all.iter()
+                    .filter_map(|p| Some(p.wall?.median_s - p.solve?.median_s))
+                    .collect(),
+            ),
+        });
+    let reason = (!placed).then(|| {
+        all.iter()
+            .find_map(|p| p.failure.as_ref().map(|f| f.detail.clone()))
+            .unwrap_or_else(|| "no setting".into())
+    });
+    ClientReport {
+        name: spec.name.clone(),
+        command: spec.command_line(),
+        peer: spec.peer,
+        fixed_step: spec.fixed_step,
+        setting_name: if spec.fixed_step { "h" } else { "tol" },
+        status: if placed {
+            ClientStatus::Ran
+        } else {
+            ClientStatus::Failed
+        },
+        reason,
+        version: says.version,
+        method: says.method,
+        scenes: out,
+        overhead,
+    }
+}
+
+fn skipped_point(setting: f64) -> ClientPoint {
+    ClientPoint {
+        setting,
+        wall: None,
+        solve: None,
+        errors: Errors::default(),
+        steps: None,
+        rhs_evals: None,
+        passes_strict: None,
+        passes_loose: None,
+        failing: Vec::new(),
+        failure: None,
+        protocol_s: None,
+    }
+}

@@ -1,0 +1,379 @@
+//! The external-solver protocol (BENCHMARK.md): a client is a command, started once per
+//! (scene, setting) with the path of a job file as its last argument; it writes the trace
+//! (and optionally the events) named in the job and may print `{"solve_seconds": S}` on
+//! standard output.
+//!
+//! Each run is its own process group, killed as a whole (SIGKILL) when it runs past the
+//! timeout; its wall time is measured from the spawn to its exit.
+
+use std::io::Read;
+use std::path::{Path, PathBuf};
+use std::process::{Command, ExitStatus, Stdio};
+use std::sync::mpsc;
+use std::time::{Duration, Instant};
+
+use serde::Serialize;
+
+/// An external solver: its name, the command (split into words), and whether its accuracy
+/// knob is a step `h` rather than a tolerance.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct ClientSpec {
+    pub name: String,
+    pub argv: Vec<String>,
+    pub fixed_step: bool,
+    /// One of the repository's own peers (scipy, Siconos), run when installed.
+    pub peer: bool,
+}
+
+impl ClientSpec {
+    /// `NAME=COMMAND` as given to `--external`. The client is fixed-step when `fixed` names
+    /// it, or when its name says so (it contains `fixed`, `moreau`, `siconos` or ends in
+    /// `:h`, which is removed).
+    pub fn parse(arg: &str, fixed: &[String]) -> Result<ClientSpec, String> {
+        let (name, command) = arg
+            .split_once('=')
+            .ok_or_else(|| format!("--external {arg:?}: expected NAME=COMMAND"))?;
+        let name = name.trim();
+        if name.is_empty() || name.contains(['/', '\\', ' ']) {
+            return Err(format!(
+                "--external {arg:?}: the name {name:?} must be non-empty, without spaces or slashes"
+            ));
+        }
+        let argv = split_words(command).map_err(|e| format!("--external {arg:?}: {e}"))?;
+        if argv.is_empty() {
+            return Err(format!("--external {arg:?}: the command is empty"));
+        }
+        let (name, by_suffix) = match name.strip_suffix(":h") {
+            Some(n) => (n, true),
+            None => (name, false),
+        };
+        let lower = name.to_lowercase();
+        let fixed_step = by_suffix
+            || fixed.iter().any(|f| f == name)
+            || ["fixed", "moreau", "siconos"]
+                .iter()
+                .any(|w| lower.contains(w));
+        Ok(ClientSpec {
+            name: name.to_owned(),
+            argv,
+            fixed_step,
+            peer: false,
+        })
+    }
+
+    /// The command as one line, words quoted where needed.
+    pub fn command_line(&self) -> String {
+        self.argv
+            .iter()
+            .map(|w| {
+                if !w.is_empty()
+                    && w.chars()
+                        .all(|c| c.is_ascii_alphanumeric() || "-_./=:,+@%".contains(c))
+                {
+                    w.clone()
+                } else {
+                    format!("'{}'", w.replace('\'', "'\\''"))
+                }
+            })
+            .collect::<Vec<_>>()
+            .join(" ")
+    }
+}
+
+/// Splits a command line into words as a POSIX shell does, without running one: blanks
+/// separate words; `'…'` is literal; `"…"` is literal except `\"`, `\\`, `\$` and `` \` ``;
+/// outside quotes `\` escapes the next character. No expansion of any kind.
+pub fn split_words(s: &str) -> Result<Vec<String>, String> {
+    let mut words = Vec::new();
+    let mut cur = String::new();
+    let mut in_word = false;
+    let mut chars = s.chars();
+    while let Some(c) = chars.next() {
+        match c {
+            ' ' | '\t' | '\n' => {
+                if in_word {
+                    words.push(std::mem::take(&mut cur));
+                    in_word = false;
+                }
+            }
+            '\'' => {
+                in_word = true;
+                loop {
+                    match chars.next() {
+                        Some('\'') => break,
+                        Some(c) => cur.push(c),
+                        None => return Err("unterminated single quote".into()),
+                    }
+                }
+            }
+            '"' => {
+                in_word = true;
+                loop {
+                    match chars.next() {
+                        Some('"') => break,
+                        Some('\\') => match chars.next() {
+                            Some(c @ ('"' | '\\' | '$' | '`')) => cur.push(c),
+                            Some(c) => {
+                                cur.push('\\');
+                                cur.push(c);
+                            }
+                            None => return Err("unterminated double quote".into()),
+                        },
+                        Some(c) => cur.push(c),
+                        None => return Err("unterminated double quote".into()),
+                    }
+                }
+            }
+            '\\' => {
+                in_word = true;
+                match chars.next() {
+                    Some(c) => cur.push(c),
+                    None => return Err("a trailing backslash".into()),
+                }
+            }
+            c => {
+                in_word = true;
+                cur.push(c);
+            }
+        }
+    }
+    if in_word {
+        words.push(cur);
+    }
+    Ok(words)
+}
+
+/// The job file of one run (BENCHMARK.md).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Job {
+    pub scenario: String,
+    /// Every field of the parameter file, friction family names included.
+    pub params: serde_json::Value,
+    pub u: f64,
+    pub x0: [f64; 3],
+    pub t_end: f64,
+    pub dt: f64,
+    pub tol: Option<f64>,
+    pub h: Option<f64>,
+    pub trace: PathBuf,
+    pub events: PathBuf,
+}
+
+/// How a client's process ended.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Ended {
+    /// It exited with this status.
+    Exited(ExitStatus),
+    /// It ran past the timeout and was killed with its process group.
+    TimedOut,
+}
+
+/// One run of a client.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RunOutput {
+    pub ended: Ended,
+    /// From the spawn to the exit (or the kill) [s].
+    pub wall_s: f64,
+    pub stdout: String,
+    pub stderr: String,
+}
+
+/// What the client printed on standard output: the last line that is a JSON object with
+/// `solve_seconds` (and the optional `steps`, `rhs_evals`, `version`, `method`).
+#[derive(Debug, Clone, Default, PartialEq, serde::Deserialize)]
+pub struct ClientSays {
+    pub solve_seconds: Option<f64>,
+    pub steps: Option<u64>,
+    pub rhs_evals: Option<u64>,
+    pub version: Option<String>,
+    pub method: Option<String>,
+}
+
+impl ClientSays {
+    /// Reads the last JSON line with a positive, finite `solve_seconds`; an absent or
+    /// unreadable line gives the default (no in-process time).
+    pub fn from_stdout(out: &str) -> ClientSays {
+        out.lines()
+            .rev()
+            .filter_map(|l| serde_json::from_str::<ClientSays>(l.trim()).ok())
+            .find(|s| s.solve_seconds.is_some_and(|x| x > 0.0 && x.is_finite()))
+            .unwrap_or_default()
+    }
+}
+
+/// Keeps at most this many bytes of a client's standard output and error.
+const KEEP: usize = 1 << 20;
+
+fn drain(mut r: impl Read + Send + 'static) -> std::thread::JoinHandle<String> {
+    std::thread::spawn(move || {
+        let mut buf = Vec::new();
+        let mut chunk = [0u8; 8192];
+        while let Ok(n) = r.read(&mut chunk) {
+            if n == 0 {
+                break;
+            }
+            if buf.len() < KEEP {
+                buf.extend_from_slice(&chunk[..n.min(KEEP - buf.len())]);
+            }
+        }
+        String::from_utf8_lossy(&buf).into_owned()
+    })
+}
+
+/// Runs `argv` with the job file's path appended, in its own process group, for at most
+/// `timeout` seconds. `Err` if it cannot be started.
+pub fn run_client(argv: &[String], job: &Path, timeout: f64) -> Result<RunOutput, String> {
+    let mut cmd = Command::new(&argv[0]);
+    cmd.args(&argv[1..])
+        .arg(job)
+        .stdin(Stdio::null())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped());
+    #[cfg(unix)]
+    {
+        use std::os::unix::process::CommandExt;
+        cmd.process_group(0);
+    }
+    let t0 = Instant::now();
+    let mut child = cmd
+        .spawn()
+        .map_err(|e| format!("cannot start {:?}: {e}", argv[0]))?;
+    let pid = child.id();
+    let out = drain(child.stdout.take().expect("piped"));
+    let err = drain(child.stderr.take().expect("piped"));
+    let (tx, rx) = mpsc::channel();
+    let waiter = std::thread::spawn(move || {
+        let status = child.wait();
+        let _ = tx.send((status, t0.elapsed().as_secs_f64()));
+    });
+    let (ended, wall_s) = match rx.recv_timeout(Duration::from_secs_f64(timeout.max(0.0))) {
+        Ok((Ok(status), wall)) => (Ended::Exited(status), wall),
+        Ok((Err(e), _)) => return Err(format!("waiting for {:?}: {e}", argv[0])),
+        Err(_) => {
+            kill_group(pid);
+            let _ = rx.recv();
+            (Ended::TimedOut, t0.elapsed().as_secs_f64())
+        }
+    };
+    let _ = waiter.join();
+    // The process group is gone, so the pipes close once any grandchildren it left are
+    // killed too (they were, with the group).
+    let stdout = out.join().unwrap_or_default();
+    let stderr = err.join().unwrap_or_default();
+    Ok(RunOutput {
+        ended,
+        wall_s,
+        stdout,
+        stderr,
+    })
+}
+
+/// SIGKILL to the whole process group of `pid` (the client and anything it started), by
+/// the POSIX `kill` utility with a negative process id (the group id is the client's pid:
+/// it was started with `process_group(0)`); no unsafe code.
+fn kill_group(pid: u32) {
+    let _ = Command::new("kill")
+        .args(["-KILL", "--", &format!("-{pid}")])
+        .stdout(Stdio::null())
+        .stderr(Stdio::null())
+        .status();
+}
+
+/// The last `n` non-empty lines of a text, joined with " | " (for failure messages).
+pub fn tail(text: &str, n: usize) -> String {
+    let lines: Vec<&str> = text.lines().filter(|l| !l.trim().is_empty()).collect();
+    lines[lines.len().saturating_sub(n)..].join(" | ")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn words_split_as_a_shell_splits_them() {
+        let w = |s: &str| split_words(s).unwrap();
+        assert_eq!(w("python3 client.py"), ["python3", "client.py"]);
+        assert_eq!(w("  a   b\tc "), ["a", "b", "c"]);
+        assert_eq!(
+            w("julia --project='my dir' x.jl"),
+            ["julia", "--project=my dir", "x.jl"]
+        );
+        assert_eq!(
+            w(r#"sh -c "echo \"hi\" \$x""#),
+            ["sh", "-c", r#"echo "hi" $x"#]
+        );
+        assert_eq!(w(r"a\ b c"), ["a b", "c"]);
+        assert_eq!(w("''"), [""]);
+        assert!(split_words("'open").is_err());
+        assert!(split_words("\"open").is_err());
+        assert!(split_words("end\\").is_err());
+    }
+
+    #[test]
+    fn external_specs_name_the_bad_part() {
+        let s = ClientSpec::parse("mine=python3 my client.py", &[]).unwrap();
+        assert_eq!(s.name, "mine");
+        assert_eq!(s.argv, ["python3", "my", "client.py"]);
+        assert!(!s.fixed_step);
+        assert!(
+            ClientSpec::parse("stepper:h=./run", &[])
+                .unwrap()
+                .fixed_step
+        );
+        assert!(
+            ClientSpec::parse("my_moreau=./run", &[])
+                .unwrap()
+                .fixed_step
+        );
+        assert!(
+            ClientSpec::parse("x=./run", &["x".into()])
+                .unwrap()
+                .fixed_step
+        );
+        for (bad, needle) in [
+            ("no-equals", "NAME=COMMAND"),
+            ("=cmd", "must be non-empty"),
+            ("a b=cmd", "without spaces"),
+            ("x=", "empty"),
+            ("x='oops", "unterminated"),
+        ] {
+            let e = ClientSpec::parse(bad, &[]).unwrap_err();
+            assert!(e.contains(needle), "{bad}: {e}");
+        }
+    }
+
+    #[test]
+    fn a_client_that_hangs_is_killed_with_its_children_at_the_timeout() {
+        let dir = std::env::temp_dir();
+        // The shell starts a grandchild that would outlive a kill of the shell alone.
+        let argv: Vec<String> = ["sh", "-c", "sleep 30 & sleep 30; true"]
+            .iter()
+            .map(|s| s.to_string())
+            .collect();
+        let t = Instant::now();
+        let r = run_client(&argv, &dir, 0.3).unwrap();
+        assert_eq!(r.ended, Ended::TimedOut);
+        // The pipes closed: the grandchild was killed with the group (else this would wait
+        // for its 30 s).
+        assert!(t.elapsed().as_secs_f64() < 10.0);
+        let ok = run_client(
+            &[
+                "sh".into(),
+                "-c".into(),
+                "echo '{\"solve_seconds\": 0.25}'; exit 3".into(),
+            ],
+            &dir,
+            10.0,
+        )
+        .unwrap();
+        let Ended::Exited(st) = ok.ended else {
+            panic!()
+        };
+        assert_eq!(st.code(), Some(3));
+        assert_eq!(
+            ClientSays::from_stdout(&ok.stdout).solve_seconds,
+            Some(0.25)
+        );
+        assert!(run_client(&["/no/such/binary".into()], &dir, 1.0).is_err());
+    }
+}
