@@ -580,9 +580,38 @@ impl<'a> Integrator<'a> {
         sink: &mut impl Sink,
     ) -> Result<RunEnd, SolveError> {
         let mut x = x_start;
+        let mut mode = mode;
         for d in Disc::BOTH {
             if mode.of(d) == DiscMode::Stick {
                 x[d.index()] = 0.0;
+            }
+        }
+        // A disc stuck exactly on an edge of its stick interval, its applied torque moving
+        // out, leaves at once: its exit guard starts at 0, and a crossing from 0 is never
+        // seen (the disc would stay stuck while the spring winds up without bound).
+        for d in Disc::BOTH {
+            if mode.of(d) != DiscMode::Stick {
+                continue;
+            }
+            let f = field(&x, mode);
+            for g in [Guard::ExitHi(d), Guard::ExitLo(d)] {
+                if self.guard(g, &x, mode) <= 0.0 && self.guard_rate(g, &x, &f, mode) < 0.0 {
+                    let (m, kind) = self.transition(g, &mut x, mode);
+                    mode = m;
+                    if let Some(kind) = kind {
+                        self.stats.events += 1;
+                        let ev = Event {
+                            t: t_start,
+                            x,
+                            kind,
+                        };
+                        sink.event(&ev);
+                        if sink.stop_after(&ev) {
+                            return Ok(RunEnd { t: t_start, x, mode });
+                        }
+                    }
+                    break;
+                }
             }
         }
         let f0 = field(&x, mode);

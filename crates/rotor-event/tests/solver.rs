@@ -653,3 +653,41 @@ fn steady_state_next_to_a_hopf_point_answers_the_focus() {
         }
     );
 }
+
+/// A start exactly on the edge of the lower disc's stick interval, with the spring torque
+/// rising through it: the disc leaves stick at once (a StickEnd at t = 0), as it does from a
+/// start a hair past the edge, instead of staying stuck while the spring winds up (its exit
+/// guard starts at exactly 0, and a crossing from 0 was never seen).
+#[test]
+fn a_start_on_the_stick_edge_with_rising_torque_leaves_at_once() {
+    let m = Model::table1();
+    let t_sl = m.friction(rotor_model::Disc::Lower).static_interval().1;
+    let edge = t_sl / m.params.k_theta;
+    let run = |alpha: f64| {
+        EventSolver::default()
+            .simulate(
+                &m,
+                &Scene {
+                    u: 4.63,
+                    x0: State::new(alpha, 8.0, 0.0),
+                    t_end: 10.0,
+                    tol: 1e-12,
+                    output: Output::Events,
+                    ..Scene::default()
+                },
+            )
+            .unwrap()
+    };
+    let on = run(edge);
+    let past = run(edge * (1.0 + 1e-14));
+    assert!(
+        on.events.first().is_some_and(|e| e.t == 0.0
+            && e.kind == rotor_model::EventKind::StickEnd(rotor_model::Disc::Lower)),
+        "{:?}",
+        on.events.first()
+    );
+    // The two starts differ by 1e-14 relative in α: after 10 s the runs agree to well within
+    // 1e-9 (the tolerance is 1e-12; before the fix they differed by 66 rad in α).
+    let d = (on.x_final - past.x_final).amax();
+    assert!(d < 1e-9, "{:?} vs {:?}", on.x_final, past.x_final);
+}
