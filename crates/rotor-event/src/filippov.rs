@@ -593,9 +593,11 @@ impl<'a> Integrator<'a> {
             if mode.of(d) != DiscMode::Stick {
                 continue;
             }
-            let f = field(&x, mode);
             for g in [Guard::ExitHi(d), Guard::ExitLo(d)] {
-                if self.guard(g, &x, mode) <= 0.0 && self.guard_rate(g, &x, &f, mode) < 0.0 {
+                // The field only where a guard is on its edge (rarely: a start exactly there).
+                if self.guard(g, &x, mode) <= 0.0
+                    && self.guard_rate(g, &x, &field(&x, mode), mode) < 0.0
+                {
                     let (m, kind) = self.transition(g, &mut x, mode);
                     mode = m;
                     if let Some(kind) = kind {
