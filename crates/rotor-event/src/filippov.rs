@@ -609,7 +609,11 @@ impl<'a> Integrator<'a> {
                         };
                         sink.event(&ev);
                         if sink.stop_after(&ev) {
-                            return Ok(RunEnd { t: t_start, x, mode });
+                            return Ok(RunEnd {
+                                t: t_start,
+                                x,
+                                mode,
+                            });
                         }
                     }
                     break;

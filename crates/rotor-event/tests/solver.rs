@@ -681,8 +681,10 @@ fn a_start_on_the_stick_edge_with_rising_torque_leaves_at_once() {
     let on = run(edge);
     let past = run(edge * (1.0 + 1e-14));
     assert!(
-        on.events.first().is_some_and(|e| e.t == 0.0
-            && e.kind == rotor_model::EventKind::StickEnd(rotor_model::Disc::Lower)),
+        on.events
+            .first()
+            .is_some_and(|e| e.t == 0.0
+                && e.kind == rotor_model::EventKind::StickEnd(rotor_model::Disc::Lower)),
         "{:?}",
         on.events.first()
     );
