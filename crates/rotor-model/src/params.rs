@@ -37,6 +37,13 @@ pub enum ParamsError {
     /// The file is not valid TOML, or a key is unknown, missing or of the wrong type.
     #[error("{}: {message}", shown(.path))]
     Parse { path: PathBuf, message: String },
+    /// A value set by name (not read from a file) is unknown or out of its range.
+    #[error("{field} = {value}: {reason}")]
+    Value {
+        field: String,
+        value: String,
+        reason: String,
+    },
     /// A value is out of its admissible range.
     #[error("{}: {field} = {value}: {reason}", shown(.path))]
     Invalid {
@@ -302,6 +309,101 @@ impl Params {
         p.validate()
             .map_err(|(field, value, reason)| bad(&field, value, &reason))?;
         Ok(p)
+    }
+
+    /// The fields of this parameter set as dotted paths (`k_theta`, `upper.b`, `lower.t_s`,
+    /// ...), those of its lower friction family included, in file order.
+    pub fn field_names(&self) -> Vec<&'static str> {
+        let mut v = vec![
+            "j_u",
+            "k_m",
+            "k_theta",
+            "j_l",
+            "upper.t_s",
+            "upper.dt_s",
+            "upper.b",
+            "upper.db",
+        ];
+        match self.lower {
+            LowerFriction::Exponential { .. } => v.extend([
+                "lower.t_s",
+                "lower.t_1",
+                "lower.t_2",
+                "lower.w_1",
+                "lower.w_2",
+                "lower.b",
+            ]),
+            LowerFriction::Stribeck { .. } => v.extend([
+                "lower.t_s",
+                "lower.t_c",
+                "lower.omega_s",
+                "lower.delta",
+                "lower.b",
+            ]),
+        }
+        v
+    }
+
+    /// A mutable reference to the field at a dotted path, if this set has it.
+    fn field_mut(&mut self, name: &str) -> Option<&mut f64> {
+        Some(match name {
+            "j_u" => &mut self.j_u,
+            "k_m" => &mut self.k_m,
+            "k_theta" => &mut self.k_theta,
+            "j_l" => &mut self.j_l,
+            "upper.t_s" => &mut self.upper.t_s,
+            "upper.dt_s" => &mut self.upper.dt_s,
+            "upper.b" => &mut self.upper.b,
+            "upper.db" => &mut self.upper.db,
+            _ => match (&mut self.lower, name) {
+                (LowerFriction::Exponential { t_s, .. }, "lower.t_s")
+                | (LowerFriction::Stribeck { t_s, .. }, "lower.t_s") => t_s,
+                (LowerFriction::Exponential { b, .. }, "lower.b")
+                | (LowerFriction::Stribeck { b, .. }, "lower.b") => b,
+                (LowerFriction::Exponential { t_1, .. }, "lower.t_1") => t_1,
+                (LowerFriction::Exponential { t_2, .. }, "lower.t_2") => t_2,
+                (LowerFriction::Exponential { w_1, .. }, "lower.w_1") => w_1,
+                (LowerFriction::Exponential { w_2, .. }, "lower.w_2") => w_2,
+                (LowerFriction::Stribeck { t_c, .. }, "lower.t_c") => t_c,
+                (LowerFriction::Stribeck { omega_s, .. }, "lower.omega_s") => omega_s,
+                (LowerFriction::Stribeck { delta, .. }, "lower.delta") => delta,
+                _ => return None,
+            },
+        })
+    }
+
+    /// The value of the field at a dotted path; the error lists the valid names.
+    pub fn get(&self, name: &str) -> Result<f64, ParamsError> {
+        let mut copy = *self;
+        copy.field_mut(name)
+            .map(|v| *v)
+            .ok_or_else(|| self.unknown(name))
+    }
+
+    /// A copy with the field at a dotted path set to `value`, validated; the error names the
+    /// field and the value (or lists the valid names).
+    pub fn with(&self, name: &str, value: f64) -> Result<Params, ParamsError> {
+        let mut copy = *self;
+        *copy.field_mut(name).ok_or_else(|| self.unknown(name))? = value;
+        copy.validate()
+            .map_err(|(field, v, reason)| ParamsError::Value {
+                field,
+                value: v.to_string(),
+                reason,
+            })?;
+        Ok(copy)
+    }
+
+    fn unknown(&self, name: &str) -> ParamsError {
+        ParamsError::Value {
+            field: "param".into(),
+            value: format!("{name:?}"),
+            reason: format!(
+                "not a parameter of this {} set (valid: {})",
+                self.lower.family(),
+                self.field_names().join(", ")
+            ),
+        }
     }
 
     /// Checks that every value is finite and in its admissible range.
@@ -713,5 +815,25 @@ mod tests {
         let e = err_of(&t);
         assert!(e.contains("j_u"), "{e}");
         assert!(err_of("  \n").contains("empty"));
+    }
+
+    #[test]
+    fn fields_are_read_and_set_by_dotted_path() {
+        let p = Params::table1();
+        assert_eq!(p.get("k_theta").unwrap(), 0.0727);
+        assert_eq!(p.get("lower.w_1").unwrap(), 5.7468);
+        let q = p.with("lower.t_s", 0.2).unwrap();
+        assert_eq!(q.get("lower.t_s").unwrap(), 0.2);
+        assert_eq!(p.field_names().len(), 14);
+        for name in p.field_names() {
+            assert_eq!(p.with(name, p.get(name).unwrap()).unwrap(), p, "{name}");
+        }
+        let e = p.get("lower.omega_s").unwrap_err().to_string();
+        assert!(
+            e.contains("\"lower.omega_s\"") && e.contains("k_theta, j_l"),
+            "{e}"
+        );
+        let e = p.with("k_theta", -0.1).unwrap_err().to_string();
+        assert_eq!(e, "k_theta = -0.1: must be positive");
     }
 }
