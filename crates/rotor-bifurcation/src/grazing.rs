@@ -127,6 +127,80 @@ pub fn touch_to_min(
     Err(BifError::NoReturn { u })
 }
 
+/// The smooth flow of one mode (no events: each disc on its branch, the friction continued
+/// across ω = 0) from `x0` for `t_end` seconds.
+pub fn smooth_flow(
+    model: &Model,
+    u: f64,
+    mode: Mode,
+    x0: State,
+    t_end: f64,
+    tol: f64,
+) -> Result<State, BifError> {
+    let mut f = |_t: f64, x: &State| model.rhs(x, u, mode);
+    let mut ctl = Dop853::new(tol, tol);
+    let (mut t, mut x) = (0.0, x0);
+    let mut f0 = f(t, &x);
+    let mut h = ctl.initial_step(&mut f, t, &x, &f0);
+    ctl.restart();
+    for _ in 0..MAX_STEPS {
+        if t >= t_end {
+            return Ok(x);
+        }
+        let hh = h.min(t_end - t);
+        let tr = ctl.trial(&mut f, t, &x, &f0, hh);
+        if !Dop853::acceptable(&tr) {
+            h = ctl.reject(tr.err, hh);
+            if h.is_nan() || h <= 1e-14 {
+                break;
+            }
+            continue;
+        }
+        let h_new = ctl.accept(tr.err, hh);
+        t = if hh == t_end - t { t_end } else { t + hh };
+        x = tr.y1;
+        f0 = f(t, &x);
+        h = h_new;
+    }
+    Err(BifError::NoReturn { u })
+}
+
+/// The nontrivial Floquet multiplier of largest modulus of the grazing orbit at `(u, w)` as
+/// an orbit of the smooth slip–slip flow: the monodromy matrix over one period (touch to
+/// touch) by central differences (steps 1e-6 relative), its eigenvalue nearest 1 dropped
+/// (the flow direction). This is the multiplier of the slipping cycle that ends at the
+/// grazing orbit; above 1, the stick-slip branch born there turns back to the slipping
+/// branch's side (a discontinuous fold).
+pub fn grazing_multiplier(model: &Model, u: f64, w: f64, tol: f64) -> Result<f64, BifError> {
+    let (_, period, _) = touch_to_min(model, u, w, tol, 1e4)?;
+    let t_sl = model.friction(Disc::Lower).static_interval().1;
+    let x0 = State::new(t_sl / model.params.k_theta, w, 0.0);
+    let mode = Mode {
+        upper: DiscMode::slip_of(w),
+        lower: DiscMode::SlipPos,
+    };
+    let mut m = nalgebra::Matrix3::zeros();
+    for k in 0..3 {
+        let d = 1e-6 * x0[k].abs().max(1.0);
+        let mut xp = x0;
+        let mut xm = x0;
+        xp[k] += d;
+        xm[k] -= d;
+        let fp = smooth_flow(model, u, mode, xp, period, tol)?;
+        let fm = smooth_flow(model, u, mode, xm, period, tol)?;
+        for i in 0..3 {
+            m[(i, k)] = (fp[i] - fm[i]) / (2.0 * d);
+        }
+    }
+    let mut ev: Vec<nalgebra::Complex<f64>> = m.complex_eigenvalues().iter().copied().collect();
+    ev.sort_by(|a, b| {
+        (*a - nalgebra::Complex::new(1.0, 0.0))
+            .norm()
+            .total_cmp(&(*b - nalgebra::Complex::new(1.0, 0.0)).norm())
+    });
+    Ok(ev[1..].iter().map(|z| z.norm()).fold(0.0, f64::max))
+}
+
 /// Root of `ω̇_l` on `[a, b]` along the dense output (bisection then secant, to rounding).
 fn root(d: &Dense<3>, acc: &impl Fn(&State) -> f64, a: f64, b: f64, fa: f64, fb: f64) -> f64 {
     let (mut a, mut b, mut fa, mut fb) = (a, b, fa, fb);

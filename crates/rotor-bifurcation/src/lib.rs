@@ -24,6 +24,7 @@
 //! Its cost is benchmarked by `cargo bench -p rotor-bifurcation` (`benches/diagram.rs`);
 //! the measurements are in `reports/measurements.md`.
 
+pub mod arc;
 pub mod continuation;
 mod diagram;
 pub mod equilibria;
@@ -31,6 +32,7 @@ pub mod grazing;
 pub mod monodromy;
 mod output;
 pub mod periodic;
+pub mod plane;
 mod points;
 mod svg;
 

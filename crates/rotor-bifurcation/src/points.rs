@@ -77,6 +77,14 @@ pub struct SpecialPoint {
     /// What `residual` is.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub condition: Option<&'static str>,
+    /// Grazing orbits: ω_u where the orbit touches ω_l = 0 \[rad/s\] (the orbit's state there is
+    /// `(T_sl/k_θ, ω_u, 0)`); a restart point for continuing the grazing condition.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub touch_omega_u: Option<f64>,
+    /// Smooth folds: the cycle's state `[α, ω_u, ω_l]` on the section `ω_l = ω*(u)`; a restart
+    /// point for continuing the fold condition.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub section_state: Option<[f64; 3]>,
     pub detail: String,
 }
 
@@ -93,6 +101,8 @@ impl SpecialPoint {
             omega_l_min: None,
             residual: None,
             condition: None,
+            touch_omega_u: None,
+            section_state: None,
             detail,
         }
     }
@@ -122,6 +132,7 @@ fn grazing_point(g: &grazing::GrazingOrbit, detail: String) -> SpecialPoint {
     p.omega_l_min = Some(0.0);
     p.residual = Some(g.residual[0].abs().max(g.residual[1].abs()));
     p.condition = Some(GRAZING_CONDITION);
+    p.touch_omega_u = Some(g.w);
     p
 }
 
@@ -231,6 +242,7 @@ pub(crate) fn special_points(
             p.discontinuous = Some(false);
             p.residual = Some(n.tangent[0]);
             p.condition = Some(FOLD_CONDITION);
+            p.section_state = Some([n.y[1], n.y[2], n.c]);
             out.push(p);
         }
         if a.info.stable != b.info.stable && !explained {

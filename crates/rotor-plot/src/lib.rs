@@ -46,6 +46,8 @@ pub struct Panel<'a> {
     pub series: Vec<Series<'a>>,
     /// Labelled points (special points of a diagram, say).
     pub labels: Vec<Label>,
+    /// Text centred at a data point, without a mark (the name of a region, say).
+    pub notes: Vec<Label>,
     /// Logarithmic axes: points with a non-positive coordinate are skipped.
     pub x_log: bool,
     pub y_log: bool,
@@ -65,6 +67,7 @@ impl<'a> Panel<'a> {
             y_label,
             series,
             labels: Vec::new(),
+            notes: Vec::new(),
             x_log: false,
             y_log: false,
         }
@@ -317,6 +320,16 @@ pub fn render(panels: &[Panel], width: f64, panel_height: f64) -> String {
                 py - 6.0,
                 esc(&lab.text)
             );
+        }
+        for note in &p.notes {
+            let (px, py) = (sx(note.x), sy(note.y));
+            if px.is_finite() && py.is_finite() {
+                let _ = writeln!(
+                    s,
+                    r##"<text x="{px:.2}" y="{py:.2}" text-anchor="middle" font-size="12" fill="#555">{}</text>"##,
+                    esc(&note.text)
+                );
+            }
         }
     }
     s.push_str("</svg>\n");

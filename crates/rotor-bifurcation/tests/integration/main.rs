@@ -5,5 +5,6 @@ mod common;
 mod diagram;
 mod floquet;
 mod output;
+mod plane;
 mod points;
 mod variational;

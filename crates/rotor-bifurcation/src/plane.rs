@@ -1,0 +1,1083 @@
+//! Two-parameter analysis: every codimension-one point of the u-diagram continued in the
+//! plane of (p, u), for any parameter p of the file, and the codimension-two points where the
+//! curves change type, turn, end or meet (`rotor bifurcation2`).
+//!
+//! Each curve is followed by pseudo-arclength ([`crate::arc`]) on its defining system, from the
+//! point of the one-parameter diagram at the file's value of p (or, outside the range, at its
+//! middle), in both directions:
+//!
+//! * **Hopf** (`hopf`): `y = (p, ω)`, `Re λ(ω; p) = 0` for the complex pair of the slipping
+//!   equilibrium at velocity ω (the branch is explicit in ω, `u = u(ω; p)`). Each point carries
+//!   its first Lyapunov coefficient `l1` (Kuznetsov's formula on the smooth slip field; `l1 < 0`
+//!   supercritical), so a change of criticality is found as a sign change.
+//! * **Grazing** (`grazing`, `discontinuous_fold`): `y = (p, u, w)`, the grazing system of
+//!   [`crate::grazing`] (the cycle touches `ω_l = 0` at `(T_sl/k_θ, w, 0)` with `ω̇_l = 0`). A
+//!   grazing orbit is a discontinuous fold where the slipping cycle that ends there is unstable
+//!   (its leading multiplier exceeds 1: the stick-slip branch then turns back to the same side,
+//!   as at the source's point E on the Stribeck set); the curve is split where that changes.
+//! * **Smooth fold of cycles** (`fold`): `y = (p, α, ω_u, u)`, the cycle's fixed point on the
+//!   section `ω_l = ω*(u)` and `det(∂P/∂z − I) = 0` (a multiplier 1).
+//! * **Stuck boundary** (`stuck_boundary`): where the slipping branch meets the stuck set,
+//!   `u = u(ω → 0⁺; p)`, explicit.
+//!
+//! Codimension-two points, located on the curves: a Hopf point changing criticality (`bautin`,
+//! a sign change of l1, by bisection), a curve turning back in p (`hopf_merge` where two Hopf
+//! points meet and vanish, `cusp` where two folds do), a grazing curve changing between
+//! grazing and discontinuous fold (`grazing_fold`: the slipping cycle at grazing has a
+//! multiplier 1, where a fold curve meets the grazing curve), a curve ending at the stuck
+//! boundary (`stuck_end`), and two curves meeting (`curves_meet`). Where the theory of such a
+//! nonsmooth point is not settled the point only records where the curves meet and what was
+//! seen; no normal form is claimed.
+
+use nalgebra::{Complex, Matrix3, Vector3};
+use rotor_model::{DiscMode, Mode, Model, Output, Params, Scene, Solver, State, SteadyState};
+use serde::Serialize;
+
+use crate::arc::{ArcEnd, ArcOptions, follow};
+use crate::continuation::{ContOptions, Continuer, Multipliers};
+use crate::periodic::Shooter;
+use crate::{BifError, DiagramOptions, PointKind, diagram, grazing};
+
+/// What [`plane`] computes.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PlaneOptions {
+    /// The parameter: a field of the parameter file as a dotted path.
+    pub param: String,
+    pub p_min: f64,
+    pub p_max: f64,
+    pub u_min: f64,
+    pub u_max: f64,
+    /// Integration tolerance of the flows.
+    pub tol: f64,
+    /// Most points per curve direction.
+    pub max_points: usize,
+    /// Cells per axis of the coarse grid whose simulations name the regions.
+    pub region_cells: usize,
+    /// Where the curves are started (the one-parameter diagram is computed there); default
+    /// the file's value if it lies in the range, else the middle of the range.
+    pub p_start: Option<f64>,
+}
+
+impl PlaneOptions {
+    /// Defaults for a parameter over `[p_min, p_max]` and u over `[0, 7]`.
+    pub fn new(param: &str, p_min: f64, p_max: f64) -> PlaneOptions {
+        PlaneOptions {
+            param: param.to_owned(),
+            p_min,
+            p_max,
+            u_min: 0.0,
+            u_max: 7.0,
+            tol: 1e-10,
+            max_points: 60,
+            region_cells: 8,
+            p_start: None,
+        }
+    }
+}
+
+/// A kind of codimension-one curve.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum CurveKind {
+    Hopf,
+    Grazing,
+    Fold,
+    DiscontinuousFold,
+    StuckBoundary,
+}
+
+/// One point of a curve.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct CurvePoint {
+    pub p: f64,
+    pub u: f64,
+    /// The defining condition's value at the point (its largest component).
+    pub residual: f64,
+    /// Hopf: the equilibrium's velocity \[rad/s\].
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub omega: Option<f64>,
+    /// Hopf: the first Lyapunov coefficient (< 0: supercritical).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub l1: Option<f64>,
+    /// Grazing: the leading multiplier of the slipping cycle that ends at the grazing orbit
+    /// (> 1: a discontinuous fold).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub multiplier: Option<f64>,
+    /// Grazing: ω_u at the touch point \[rad/s\].
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub touch_omega_u: Option<f64>,
+    /// Fold: the cycle's `[α, ω_u]` on the section `ω_l = ω*(u)`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub section_state: Option<[f64; 2]>,
+}
+
+/// A codimension-one curve.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Curve {
+    pub kind: CurveKind,
+    /// `H1`, `G2`, `E`, `S`, … (as in the u-diagram: numbered by u at the start).
+    pub label: String,
+    pub points: Vec<CurvePoint>,
+    /// Why each end of the curve ended (first end, last end).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub ends: Vec<String>,
+}
+
+/// A codimension-two point.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Codim2 {
+    pub kind: &'static str,
+    pub p: f64,
+    pub u: f64,
+    /// The curves involved.
+    pub curves: Vec<String>,
+    pub detail: String,
+}
+
+/// A named region of the plane, at a representative point.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Region {
+    pub name: String,
+    pub p: f64,
+    pub u: f64,
+}
+
+/// The two-parameter picture (the JSON of `rotor bifurcation2`).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Plane {
+    pub param: String,
+    /// The parameter's value in the file.
+    pub p_file: f64,
+    pub curves: Vec<Curve>,
+    pub points: Vec<Codim2>,
+    pub regions: Vec<Region>,
+}
+
+/// The parameter set with `name` = `p` (validated).
+fn params_at(base: &Params, name: &str, p: f64) -> Result<Params, BifError> {
+    base.with(name, p)
+        .map_err(|e| BifError::Degenerate(format!("parameter {name} = {p}: {e}")))
+}
+
+/// Checks the options and that every parameter value of the range is admissible (both ends
+/// and 64 values between).
+pub fn validate(base: &Params, opts: &PlaneOptions) -> Result<(), BifError> {
+    let bad = |field, value, reason| {
+        Err(BifError::InvalidOption {
+            field,
+            value,
+            reason,
+        })
+    };
+    base.get(&opts.param)
+        .map_err(|e| BifError::Degenerate(e.to_string()))?;
+    if !(opts.p_min.is_finite() && opts.p_max.is_finite() && opts.p_max > opts.p_min) {
+        return bad("p_max", opts.p_max, "must be finite and greater than p_min");
+    }
+    if !(opts.u_min >= 0.0 && opts.u_max > opts.u_min && opts.u_max <= crate::U_MAX) {
+        return bad("u_max", opts.u_max, "need 0 <= u_min < u_max <= 1000");
+    }
+    for k in 0..=64 {
+        let p = opts.p_min + (opts.p_max - opts.p_min) * k as f64 / 64.0;
+        base.with(&opts.param, p).map_err(|e| {
+            BifError::Degenerate(format!(
+                "--param {} over [{}, {}]: {e}",
+                opts.param, opts.p_min, opts.p_max
+            ))
+        })?;
+    }
+    Ok(())
+}
+
+/// The first Lyapunov coefficient of the Hopf point of the slipping equilibrium at velocity
+/// `omega` (Kuznetsov, *Elements of Applied Bifurcation Theory*, eq. (3.20)):
+///
+/// ```text
+/// l1 = Re[⟨p, C(q,q,q̄)⟩ − 2⟨p, B(q, A⁻¹B(q,q̄))⟩ + ⟨p, B(q̄, (2iβ − A)⁻¹B(q,q))⟩] / (2β),
+/// ```
+///
+/// with `Aq = iβq`, `Aᵀp = −iβp`, `⟨p, q⟩ = p̄ᵀq = 1`. In the slip field only the friction
+/// torques are nonlinear, each in its own disc's velocity, so B and C are diagonal:
+/// `B(x, y)_i = f_i'' x_i y_i`, `C(x, y, z)_i = f_i''' x_i y_i z_i` for the two velocity rows,
+/// with `f_i'' = −T_fi''(ω)/J_i` (central differences of the branch torque, steps 1e-3 and
+/// 2e-3 of 1 + |ω|: the torque is analytic on the branch). `None` if there is no complex pair.
+pub fn first_lyapunov(model: &Model, omega: f64) -> Option<f64> {
+    let e = model.slip_equilibrium_at(omega);
+    let mode = Mode {
+        upper: DiscMode::SlipPos,
+        lower: DiscMode::SlipPos,
+    };
+    let a = model.jacobian(&e.state(), e.u, mode);
+    let beta = crate::equilibria::complex_pair(model, omega)?.im;
+    let c = |v: f64| Complex::new(v, 0.0);
+    let ac: Matrix3<Complex<f64>> = a.map(c);
+    let ib = Complex::new(0.0, beta);
+    let null = |m: Matrix3<Complex<f64>>| -> Vector3<Complex<f64>> {
+        let r = |i: usize| Vector3::new(m[(i, 0)], m[(i, 1)], m[(i, 2)]);
+        [r(0).cross(&r(1)), r(0).cross(&r(2)), r(1).cross(&r(2))]
+            .into_iter()
+            .max_by(|x, y| x.norm().total_cmp(&y.norm()))
+            .expect("three candidates")
+    };
+    let id = Matrix3::<Complex<f64>>::identity();
+    let q = null(ac - id * ib);
+    let q = q / c(q.norm());
+    let p = null(ac.transpose() + id * ib);
+    let dot = |x: &Vector3<Complex<f64>>, y: &Vector3<Complex<f64>>| {
+        x.iter()
+            .zip(y.iter())
+            .map(|(a, b)| a.conj() * b)
+            .sum::<Complex<f64>>()
+    };
+    let pq = dot(&p, &q);
+    let p = p / pq.conj();
+    // Second and third derivatives of the two velocity rows of f = rhs(x) in ω_u, ω_l.
+    let d = |disc: rotor_model::Disc, j: f64| {
+        let fr = model.friction(disc);
+        let w = e.omega;
+        let t = |x: f64| fr.torque(x, 1.0);
+        let h2 = 1e-3 * (1.0 + w.abs());
+        let second = (t(w + h2) - 2.0 * t(w) + t(w - h2)) / (h2 * h2);
+        let h3 = 2e-3 * (1.0 + w.abs());
+        let third = (t(w + 2.0 * h3) - 2.0 * t(w + h3) + 2.0 * t(w - h3) - t(w - 2.0 * h3))
+            / (2.0 * h3 * h3 * h3);
+        (-second / j, -third / j)
+    };
+    let (bu, cu) = d(rotor_model::Disc::Upper, model.params.j_u);
+    let (bl, cl) = d(rotor_model::Disc::Lower, model.params.j_l);
+    let b = |x: &Vector3<Complex<f64>>, y: &Vector3<Complex<f64>>| {
+        Vector3::new(c(0.0), x[1] * y[1] * bu, x[2] * y[2] * bl)
+    };
+    let cc = |x: &Vector3<Complex<f64>>, y: &Vector3<Complex<f64>>, z: &Vector3<Complex<f64>>| {
+        Vector3::new(c(0.0), x[1] * y[1] * z[1] * cu, x[2] * y[2] * z[2] * cl)
+    };
+    let qb = q.map(|z| z.conj());
+    let inv_a = ac.try_inverse()?;
+    let inv_2 = (id * (ib * c(2.0)) - ac).try_inverse()?;
+    let term = dot(&p, &cc(&q, &q, &qb)) - dot(&p, &b(&q, &(inv_a * b(&q, &qb)))) * c(2.0)
+        + dot(&p, &b(&qb, &(inv_2 * b(&q, &q))));
+    Some(term.re / (2.0 * beta))
+}
+
+/// Hopf: `H(p, ω) = Re λ(ω; p)`.
+fn hopf_system<'a>(
+    base: &'a Params,
+    name: &'a str,
+) -> impl Fn(&[f64]) -> Result<Vec<f64>, BifError> + 'a {
+    move |y| {
+        let m = Model::new(params_at(base, name, y[0])?);
+        if y[1] <= 0.0 {
+            return Err(BifError::Degenerate(
+                "omega <= 0: the stuck boundary".into(),
+            ));
+        }
+        let l = crate::equilibria::complex_pair(&m, y[1])
+            .ok_or_else(|| BifError::Degenerate("no complex pair".into()))?;
+        Ok(vec![l.re])
+    }
+}
+
+/// Grazing: `H(p, u, w) = G(u, w; p)`.
+fn grazing_system<'a>(
+    base: &'a Params,
+    name: &'a str,
+    tol: f64,
+) -> impl Fn(&[f64]) -> Result<Vec<f64>, BifError> + 'a {
+    move |y| {
+        let m = Model::new(params_at(base, name, y[0])?);
+        let (g, _, _) = grazing::residual(&m, y[1], y[2], tol)?;
+        Ok(g.to_vec())
+    }
+}
+
+fn continuer(model: &Model, tol: f64) -> Continuer<'_> {
+    Continuer {
+        sh: Shooter { model, tol },
+        opts: ContOptions {
+            u_min: 0.0,
+            u_max: crate::U_MAX,
+            h_max: 0.0,
+            h_min: 0.0,
+            newton_tol: 1e-10,
+            amp_stop: 0.0,
+            max_nodes: 0,
+            fd_step: 1e-6,
+            multipliers: Multipliers::Saltation,
+        },
+    }
+}
+
+/// Smooth fold: `H(p, α, ω_u, u) = (P(z) − z, det(∂P/∂z − I))` on the section `ω_l = ω*(u)`.
+fn fold_system<'a>(
+    base: &'a Params,
+    name: &'a str,
+    tol: f64,
+) -> impl Fn(&[f64]) -> Result<Vec<f64>, BifError> + 'a {
+    move |y| {
+        let m = Model::new(params_at(base, name, y[0])?);
+        let cont = continuer(&m, tol);
+        let lin = cont.residual_jacobian(&[y[3], y[1], y[2]])?;
+        let dz = lin.derivs.dz - nalgebra::Matrix2::identity();
+        Ok(vec![lin.f[0], lin.f[1], dz.determinant()])
+    }
+}
+
+fn arc_opts(max_points: usize) -> ArcOptions {
+    ArcOptions {
+        h0: 0.02,
+        h_max: 0.1,
+        h_min: 1e-5,
+        max_points,
+        tol: 1e-10,
+        fd: 1e-7,
+    }
+}
+
+/// Both directions of a curve from `y0`, joined into one ordered list (the backward part
+/// reversed), with the reason each end ended.
+fn both_ways(
+    h: &crate::arc::System,
+    y0: &[f64],
+    scale: &[f64],
+    opts: &ArcOptions,
+    inside: &dyn Fn(&[f64]) -> bool,
+) -> (Vec<Vec<f64>>, [ArcEnd; 2]) {
+    let mut dir = vec![0.0; y0.len()];
+    dir[0] = 1.0;
+    let (fwd, e1) = follow(h, y0, &dir, scale, opts, inside);
+    dir[0] = -1.0;
+    let (bwd, e0) = follow(h, y0, &dir, scale, opts, inside);
+    let mut pts: Vec<Vec<f64>> = bwd.into_iter().skip(1).rev().collect();
+    pts.extend(fwd);
+    (pts, [e0, e1])
+}
+
+fn end_text(e: &ArcEnd) -> String {
+    match e {
+        ArcEnd::Left => "left the range".into(),
+        ArcEnd::MaxPoints => "point limit".into(),
+        ArcEnd::Stuck(why) => format!("stopped: {why}"),
+    }
+}
+
+/// The two-parameter picture (see the module docs).
+pub fn plane(base: &Params, opts: &PlaneOptions) -> Result<Plane, BifError> {
+    validate(base, opts)?;
+    let name = opts.param.as_str();
+    let p_file = base
+        .get(name)
+        .map_err(|e| BifError::Degenerate(e.to_string()))?;
+    let p0 = match opts.p_start {
+        Some(p) => p,
+        None if (opts.p_min..=opts.p_max).contains(&p_file) => p_file,
+        None => 0.5 * (opts.p_min + opts.p_max),
+    };
+    let model0 = Model::new(params_at(base, name, p0)?);
+    let d = diagram(
+        &model0,
+        &DiagramOptions {
+            u_min: opts.u_min,
+            u_max: opts.u_max,
+            ..DiagramOptions::default()
+        },
+    )?;
+    let p_scale = p0.abs().max(1e-3 * (opts.p_max - opts.p_min)).max(1e-12);
+    let inside_pu =
+        |p: f64, u: f64| p >= opts.p_min && p <= opts.p_max && u >= opts.u_min && u <= opts.u_max;
+    let ao = arc_opts(opts.max_points);
+    let mut curves = Vec::new();
+    let mut counts = std::collections::BTreeMap::<&str, usize>::new();
+    let mut label = |prefix: &'static str| {
+        let n = counts.entry(prefix).or_insert(0);
+        *n += 1;
+        format!("{prefix}{n}")
+    };
+    for sp in &d.points {
+        match sp.kind {
+            PointKind::Hopf => {
+                let Some(w0) = sp.omega else { continue };
+                let h = hopf_system(base, name);
+                let inside = |y: &[f64]| {
+                    y[1] > 0.0
+                        && params_at(base, name, y[0]).is_ok_and(|pp| {
+                            inside_pu(y[0], Model::new(pp).slip_equilibrium_at(y[1]).u)
+                        })
+                };
+                let (pts, ends) = both_ways(&h, &[p0, w0], &[p_scale, w0.max(0.1)], &ao, &inside);
+                let points = pts
+                    .iter()
+                    .filter_map(|y| {
+                        let m = Model::new(params_at(base, name, y[0]).ok()?);
+                        let res = h(y).ok()?[0];
+                        Some(CurvePoint {
+                            p: y[0],
+                            u: m.slip_equilibrium_at(y[1]).u,
+                            residual: res,
+                            omega: Some(y[1]),
+                            l1: first_lyapunov(&m, y[1]),
+                            multiplier: None,
+                            touch_omega_u: None,
+                            section_state: None,
+                        })
+                    })
+                    .collect();
+                curves.push(Curve {
+                    kind: CurveKind::Hopf,
+                    label: label("H"),
+                    points,
+                    ends: ends.iter().map(end_text).collect(),
+                });
+            }
+            PointKind::Grazing => {
+                let Some(w0) = sp.touch_omega_u else { continue };
+                let h = grazing_system(base, name, opts.tol);
+                let inside = |y: &[f64]| inside_pu(y[0], y[1]);
+                let (pts, ends) = both_ways(
+                    &h,
+                    &[p0, sp.u, w0],
+                    &[p_scale, sp.u.max(1.0), w0.abs().max(1.0)],
+                    &ao,
+                    &inside,
+                );
+                let lab = label("G");
+                let points: Vec<CurvePoint> = pts
+                    .iter()
+                    .filter_map(|y| {
+                        let m = Model::new(params_at(base, name, y[0]).ok()?);
+                        let g = h(y).ok()?;
+                        Some(CurvePoint {
+                            p: y[0],
+                            u: y[1],
+                            residual: g[0].abs().max(g[1].abs()),
+                            omega: None,
+                            l1: None,
+                            multiplier: grazing::grazing_multiplier(&m, y[1], y[2], opts.tol).ok(),
+                            touch_omega_u: Some(y[2]),
+                            section_state: None,
+                        })
+                    })
+                    .collect();
+                curves.extend(split_grazing(&lab, points, ends));
+            }
+            PointKind::Fold if sp.discontinuous == Some(false) => {
+                let Some(z) = sp.section_state else { continue };
+                let h = fold_system(base, name, opts.tol);
+                let inside = |y: &[f64]| inside_pu(y[0], y[3]);
+                let (pts, ends) = both_ways(
+                    &h,
+                    &[p0, z[0], z[1], sp.u],
+                    &[
+                        p_scale,
+                        z[0].abs().max(1.0),
+                        z[1].abs().max(1.0),
+                        sp.u.max(1.0),
+                    ],
+                    &ao,
+                    &inside,
+                );
+                let points = pts
+                    .iter()
+                    .filter_map(|y| {
+                        let r = h(y).ok()?;
+                        Some(CurvePoint {
+                            p: y[0],
+                            u: y[3],
+                            residual: r.iter().fold(0.0f64, |a, v| a.max(v.abs())),
+                            omega: None,
+                            l1: None,
+                            multiplier: None,
+                            touch_omega_u: None,
+                            section_state: Some([y[1], y[2]]),
+                        })
+                    })
+                    .collect();
+                curves.push(Curve {
+                    kind: CurveKind::Fold,
+                    label: label("F"),
+                    points,
+                    ends: ends.iter().map(end_text).collect(),
+                });
+            }
+            PointKind::StickLimit => {
+                let n = 41;
+                let points = (0..n)
+                    .filter_map(|k| {
+                        let p = opts.p_min + (opts.p_max - opts.p_min) * k as f64 / (n - 1) as f64;
+                        let m = Model::new(params_at(base, name, p).ok()?);
+                        let u = m.slip_equilibrium_at(0.0).u;
+                        (u >= opts.u_min && u <= opts.u_max).then_some(CurvePoint {
+                            p,
+                            u,
+                            residual: 0.0,
+                            omega: Some(0.0),
+                            l1: None,
+                            multiplier: None,
+                            touch_omega_u: None,
+                            section_state: None,
+                        })
+                    })
+                    .collect();
+                curves.push(Curve {
+                    kind: CurveKind::StuckBoundary,
+                    label: "S".into(),
+                    points,
+                    ends: Vec::new(),
+                });
+            }
+            _ => {}
+        }
+    }
+    let points = codim2(base, name, &curves, opts);
+    let regions = regions(base, name, opts)?;
+    Ok(Plane {
+        param: opts.param.clone(),
+        p_file,
+        curves,
+        points,
+        regions,
+    })
+}
+
+/// A grazing curve split where it changes between a plain grazing orbit and a discontinuous
+/// fold (the slipping cycle's multiplier crosses 1); points whose multiplier could not be
+/// computed keep the kind of the point before.
+fn split_grazing(label: &str, points: Vec<CurvePoint>, ends: [ArcEnd; 2]) -> Vec<Curve> {
+    let fold = |p: &CurvePoint| p.multiplier.map(|m| m > 1.0);
+    let mut out: Vec<Curve> = Vec::new();
+    let mut current: Option<bool> = None;
+    for p in points {
+        let f = fold(&p).or(current).unwrap_or(false);
+        if current != Some(f) {
+            // The new piece starts at the last point of the old one, so the curve stays whole.
+            let start = out.last().and_then(|c| c.points.last().cloned());
+            out.push(Curve {
+                kind: if f {
+                    CurveKind::DiscontinuousFold
+                } else {
+                    CurveKind::Grazing
+                },
+                label: label.to_owned(),
+                points: start.into_iter().collect(),
+                ends: Vec::new(),
+            });
+            current = Some(f);
+        }
+        out.last_mut().expect("pushed above").points.push(p);
+    }
+    if let Some(first) = out.first_mut() {
+        first.ends.push(end_text(&ends[0]));
+    }
+    if let Some(last) = out.last_mut() {
+        last.ends.push(end_text(&ends[1]));
+    }
+    out
+}
+
+/// The codimension-two points on and between the curves.
+fn codim2(base: &Params, name: &str, curves: &[Curve], opts: &PlaneOptions) -> Vec<Codim2> {
+    let mut out = Vec::new();
+    for c in curves {
+        let pts = &c.points;
+        for w in pts.windows(2) {
+            let (a, b) = (&w[0], &w[1]);
+            if let (Some(la), Some(lb)) = (a.l1, b.l1)
+                && la * lb < 0.0
+            {
+                out.push(bautin(base, name, a, b, &c.label));
+            }
+        }
+        // Turning points in p (interior extremum of p along the curve).
+        for w in pts.windows(3) {
+            let (a, b, cc) = (&w[0], &w[1], &w[2]);
+            if (b.p - a.p) * (cc.p - b.p) < 0.0 {
+                let (kind, what) = match c.kind {
+                    CurveKind::Hopf => ("hopf_merge", "two Hopf points meet and vanish"),
+                    CurveKind::Fold => ("cusp", "two folds of cycles meet"),
+                    _ => ("turning", "the curve turns back in the parameter"),
+                };
+                out.push(Codim2 {
+                    kind,
+                    p: b.p,
+                    u: b.u,
+                    curves: vec![c.label.clone()],
+                    detail: format!(
+                        "{what}: the extreme value of {name} along {} (to the step of the \
+                         continuation)",
+                        c.label
+                    ),
+                });
+            }
+        }
+        // Hopf curves end where the equilibrium's velocity reaches 0: the stuck boundary.
+        if c.kind == CurveKind::Hopf {
+            for end in [pts.first(), pts.last()].into_iter().flatten() {
+                if end.omega.is_some_and(|w| w < 1e-3) {
+                    out.push(Codim2 {
+                        kind: "stuck_end",
+                        p: end.p,
+                        u: end.u,
+                        curves: vec![c.label.clone(), "S".into()],
+                        detail: "the Hopf curve ends where the equilibrium's velocity reaches 0 \
+                                 (the stuck boundary)"
+                            .into(),
+                    });
+                }
+            }
+        }
+    }
+    // Where a grazing curve changes type: between the last point of one piece and the second
+    // of the next (the first is shared), by bisection in p on the multiplier's distance from 1.
+    for w in curves.windows(2) {
+        let (a, b) = (&w[0], &w[1]);
+        if a.label == b.label
+            && a.kind != b.kind
+            && let (Some(pa), Some(pb)) = (
+                a.points.iter().rev().nth(1).or(a.points.last()),
+                b.points.get(1),
+            )
+        {
+            let (p, u) = grazing_fold(base, name, pa, pb, opts.tol)
+                .unwrap_or((b.points[0].p, b.points[0].u));
+            out.push(Codim2 {
+                kind: "grazing_fold",
+                p,
+                u,
+                curves: vec![a.label.clone()],
+                detail: format!(
+                    "the grazing orbit changes from {} to {}: the slipping cycle ending there has \
+                     a multiplier 1, so a fold of cycles meets the grazing curve",
+                    kind_name(a.kind),
+                    kind_name(b.kind)
+                ),
+            });
+        }
+    }
+    // Curves of different labels that cross: at each point of one curve inside the other's
+    // range of p, the other solved at that p exactly (its defining system from the
+    // interpolation between its neighbouring points); a sign change of the difference in u
+    // is bisected (on exact solves of both) to 1e-10 of the range of p. Two curves close
+    // together (Stribeck's H1 and G1 are 2.4e-4 V apart) would cross spuriously as chords.
+    for (i, a) in curves.iter().enumerate() {
+        for b in curves.iter().skip(i + 1) {
+            if a.label == b.label {
+                continue;
+            }
+            let diff = |p: f64, near: f64| -> Option<(f64, f64)> {
+                let ua = solve_u(base, name, a, p, near, opts.tol)?;
+                let ub = solve_u(base, name, b, p, ua, opts.tol)?;
+                Some((ua - ub, ua))
+            };
+            let mut prev: Option<(f64, f64)> = None;
+            for q in &a.points {
+                let Some((d, _)) = diff(q.p, q.u) else {
+                    prev = None;
+                    continue;
+                };
+                if let Some((pp, dp)) = prev
+                    && dp * d < 0.0
+                {
+                    let (mut lo, mut hi, mut dlo) = (pp, q.p, dp);
+                    let mut at = (0.5 * (lo + hi), q.u);
+                    for _ in 0..60 {
+                        let mid = 0.5 * (lo + hi);
+                        let Some((dm, um)) = diff(mid, q.u) else {
+                            break;
+                        };
+                        at = (mid, um);
+                        if dm * dlo > 0.0 {
+                            (lo, dlo) = (mid, dm);
+                        } else {
+                            hi = mid;
+                        }
+                        if (hi - lo).abs() <= 1e-10 * (opts.p_max - opts.p_min) {
+                            break;
+                        }
+                    }
+                    out.push(Codim2 {
+                        kind: "curves_cross",
+                        p: at.0,
+                        u: at.1,
+                        curves: vec![a.label.clone(), b.label.clone()],
+                        detail: format!(
+                            "{} ({}) and {} ({}) cross here; no normal form is claimed",
+                            a.label,
+                            kind_name(a.kind),
+                            b.label,
+                            kind_name(b.kind)
+                        ),
+                    });
+                }
+                prev = Some((q.p, d));
+            }
+        }
+    }
+    out.sort_by(|a, b| a.p.total_cmp(&b.p));
+    out
+}
+
+/// u of curve `c` at parameter `p`, solved exactly from the interpolation between its two
+/// points around `p` (the pair whose u is nearest `near` if the curve passes `p` more than
+/// once): Hopf by a secant in ω on Re λ, grazing by the grazing Newton, the stuck boundary
+/// explicitly, a fold by Newton on its augmented system. `None` outside the curve's range of p
+/// or if the solve does not converge.
+pub fn solve_u(base: &Params, name: &str, c: &Curve, p: f64, near: f64, tol: f64) -> Option<f64> {
+    let seg = c
+        .points
+        .windows(2)
+        .filter(|w| (w[0].p - p) * (w[1].p - p) <= 0.0 && w[0].p != w[1].p)
+        .min_by(|x, y| {
+            let ux = 0.5 * (x[0].u + x[1].u);
+            let uy = 0.5 * (y[0].u + y[1].u);
+            (ux - near).abs().total_cmp(&(uy - near).abs())
+        })?;
+    let (a, b) = (&seg[0], &seg[1]);
+    let s = (p - a.p) / (b.p - a.p);
+    let lerp = |x: f64, y: f64| x + s * (y - x);
+    let m = Model::new(params_at(base, name, p).ok()?);
+    match c.kind {
+        CurveKind::StuckBoundary => Some(m.slip_equilibrium_at(0.0).u),
+        CurveKind::Hopf => {
+            let g = |w: f64| crate::equilibria::complex_pair(&m, w).map(|l| l.re);
+            let w0 = lerp(a.omega?, b.omega?);
+            let (mut x0, mut x1) = (w0, w0 * (1.0 + 1e-6) + 1e-9);
+            let (mut f0, mut f1) = (g(x0)?, g(x1)?);
+            for _ in 0..60 {
+                if f1 == f0 || f1 == 0.0 {
+                    break;
+                }
+                let x2 = x1 - f1 * (x1 - x0) / (f1 - f0);
+                (x0, f0, x1) = (x1, f1, x2);
+                f1 = g(x1)?;
+            }
+            (f1.abs() < 1e-13).then(|| m.slip_equilibrium_at(x1).u)
+        }
+        CurveKind::Grazing | CurveKind::DiscontinuousFold => {
+            let w0 = lerp(a.touch_omega_u?, b.touch_omega_u?);
+            grazing::locate(&m, lerp(a.u, b.u), w0, tol, 1e-11)
+                .ok()
+                .map(|g| g.u)
+        }
+        CurveKind::Fold => {
+            // Newton at fixed p on (P(z) − z, det(∂P/∂z − I)) in (α, ω_u, u).
+            let (za, zb) = (a.section_state?, b.section_state?);
+            let h = fold_system(base, name, tol);
+            let mut y = [p, lerp(za[0], zb[0]), lerp(za[1], zb[1]), lerp(a.u, b.u)];
+            for _ in 0..20 {
+                let r = h(&y).ok()?;
+                if r.iter().all(|v| v.abs() <= 1e-11) {
+                    return Some(y[3]);
+                }
+                let mut j = Matrix3::zeros();
+                for k in 0..3 {
+                    let d = 1e-7 * y[k + 1].abs().max(1.0);
+                    let mut yk = y;
+                    yk[k + 1] += d;
+                    let rk = h(&yk).ok()?;
+                    for i in 0..3 {
+                        j[(i, k)] = (rk[i] - r[i]) / d;
+                    }
+                }
+                let dy = j.lu().solve(&Vector3::new(-r[0], -r[1], -r[2]))?;
+                for k in 0..3 {
+                    y[k + 1] += dy[k];
+                }
+            }
+            None
+        }
+    }
+}
+
+fn kind_name(k: CurveKind) -> &'static str {
+    match k {
+        CurveKind::Hopf => "Hopf",
+        CurveKind::Grazing => "grazing",
+        CurveKind::Fold => "fold of cycles",
+        CurveKind::DiscontinuousFold => "discontinuous fold",
+        CurveKind::StuckBoundary => "stuck boundary",
+    }
+}
+
+/// The point between two grazing points whose slipping multipliers lie on either side of
+/// 1: bisection in p, the grazing orbit located at each p from the linear interpolation.
+fn grazing_fold(
+    base: &Params,
+    name: &str,
+    a: &CurvePoint,
+    b: &CurvePoint,
+    tol: f64,
+) -> Option<(f64, f64)> {
+    let at = |p: f64, s: f64| -> Option<(f64, f64, f64)> {
+        let m = Model::new(params_at(base, name, p).ok()?);
+        let (u0, w0) = (
+            a.u + s * (b.u - a.u),
+            a.touch_omega_u? + s * (b.touch_omega_u? - a.touch_omega_u?),
+        );
+        let g = grazing::locate(&m, u0, w0, tol, 1e-11).ok()?;
+        let mu = grazing::grazing_multiplier(&m, g.u, g.w, tol).ok()?;
+        Some((g.u, mu - 1.0, p))
+    };
+    let sign_a = a.multiplier? - 1.0;
+    let (mut lo, mut hi) = (0.0, 1.0);
+    let mut best = (a.p, a.u);
+    for _ in 0..30 {
+        let s = 0.5 * (lo + hi);
+        let p = a.p + s * (b.p - a.p);
+        let (u, f, _) = at(p, s)?;
+        best = (p, u);
+        if f * sign_a > 0.0 {
+            lo = s;
+        } else {
+            hi = s;
+        }
+    }
+    Some(best)
+}
+
+/// The Bautin point between two points of a Hopf curve whose l1 differ in sign: bisection in
+/// p on the segment, the Hopf condition solved for ω at each p (secant on Re λ).
+fn bautin(base: &Params, name: &str, a: &CurvePoint, b: &CurvePoint, label: &str) -> Codim2 {
+    let (mut pa, mut wa, mut la) = (a.p, a.omega.unwrap_or(0.0), a.l1.unwrap_or(0.0));
+    let (mut pb, mut wb) = (b.p, b.omega.unwrap_or(0.0));
+    let hopf_at = |p: f64, w0: f64| -> Option<(f64, f64, f64)> {
+        let m = Model::new(params_at(base, name, p).ok()?);
+        let g = |w: f64| crate::equilibria::complex_pair(&m, w).map(|l| l.re);
+        let (mut x0, mut x1) = (w0, w0 * (1.0 + 1e-4) + 1e-8);
+        let (mut f0, mut f1) = (g(x0)?, g(x1)?);
+        for _ in 0..50 {
+            if f1 == f0 {
+                break;
+            }
+            let x2 = x1 - f1 * (x1 - x0) / (f1 - f0);
+            (x0, f0, x1) = (x1, f1, x2);
+            f1 = g(x1)?;
+            if f1.abs() < 1e-15 {
+                break;
+            }
+        }
+        Some((x1, m.slip_equilibrium_at(x1).u, first_lyapunov(&m, x1)?))
+    };
+    let mut best = (a.p, a.u);
+    for _ in 0..40 {
+        let pm = 0.5 * (pa + pb);
+        let wm = 0.5 * (wa + wb);
+        let Some((w, u, l)) = hopf_at(pm, wm) else {
+            break;
+        };
+        best = (pm, u);
+        if l * la > 0.0 {
+            (pa, wa, la) = (pm, w, l);
+        } else {
+            (pb, wb) = (pm, w);
+        }
+    }
+    Codim2 {
+        kind: "bautin",
+        p: best.0,
+        u: best.1,
+        curves: vec![label.to_owned()],
+        detail: "the first Lyapunov coefficient changes sign: the Hopf point changes from \
+                 super- to subcritical (a fold of small cycles is born here)"
+            .into(),
+    }
+}
+
+/// What the orbit from a start reaches: `stuck`, `equilibrium`, `stick-slip cycle` or
+/// `slipping cycle` (event-driven solver, metrics only, 1500 s, metrics over the last 500 s:
+/// long enough for the slow transients a few tenths of a volt from a Hopf point).
+pub fn classify(model: &Model, u: f64, x0: State) -> &'static str {
+    let scene = Scene {
+        u,
+        x0,
+        t_end: 1500.0,
+        tol: 1e-8,
+        output: Output::Metrics,
+        metrics_from: Some(1000.0),
+        ..Scene::default()
+    };
+    match rotor_event::EventSolver::default()
+        .simulate(model, &scene)
+        .map(|t| t.metrics)
+    {
+        Ok(Some(SteadyState::Equilibrium {
+            omega_u, omega_l, ..
+        })) if omega_u == 0.0 && omega_l == 0.0 => "stuck",
+        Ok(Some(SteadyState::Equilibrium { .. })) => "equilibrium",
+        Ok(Some(SteadyState::LimitCycle { stick_time, .. })) if stick_time > 0.0 => {
+            "stick-slip cycle"
+        }
+        Ok(Some(SteadyState::LimitCycle { .. })) => "slipping cycle",
+        _ => "unresolved",
+    }
+}
+
+/// The perturbed equilibrium at u: the slipping equilibrium nearest rest with ω_l raised by
+/// 1e-3 rad/s, or the middle of the stuck set with it.
+pub fn perturbed_equilibrium(model: &Model, u: f64) -> State {
+    let base = model
+        .slip_equilibria(u)
+        .into_iter()
+        .min_by(|a, b| a.omega.abs().total_cmp(&b.omega.abs()))
+        .map(|e| e.state())
+        .or_else(|| {
+            model
+                .stuck_equilibria(u)
+                .map(|s| State::new(0.5 * (s.alpha_min + s.alpha_max), 0.0, 0.0))
+        })
+        .unwrap_or_else(State::zeros);
+    base + State::new(0.0, 0.0, 1e-3)
+}
+
+/// The region's name from what rest and the perturbed equilibrium reach.
+pub fn region_name(from_rest: &str, from_eq: &str) -> String {
+    match (from_rest, from_eq) {
+        ("stuck", "stuck") => "both discs stuck".into(),
+        (a, b) if a == b => format!("{a} only"),
+        (a, b) => {
+            let mut v = [a, b];
+            v.sort_unstable();
+            format!("bistable: {} and {}", v[0], v[1])
+        }
+    }
+}
+
+/// Names the regions: the coarse grid's cells classified from rest and from the perturbed
+/// equilibrium, each name placed at the cell nearest the centroid of its cells.
+fn regions(base: &Params, name: &str, opts: &PlaneOptions) -> Result<Vec<Region>, BifError> {
+    let n = opts.region_cells.max(2);
+    let mut cells: Vec<(String, f64, f64)> = Vec::new();
+    for i in 0..n {
+        for j in 0..n {
+            let p = opts.p_min + (opts.p_max - opts.p_min) * (i as f64 + 0.5) / n as f64;
+            let u = opts.u_min + (opts.u_max - opts.u_min) * (j as f64 + 0.5) / n as f64;
+            let m = Model::new(params_at(base, name, p)?);
+            let a = classify(&m, u, State::zeros());
+            let b = classify(&m, u, perturbed_equilibrium(&m, u));
+            cells.push((region_name(a, b), p, u));
+        }
+    }
+    let mut names: Vec<String> = cells.iter().map(|c| c.0.clone()).collect();
+    names.sort();
+    names.dedup();
+    Ok(names
+        .into_iter()
+        .filter_map(|nm| {
+            let mine: Vec<&(String, f64, f64)> = cells.iter().filter(|c| c.0 == nm).collect();
+            let k = mine.len() as f64;
+            let (cp, cu) = (
+                mine.iter().map(|c| c.1).sum::<f64>() / k,
+                mine.iter().map(|c| c.2).sum::<f64>() / k,
+            );
+            let sp = opts.p_max - opts.p_min;
+            let su = opts.u_max - opts.u_min;
+            let best = mine.iter().min_by(|a, b| {
+                let da = ((a.1 - cp) / sp).hypot((a.2 - cu) / su);
+                let db = ((b.1 - cp) / sp).hypot((b.2 - cu) / su);
+                da.total_cmp(&db)
+            })?;
+            Some(Region {
+                name: nm,
+                p: best.1,
+                u: best.2,
+            })
+        })
+        .collect())
+}
+
+impl Plane {
+    /// The plane as JSON (`rotor bifurcation2`); a non-finite number is an error.
+    pub fn to_json(&self) -> Result<String, BifError> {
+        for c in &self.curves {
+            for q in &c.points {
+                for (what, v) in [("p", q.p), ("u", q.u), ("residual", q.residual)] {
+                    if !v.is_finite() {
+                        return Err(BifError::NonFinite {
+                            what: format!("curve {} {what}", c.label),
+                            value: v,
+                        });
+                    }
+                }
+            }
+        }
+        serde_json::to_string_pretty(self).map_err(|e| BifError::Io(e.to_string()))
+    }
+
+    /// The (p, u) plane as an SVG figure: the curves labelled, the codimension-two points
+    /// marked, the regions named, the file's value of p as a dashed line.
+    pub fn to_svg(&self, title: &str) -> String {
+        use rotor_plot::{Label, Panel, Series, render};
+        let color = |k: CurveKind| match k {
+            CurveKind::Hopf => "#1f77b4",
+            CurveKind::Grazing => "#2ca02c",
+            CurveKind::Fold => "#d62728",
+            CurveKind::DiscontinuousFold => "#9467bd",
+            CurveKind::StuckBoundary => "#7f7f7f",
+        };
+        let (u_lo, u_hi) = self
+            .curves
+            .iter()
+            .flat_map(|c| c.points.iter().map(|q| q.u))
+            .chain(self.regions.iter().map(|r| r.u))
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), u| {
+                (a.min(u), b.max(u))
+            });
+        let mut series: Vec<Series> = self
+            .curves
+            .iter()
+            .map(|c| Series {
+                marker: None,
+                ..Series::line(
+                    "",
+                    color(c.kind),
+                    c.points.iter().map(|q| (q.p, q.u)).collect(),
+                )
+            })
+            .collect();
+        for (kind, text) in [
+            (CurveKind::Hopf, "Hopf"),
+            (CurveKind::Grazing, "grazing"),
+            (CurveKind::Fold, "fold of cycles"),
+            (CurveKind::DiscontinuousFold, "discontinuous fold"),
+            (CurveKind::StuckBoundary, "stuck boundary"),
+        ] {
+            if self.curves.iter().any(|c| c.kind == kind) {
+                series.push(Series::line(text, color(kind), Vec::new()));
+            }
+        }
+        if u_lo.is_finite() {
+            series.push(Series {
+                dash: Some("4 4"),
+                width: 1.0,
+                ..Series::line(
+                    "file value",
+                    "#000000",
+                    vec![(self.p_file, u_lo), (self.p_file, u_hi)],
+                )
+            });
+        }
+        let mut panel = Panel::new(title.to_owned(), &self.param, "u [V]", series);
+        for c in &self.curves {
+            if let Some(q) = c.points.get(c.points.len() / 2) {
+                panel.labels.push(Label {
+                    x: q.p,
+                    y: q.u,
+                    text: c.label.clone(),
+                });
+            }
+        }
+        for q in &self.points {
+            panel.labels.push(Label {
+                x: q.p,
+                y: q.u,
+                text: q.kind.to_owned(),
+            });
+        }
+        for r in &self.regions {
+            panel.notes.push(Label {
+                x: r.p,
+                y: r.u,
+                text: r.name.clone(),
+            });
+        }
+        render(&[panel], 760.0, 560.0)
+    }
+}

@@ -1,0 +1,164 @@
+//! The two-parameter curves: through the one-parameter points, with the criticality and the
+//! grazing type the one-parameter diagram finds independently, and the codimension-two
+//! points of the Stribeck set over its lower static level.
+
+use rotor_bifurcation::PointKind;
+use rotor_bifurcation::plane::{Curve, CurveKind, PlaneOptions, first_lyapunov, plane, solve_u};
+
+use crate::common::{model, st_diagram, t1_diagram};
+
+/// Started away from the file's value (at k_θ = 0.06 and lower.t_s = 0.25, from those
+/// parameters' own one-parameter diagrams), the curves pass through the points of the
+/// default diagram at the file's value to 1e-9 V: the Hopf, grazing and fold points of
+/// Table 1, and the Hopf and grazing points of the Stribeck set.
+#[test]
+fn curves_started_elsewhere_pass_through_the_one_parameter_points() {
+    for (name, d, param, range, start) in [
+        ("table1", t1_diagram(), "k_theta", (0.05, 0.11), 0.06),
+        ("stribeck", st_diagram(), "lower.t_s", (0.2, 0.35), 0.25),
+    ] {
+        let base = model(name).params;
+        let p_file = base.get(param).unwrap();
+        let opts = PlaneOptions {
+            p_start: Some(start),
+            region_cells: 2,
+            ..PlaneOptions::new(param, range.0, range.1)
+        };
+        let pl = plane(&base, &opts).unwrap();
+        let mut matched = 0;
+        for sp in &d.points {
+            let kind = match sp.kind {
+                PointKind::Hopf => CurveKind::Hopf,
+                PointKind::Grazing => CurveKind::Grazing,
+                PointKind::Fold if sp.discontinuous == Some(false) => CurveKind::Fold,
+                _ => continue,
+            };
+            let same_kind = |c: &&Curve| {
+                c.kind == kind
+                    || (kind == CurveKind::Grazing && c.kind == CurveKind::DiscontinuousFold)
+            };
+            let best = pl
+                .curves
+                .iter()
+                .filter(same_kind)
+                .filter_map(|c| solve_u(&base, param, c, p_file, sp.u, 1e-11))
+                .map(|u| (u - sp.u).abs())
+                .fold(f64::INFINITY, f64::min);
+            assert!(best <= 1e-9, "{name} {:?} at {}: {best:e}", sp.kind, sp.u);
+            matched += 1;
+        }
+        assert!(matched >= 4, "{name}: {matched}");
+    }
+}
+
+/// The first Lyapunov coefficient agrees with the direction of the small cycles the
+/// one-parameter diagram finds by shooting: Table 1's H1 supercritical (l1 < 0), H2 and both
+/// Hopf points of the Stribeck set subcritical (l1 > 0).
+#[test]
+fn the_lyapunov_coefficient_agrees_with_the_cycles_direction() {
+    for (name, d) in [("table1", t1_diagram()), ("stribeck", st_diagram())] {
+        let m = model(name);
+        for sp in d.points.iter().filter(|p| p.kind == PointKind::Hopf) {
+            let l1 = first_lyapunov(&m, sp.omega.unwrap()).unwrap();
+            let sup = sp.detail.starts_with("supercritical");
+            assert!(
+                sup == (l1 < 0.0) && sp.detail.contains("critical"),
+                "{name} at {}: l1 = {l1}, {}",
+                sp.u,
+                sp.detail
+            );
+        }
+    }
+}
+
+/// Over the Stribeck set's lower static level T_sl ∈ [0.1, 0.45] the curves meet in a
+/// cluster near T_sl ≈ 0.13: the first Hopf point changes criticality (l1 changes sign on
+/// either side), both grazing curves change from grazing to discontinuous fold (the
+/// slipping cycle's multiplier crosses 1), and the first Hopf and grazing curves cross (both
+/// solved exactly there agree). At the file's T_sl both grazing points are discontinuous
+/// folds, as the one-parameter diagram says.
+#[test]
+fn the_stribeck_set_has_its_codimension_two_points_where_the_curves_say() {
+    let base = model("stribeck").params;
+    let opts = PlaneOptions {
+        region_cells: 2,
+        ..PlaneOptions::new("lower.t_s", 0.1, 0.45)
+    };
+    let pl = plane(&base, &opts).unwrap();
+    let kinds: Vec<&str> = pl.points.iter().map(|q| q.kind).collect();
+    for k in ["bautin", "grazing_fold", "curves_cross"] {
+        assert!(kinds.contains(&k), "{kinds:?}");
+    }
+    let h1 = pl.curves.iter().find(|c| c.label == "H1").unwrap();
+    let g1 = pl
+        .curves
+        .iter()
+        .filter(|c| c.label == "G1")
+        .collect::<Vec<_>>();
+    for q in &pl.points {
+        match q.kind {
+            "bautin" => {
+                let m = |p: f64| model_at(&base, p);
+                let l1 = |p: f64| {
+                    let u = solve_u(&base, "lower.t_s", h1, p, q.u, 1e-11).unwrap();
+                    let w = m(p)
+                        .slip_equilibria(u)
+                        .into_iter()
+                        .min_by(|a, b| a.omega.total_cmp(&b.omega))
+                        .unwrap()
+                        .omega;
+                    first_lyapunov(&m(p), w).unwrap()
+                };
+                assert!(l1(q.p - 1e-3) * l1(q.p + 1e-3) < 0.0, "{q:?}");
+            }
+            "curves_cross" => {
+                let uh = solve_u(&base, "lower.t_s", h1, q.p, q.u, 1e-11).unwrap();
+                let ug = g1
+                    .iter()
+                    .filter_map(|c| solve_u(&base, "lower.t_s", c, q.p, q.u, 1e-11))
+                    .next()
+                    .unwrap();
+                // Located by bisection to 1e-10 of the range in p; the curves' slopes differ
+                // by ~1 V per unit of T_sl, so they agree to ~1e-10 V there (bound 1e-8).
+                assert!((uh - ug).abs() < 1e-8, "{q:?}: {uh} vs {ug}");
+            }
+            _ => {}
+        }
+        assert!((0.12..0.14).contains(&q.p), "{q:?}");
+    }
+    let at_file = |label: &str| {
+        pl.curves
+            .iter()
+            .filter(|c| c.label == label)
+            .find(|c| c.points.first().unwrap().p <= 0.2781 && c.points.last().unwrap().p >= 0.2781)
+            .unwrap()
+            .kind
+    };
+    assert_eq!(at_file("G1"), CurveKind::DiscontinuousFold);
+    assert_eq!(at_file("G2"), CurveKind::DiscontinuousFold);
+}
+
+fn model_at(base: &rotor_model::Params, p: f64) -> rotor_model::Model {
+    rotor_model::Model::new(base.with("lower.t_s", p).unwrap())
+}
+
+/// Bad input is refused before any computation, naming the value.
+#[test]
+fn a_bad_parameter_or_range_is_refused_with_the_value() {
+    let base = model("table1").params;
+    let e = plane(&base, &PlaneOptions::new("lower.delta", 1.0, 2.0))
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("\"lower.delta\"") && e.contains("valid: j_u"),
+        "{e}"
+    );
+    let e = plane(&base, &PlaneOptions::new("k_theta", -0.01, 0.1))
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("k_theta = -0.01: must be positive"), "{e}");
+    let e = plane(&base, &PlaneOptions::new("lower.t_2", -1.0, -0.2))
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("lower.t_2 = -1"), "{e}");
+}
