@@ -13,6 +13,7 @@ pub mod snapshot;
 pub mod solvers;
 pub mod steady;
 pub mod stress;
+pub mod sweep;
 pub mod trace;
 
 pub use gate::{Failure, GateResult, Measured, check_pair};

@@ -1,0 +1,746 @@
+//! Brute force over a (u, p) grid (`rotor sweep`, `rotor merge`): every grid point's steady
+//! state from the scene's initial state, metrics only, one CSV row per point.
+//!
+//! Rows are written in grid order (p outer, u inner: point `k = i_p·N_u + i_u`) as they are
+//! finished, through a reorder buffer, so the file is always a prefix of the full output and
+//! an interrupted sweep resumes where it stopped (`--resume`: the rows already there are
+//! kept, a half-written last row is dropped). `--shard I/N` runs the points `k ≡ I − 1 (mod
+//! N)`, for a Slurm job array or GNU parallel; [`merge`] joins the shards into exactly what
+//! one unsharded run writes, and refuses shards that do not fit together.
+//!
+//! Beside each output file, `OUT.shard.json` records the grid, the settings and the shard,
+//! so that [`merge`] can tell a missing shard from a smaller grid (a shard's own rows can
+//! form a complete-looking grid of their own); without it, merge checks that the rows form a
+//! full grid.
+
+use std::io::{BufRead, Write};
+use std::path::{Path, PathBuf};
+
+use rotor_model::{Model, Output, Params, Scene, State, SteadyState};
+
+use crate::solvers::SolverKind;
+
+/// The header of a sweep file.
+pub const HEADER: &str = "u,p,kind,period,omega_l_max,omega_l_min,stick_time";
+
+/// Largest number of points one process is asked to run: more asks for sharding.
+pub const MAX_POINTS: usize = 10_000_000;
+
+/// Why a sweep or a merge cannot run.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum SweepError {
+    #[error("{flag} {value:?}: {reason}")]
+    Arg {
+        flag: &'static str,
+        value: String,
+        reason: String,
+    },
+    #[error("{}: {message}", .path.display())]
+    File { path: PathBuf, message: String },
+    #[error("the shards do not fit together: {0}")]
+    Merge(String),
+}
+
+fn arg(flag: &'static str, value: &str, reason: impl Into<String>) -> SweepError {
+    SweepError::Arg {
+        flag,
+        value: value.to_owned(),
+        reason: reason.into(),
+    }
+}
+
+/// One axis `A:B:N`: N values from A to B, both included.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Axis {
+    pub a: f64,
+    pub b: f64,
+    pub n: usize,
+}
+
+impl Axis {
+    /// Parses `A:B:N`; `flag` names the option in the error.
+    pub fn parse(flag: &'static str, s: &str) -> Result<Axis, SweepError> {
+        let parts: Vec<&str> = s.split(':').collect();
+        let [a, b, n] = parts[..] else {
+            return Err(arg(flag, s, "expected A:B:N (from A to B in N values)"));
+        };
+        let num = |t: &str| {
+            t.trim()
+                .parse::<f64>()
+                .ok()
+                .filter(|v| v.is_finite())
+                .ok_or_else(|| arg(flag, s, format!("{t:?} is not a finite number")))
+        };
+        let n = n
+            .trim()
+            .parse::<usize>()
+            .ok()
+            .filter(|&n| n >= 1)
+            .ok_or_else(|| arg(flag, s, format!("N = {n:?} must be a whole number >= 1")))?;
+        let (a, b) = (num(a)?, num(b)?);
+        if n == 1 && a != b {
+            return Err(arg(flag, s, "N = 1 needs A = B"));
+        }
+        Ok(Axis { a, b, n })
+    }
+
+    /// The i-th value: `A + (B − A)·i/(N − 1)` (the same bits in every process).
+    pub fn value(&self, i: usize) -> f64 {
+        if self.n == 1 {
+            self.a
+        } else {
+            self.a + (self.b - self.a) * (i as f64 / (self.n - 1) as f64)
+        }
+    }
+}
+
+/// `I/N`: the I-th of N shards (I from 1).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Shard {
+    pub i: usize,
+    pub n: usize,
+}
+
+impl Shard {
+    pub const ALL: Shard = Shard { i: 1, n: 1 };
+
+    pub fn parse(s: &str) -> Result<Shard, SweepError> {
+        let bad = |why: &str| arg("--shard", s, why);
+        let (i, n) = s
+            .split_once('/')
+            .ok_or_else(|| bad("expected I/N, e.g. 3/8"))?;
+        let i: usize = i
+            .trim()
+            .parse()
+            .map_err(|_| bad("I must be a whole number"))?;
+        let n: usize = n
+            .trim()
+            .parse()
+            .map_err(|_| bad("N must be a whole number"))?;
+        if n == 0 {
+            return Err(bad("N must be at least 1"));
+        }
+        if i == 0 || i > n {
+            return Err(bad("I must lie in 1..=N (shards count from 1)"));
+        }
+        Ok(Shard { i, n })
+    }
+
+    /// Whether grid point `k` belongs to this shard.
+    pub fn owns(&self, k: usize) -> bool {
+        k % self.n == self.i - 1
+    }
+}
+
+/// Where each point starts.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum SweepStart {
+    /// The same state everywhere (`--x0 A,WU,WL`, default rest).
+    State(State),
+    /// The perturbed equilibrium at each point (`--x0 eq`): the slipping equilibrium nearest
+    /// rest with ω_l raised by 1e-3 rad/s, or the middle of the stuck set.
+    PerturbedEquilibrium,
+}
+
+/// A sweep: the grid, the parameter, the start and the solver.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Sweep {
+    pub base: Params,
+    pub u: Axis,
+    pub param: String,
+    pub p: Axis,
+    pub start: SweepStart,
+    pub solver: SolverKind,
+    /// Horizon of each run [s]; the metrics are read over its second half.
+    pub t_end: f64,
+}
+
+impl Sweep {
+    /// The number of grid points.
+    pub fn len(&self) -> usize {
+        self.u.n.saturating_mul(self.p.n)
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// (u, p) of point k.
+    pub fn point(&self, k: usize) -> (f64, f64) {
+        (self.u.value(k % self.u.n), self.p.value(k / self.u.n))
+    }
+
+    /// Checks the grid before any run: the parameter name, every parameter value of the grid
+    /// admissible, and the number of points one process runs.
+    pub fn validate(&self, shard: Shard) -> Result<(), SweepError> {
+        self.base
+            .get(&self.param)
+            .map_err(|e| arg("--param", &self.param, e.to_string()))?;
+        for i in 0..self.p.n {
+            let p = self.p.value(i);
+            self.base
+                .with(&self.param, p)
+                .map_err(|e| arg("--param", &format!("{}={p}", self.param), e.to_string()))?;
+        }
+        let mine = self.len().div_ceil(shard.n);
+        if self.u.n.checked_mul(self.p.n).is_none() || mine > MAX_POINTS {
+            return Err(arg(
+                "--u/--param",
+                &format!("{} x {} points", self.u.n, self.p.n),
+                format!(
+                    "more than {MAX_POINTS} points for one process: split the grid with \
+                     --shard I/N (N >= {})",
+                    self.len().div_ceil(MAX_POINTS).max(2)
+                ),
+            ));
+        }
+        Ok(())
+    }
+
+    /// The CSV row of point k.
+    pub fn row(&self, k: usize) -> String {
+        let (u, p) = self.point(k);
+        let mut b = ryu::Buffer::new();
+        let mut s = format!("{},", b.format(u));
+        s.push_str(b.format(p));
+        let model = self
+            .base
+            .with(&self.param, p)
+            .map(Model::new)
+            .expect("validated before the run");
+        let x0 = match self.start {
+            SweepStart::State(x) => x,
+            SweepStart::PerturbedEquilibrium => {
+                rotor_bifurcation::plane::perturbed_equilibrium(&model, u)
+            }
+        };
+        let scene = Scene {
+            u,
+            x0,
+            t_end: self.t_end,
+            output: Output::Metrics,
+            metrics_from: Some(0.5 * self.t_end),
+            ..Scene::default()
+        };
+        let f = |v: f64| ryu::Buffer::new().format(v).to_owned();
+        match self.solver.solver().simulate_finite(&model, &scene) {
+            Ok(tr) => match tr.metrics {
+                Some(SteadyState::Equilibrium {
+                    omega_u, omega_l, ..
+                }) if omega_u == 0.0 && omega_l == 0.0 => s.push_str(",stuck,,,,"),
+                Some(SteadyState::Equilibrium { .. }) => s.push_str(",equilibrium,,,,"),
+                Some(SteadyState::LimitCycle {
+                    period,
+                    omega_l_max,
+                    omega_l_min,
+                    stick_time,
+                    ..
+                }) => s.push_str(&format!(
+                    ",limit_cycle,{},{},{},{}",
+                    f(period),
+                    f(omega_l_max),
+                    f(omega_l_min),
+                    f(stick_time)
+                )),
+                None => s.push_str(",failed,,,,"),
+            },
+            Err(_) => s.push_str(",failed,,,,"),
+        }
+        s
+    }
+}
+
+/// What `OUT.shard.json` records.
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct ShardInfo {
+    pub u: String,
+    pub param: String,
+    pub x0: String,
+    pub solver: String,
+    pub t_end: f64,
+    /// The parameter set, as a fingerprint of its fields.
+    pub params: String,
+    pub shard: usize,
+    pub shards: usize,
+}
+
+impl Sweep {
+    /// The shard file's record of this sweep.
+    pub fn info(&self, shard: Shard) -> ShardInfo {
+        let axis = |a: &Axis| {
+            let mut b = ryu::Buffer::new();
+            let mut s = format!("{}:", b.format(a.a));
+            s.push_str(b.format(a.b));
+            format!("{s}:{}", a.n)
+        };
+        ShardInfo {
+            u: axis(&self.u),
+            param: format!("{}={}", self.param, axis(&self.p)),
+            x0: match self.start {
+                SweepStart::State(x) => format!("{},{},{}", x[0], x[1], x[2]),
+                SweepStart::PerturbedEquilibrium => "eq".into(),
+            },
+            solver: self.solver.name().into(),
+            t_end: self.t_end,
+            params: format!("{:?}", self.base),
+            shard: shard.i,
+            shards: shard.n,
+        }
+    }
+}
+
+/// The record beside an output file.
+pub fn info_path(out: &Path) -> PathBuf {
+    let mut s = out.as_os_str().to_owned();
+    s.push(".shard.json");
+    PathBuf::from(s)
+}
+
+/// Runs the points of `shard` into `out` (`-`: standard output, no resume), in parallel
+/// through `map` (which must return `f` of each index, in any order), calling `progress`
+/// with the number done. With `resume`, the rows already in `out` are kept (a half-written
+/// last row is dropped) and only the rest run. Returns the number of points run.
+pub fn run(
+    sweep: &Sweep,
+    shard: Shard,
+    out: &Path,
+    resume: bool,
+    run_all: impl FnOnce(&[usize], &(dyn Fn(usize) -> String + Sync), &mut dyn FnMut(usize, String)),
+) -> Result<usize, SweepError> {
+    sweep.validate(shard)?;
+    let mine: Vec<usize> = (0..sweep.len()).filter(|&k| shard.owns(k)).collect();
+    let io = |e: std::io::Error| SweepError::File {
+        path: out.to_owned(),
+        message: e.to_string(),
+    };
+    let stdout = out.as_os_str() == "-";
+    let done = if resume && !stdout && out.exists() {
+        resume_count(sweep, &mine, out)?
+    } else {
+        0
+    };
+    let mut w: Box<dyn Write> = if stdout {
+        Box::new(std::io::stdout().lock())
+    } else if done > 0 {
+        Box::new(
+            std::fs::OpenOptions::new()
+                .append(true)
+                .open(out)
+                .map_err(io)?,
+        )
+    } else {
+        Box::new(std::fs::File::create(out).map_err(io)?)
+    };
+    if done == 0 {
+        writeln!(w, "{HEADER}").map_err(io)?;
+        w.flush().map_err(io)?;
+    }
+    if !stdout {
+        let text = serde_json::to_string_pretty(&sweep.info(shard)).expect("plain fields");
+        crate::report::write_atomic(&info_path(out), text.as_bytes()).map_err(|e| {
+            SweepError::File {
+                path: info_path(out),
+                message: e.to_string(),
+            }
+        })?;
+    }
+    let todo = &mine[done..];
+    // Reorder buffer: rows arrive in any order and leave in grid order.
+    let mut pending = std::collections::BTreeMap::new();
+    let mut next = 0usize;
+    let mut failed: Option<std::io::Error> = None;
+    let mut sink = |idx: usize, row: String| {
+        pending.insert(idx, row);
+        while let Some(r) = pending.remove(&next) {
+            if failed.is_none()
+                && let Err(e) = writeln!(w, "{r}").and_then(|_| w.flush())
+            {
+                failed = Some(e);
+            }
+            next += 1;
+        }
+    };
+    let row = |i: usize| sweep.row(todo[i]);
+    let indices: Vec<usize> = (0..todo.len()).collect();
+    run_all(&indices, &row, &mut sink);
+    if let Some(e) = failed {
+        return Err(io(e));
+    }
+    Ok(todo.len())
+}
+
+/// How many of `mine` are complete in an existing output; a half-written last row is cut
+/// off the file.
+fn resume_count(sweep: &Sweep, mine: &[usize], out: &Path) -> Result<usize, SweepError> {
+    let io = |e: std::io::Error| SweepError::File {
+        path: out.to_owned(),
+        message: e.to_string(),
+    };
+    let bytes = std::fs::read(out).map_err(io)?;
+    let complete = bytes.iter().rposition(|&b| b == b'\n').map_or(0, |i| i + 1);
+    if complete < bytes.len() {
+        let f = std::fs::OpenOptions::new()
+            .write(true)
+            .open(out)
+            .map_err(io)?;
+        f.set_len(complete as u64).map_err(io)?;
+    }
+    let text = String::from_utf8_lossy(&bytes[..complete]);
+    let mut lines = text.lines();
+    match lines.next() {
+        None => return Ok(0),
+        Some(h) if h == HEADER => {}
+        Some(h) => {
+            return Err(SweepError::File {
+                path: out.to_owned(),
+                message: format!("line 1: {h:?} is not the sweep header {HEADER:?}; not resumed"),
+            });
+        }
+    }
+    let mut n = 0;
+    let mut b = ryu::Buffer::new();
+    for (line, &k) in lines.zip(mine) {
+        let (u, p) = sweep.point(k);
+        let head = format!("{},{},", b.format(u), ryu::Buffer::new().format(p));
+        if !line.starts_with(&head) {
+            return Err(SweepError::File {
+                path: out.to_owned(),
+                message: format!(
+                    "line {}: {line:?} is not grid point {k} (u = {u}, p = {p}) of this sweep; \
+                     not resumed",
+                    n + 2
+                ),
+            });
+        }
+        n += 1;
+    }
+    Ok(n)
+}
+
+/// A row of a shard: u, p, the line's text, its file and line number.
+type Row = (f64, f64, String, PathBuf, usize);
+
+/// Merges shard files into the output of one unsharded run (row order included): the
+/// rows' u and p values must form a full grid, each point once. The row order is the grid
+/// order: p outer, u inner, each axis in the direction of the row of point 0 (the first row
+/// of the shard that holds it).
+pub fn merge(paths: &[PathBuf]) -> Result<Vec<u8>, SweepError> {
+    check_records(paths)?;
+    let mut rows: Vec<Row> = Vec::new();
+    let mut first_rows: Vec<(f64, f64)> = Vec::new();
+    for path in paths {
+        let io = |e: std::io::Error| SweepError::File {
+            path: path.clone(),
+            message: e.to_string(),
+        };
+        let f = std::fs::File::open(path).map_err(io)?;
+        let mut lines = std::io::BufReader::new(f).lines();
+        match lines.next() {
+            Some(Ok(h)) if h == HEADER => {}
+            Some(Ok(h)) => {
+                return Err(SweepError::File {
+                    path: path.clone(),
+                    message: format!("line 1: {h:?} is not the sweep header {HEADER:?}"),
+                });
+            }
+            Some(Err(e)) => return Err(io(e)),
+            None => {
+                return Err(SweepError::File {
+                    path: path.clone(),
+                    message: "empty (no header)".into(),
+                });
+            }
+        }
+        let mut first = true;
+        for (i, line) in lines.enumerate() {
+            let line = line.map_err(io)?;
+            if line.is_empty() {
+                continue;
+            }
+            let bad = |m: String| SweepError::File {
+                path: path.clone(),
+                message: format!("line {}: {m}", i + 2),
+            };
+            let mut it = line.splitn(3, ',');
+            let num = |t: Option<&str>, what: &str| {
+                t.and_then(|t| t.parse::<f64>().ok())
+                    .ok_or_else(|| bad(format!("{what} is not a number: {line:?}")))
+            };
+            let u = num(it.next(), "u")?;
+            let p = num(it.next(), "p")?;
+            if first {
+                first_rows.push((u, p));
+                first = false;
+            }
+            rows.push((u, p, line, path.clone(), i + 2));
+        }
+    }
+    // The grid: the distinct values of each axis, in the direction point 0 gives.
+    let distinct = |f: &dyn Fn(&Row) -> f64| {
+        let mut v: Vec<f64> = rows.iter().map(f).collect();
+        v.sort_by(f64::total_cmp);
+        v.dedup();
+        v
+    };
+    let mut us = distinct(&|r| r.0);
+    let mut ps = distinct(&|r| r.1);
+    let (Some(&umin), Some(&pmin)) = (us.first(), ps.first()) else {
+        return Err(SweepError::Merge("no rows".into()));
+    };
+    // Point 0 is (A_u, A_p); of the shards' first rows it is the one at a corner of the grid
+    // where both values are ends of their axes. Its u and p tell each axis' direction.
+    let corner = first_rows
+        .iter()
+        .find(|(u, p)| (*u == umin || Some(u) == us.last()) && (*p == pmin || Some(p) == ps.last()))
+        .copied()
+        .unwrap_or((umin, pmin));
+    if corner.0 != umin {
+        us.reverse();
+    }
+    if corner.1 != pmin {
+        ps.reverse();
+    }
+    let index = |v: &[f64], x: f64| v.iter().position(|&y| y == x).expect("a distinct value");
+    let mut slots: Vec<Option<(String, PathBuf, usize)>> = vec![None; us.len() * ps.len()];
+    for (u, p, line, path, lineno) in rows {
+        let k = index(&ps, p) * us.len() + index(&us, u);
+        if let Some((_, other, other_line)) = &slots[k] {
+            return Err(SweepError::Merge(format!(
+                "point u = {u}, p = {p} is in {}:{lineno} and in {}:{other_line}",
+                path.display(),
+                other.display()
+            )));
+        }
+        slots[k] = Some((line, path, lineno));
+    }
+    let missing: Vec<String> = slots
+        .iter()
+        .enumerate()
+        .filter(|(_, s)| s.is_none())
+        .map(|(k, _)| format!("u = {}, p = {}", us[k % us.len()], ps[k / us.len()]))
+        .collect();
+    if !missing.is_empty() {
+        return Err(SweepError::Merge(format!(
+            "{} of the {} x {} grid's points are missing (a shard of another grid, or one not \
+             given): {}{}",
+            missing.len(),
+            us.len(),
+            ps.len(),
+            missing[..missing.len().min(5)].join("; "),
+            if missing.len() > 5 { "; ..." } else { "" }
+        )));
+    }
+    let mut out = Vec::new();
+    out.extend_from_slice(HEADER.as_bytes());
+    out.push(b'\n');
+    for (line, _, _) in slots.into_iter().flatten() {
+        out.extend_from_slice(line.as_bytes());
+        out.push(b'\n');
+    }
+    Ok(out)
+}
+
+/// With a record beside every shard: the same sweep in each, and shards 1..=N each once.
+fn check_records(paths: &[PathBuf]) -> Result<(), SweepError> {
+    let mut infos = Vec::new();
+    for p in paths {
+        let ip = info_path(p);
+        let Ok(text) = std::fs::read_to_string(&ip) else {
+            return Ok(());
+        };
+        let info: ShardInfo = serde_json::from_str(&text).map_err(|e| SweepError::File {
+            path: ip.clone(),
+            message: format!("not a shard record: {e}"),
+        })?;
+        infos.push((p, info));
+    }
+    let Some((p0, first)) = infos.first() else {
+        return Ok(());
+    };
+    for (p, i) in &infos[1..] {
+        let same = ShardInfo {
+            shard: first.shard,
+            ..i.clone()
+        };
+        if same != *first {
+            return Err(SweepError::Merge(format!(
+                "{} is a shard of another sweep than {} ({:?} vs {:?})",
+                p.display(),
+                p0.display(),
+                (&i.u, &i.param, &i.x0, &i.solver, i.t_end, i.shards),
+                (
+                    &first.u,
+                    &first.param,
+                    &first.x0,
+                    &first.solver,
+                    first.t_end,
+                    first.shards
+                )
+            )));
+        }
+    }
+    let n = first.shards;
+    let mut seen = vec![Vec::new(); n + 1];
+    for (p, i) in &infos {
+        seen[i.shard.min(n)].push(p.display().to_string());
+    }
+    let missing: Vec<String> = (1..=n)
+        .filter(|&k| seen[k].is_empty())
+        .map(|k| format!("{k}/{n}"))
+        .collect();
+    if !missing.is_empty() {
+        return Err(SweepError::Merge(format!(
+            "shard(s) {} of {n} are missing",
+            missing.join(", ")
+        )));
+    }
+    if let Some(k) = (1..=n).find(|&k| seen[k].len() > 1) {
+        return Err(SweepError::Merge(format!(
+            "shard {k}/{n} is given twice: {}",
+            seen[k].join(" and ")
+        )));
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn axes_and_shards_parse_or_name_the_problem() {
+        let a = Axis::parse("--u", "0:2:5").unwrap();
+        assert_eq!((a.value(0), a.value(2), a.value(4)), (0.0, 1.0, 2.0));
+        assert_eq!(Axis::parse("--u", "3:1:3").unwrap().value(1), 2.0);
+        for bad in ["0:1", "a:1:3", "0:1:0", "0:1:x", "0:inf:3", "0:1:1"] {
+            let e = Axis::parse("--u", bad).unwrap_err().to_string();
+            assert!(e.starts_with(&format!("--u {bad:?}")), "{e}");
+        }
+        assert_eq!(Shard::parse("2/3").unwrap(), Shard { i: 2, n: 3 });
+        for bad in ["0/3", "4/3", "a/b", "3", "1/0"] {
+            let e = Shard::parse(bad).unwrap_err().to_string();
+            assert!(e.starts_with(&format!("--shard {bad:?}")), "{e}");
+        }
+        let s = Shard { i: 2, n: 3 };
+        assert_eq!((0..9).filter(|&k| s.owns(k)).collect::<Vec<_>>(), [1, 4, 7]);
+    }
+
+    fn sweep() -> Sweep {
+        Sweep {
+            base: Params::table1(),
+            u: Axis::parse("--u", "0.5:6:4").unwrap(),
+            param: "k_theta".into(),
+            p: Axis::parse("--param", "0.06:0.09:3").unwrap(),
+            start: SweepStart::State(State::zeros()),
+            solver: SolverKind::EVENT,
+            t_end: 300.0,
+        }
+    }
+
+    #[test]
+    fn a_grid_too_large_or_out_of_range_is_refused_before_any_run() {
+        let mut s = sweep();
+        s.u.n = 5_000_000;
+        s.p.n = 3;
+        let e = s.validate(Shard::ALL).unwrap_err().to_string();
+        assert!(e.contains("--shard I/N"), "{e}");
+        assert!(s.validate(Shard { i: 1, n: 2 }).is_ok());
+        let mut s = sweep();
+        s.p = Axis::parse("--param", "-0.01:0.09:3").unwrap();
+        let e = s.validate(Shard::ALL).unwrap_err().to_string();
+        assert!(e.contains("k_theta = -0.01: must be positive"), "{e}");
+        let mut s = sweep();
+        s.param = "lower.delta".into();
+        let e = s.validate(Shard::ALL).unwrap_err().to_string();
+        assert!(e.contains("valid: j_u"), "{e}");
+    }
+
+    fn run_serial(s: &Sweep, shard: Shard, out: &Path, resume: bool) -> usize {
+        run(s, shard, out, resume, |idx, f, sink| {
+            // Backwards, to exercise the reorder buffer.
+            for &i in idx.iter().rev() {
+                sink(i, f(i));
+            }
+        })
+        .unwrap()
+    }
+
+    #[test]
+    fn shards_merge_to_the_unsharded_file_and_a_cut_file_resumes() {
+        let dir = std::env::temp_dir().join(format!("rotor-sweep-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let s = sweep();
+        let whole = dir.join("whole.csv");
+        assert_eq!(run_serial(&s, Shard::ALL, &whole, false), 12);
+        let bytes = std::fs::read(&whole).unwrap();
+        let text = String::from_utf8(bytes.clone()).unwrap();
+        assert_eq!(text.lines().count(), 13);
+        assert!(text.starts_with(&format!("{HEADER}\n0.5,0.06,")), "{text}");
+        let shards: Vec<PathBuf> = (1..=3)
+            .map(|i| {
+                let p = dir.join(format!("s{i}.csv"));
+                run_serial(&s, Shard { i, n: 3 }, &p, false);
+                p
+            })
+            .collect();
+        // In any order on the command line.
+        let merged = merge(&[shards[2].clone(), shards[0].clone(), shards[1].clone()]).unwrap();
+        assert_eq!(merged, bytes);
+        // Cut in the middle of a row: the resumed run completes it to the same bytes.
+        let cut = dir.join("cut.csv");
+        std::fs::write(&cut, &bytes[..bytes.len() * 2 / 3]).unwrap();
+        let ran = run_serial(&s, Shard::ALL, &cut, true);
+        assert!(ran < 12 && ran > 0, "{ran}");
+        assert_eq!(std::fs::read(&cut).unwrap(), bytes);
+        // Refusals: a missing shard, a duplicated one, another grid's shard.
+        let e = merge(&shards[..2]).unwrap_err().to_string();
+        assert!(e.contains("shard(s) 3/3 of 3 are missing"), "{e}");
+        let e = merge(&[shards[0].clone(), shards[0].clone(), shards[1].clone()])
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("3/3") || e.contains("given twice"), "{e}");
+        // Without the records, from the rows alone.
+        for p in &shards {
+            std::fs::remove_file(info_path(p)).unwrap();
+        }
+        let e = merge(&shards[..2]).unwrap_err().to_string();
+        assert!(
+            e.contains("4 of the 4 x 3 grid's points are missing"),
+            "{e}"
+        );
+        let e = merge(&[shards[0].clone(), shards[0].clone()])
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("is in") && e.contains("s1.csv"), "{e}");
+        assert_eq!(
+            merge(&[shards[2].clone(), shards[0].clone(), shards[1].clone()]).unwrap(),
+            bytes
+        );
+        let other = Sweep {
+            u: Axis::parse("--u", "0.5:6:5").unwrap(),
+            ..sweep()
+        };
+        let o = dir.join("other.csv");
+        run_serial(&other, Shard { i: 2, n: 3 }, &o, false);
+        std::fs::remove_file(info_path(&o)).unwrap();
+        let e = merge(&[shards[0].clone(), o.clone(), shards[2].clone()])
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("do not fit together") && e.contains("other.csv"),
+            "{e}"
+        );
+        run_serial(&other, Shard { i: 2, n: 3 }, &o, false);
+        for (i, p) in shards.iter().enumerate() {
+            run_serial(&s, Shard { i: i + 1, n: 3 }, p, false);
+        }
+        let e = merge(&[shards[0].clone(), o, shards[2].clone()])
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("another sweep") && e.contains("other.csv"),
+            "{e}"
+        );
+        std::fs::remove_dir_all(&dir).ok();
+    }
+}
