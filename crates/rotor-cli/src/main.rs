@@ -62,6 +62,74 @@ enum Command {
         #[arg(long)]
         csv: Option<PathBuf>,
     },
+    /// Two-parameter analysis: every codimension-one point of the u-diagram (Hopf, grazing,
+    /// folds, the stuck boundary) continued in (p, u), and the codimension-two points where
+    /// the curves change type, turn, end or cross; JSON, and an SVG of the plane.
+    Bifurcation2 {
+        /// The parameter: a field of the parameter file as a dotted path (k_theta, lower.t_s,
+        /// upper.b, ...).
+        #[arg(long)]
+        param: String,
+        /// Lower end of the parameter's range.
+        #[arg(long, allow_hyphen_values = true)]
+        p_min: f64,
+        /// Upper end of the parameter's range.
+        #[arg(long, allow_hyphen_values = true)]
+        p_max: f64,
+        /// Parameter file (default: the source's Table 1).
+        #[arg(long)]
+        params: Option<PathBuf>,
+        #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
+        u_min: f64,
+        #[arg(long, default_value_t = 7.0, allow_hyphen_values = true)]
+        u_max: f64,
+        /// Output JSON file (`-`: standard output).
+        #[arg(long)]
+        json: PathBuf,
+        /// Output SVG of the (p, u) plane (`-`: standard output).
+        #[arg(long)]
+        svg: Option<PathBuf>,
+    },
+    /// Brute force over a (u, p) grid: every point's steady state (metrics only), one CSV row
+    /// per point (u,p,kind,period,omega_l_max,omega_l_min,stick_time), written as it goes.
+    Sweep {
+        /// The u axis, A:B:N (N values from A to B) [V].
+        #[arg(long)]
+        u: String,
+        /// The parameter axis, NAME=A:B:N (NAME a field of the parameter file).
+        #[arg(long)]
+        param: String,
+        /// Parameter file (default: the source's Table 1).
+        #[arg(long)]
+        params: Option<PathBuf>,
+        /// Initial state A,WU,WL (default rest), or `eq`: the perturbed equilibrium at each
+        /// point (omega_l of the slipping equilibrium + 1e-3).
+        #[arg(long, allow_hyphen_values = true)]
+        x0: Option<String>,
+        /// Solver (default event).
+        #[arg(long, default_value = "event")]
+        solver: String,
+        /// Run only every N-th point from the I-th (I from 1), for job arrays.
+        #[arg(long)]
+        shard: Option<String>,
+        /// Keep the rows already in the output and run only the rest.
+        #[arg(long)]
+        resume: bool,
+        /// Horizon of each run [s] (metrics over its second half).
+        #[arg(long, default_value_t = 600.0, allow_hyphen_values = true)]
+        t_end: f64,
+        /// Output CSV (`-`: standard output).
+        #[arg(long)]
+        csv: PathBuf,
+    },
+    /// Join sweep shards into exactly what one unsharded run writes.
+    Merge {
+        /// The shard files.
+        shards: Vec<PathBuf>,
+        /// Output CSV (`-`: standard output).
+        #[arg(long)]
+        csv: PathBuf,
+    },
     /// Work-precision benchmark: each solver over a ladder of tolerances / steps, error
     /// against a tight reference, median run time, counters; peers (scipy, Siconos) side by
     /// side when installed. Prints a table.
@@ -355,6 +423,144 @@ fn bifurcation(
     Ok(())
 }
 
+fn bifurcation2(
+    param: &str,
+    [p_min, p_max, u_min, u_max]: [f64; 4],
+    params: Option<&Path>,
+    json: &Path,
+    svg: Option<&Path>,
+) -> Result<()> {
+    use rotor_compare::report::write_output;
+    let base = load_model(params)?.params;
+    let opts = rotor_bifurcation::plane::PlaneOptions {
+        u_min,
+        u_max,
+        ..rotor_bifurcation::plane::PlaneOptions::new(param, p_min, p_max)
+    };
+    rotor_bifurcation::plane::validate(&base, &opts).map_err(|e| {
+        anyhow!(
+            "{}",
+            e.to_string()
+                .replace("p_max", "--p-max")
+                .replace("u_max", "--u-max")
+        )
+    })?;
+    let t0 = std::time::Instant::now();
+    let plane = rotor_bifurcation::plane::plane(&base, &opts)?;
+    let secs = t0.elapsed().as_secs_f64();
+    write_output(json, plane.to_json()?.as_bytes())
+        .with_context(|| format!("{}: cannot write", json.display()))?;
+    if let Some(path) = svg {
+        let name = params.map_or("Table 1".to_owned(), |p| p.display().to_string());
+        write_output(
+            path,
+            plane.to_svg(&format!("{name}: ({param}, u)")).as_bytes(),
+        )
+        .with_context(|| format!("{}: cannot write", path.display()))?;
+    }
+    let mut summary = format!(
+        "{} curves, {} codimension-two points in {secs:.2} s\n",
+        plane.curves.len(),
+        plane.points.len()
+    );
+    for c in &plane.curves {
+        summary.push_str(&format!(
+            "  {} ({:?}): {} points\n",
+            c.label,
+            c.kind,
+            c.points.len()
+        ));
+    }
+    for q in &plane.points {
+        summary.push_str(&format!(
+            "  {} at {param} = {:.6}, u = {:.6}: {}\n",
+            q.kind,
+            q.p,
+            q.u,
+            q.curves.join(", ")
+        ));
+    }
+    say(&summary, [Some(json), svg]);
+    Ok(())
+}
+
+#[allow(clippy::too_many_arguments)]
+fn sweep(
+    u: &str,
+    param: &str,
+    params: Option<&Path>,
+    x0: Option<&str>,
+    solver: &str,
+    shard: Option<&str>,
+    (resume, t_end): (bool, f64),
+    csv: &Path,
+) -> Result<()> {
+    use rayon::prelude::*;
+    use rotor_compare::sweep::{Axis, Shard, Sweep, SweepStart, run};
+    let base = load_model(params)?.params;
+    let (name, range) = param
+        .split_once('=')
+        .ok_or_else(|| anyhow!("--param {param:?}: expected NAME=A:B:N"))?;
+    check("t-end", t_end, t_end > 0.0, "must be positive and finite")?;
+    let start = match x0 {
+        Some("eq") => SweepStart::PerturbedEquilibrium,
+        other => SweepStart::State(parse_x0(other)?),
+    };
+    let s = Sweep {
+        base,
+        u: Axis::parse("--u", u)?,
+        param: name.to_owned(),
+        p: Axis::parse("--param", range)?,
+        start,
+        solver: kind_by_name(solver)?,
+        t_end,
+    };
+    let shard = shard.map(Shard::parse).transpose()?.unwrap_or(Shard::ALL);
+    if resume && csv.as_os_str() == "-" {
+        bail!("--resume needs an output file, not standard output");
+    }
+    let total = (0..s.len()).filter(|&k| shard.owns(k)).count();
+    let bar = progress_bar(total as u64, "points");
+    let t0 = std::time::Instant::now();
+    let ran = run(&s, shard, csv, resume, |idx, f, sink| {
+        let (tx, rx) = std::sync::mpsc::channel();
+        std::thread::scope(|scope| {
+            scope.spawn(move || {
+                idx.par_iter().for_each_with(tx, |tx, &i| {
+                    let _ = tx.send((i, f(i)));
+                });
+            });
+            for (i, row) in rx {
+                bar.inc(1);
+                sink(i, row);
+            }
+        });
+    })?;
+    bar.finish_and_clear();
+    let secs = t0.elapsed().as_secs_f64();
+    eprintln!(
+        "{ran} points in {secs:.2} s ({:.3} ms per point on {} threads){}",
+        1e3 * secs / ran.max(1) as f64,
+        rayon::current_num_threads(),
+        if ran < total {
+            format!("; {} already in {}", total - ran, csv.display())
+        } else {
+            String::new()
+        }
+    );
+    Ok(())
+}
+
+fn merge(shards: &[PathBuf], csv: &Path) -> Result<()> {
+    if shards.is_empty() {
+        bail!("merge: no shard files given");
+    }
+    let bytes = rotor_compare::sweep::merge(shards)?;
+    rotor_compare::report::write_output(csv, &bytes)
+        .with_context(|| format!("{}: cannot write", csv.display()))?;
+    Ok(())
+}
+
 /// `rotor bench`'s external clients and scenes.
 struct BenchClients<'a> {
     external: &'a [String],
@@ -498,6 +704,87 @@ fn bifurcation_section(
         out.push(d);
     }
     Ok((sec, out))
+}
+
+/// The report section with the two-parameter pictures: (k_θ, u) and (T_sl, u) for both
+/// parameter sets.
+fn plane_section(sets: &[(&str, &str, Params)]) -> Result<rotor_compare::report::Section> {
+    use rayon::prelude::*;
+    use std::fmt::Write as _;
+    let jobs: Vec<(&str, &str, Params, &str, f64, f64)> = sets
+        .iter()
+        .flat_map(|(name, slug, p)| {
+            // T_sl over a range that keeps the law admissible and, for the Stribeck set,
+            // reaches the cluster of codimension-two points near 0.13.
+            let ts = if *slug == "stribeck" {
+                (0.1, 0.45)
+            } else {
+                (0.1, 0.25)
+            };
+            [
+                (*name, *slug, *p, "k_theta", 0.05, 0.11),
+                (*name, *slug, *p, "lower.t_s", ts.0, ts.1),
+            ]
+        })
+        .collect();
+    let planes = jobs
+        .par_iter()
+        .map(|(_, _, p, param, a, b)| {
+            let t0 = std::time::Instant::now();
+            let pl = rotor_bifurcation::plane::plane(
+                p,
+                &rotor_bifurcation::plane::PlaneOptions::new(param, *a, *b),
+            );
+            (pl, t0.elapsed().as_secs_f64())
+        })
+        .collect::<Vec<_>>();
+    let mut sec = rotor_compare::report::Section::default();
+    sec.markdown.push_str(
+        "## Two parameters (rotor bifurcation2)\n\n\
+         Every codimension-one point of the u-diagram continued in the plane of (p, u) for the \
+         stiffness k_θ and the lower disc's static level T_sl, \
+         with the codimension-two points located on the curves and the regions named from \
+         simulations from rest and from the perturbed equilibrium on a coarse grid \
+         (docs/methods.md, section 4a). The dashed line is the file's value.\n",
+    );
+    for ((name, slug, _, param, a, b), (pl, secs)) in jobs.iter().zip(planes) {
+        let pl = pl.with_context(|| format!("{name}: two-parameter analysis over {param}"))?;
+        let file = format!("plane-{slug}-{}", param.replace('.', "_"));
+        let _ = write!(
+            sec.timings,
+            "\n## Two parameters, {name}, {param}\n\nComputed in {secs:.2} s.\n"
+        );
+        let _ = write!(
+            sec.markdown,
+            "\n### {name}: ({param}, u), {param} in [{a:.4}, {b:.4}]\n\n![{name} {param}]({file}.svg)\n\n\
+             {} curves ([JSON]({file}.json)); codimension-two points:\n\n",
+            pl.curves.len()
+        );
+        if pl.points.is_empty() {
+            sec.markdown.push_str("none in this range.\n");
+        } else {
+            sec.markdown
+                .push_str("| kind | p | u [V] | curves | detail |\n|---|---|---|---|---|\n");
+            for q in &pl.points {
+                let _ = writeln!(
+                    sec.markdown,
+                    "| {} | {:.5} | {:.5} | {} | {} |",
+                    q.kind,
+                    q.p,
+                    q.u,
+                    q.curves.join(", "),
+                    q.detail
+                );
+            }
+        }
+        sec.files.push((
+            format!("{file}.svg"),
+            pl.to_svg(&format!("{name}: ({param}, u)")).into_bytes(),
+        ));
+        sec.files
+            .push((format!("{file}.json"), pl.to_json()?.into_bytes()));
+    }
+    Ok(sec)
 }
 
 /// The report section with the steady states probed next to every special point of both
@@ -660,15 +947,15 @@ fn compare(files: &[PathBuf], report: &Path, main_job: bool) -> Result<()> {
         },
         || -> Result<Vec<rotor_compare::report::Section>> {
             if main_job {
-                let (bif, stress) = rayon::join(
+                let (bif, (stress, plane)) = rayon::join(
                     || {
                         let (sec, diagrams) = bifurcation_section(&sets)?;
                         Ok::<_, anyhow::Error>((sec, probe_section(&sets, &diagrams)))
                     },
-                    stress_section,
+                    || rayon::join(stress_section, || plane_section(&sets)),
                 );
                 let (bif, probes) = bif?;
-                Ok(vec![bif, stress, probes])
+                Ok(vec![bif, plane?, stress, probes])
             } else {
                 Ok(Vec::new())
             }
@@ -803,6 +1090,43 @@ fn main() -> ExitCode {
             },
         ),
         Some(Command::Compare { scenarios, report }) => compare(scenarios, report, false),
+        Some(Command::Sweep {
+            u,
+            param,
+            params,
+            x0,
+            solver,
+            shard,
+            resume,
+            t_end,
+            csv,
+        }) => sweep(
+            u,
+            param,
+            params.as_deref(),
+            x0.as_deref(),
+            solver,
+            shard.as_deref(),
+            (*resume, *t_end),
+            csv,
+        ),
+        Some(Command::Merge { shards, csv }) => merge(shards, csv),
+        Some(Command::Bifurcation2 {
+            param,
+            p_min,
+            p_max,
+            params,
+            u_min,
+            u_max,
+            json,
+            svg,
+        }) => bifurcation2(
+            param,
+            [*p_min, *p_max, *u_min, *u_max],
+            params.as_deref(),
+            json,
+            svg.as_deref(),
+        ),
         Some(Command::Reference { out }) => {
             let fixtures = fixtures_dir();
             let out = out.clone().unwrap_or_else(|| open::default_out(&fixtures));

@@ -413,3 +413,136 @@ fn the_minimal_client_of_benchmark_md_passes_check() {
     );
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// `rotor sweep` in shards, each its own process, merges to the unsharded run's file byte
+/// for byte; so does the README's GNU parallel block, run as it stands (with Debian's
+/// `parallel`; where it is missing the block is skipped with a note, unless
+/// `ROTOR_REQUIRE_PEERS=1`, as in .ci/run, which installs it). A sweep cut off mid-row
+/// resumes to the same file.
+#[test]
+fn sweep_shards_merge_to_the_single_run_and_resume() {
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
+    let readme = std::fs::read_to_string(root.join("README.md")).unwrap();
+    let block = readme
+        .split("<!-- parallel begin -->\n```sh\n")
+        .nth(1)
+        .and_then(|r| r.split("```\n<!-- parallel end -->").next())
+        .expect("the README's parallel block");
+    let dir = std::env::temp_dir().join(format!("rotor-cli-sweep-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let grid = ["--u", "0.02:6:24", "--param", "k_theta=0.05:0.11:10"];
+    assert!(block.contains("--u 0.02:6:24 --param k_theta=0.05:0.11:10"));
+    let whole = dir.join("whole.csv");
+    let o = rotor(
+        &[&grid[..], &["--csv", whole.to_str().unwrap()]]
+            .concat()
+            .iter()
+            .fold(vec!["sweep"], |mut v, a| {
+                v.push(a);
+                v
+            }),
+    );
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let expected = std::fs::read(&whole).unwrap();
+    assert_eq!(String::from_utf8_lossy(&expected).lines().count(), 241);
+    // Three shards as separate processes, merged in another order.
+    let mut shards = Vec::new();
+    for i in 1..=3 {
+        let out = dir.join(format!("p{i}.csv"));
+        let shard = format!("{i}/3");
+        let mut args = vec!["sweep"];
+        args.extend(grid);
+        args.extend(["--shard", &shard, "--csv", out.to_str().unwrap()]);
+        assert!(rotor(&args).status.success());
+        shards.push(out);
+    }
+    let merged = dir.join("merged.csv");
+    let o = rotor(&[
+        "merge",
+        shards[1].to_str().unwrap(),
+        shards[2].to_str().unwrap(),
+        shards[0].to_str().unwrap(),
+        "--csv",
+        merged.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert_eq!(std::fs::read(&merged).unwrap(), expected);
+    // A missing shard is refused, naming what is missing.
+    let o = rotor(&["merge", shards[0].to_str().unwrap(), "--csv", "-"]);
+    assert!(!o.status.success());
+    assert!(String::from_utf8_lossy(&o.stderr).contains("missing"));
+    // Resume: a file cut in the middle of a row completes to the same bytes.
+    let cut = dir.join("cut.csv");
+    std::fs::write(&cut, &expected[..expected.len() / 2 + 7]).unwrap();
+    let mut args = vec!["sweep"];
+    args.extend(grid);
+    args.extend(["--resume", "--csv", cut.to_str().unwrap()]);
+    let o = rotor(&args);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("already in"));
+    assert_eq!(std::fs::read(&cut).unwrap(), expected);
+    // The README's block through GNU parallel, with this build's rotor first on PATH.
+    let has_parallel = std::process::Command::new("parallel")
+        .arg("--version")
+        .output()
+        .is_ok_and(|o| o.status.success());
+    if has_parallel {
+        let bin = std::path::Path::new(env!("CARGO_BIN_EXE_rotor"))
+            .parent()
+            .unwrap();
+        let path = format!(
+            "{}:{}",
+            bin.display(),
+            std::env::var("PATH").unwrap_or_default()
+        );
+        let o = std::process::Command::new("sh")
+            .args(["-c", block])
+            .current_dir(&dir)
+            .env("PATH", path)
+            .output()
+            .unwrap();
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        assert_eq!(std::fs::read(dir.join("sweep.csv")).unwrap(), expected);
+    } else {
+        assert!(
+            std::env::var("ROTOR_REQUIRE_PEERS").as_deref() != Ok("1"),
+            "ROTOR_REQUIRE_PEERS=1 but GNU parallel is missing"
+        );
+        eprintln!("README parallel block not run: GNU parallel is missing");
+    }
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+/// Bad sweep input is refused before any run, naming the flag and the value.
+#[test]
+fn sweep_refuses_bad_shards_parameters_and_huge_grids() {
+    let run = |extra: &[&str]| {
+        let mut args = vec!["sweep", "--u", "0:6:10", "--csv", "-"];
+        args.extend(extra);
+        let o = rotor(&args);
+        assert!(!o.status.success() && o.stdout.is_empty());
+        String::from_utf8_lossy(&o.stderr).into_owned()
+    };
+    for (shard, needle) in [
+        ("0/3", "--shard \"0/3\""),
+        ("4/3", "--shard \"4/3\""),
+        ("a/b", "--shard \"a/b\""),
+    ] {
+        let e = run(&["--param", "k_theta=0.05:0.1:3", "--shard", shard]);
+        assert!(e.contains(needle), "{e}");
+    }
+    let e = run(&["--param", "lower.omega_s=1:2:3"]);
+    assert!(e.contains("valid: j_u, k_m, k_theta"), "{e}");
+    let e = run(&["--param", "k_theta=-0.1:0.1:3"]);
+    assert!(e.contains("k_theta = -0.1: must be positive"), "{e}");
+    let mut args = vec![
+        "sweep",
+        "--u",
+        "0:6:100000",
+        "--param",
+        "k_theta=0.05:0.1:1000",
+    ];
+    args.extend(["--csv", "-"]);
+    let o = rotor(&args);
+    assert!(String::from_utf8_lossy(&o.stderr).contains("--shard I/N"));
+}
