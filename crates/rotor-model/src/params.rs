@@ -223,6 +223,30 @@ impl Params {
             path: path.to_owned(),
             message: one_line(&e.to_string()),
         })?;
+        Params::from_raw(raw, path)
+    }
+
+    /// Validates parameters given as a table of the file's keys (the Python package's dict);
+    /// `origin` names them in messages.
+    pub fn from_table(table: toml::Table, origin: &Path) -> Result<Params, ParamsError> {
+        use serde::Deserialize;
+        let raw =
+            RawParams::deserialize(toml::Value::Table(table)).map_err(|e| ParamsError::Parse {
+                path: origin.to_owned(),
+                message: one_line(&e.to_string()),
+            })?;
+        Params::from_raw(raw, origin)
+    }
+
+    /// The parameters as a table of the file's keys (the inverse of [`Params::from_table`]).
+    pub fn to_table(&self) -> toml::Table {
+        match toml::Table::try_from(self) {
+            Ok(t) => t,
+            Err(e) => unreachable!("plain numbers and a family name serialize: {e}"),
+        }
+    }
+
+    fn from_raw(raw: RawParams, path: &Path) -> Result<Params, ParamsError> {
         let bad = |field: &str, value: f64, reason: &str| ParamsError::Invalid {
             path: path.to_owned(),
             field: field.to_owned(),
@@ -835,5 +859,27 @@ mod tests {
         );
         let e = p.with("k_theta", -0.1).unwrap_err().to_string();
         assert_eq!(e, "k_theta = -0.1: must be positive");
+    }
+
+    /// A parameter set given as a table (the Python package's dict) reads back as itself,
+    /// and a bad table is refused naming the origin and the field, as a file is.
+    #[test]
+    fn tables_round_trip_and_name_bad_fields() {
+        for text in [TABLE1, STRIBECK] {
+            let p = Params::from_toml_str(text, Path::new("f.toml")).unwrap();
+            let back = Params::from_table(p.to_table(), Path::new("params")).unwrap();
+            assert_eq!(back, p);
+        }
+        let mut t = Params::table1().to_table();
+        t.insert("k_theta".into(), toml::Value::Float(-1.0));
+        let e = Params::from_table(t, Path::new("params")).unwrap_err();
+        assert_eq!(e.to_string(), "params: k_theta = -1: must be positive");
+        let mut t = Params::table1().to_table();
+        t.insert("k_thta".into(), toml::Value::Float(1.0));
+        let e = Params::from_table(t, Path::new("params")).unwrap_err();
+        assert!(
+            e.to_string().starts_with("params: unknown field `k_thta`"),
+            "{e}"
+        );
     }
 }

@@ -406,6 +406,31 @@ pub enum SolveError {
     NonFiniteOutput { t: f64, what: &'static str },
 }
 
+impl SolveError {
+    /// The time at which the run failed, where the failure has one.
+    pub fn time(&self) -> Option<f64> {
+        match *self {
+            SolveError::StepSizeUnderflow { t, .. }
+            | SolveError::NonFinite { t, .. }
+            | SolveError::Complementarity { t, .. }
+            | SolveError::Zeno { t, .. }
+            | SolveError::TooManySteps { t, .. }
+            | SolveError::NonFiniteOutput { t, .. } => Some(t),
+            SolveError::InvalidScene { .. }
+            | SolveError::NoConvergence { .. }
+            | SolveError::Unsupported { .. } => None,
+        }
+    }
+
+    /// The state `[α, ω_u, ω_l]` at which the run failed, where the failure records it.
+    pub fn state(&self) -> Option<[f64; 3]> {
+        match *self {
+            SolveError::StepSizeUnderflow { x, .. } | SolveError::NonFinite { x, .. } => Some(x),
+            _ => None,
+        }
+    }
+}
+
 /// A solver: takes a model and a scene and returns a trajectory.
 pub trait Solver: Sync {
     /// Short name (`"event"`, `"switch"`, `"moreau"`).
