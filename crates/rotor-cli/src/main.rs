@@ -8,7 +8,7 @@ mod open;
 use anyhow::{Context, Result, anyhow, bail};
 use clap::{Parser, Subcommand};
 use rotor_compare::SolverKind;
-use rotor_model::{Model, Output, Params, Scene, Solver, State, SteadyState};
+use rotor_model::{Model, Params, State, SteadyState};
 
 /// Two-disc rotor with set-valued friction: three independent solvers, cross-validated.
 #[derive(Parser, Debug)]
@@ -223,18 +223,8 @@ struct Common {
     h: Option<f64>,
 }
 
-fn solver_by_name(name: &str) -> Result<Box<dyn Solver>> {
-    Ok(kind_by_name(name)?.solver())
-}
-
 fn kind_by_name(name: &str) -> Result<SolverKind> {
-    match SolverKind::by_name(name) {
-        Some(kind) => Ok(kind),
-        None => bail!(
-            "--solver {name:?}: unknown solver (expected one of: {})",
-            rotor_compare::SOLVERS.map(SolverKind::name).join(", ")
-        ),
-    }
+    rotor_compare::request::solver_kind(name).map_err(|e| anyhow!(e.as_flag()))
 }
 
 /// Prints a command's summary: on standard output, unless one of its outputs goes there
@@ -278,12 +268,8 @@ fn parse_x0(s: Option<&str>) -> Result<State> {
 
 /// Moreau–Jean steps whose step problem did not converge are answers to distrust: say so.
 fn warn_inexact(stats: &rotor_model::Stats) {
-    if stats.inexact_steps > 0 {
-        eprintln!(
-            "warning: {} of {} steps fell back to an inexact iteration (the step is too large \
-             for the friction law's slope); reduce --h",
-            stats.inexact_steps, stats.steps
-        );
+    if let Some(w) = rotor_compare::request::inexact_warning(stats, "--h") {
+        eprintln!("warning: {w}");
     }
 }
 
@@ -295,54 +281,29 @@ fn check(flag: &str, v: f64, ok: bool, what: &str) -> Result<()> {
     Ok(())
 }
 
-/// A flag the chosen solver has no use for is said so, not silently dropped: the adaptive
-/// solvers take no step size, Moreau–Jean no tolerance.
-fn warn_ignored(common: &Common) {
-    let Some(kind) = SolverKind::by_name(&common.solver) else {
-        return;
-    };
-    let s = kind.name();
-    if kind.is_fixed_step() && common.tol.is_some() {
-        eprintln!("warning: --tol is ignored by {s} (fixed steps: its accuracy is set by --h)");
-    } else if !kind.is_fixed_step() && common.h.is_some() {
-        eprintln!("warning: --h is ignored by {s} (adaptive steps: its accuracy is set by --tol)");
-    }
-}
-
-fn scene_from(common: &Common, t_end: f64, output: Output) -> Result<Scene> {
-    check("u", common.u, true, "must be a finite number")?;
-    let d = Scene::default();
-    let tol = common.tol.unwrap_or(d.tol);
-    check("tol", tol, tol > 0.0 && tol < 1.0, "must lie in (0, 1)")?;
-    // The default step shrinks to a horizon shorter than itself; an explicit --h does not.
-    let h = common.h.unwrap_or(d.h.min(t_end));
-    check(
-        "h",
-        h,
-        h > 0.0 && h <= t_end,
-        &format!(
-            "must lie in (0, {}] s (the run's horizon)",
-            rotor_model::Num(t_end)
-        ),
-    )?;
-    warn_ignored(common);
-    Ok(Scene {
+/// The checked request of `simulate` and `steady` (the same checks and words as the Python
+/// package's), with a warning for a setting the solver ignores.
+fn request(common: &Common) -> Result<rotor_compare::request::Request<'_>> {
+    let x = parse_x0(common.x0.as_deref())?;
+    let req = rotor_compare::request::Request {
+        solver: &common.solver,
         u: common.u,
-        x0: parse_x0(common.x0.as_deref())?,
-        t_end,
-        tol,
-        h,
-        output,
-        metrics_from: None,
-    })
+        x0: [x[0], x[1], x[2]],
+        tol: common.tol,
+        h: common.h,
+    };
+    if let Some(i) = req.ignored() {
+        eprintln!("warning: {}", i.as_flag());
+    }
+    Ok(req)
 }
 
 fn simulate(common: &Common, t_end: f64, dt: f64, csv_path: &Path) -> Result<()> {
-    check("t-end", t_end, t_end > 0.0, "must be positive and finite")?;
-    check("dt", dt, dt > 0.0, "must be positive and finite")?;
-    let solver = solver_by_name(&common.solver)?;
+    let (kind, scene) = request(common)?
+        .simulation(t_end, dt)
+        .map_err(|e| anyhow!(e.as_flag()))?;
     let model = load_model(common.params.as_deref())?;
-    let scene = scene_from(common, t_end, Output::Grid { dt })?;
+    let solver = kind.solver();
     let traj = solver
         .simulate_finite(&model, &scene)
         .with_context(|| format!("solver {}", solver.name()))?;
@@ -355,14 +316,10 @@ fn simulate(common: &Common, t_end: f64, dt: f64, csv_path: &Path) -> Result<()>
 }
 
 fn steady(common: &Common) -> Result<()> {
+    let (kind, scene, opts) = request(common)?
+        .steady()
+        .map_err(|e| anyhow!(e.as_flag()))?;
     let model = load_model(common.params.as_deref())?;
-    let kind = kind_by_name(&common.solver)?;
-    let mut opts = rotor_compare::SteadyOptions::default();
-    if let Some(tol) = common.tol {
-        check("tol", tol, tol > 0.0 && tol < 1.0, "must lie in (0, 1)")?;
-        opts.event.tol = tol;
-    }
-    let scene = scene_from(common, opts.settle.chunk, Output::Final)?;
     let answer = rotor_compare::steady(kind, &model, &scene, &opts)
         .with_context(|| format!("solver {}", kind.name()))?;
     warn_inexact(&answer.stats);

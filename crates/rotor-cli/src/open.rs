@@ -5,7 +5,7 @@ use std::process::ExitCode;
 
 use anyhow::{Context, Result};
 use rayon::prelude::*;
-use rotor_compare::check::{CheckError, Strictness, check};
+use rotor_compare::check::{CheckError, Strictness, grade};
 use rotor_compare::reference;
 
 /// `rotor reference [--out DIR]`: the reference files of every scenario.
@@ -53,7 +53,7 @@ pub fn check_trace(
     gate: &str,
     json: Option<&Path>,
 ) -> ExitCode {
-    match grade(scenario, trace, events, gate, json) {
+    match verdict(scenario, trace, events, gate, json) {
         Ok(true) => ExitCode::SUCCESS,
         Ok(false) => ExitCode::from(1),
         Err(e) => {
@@ -64,27 +64,20 @@ pub fn check_trace(
 }
 
 /// The verdict (`Ok(passed)`), or why the input cannot be graded.
-fn grade(
+fn verdict(
     scenario: &Path,
     trace: &Path,
     events: Option<&Path>,
     gate: &str,
     json: Option<&Path>,
 ) -> Result<bool> {
-    let strictness = Strictness::by_name(gate).ok_or_else(|| {
-        anyhow::anyhow!(
-            "--gate {gate:?}: expected strict (event-switch tolerances) or loose (event-moreau)"
-        )
-    })?;
-    let sc = rotor_compare::load_scenario(scenario)?;
-    let dir = reference::dir_for(scenario);
-    let r = reference::read(&dir, &sc.name)?;
+    let strictness = Strictness::parse(gate).map_err(|e| anyhow::anyhow!(e.as_flag()))?;
     let t = rotor_compare::trace::read_trace(trace).map_err(CheckError::from)?;
     let ev = events
         .map(rotor_compare::trace::read_events)
         .transpose()
         .map_err(CheckError::from)?;
-    let report = check(&sc, &r, &t, ev.as_ref(), strictness)?;
+    let report = grade(scenario, &t, ev.as_ref(), strictness)?;
     if let Some(path) = json {
         let text = serde_json::to_string_pretty(&report)? + "\n";
         rotor_compare::report::write_output(path, text.as_bytes())

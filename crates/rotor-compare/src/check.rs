@@ -22,8 +22,9 @@ use serde::Serialize;
 
 use crate::gate::steady_differences;
 use crate::gridmetrics::{StickExit, grid_metrics};
-use crate::reference::Reference;
-use crate::trace::{EventsFile, Trace};
+use crate::reference::{Reference, ReferenceError};
+use crate::request::BadInput;
+use crate::trace::{At, EventsFile, Trace};
 
 /// Which of the scenario's tolerance tables grades the trace.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
@@ -50,6 +51,15 @@ impl Strictness {
             Strictness::Strict => "event-switch",
             Strictness::Loose => "event-moreau",
         }
+    }
+
+    /// The gate of a name, or a [`BadInput`] naming `gate` and the value.
+    pub fn parse(s: &str) -> Result<Strictness, BadInput> {
+        Strictness::by_name(s).ok_or_else(|| BadInput {
+            name: "gate",
+            value: format!("{s:?}"),
+            reason: "expected strict (event-switch tolerances) or loose (event-moreau)".into(),
+        })
     }
 
     pub fn by_name(s: &str) -> Option<Strictness> {
@@ -124,7 +134,7 @@ impl CheckReport {
 pub enum CheckError {
     #[error(transparent)]
     Trace(#[from] crate::trace::TraceError),
-    #[error("{}: line {line}: t = {found} is not the grid time {expected} (the scenario's grid: every {dt} s from 0 to {t_end} s, times within 1e-9 s)", .path.display())]
+    #[error("{}: t = {found} is not the grid time {expected} (the scenario's grid: every {dt} s from 0 to {t_end} s, times within 1e-9 s)", At(.path, *.line))]
     OffGrid {
         path: PathBuf,
         line: u64,
@@ -133,21 +143,21 @@ pub enum CheckError {
         dt: f64,
         t_end: f64,
     },
-    #[error("{}: the trace ends at line {line} (t = {last}); the grid time {missing} s and later are missing", .path.display())]
+    #[error("{}: the trace ends here (t = {last}); the grid time {missing} s and later are missing", At(.path, *.line))]
     Missing {
         path: PathBuf,
         line: u64,
         last: f64,
         missing: f64,
     },
-    #[error("{}: line {line}: t = {found} is past the grid's last time {t_end} s", .path.display())]
+    #[error("{}: t = {found} is past the grid's last time {t_end} s", At(.path, *.line))]
     Extra {
         path: PathBuf,
         line: u64,
         found: f64,
         t_end: f64,
     },
-    #[error("{}: line {line}: event time {t} is outside [0, {t_end}] s or before the event above it", .path.display())]
+    #[error("{}: event time {t} is outside [0, {t_end}] s or before the previous event", At(.path, *.line))]
     EventTime {
         path: PathBuf,
         line: u64,
@@ -351,4 +361,29 @@ pub fn check(
         gate,
         quantities: q,
     })
+}
+
+/// Why a trace cannot be graded at all: the scenario or its reference cannot be read, or the
+/// trace (or events) is unusable.
+#[derive(Debug, thiserror::Error)]
+pub enum GradeError {
+    #[error(transparent)]
+    Scenario(#[from] rotor_model::ScenarioError),
+    #[error(transparent)]
+    Reference(#[from] ReferenceError),
+    #[error(transparent)]
+    Check(#[from] CheckError),
+}
+
+/// `rotor check`'s grading: the scenario file, its reference from `fixtures/reference` beside
+/// it ([`crate::reference::dir_for`]), and [`check`].
+pub fn grade(
+    scenario: &std::path::Path,
+    trace: &Trace,
+    events: Option<&EventsFile>,
+    gate: Strictness,
+) -> Result<CheckReport, GradeError> {
+    let sc = crate::load_scenario(scenario)?;
+    let r = crate::reference::read(&crate::reference::dir_for(scenario), &sc.name)?;
+    Ok(check(&sc, &r, trace, events, gate)?)
 }

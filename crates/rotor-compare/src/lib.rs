@@ -7,6 +7,7 @@ pub mod gridmetrics;
 pub mod probes;
 pub mod reference;
 pub mod report;
+pub mod request;
 pub mod run;
 pub mod settle;
 pub mod snapshot;

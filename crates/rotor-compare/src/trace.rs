@@ -76,6 +76,25 @@ fn write_rows(w: impl std::io::Write, samples: &[Sample], digits: i32) -> std::i
     w.flush()
 }
 
+/// The name of a trace given as arrays (the Python package's `check`) instead of a file: its
+/// rows are named by their index, not a line.
+pub const ARRAYS: &str = "<arrays>";
+
+/// Where a row is, for messages: `trace.csv: line 7`, or `index 5` for a trace given as
+/// arrays ([`ARRAYS`]).
+#[derive(Debug, Clone, Copy)]
+pub struct At<'a>(pub &'a Path, pub u64);
+
+impl std::fmt::Display for At<'_> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        if self.0 == Path::new(ARRAYS) {
+            write!(f, "index {}", self.1)
+        } else {
+            write!(f, "{}: line {}", self.0.display(), self.1)
+        }
+    }
+}
+
 /// A trace file could not be read, or is not a trace.
 #[derive(Debug, Error, Clone, PartialEq)]
 pub enum TraceError {
@@ -122,6 +141,24 @@ pub enum TraceError {
     },
     #[error("{}: no data rows after the header", .path.display())]
     NoRows { path: PathBuf },
+    /// A trace given as arrays: one value is not finite.
+    #[error("{name}[{index}] = {value}: not a finite number")]
+    Column {
+        name: &'static str,
+        index: usize,
+        value: f64,
+    },
+    /// Events given as a list: an entry's disc or kind is not one of its words.
+    #[error("events[{index}][{name:?}] = {value:?}: not one of {expected}")]
+    Entry {
+        index: usize,
+        name: &'static str,
+        value: String,
+        expected: &'static str,
+    },
+    /// A trace given as arrays: the arrays are empty or of different lengths.
+    #[error("{message}")]
+    Arrays { message: String },
 }
 
 /// A trace as read: the samples with the line each came from.
@@ -131,6 +168,98 @@ pub struct Trace {
     pub samples: Vec<Sample>,
     /// The file line of each sample (1-based; the header is line 1).
     pub lines: Vec<u64>,
+}
+
+impl Trace {
+    /// A trace from its four columns (the Python package's arrays): of equal, nonzero
+    /// lengths, every value finite. Its rows are named by index ([`ARRAYS`]).
+    pub fn from_columns(columns: [&[f64]; 4]) -> Result<Trace, TraceError> {
+        let n = columns[0].len();
+        if columns.iter().any(|c| c.len() != n) {
+            let lengths: Vec<String> = TRACE_HEADER
+                .iter()
+                .zip(&columns)
+                .map(|(name, c)| format!("{name} has {}", c.len()))
+                .collect();
+            return Err(TraceError::Arrays {
+                message: format!(
+                    "the four arrays must have one length: {}",
+                    lengths.join(", ")
+                ),
+            });
+        }
+        if n == 0 {
+            return Err(TraceError::Arrays {
+                message: "the arrays are empty".into(),
+            });
+        }
+        for (name, c) in TRACE_HEADER.iter().zip(&columns) {
+            if let Some(index) = c.iter().position(|v| !v.is_finite()) {
+                return Err(TraceError::Column {
+                    name,
+                    index,
+                    value: c[index],
+                });
+            }
+        }
+        let [t, a, wu, wl] = columns;
+        Ok(Trace {
+            path: ARRAYS.into(),
+            samples: (0..n)
+                .map(|i| Sample {
+                    t: t[i],
+                    x: State::new(a[i], wu[i], wl[i]),
+                })
+                .collect(),
+            lines: (0..n as u64).collect(),
+        })
+    }
+}
+
+impl EventsFile {
+    /// Events given as a list (the Python package's `check`): each `(t, disc, kind)` with disc
+    /// `upper|lower` and kind `stick_start|stick_end|reversal`, as in an events file. Named by
+    /// index ([`ARRAYS`]); the times are checked by [`crate::check::check_events`].
+    pub fn from_rows(rows: &[(f64, &str, &str)]) -> Result<EventsFile, TraceError> {
+        let mut events = Vec::with_capacity(rows.len());
+        for (index, &(t, disc, kind)) in rows.iter().enumerate() {
+            let bad = |name, value: &str, expected| TraceError::Entry {
+                index,
+                name,
+                value: value.to_owned(),
+                expected,
+            };
+            if !t.is_finite() {
+                return Err(TraceError::Entry {
+                    index,
+                    name: "t",
+                    value: t.to_string(),
+                    expected: "the finite numbers",
+                });
+            }
+            let disc = match disc {
+                "upper" => Disc::Upper,
+                "lower" => Disc::Lower,
+                _ => return Err(bad("disc", disc, "upper, lower")),
+            };
+            let kind = match kind {
+                "stick_start" => EventKind::StickStart(disc),
+                "stick_end" => EventKind::StickEnd(disc),
+                "reversal" => EventKind::Reversal(disc),
+                _ => return Err(bad("kind", kind, "stick_start, stick_end, reversal")),
+            };
+            events.push(Event {
+                t,
+                x: State::zeros(),
+                kind,
+            });
+        }
+        Ok(EventsFile {
+            path: ARRAYS.into(),
+            lines: (0..events.len() as u64).collect(),
+            events,
+        })
+    }
 }
 
 /// Reads a trace file.
@@ -503,5 +632,47 @@ mod tests {
         assert!(e.contains("line 2, column 1 (t)"), "{e}");
         let e = err("t,disc,kind\n1,lower\n");
         assert!(e.contains("line 2: 2 fields, expected 3"), "{e}");
+    }
+
+    /// Arrays make the same trace as the file of the same numbers; bad arrays name the array
+    /// and the index.
+    #[test]
+    fn traces_from_arrays_match_files_and_name_bad_entries() {
+        let samples = vec![s(0.0, 0.0, 0.0, 0.0), s(0.1, 0.5, -1.5e-7, 6.3)];
+        let file = parse_trace(&write_trace(&samples, 0.1), Path::new("x.csv")).unwrap();
+        let col = |k: usize| -> Vec<f64> {
+            samples
+                .iter()
+                .map(|s| if k == 0 { s.t } else { s.x[k - 1] })
+                .collect()
+        };
+        let (t, a, wu, wl) = (col(0), col(1), col(2), col(3));
+        let arrays = Trace::from_columns([&t, &a, &wu, &wl]).unwrap();
+        assert_eq!(arrays.samples, file.samples);
+        assert_eq!(arrays.lines, [0, 1]);
+        let e = Trace::from_columns([&t, &a, &wu[..1], &wl]).unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            "the four arrays must have one length: t has 2, alpha has 2, omega_u has 1, \
+             omega_l has 2"
+        );
+        let nan = [0.0, f64::NAN];
+        let e = Trace::from_columns([&t, &a, &wu, &nan]).unwrap_err();
+        assert_eq!(e.to_string(), "omega_l[1] = NaN: not a finite number");
+        let empty: [f64; 0] = [];
+        let e = Trace::from_columns([&empty; 4]).unwrap_err();
+        assert_eq!(e.to_string(), "the arrays are empty");
+        assert_eq!(At(Path::new(ARRAYS), 7).to_string(), "index 7");
+        assert_eq!(At(Path::new("x.csv"), 7).to_string(), "x.csv: line 7");
+
+        let ev = EventsFile::from_rows(&[(0.5, "lower", "stick_start")]).unwrap();
+        let back = parse_events(b"t,disc,kind\n0.5,lower,stick_start\n", Path::new("e")).unwrap();
+        assert_eq!(ev.events, back.events);
+        let e =
+            EventsFile::from_rows(&[(0.5, "lower", "stick"), (1.0, "x", "reversal")]).unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            "events[0][\"kind\"] = \"stick\": not one of stick_start, stick_end, reversal"
+        );
     }
 }

@@ -233,7 +233,7 @@ fn malformed_traces_are_unusable_with_the_line_named() {
     );
     let m = msg(with(&|v| v.truncate(5000)));
     assert!(
-        m.contains("ends at line 5000") && m.contains("49.99"),
+        m.contains("line 5000: the trace ends here") && m.contains("49.99"),
         "{m}"
     );
     let m = msg(with(&|v| v.push("100.01,0,0,0".into())));

@@ -1,0 +1,309 @@
+//! What a user asks for, checked in one place for every front end.
+//!
+//! `rotor simulate`/`rotor steady` and the Python package's `simulate`/`steady`/`sweep` take
+//! the same inputs (a solver name, u, x0, a horizon, tol or h). A [`Request`] turns them into
+//! a solver and a validated [`Scene`], and refuses bad input with a [`BadInput`] that names
+//! the input and the value. The reason is worded once, here; each front end only spells the
+//! name its own way ([`BadInput::as_flag`] for the command line, `name = value` for Python).
+
+use rotor_model::{Num, Output, Scene, State, Stats};
+use thiserror::Error;
+
+use crate::{SOLVERS, SolverKind, SteadyOptions};
+
+/// An input refused before any run: its name (as the Python argument: `t_end`, `x0`), its
+/// value as typed or printed, and why.
+#[derive(Debug, Clone, PartialEq, Error)]
+#[error("{name} = {value}: {reason}")]
+pub struct BadInput {
+    pub name: &'static str,
+    pub value: String,
+    pub reason: String,
+}
+
+impl BadInput {
+    fn num(name: &'static str, v: f64, reason: impl Into<String>) -> BadInput {
+        BadInput {
+            name,
+            value: Num(v).to_string(),
+            reason: reason.into(),
+        }
+    }
+
+    /// The same message as the command line spells it: `--t-end 0: must be positive and
+    /// finite`.
+    pub fn as_flag(&self) -> String {
+        format!(
+            "--{} {}: {}",
+            self.name.replace('_', "-"),
+            self.value,
+            self.reason
+        )
+    }
+}
+
+/// Checks a number: finite and `ok`, else a [`BadInput`] naming it.
+pub fn check_number(name: &'static str, v: f64, ok: bool, reason: &str) -> Result<(), BadInput> {
+    if !v.is_finite() || !ok {
+        return Err(BadInput::num(name, v, reason));
+    }
+    Ok(())
+}
+
+/// The solver of a name, or a [`BadInput`] listing the names.
+pub fn solver_kind(name: &str) -> Result<SolverKind, BadInput> {
+    SolverKind::by_name(name).ok_or_else(|| BadInput {
+        name: "solver",
+        value: format!("{name:?}"),
+        reason: format!(
+            "unknown solver (expected one of: {})",
+            SOLVERS.map(SolverKind::name).join(", ")
+        ),
+    })
+}
+
+/// A setting the chosen solver has no use for (the adaptive solvers take no step size,
+/// Moreau–Jean no tolerance): said so, not silently dropped.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Ignored {
+    /// `tol` or `h`.
+    pub name: &'static str,
+    /// The solver.
+    pub solver: &'static str,
+    /// What sets its accuracy instead.
+    pub instead: &'static str,
+    pub fixed_step: bool,
+}
+
+impl Ignored {
+    fn text(&self, spell: impl Fn(&str) -> String) -> String {
+        let how = if self.fixed_step {
+            "fixed steps"
+        } else {
+            "adaptive steps"
+        };
+        format!(
+            "{} is ignored by {} ({how}: its accuracy is set by {})",
+            spell(self.name),
+            self.solver,
+            spell(self.instead)
+        )
+    }
+
+    /// `tol is ignored by moreau (fixed steps: its accuracy is set by h)`.
+    pub fn message(&self) -> String {
+        self.text(str::to_owned)
+    }
+
+    /// The command line's spelling: `--tol is ignored by moreau (... set by --h)`.
+    pub fn as_flag(&self) -> String {
+        self.text(|n| format!("--{n}"))
+    }
+}
+
+/// Moreau–Jean steps whose step problem did not converge are answers to distrust: the
+/// warning, if any, naming the step size as the front end spells it (`h`, `--h`).
+pub fn inexact_warning(stats: &Stats, h: &str) -> Option<String> {
+    (stats.inexact_steps > 0).then(|| {
+        format!(
+            "{} of {} steps fell back to an inexact iteration (the step is too large for the \
+             friction law's slope); reduce {h}",
+            stats.inexact_steps, stats.steps
+        )
+    })
+}
+
+/// One run as asked: the solver's name, the input voltage, the initial state and the
+/// solver's accuracy setting (`tol` for the adaptive solvers, `h` for Moreau–Jean; `None`
+/// takes [`Scene::default`]'s).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Request<'a> {
+    pub solver: &'a str,
+    pub u: f64,
+    pub x0: [f64; 3],
+    pub tol: Option<f64>,
+    pub h: Option<f64>,
+}
+
+impl Request<'_> {
+    /// The solver asked for.
+    pub fn solver_kind(&self) -> Result<SolverKind, BadInput> {
+        solver_kind(self.solver)
+    }
+
+    /// The setting the solver ignores, if one was given.
+    pub fn ignored(&self) -> Option<Ignored> {
+        let kind = SolverKind::by_name(self.solver)?;
+        let fixed = kind.is_fixed_step();
+        let (given, instead) = if fixed {
+            (self.tol.map(|_| "tol"), "h")
+        } else {
+            (self.h.map(|_| "h"), "tol")
+        };
+        given.map(|name| Ignored {
+            name,
+            solver: kind.name(),
+            instead,
+            fixed_step: fixed,
+        })
+    }
+
+    /// The scene of a run over `[0, t_end]` keeping `output`: u finite, x0 finite, tol in
+    /// (0, 1), h in (0, t_end] (the default step shrinks to a horizon shorter than itself; an
+    /// explicit h does not).
+    pub fn scene(&self, t_end: f64, output: Output) -> Result<Scene, BadInput> {
+        check_number("u", self.u, true, "must be a finite number")?;
+        for (k, v) in self.x0.iter().enumerate() {
+            if !v.is_finite() {
+                return Err(BadInput {
+                    name: "x0",
+                    value: format!("{:?}", self.x0.map(|x| Num(x).to_string())),
+                    reason: format!(
+                        "component {} ({}) is not finite",
+                        k + 1,
+                        ["alpha", "omega_u", "omega_l"][k]
+                    ),
+                });
+            }
+        }
+        let d = Scene::default();
+        let tol = self.tol.unwrap_or(d.tol);
+        check_number("tol", tol, tol > 0.0 && tol < 1.0, "must lie in (0, 1)")?;
+        let h = self.h.unwrap_or(d.h.min(t_end));
+        check_number(
+            "h",
+            h,
+            h > 0.0 && h <= t_end,
+            &format!("must lie in (0, {}] s (the run's horizon)", Num(t_end)),
+        )?;
+        let [a, wu, wl] = self.x0;
+        Ok(Scene {
+            u: self.u,
+            x0: State::new(a, wu, wl),
+            t_end,
+            tol,
+            h,
+            output,
+            metrics_from: None,
+        })
+    }
+
+    /// A simulation over `[0, t_end]` sampled every `dt`: the solver and the scene.
+    pub fn simulation(&self, t_end: f64, dt: f64) -> Result<(SolverKind, Scene), BadInput> {
+        check_number("t_end", t_end, t_end > 0.0, "must be positive and finite")?;
+        check_number("dt", dt, dt > 0.0, "must be positive and finite")?;
+        let kind = self.solver_kind()?;
+        Ok((kind, self.scene(t_end, Output::Grid { dt })?))
+    }
+
+    /// A steady-state computation ([`crate::steady`]): the solver, the scene and the options
+    /// (the event-driven solver's refinement runs at `tol`).
+    pub fn steady(&self) -> Result<(SolverKind, Scene, SteadyOptions), BadInput> {
+        let mut opts = SteadyOptions::default();
+        if let Some(tol) = self.tol {
+            check_number("tol", tol, tol > 0.0 && tol < 1.0, "must lie in (0, 1)")?;
+            opts.event.tol = tol;
+        }
+        let kind = self.solver_kind()?;
+        Ok((kind, self.scene(opts.settle.chunk, Output::Final)?, opts))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn req() -> Request<'static> {
+        Request {
+            solver: "event",
+            u: 1.5,
+            x0: [0.0; 3],
+            tol: None,
+            h: None,
+        }
+    }
+
+    #[test]
+    fn bad_inputs_name_the_input_and_the_value() {
+        let e = Request {
+            solver: "rk4",
+            ..req()
+        }
+        .simulation(10.0, 0.01)
+        .unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            "solver = \"rk4\": unknown solver (expected one of: event, switch, moreau)"
+        );
+        assert_eq!(
+            e.as_flag(),
+            "--solver \"rk4\": unknown solver (expected one of: event, switch, moreau)"
+        );
+        let e = req().simulation(0.0, 0.01).unwrap_err();
+        assert_eq!(e.as_flag(), "--t-end 0: must be positive and finite");
+        let e = Request {
+            tol: Some(2.0),
+            ..req()
+        }
+        .steady()
+        .unwrap_err();
+        assert_eq!(e.to_string(), "tol = 2: must lie in (0, 1)");
+        let e = Request {
+            h: Some(20.0),
+            solver: "moreau",
+            ..req()
+        }
+        .simulation(10.0, 0.01)
+        .unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            "h = 20: must lie in (0, 10] s (the run's horizon)"
+        );
+        let e = Request {
+            x0: [0.0, f64::NAN, 0.0],
+            ..req()
+        }
+        .simulation(10.0, 0.01)
+        .unwrap_err();
+        assert_eq!(e.name, "x0");
+        assert!(e.reason.contains("omega_u"), "{e}");
+    }
+
+    #[test]
+    fn an_unused_setting_is_named_with_what_sets_the_accuracy() {
+        let i = Request {
+            solver: "moreau",
+            tol: Some(1e-8),
+            ..req()
+        }
+        .ignored()
+        .unwrap();
+        assert_eq!(
+            i.as_flag(),
+            "--tol is ignored by moreau (fixed steps: its accuracy is set by --h)"
+        );
+        assert_eq!(
+            i.message(),
+            "tol is ignored by moreau (fixed steps: its accuracy is set by h)"
+        );
+        let i = Request {
+            h: Some(1e-3),
+            ..req()
+        }
+        .ignored()
+        .unwrap();
+        assert_eq!(i.name, "h");
+        assert!(req().ignored().is_none());
+    }
+
+    #[test]
+    fn the_default_step_shrinks_to_a_short_horizon() {
+        let (_, sc) = Request {
+            solver: "moreau",
+            ..req()
+        }
+        .simulation(1e-4, 1e-5)
+        .unwrap();
+        assert_eq!(sc.h, 1e-4);
+    }
+}
