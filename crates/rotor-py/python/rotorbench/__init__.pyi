@@ -1,0 +1,116 @@
+"""Type stubs of rotorbench (the functions live in the native module rotorbench._rotorbench)."""
+
+import os
+from typing import Any, Dict, List, Literal, Mapping, Optional, Sequence, Tuple, TypedDict, Union
+
+import numpy as np
+import numpy.typing as npt
+
+__version__: str
+#: The repository's fixtures directory (scenarios, params, reference), or None when neither
+#: $ROTORBENCH_FIXTURES nor the source checkout the package was built from is there.
+FIXTURES: Optional[str]
+
+Solver = Literal["event", "switch", "moreau"]
+#: None (Table 1), a parameter file's path or name ("table1", "stribeck"), or a dict of its keys.
+ParamsLike = Union[None, str, "os.PathLike[str]", Mapping[str, Any]]
+ArrayLike = Union[Sequence[float], npt.NDArray[np.floating[Any]]]
+
+class SolveError(RuntimeError):
+    """A solver could not finish the run."""
+
+    #: Time of the failure [s], where the failure records it.
+    t: Optional[float]
+    #: State (alpha, omega_u, omega_l) at the failure, where the failure records it.
+    state: Optional[Tuple[float, float, float]]
+    #: The input voltage of the failing point (``sweep`` only).
+    u: float
+
+class InternalError(RuntimeError):
+    """A bug in rotorbench (a Rust panic caught before it reached Python)."""
+
+class Event(TypedDict):
+    t: float
+    disc: Literal["upper", "lower"]
+    kind: Literal["stick_start", "stick_end", "reversal"]
+
+class Simulation(TypedDict):
+    t: npt.NDArray[np.float64]
+    alpha: npt.NDArray[np.float64]
+    omega_u: npt.NDArray[np.float64]
+    omega_l: npt.NDArray[np.float64]
+    events: List[Event]
+    stats: Dict[str, int]
+
+def simulate(
+    solver: Solver = "event",
+    u: float = 1.5,
+    params: ParamsLike = None,
+    x0: Sequence[float] = (0.0, 0.0, 0.0),
+    t_end: float = 100.0,
+    dt: float = 0.01,
+    tol: Optional[float] = None,
+    h: Optional[float] = None,
+) -> Simulation:
+    """Simulates one scene; the trajectory on the grid 0, dt, ..., t_end.
+
+    ``tol`` is the adaptive solvers' tolerance (event, switch; default 1e-10), ``h``
+    Moreau-Jean's step (default 1e-3 s). Returns numpy arrays t, alpha, omega_u, omega_l, the
+    events (stick onsets and exits, reversals) and the work counters. Raises ValueError for bad
+    input, SolveError when the run cannot finish. Releases the GIL.
+    """
+
+def steady(
+    solver: Solver = "event",
+    u: float = 1.5,
+    params: ParamsLike = None,
+    x0: Sequence[float] = (0.0, 0.0, 0.0),
+    tol: Optional[float] = None,
+    h: Optional[float] = None,
+) -> Dict[str, Any]:
+    """The steady state reached from x0 at u, as ``rotor steady`` prints it.
+
+    Keys: kind ("equilibrium" or "limit_cycle"), its metrics (omega_u, omega_l; or period,
+    omega_l_max, omega_l_min, omega_u_max, omega_u_min, stick_time), method ("refined",
+    "settled", "simulated") and multipliers ([re, im] pairs of a refined cycle, else None).
+    """
+
+def sweep(
+    u: ArrayLike,
+    solver: Solver = "event",
+    params: ParamsLike = None,
+    x0: Sequence[float] = (0.0, 0.0, 0.0),
+    tol: Optional[float] = None,
+    h: Optional[float] = None,
+) -> List[Dict[str, Any]]:
+    """``steady`` at every u, on all cores; one dict per u, in order."""
+
+def bifurcation(
+    params: ParamsLike = None, u_min: float = 0.0, u_max: float = 7.0
+) -> Dict[str, Any]:
+    """The bifurcation diagram over u, as ``rotor bifurcation`` writes it.
+
+    Keys: equilibria, periodic (with Floquet multipliers), points (Hopf, grazing, folds, each
+    with the residual of its defining condition).
+    """
+
+def check(
+    scenario: Union[str, "os.PathLike[str]"],
+    t: ArrayLike,
+    alpha: ArrayLike,
+    omega_u: ArrayLike,
+    omega_l: ArrayLike,
+    gate: Literal["loose", "strict"] = "loose",
+    events: Optional[Sequence[Union[Event, Tuple[float, str, str]]]] = None,
+) -> Dict[str, Any]:
+    """Grades a trace on the scenario's grid against the reference, as ``rotor check --json``.
+
+    Keys: scenario, passed, gate, quantities (name, difference, tolerance, passed, digits).
+    """
+
+def params(source: ParamsLike = None) -> Dict[str, Any]:
+    """A parameter set as a dict of its file's keys (Table 1 by default)."""
+
+def scenario(source: Union[str, "os.PathLike[str]"]) -> Dict[str, Any]:
+    """A benchmark scenario: name, description, path, params, u, x0, t_end, dt, transient,
+    steady_from."""

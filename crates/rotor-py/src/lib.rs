@@ -1,0 +1,698 @@
+//! `rotorbench._rotorbench`: the native module of the Python package (docs/python.md).
+//!
+//! A thin layer. Every check, run and answer belongs to the Rust crates: the inputs go through
+//! [`rotor_compare::request`] (the checks and the words of the command line), the runs through
+//! the solvers, [`rotor_compare::steady`], [`rotor_bifurcation::diagram`] and
+//! [`rotor_compare::check::grade`]. This file converts arguments and results, releases the GIL
+//! around every run, and maps errors to exceptions:
+//!
+//! * bad input → `ValueError` (a wrong type → `TypeError`), naming the argument or field and
+//!   the value;
+//! * a solver that cannot finish → `rotorbench.SolveError`, with the time `t` and the state
+//!   `state` where the failure records them;
+//! * a panic (a bug) → `rotorbench.InternalError`; it never unwinds into Python.
+
+use std::ffi::CString;
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use numpy::{AllowTypeChange, PyArray1, PyArrayLike1};
+use pyo3::exceptions::{PyOSError, PyRuntimeError, PyTypeError, PyUserWarning, PyValueError};
+use pyo3::prelude::*;
+use pyo3::types::{PyBool, PyDict, PyList, PyString};
+use rayon::prelude::*;
+use rotor_bifurcation::{BifError, DiagramOptions};
+use rotor_compare::check::{GradeError, Strictness};
+use rotor_compare::request::{BadInput, Request};
+use rotor_compare::trace::{EventsFile, Trace, disc_name, event_row, round_to, time_digits};
+use rotor_compare::{SettleError, SteadyAnswer, SteadyError};
+use rotor_model::{Model, Params, Stats};
+
+pyo3::create_exception!(
+    rotorbench,
+    SolveError,
+    PyRuntimeError,
+    "A solver could not finish the run. `t` is the time of the failure and `state` the state \
+     (alpha, omega_u, omega_l) there, where the failure records them (else None)."
+);
+
+pyo3::create_exception!(
+    rotorbench,
+    InternalError,
+    PyRuntimeError,
+    "A bug in rotorbench (a Rust panic, caught before it reached Python): please report it \
+     with the call that raised it."
+);
+
+/// Runs `f` with the GIL released, so that other Python threads run meanwhile; a panic in
+/// `f` becomes an [`InternalError`] instead of unwinding into Python.
+fn detached<T: Send>(py: Python<'_>, f: impl FnOnce() -> T + Send) -> PyResult<T> {
+    py.detach(|| std::panic::catch_unwind(std::panic::AssertUnwindSafe(f)))
+        .map_err(|payload| {
+            let what = payload
+                .downcast_ref::<String>()
+                .map(String::as_str)
+                .or_else(|| payload.downcast_ref::<&str>().copied())
+                .unwrap_or("(no message)");
+            InternalError::new_err(format!(
+                "internal error (a bug in rotorbench; please report it): {what}"
+            ))
+        })
+}
+
+fn value_error(e: impl std::fmt::Display) -> PyErr {
+    PyValueError::new_err(e.to_string())
+}
+
+fn bad(e: BadInput) -> PyErr {
+    value_error(e)
+}
+
+/// A [`SolveError`] with its `t` and `state` attributes.
+fn solve_error(py: Python<'_>, message: String, t: Option<f64>, state: Option<[f64; 3]>) -> PyErr {
+    let err = SolveError::new_err(message);
+    let v = err.value(py);
+    // Setting an attribute on a fresh exception instance cannot fail but for lack of
+    // memory; then the exception still carries its message.
+    let _ = v.setattr("t", t);
+    let _ = v.setattr("state", state.map(|[a, b, c]| (a, b, c)));
+    err
+}
+
+fn from_solve(py: Python<'_>, e: rotor_model::SolveError) -> PyErr {
+    match e {
+        rotor_model::SolveError::InvalidScene { .. } => value_error(e),
+        _ => solve_error(py, e.to_string(), e.time(), e.state()),
+    }
+}
+
+fn from_steady(py: Python<'_>, e: SteadyError) -> PyErr {
+    match e {
+        SteadyError::Solve(e) | SteadyError::Settle(SettleError::Solve(e)) => from_solve(py, e),
+        SteadyError::Settle(SettleError::NotSettled { t, .. }) => {
+            solve_error(py, e.to_string(), Some(t), None)
+        }
+        _ => solve_error(py, e.to_string(), None, None),
+    }
+}
+
+fn from_bif(py: Python<'_>, e: BifError) -> PyErr {
+    match e {
+        BifError::InvalidOption { .. } => value_error(e),
+        BifError::Solve(e) => from_solve(py, e),
+        BifError::Grazing { state, .. } => solve_error(py, e.to_string(), None, Some(state)),
+        _ => solve_error(py, e.to_string(), None, None),
+    }
+}
+
+fn from_grade(e: GradeError) -> PyErr {
+    use rotor_compare::reference::ReferenceError;
+    match e {
+        GradeError::Scenario(rotor_model::ScenarioError::Io { .. })
+        | GradeError::Reference(ReferenceError::File { .. }) => PyOSError::new_err(e.to_string()),
+        _ => value_error(e),
+    }
+}
+
+fn warn(py: Python<'_>, message: &str) -> PyResult<()> {
+    let message = CString::new(message.replace('\0', " "))?;
+    PyErr::warn(py, py.get_type::<PyUserWarning>().as_any(), &message, 1)
+}
+
+fn warn_ignored(py: Python<'_>, req: &Request<'_>) -> PyResult<()> {
+    match req.ignored() {
+        Some(i) => warn(py, &i.message()),
+        None => Ok(()),
+    }
+}
+
+fn warn_inexact(py: Python<'_>, stats: &Stats) -> PyResult<()> {
+    match rotor_compare::request::inexact_warning(stats, "h") {
+        Some(w) => warn(py, &w),
+        None => Ok(()),
+    }
+}
+
+/// The repository's fixtures: `$ROTORBENCH_FIXTURES`, else those of the source checkout this
+/// module was built from, if it is still there.
+fn fixtures() -> Option<PathBuf> {
+    if let Some(dir) = std::env::var_os("ROTORBENCH_FIXTURES") {
+        return Some(PathBuf::from(dir));
+    }
+    let built = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../fixtures");
+    built
+        .is_dir()
+        .then(|| built.canonicalize().unwrap_or(built))
+}
+
+/// A file argument: an existing path, else the name of a file of `fixtures/<kind>/` (without
+/// `.toml`), else a `ValueError` naming the argument and what was looked for.
+fn resolve(arg: &str, value: &Bound<'_, PyAny>, kind: &str) -> PyResult<PathBuf> {
+    let path: PathBuf = value.extract().map_err(|_| {
+        PyTypeError::new_err(format!(
+            "{arg}: expected a path or a name, got {}",
+            type_name(value)
+        ))
+    })?;
+    if path.is_file() {
+        return Ok(path);
+    }
+    let name = path.to_string_lossy().into_owned();
+    // Scenario names hold dots (`t1-u1.5-rest`): a single component is tried as a name.
+    let plain = path.components().count() == 1;
+    let dir = fixtures().map(|f| f.join(kind));
+    if plain && let Some(dir) = &dir {
+        let candidate = dir.join(format!("{name}.toml"));
+        if candidate.is_file() {
+            return Ok(candidate);
+        }
+    }
+    let known = dir
+        .as_deref()
+        .and_then(|d| std::fs::read_dir(d).ok())
+        .map(|entries| {
+            let mut names: Vec<String> = entries
+                .flatten()
+                .filter_map(|e| {
+                    let p = e.path();
+                    (p.extension()? == "toml")
+                        .then(|| p.file_stem()?.to_str().map(str::to_owned))?
+                })
+                .collect();
+            names.sort();
+            names.join(", ")
+        });
+    Err(PyValueError::new_err(match known {
+        Some(known) => format!(
+            "{arg} = {name:?}: no such file, nor a name in {} (names: {known})",
+            dir.map(|d| d.display().to_string()).unwrap_or_default()
+        ),
+        None => format!(
+            "{arg} = {name:?}: no such file (names of fixtures need the source checkout or \
+             $ROTORBENCH_FIXTURES)"
+        ),
+    }))
+}
+
+fn type_name(v: &Bound<'_, PyAny>) -> String {
+    v.get_type()
+        .name()
+        .map(|n| n.to_string())
+        .unwrap_or_else(|_| "?".into())
+}
+
+/// A dict of a parameter file's keys as a TOML table; `at` names it in messages
+/// (`params['lower']`).
+fn table_of(d: &Bound<'_, PyDict>, at: &str) -> PyResult<toml::Table> {
+    let mut table = toml::Table::new();
+    for (k, v) in d.iter() {
+        let key: String = k.extract().map_err(|_| {
+            PyTypeError::new_err(format!("{at}: keys must be strings, got {}", type_name(&k)))
+        })?;
+        let here = format!("{at}['{key}']");
+        let value = if let Ok(sub) = v.cast::<PyDict>() {
+            toml::Value::Table(table_of(sub, &here)?)
+        } else if v.is_instance_of::<PyString>() {
+            toml::Value::String(v.extract()?)
+        } else if v.is_instance_of::<PyBool>() {
+            return Err(PyTypeError::new_err(format!(
+                "{here} = {v}: expected a number, got bool"
+            )));
+        } else if let Ok(x) = v.extract::<f64>() {
+            toml::Value::Float(x)
+        } else {
+            return Err(PyTypeError::new_err(format!(
+                "{here}: expected a number, a string or a dict, got {}",
+                type_name(&v)
+            )));
+        };
+        table.insert(key, value);
+    }
+    Ok(table)
+}
+
+/// `params`: None (Table 1), a path or the name of a file in `fixtures/params`, or a dict of
+/// the file's keys.
+fn params_of(params: Option<&Bound<'_, PyAny>>) -> PyResult<Params> {
+    let Some(p) = params.filter(|p| !p.is_none()) else {
+        return Ok(Params::table1());
+    };
+    if let Ok(d) = p.cast::<PyDict>() {
+        return Params::from_table(table_of(d, "params")?, Path::new("params"))
+            .map_err(value_error);
+    }
+    let path = resolve("params", p, "params")?;
+    Params::from_file(&path).map_err(value_error)
+}
+
+/// A JSON value as plain Python objects (dict, list, float, int, str, bool, None).
+fn py_of<'py>(py: Python<'py>, v: &serde_json::Value) -> PyResult<Bound<'py, PyAny>> {
+    use serde_json::Value;
+    Ok(match v {
+        Value::Null => py.None().into_bound(py),
+        Value::Bool(b) => PyBool::new(py, *b).to_owned().into_any(),
+        Value::Number(n) => {
+            if let Some(i) = n.as_i64() {
+                i.into_pyobject(py)?.into_any()
+            } else if let Some(u) = n.as_u64() {
+                u.into_pyobject(py)?.into_any()
+            } else {
+                n.as_f64().into_pyobject(py)?.into_any()
+            }
+        }
+        Value::String(s) => PyString::new(py, s).into_any(),
+        Value::Array(a) => {
+            let items = a
+                .iter()
+                .map(|x| py_of(py, x))
+                .collect::<PyResult<Vec<_>>>()?;
+            PyList::new(py, items)?.into_any()
+        }
+        Value::Object(o) => {
+            let d = PyDict::new(py);
+            for (k, x) in o {
+                d.set_item(k, py_of(py, x)?)?;
+            }
+            d.into_any()
+        }
+    })
+}
+
+/// Any serializable answer as plain Python objects.
+fn to_py<'py>(py: Python<'py>, v: &impl serde::Serialize) -> PyResult<Bound<'py, PyAny>> {
+    let value = serde_json::to_value(v)
+        .map_err(|e| InternalError::new_err(format!("internal error: {e}")))?;
+    py_of(py, &value)
+}
+
+/// A run's output in the columns `simulate` returns.
+struct Columns {
+    t: Vec<f64>,
+    alpha: Vec<f64>,
+    omega_u: Vec<f64>,
+    omega_l: Vec<f64>,
+    events: Vec<(f64, &'static str, &'static str)>,
+    stats: Stats,
+}
+
+impl Columns {
+    /// The samples as `rotor simulate` writes them: times rounded to the grid's decimals
+    /// ([`time_digits`]), states as computed; the mode switches as in an events file.
+    fn of(tr: rotor_model::Trajectory, dt: f64) -> Columns {
+        let digits = time_digits(dt);
+        let n = tr.samples.len();
+        let mut c = Columns {
+            t: Vec::with_capacity(n),
+            alpha: Vec::with_capacity(n),
+            omega_u: Vec::with_capacity(n),
+            omega_l: Vec::with_capacity(n),
+            events: Vec::new(),
+            stats: tr.stats,
+        };
+        for s in &tr.samples {
+            c.t.push(round_to(s.t, digits));
+            c.alpha.push(s.x[0]);
+            c.omega_u.push(s.x[1]);
+            c.omega_l.push(s.x[2]);
+        }
+        c.events = tr
+            .events
+            .iter()
+            .filter_map(|e| event_row(e.kind).map(|(d, k)| (e.t, disc_name(d), k)))
+            .collect();
+        c
+    }
+}
+
+/// Simulates one scene and returns the trajectory on the output grid.
+///
+/// Returns a dict: numpy float64 arrays ``t``, ``alpha``, ``omega_u``, ``omega_l`` at
+/// ``0, dt, 2 dt, ..., t_end`` (times as ``rotor simulate`` writes them); ``events``, a list of
+/// ``{"t", "disc", "kind"}`` (stick onsets and exits and reversals, as an events file);
+/// ``stats``, a dict of the work counters.
+///
+/// ``solver`` is ``"event"`` (the accuracy reference), ``"switch"`` or ``"moreau"``; ``tol``
+/// sets the adaptive solvers' tolerance (default 1e-10), ``h`` Moreau–Jean's step (default
+/// 1e-3 s). ``params`` is None (Table 1), a parameter file's path or name (``"stribeck"``),
+/// or a dict of its keys (see ``rotorbench.params()``). Bad input raises ValueError naming
+/// the argument and the value; a failed run raises ``rotorbench.SolveError``. The GIL is
+/// released during the run.
+#[pyfunction]
+#[pyo3(
+    signature = (solver="event", u=1.5, params=None, x0=[0.0; 3], t_end=100.0, dt=0.01, tol=None, h=None),
+    text_signature = "(solver='event', u=1.5, params=None, x0=(0.0, 0.0, 0.0), t_end=100.0, dt=0.01, tol=None, h=None)"
+)]
+fn simulate<'py>(
+    py: Python<'py>,
+    solver: &str,
+    u: f64,
+    params: Option<&Bound<'py, PyAny>>,
+    x0: [f64; 3],
+    t_end: f64,
+    dt: f64,
+    tol: Option<f64>,
+    h: Option<f64>,
+) -> PyResult<Bound<'py, PyDict>> {
+    let req = Request {
+        solver,
+        u,
+        x0,
+        tol,
+        h,
+    };
+    let (kind, scene) = req.simulation(t_end, dt).map_err(bad)?;
+    let model = Model::new(params_of(params)?);
+    warn_ignored(py, &req)?;
+    let columns = detached(py, move || {
+        kind.solver()
+            .simulate_finite(&model, &scene)
+            .map(|tr| Columns::of(tr, dt))
+    })?
+    .map_err(|e| from_solve(py, e))?;
+    warn_inexact(py, &columns.stats)?;
+    let out = PyDict::new(py);
+    out.set_item("t", PyArray1::from_vec(py, columns.t))?;
+    out.set_item("alpha", PyArray1::from_vec(py, columns.alpha))?;
+    out.set_item("omega_u", PyArray1::from_vec(py, columns.omega_u))?;
+    out.set_item("omega_l", PyArray1::from_vec(py, columns.omega_l))?;
+    let events = PyList::empty(py);
+    for (t, disc, kind) in columns.events {
+        let e = PyDict::new(py);
+        e.set_item("t", t)?;
+        e.set_item("disc", disc)?;
+        e.set_item("kind", kind)?;
+        events.append(e)?;
+    }
+    out.set_item("events", events)?;
+    out.set_item("stats", to_py(py, &columns.stats)?)?;
+    Ok(out)
+}
+
+/// The steady state reached from ``x0`` at input ``u``, as ``rotor steady`` prints it.
+///
+/// Returns a dict: ``kind`` (``"equilibrium"`` or ``"limit_cycle"``), its metrics
+/// (``omega_u``/``omega_l`` of an equilibrium; ``period``, ``omega_l_max``, ``omega_l_min``,
+/// ``omega_u_max``, ``omega_u_min``, ``stick_time`` of a cycle), ``method`` (how it was
+/// obtained: ``"refined"``, ``"settled"`` or ``"simulated"``) and ``multipliers`` (Floquet
+/// multipliers as ``[re, im]`` pairs of a refined cycle, else None).
+///
+/// The event-driven solver refines the cycle to a fixed point of its return map at ``tol``;
+/// the others simulate until the metrics stop changing. Arguments as for ``simulate``.
+#[pyfunction]
+#[pyo3(
+    signature = (solver="event", u=1.5, params=None, x0=[0.0; 3], tol=None, h=None),
+    text_signature = "(solver='event', u=1.5, params=None, x0=(0.0, 0.0, 0.0), tol=None, h=None)"
+)]
+fn steady<'py>(
+    py: Python<'py>,
+    solver: &str,
+    u: f64,
+    params: Option<&Bound<'py, PyAny>>,
+    x0: [f64; 3],
+    tol: Option<f64>,
+    h: Option<f64>,
+) -> PyResult<Bound<'py, PyAny>> {
+    let req = Request {
+        solver,
+        u,
+        x0,
+        tol,
+        h,
+    };
+    let (kind, scene, opts) = req.steady().map_err(bad)?;
+    let model = Model::new(params_of(params)?);
+    warn_ignored(py, &req)?;
+    let answer = detached(py, move || {
+        rotor_compare::steady(kind, &model, &scene, &opts)
+    })?
+    .map_err(|e| from_steady(py, e))?;
+    warn_inexact(py, &answer.stats)?;
+    to_py(py, &answer)
+}
+
+/// ``steady`` at every value of ``u`` (a sequence or 1-d array), on all cores.
+///
+/// Returns a list of dicts, one per u in order, each as ``steady`` returns it. A u at which
+/// no steady state is found raises ``rotorbench.SolveError`` naming that u (its attribute
+/// ``u``). Other arguments as for ``steady``.
+#[pyfunction]
+#[pyo3(
+    signature = (u, solver="event", params=None, x0=[0.0; 3], tol=None, h=None),
+    text_signature = "(u, solver='event', params=None, x0=(0.0, 0.0, 0.0), tol=None, h=None)"
+)]
+fn sweep<'py>(
+    py: Python<'py>,
+    u: PyArrayLike1<'py, f64, AllowTypeChange>,
+    solver: &str,
+    params: Option<&Bound<'py, PyAny>>,
+    x0: [f64; 3],
+    tol: Option<f64>,
+    h: Option<f64>,
+) -> PyResult<Bound<'py, PyList>> {
+    let us = u.as_array().to_vec();
+    let mut jobs = Vec::with_capacity(us.len());
+    for (i, &u) in us.iter().enumerate() {
+        let req = Request {
+            solver,
+            u,
+            x0,
+            tol,
+            h,
+        };
+        jobs.push(req.steady().map_err(|e| match e.name {
+            "u" => PyValueError::new_err(format!("u[{i}] = {}: {}", e.value, e.reason)),
+            _ => bad(e),
+        })?);
+        if i == 0 {
+            warn_ignored(py, &req)?;
+        }
+    }
+    let model = Model::new(params_of(params)?);
+    let answers: Vec<Result<SteadyAnswer, SteadyError>> = detached(py, move || {
+        jobs.par_iter()
+            .map(|(kind, scene, opts)| rotor_compare::steady(*kind, &model, scene, opts))
+            .collect()
+    })?;
+    let out = PyList::empty(py);
+    let mut stats = Stats::default();
+    for (answer, &u) in answers.into_iter().zip(&us) {
+        match answer {
+            Ok(a) => {
+                stats += a.stats;
+                out.append(to_py(py, &a)?)?;
+            }
+            Err(e) => {
+                let err = from_steady(py, e);
+                let msg = format!("u = {}: {}", rotor_model::Num(u), err.value(py));
+                let tagged = if err.is_instance_of::<SolveError>(py) {
+                    let v = err.value(py);
+                    solve_error(
+                        py,
+                        msg,
+                        v.getattr("t").ok().and_then(|t| t.extract().ok()),
+                        v.getattr("state").ok().and_then(|s| s.extract().ok()),
+                    )
+                } else {
+                    PyValueError::new_err(msg)
+                };
+                let _ = tagged.value(py).setattr("u", u);
+                return Err(tagged);
+            }
+        }
+    }
+    warn_inexact(py, &stats)?;
+    Ok(out)
+}
+
+/// The bifurcation diagram over ``u_min <= u <= u_max``, as ``rotor bifurcation`` writes it.
+///
+/// Returns a dict: ``equilibria`` (the equilibrium branch with its stability), ``periodic``
+/// (the periodic branches with Floquet multipliers and extrema of omega_l) and ``points``
+/// (Hopf, grazing and fold points, each with the residual of its defining condition).
+#[pyfunction]
+#[pyo3(signature = (params=None, u_min=0.0, u_max=7.0))]
+fn bifurcation<'py>(
+    py: Python<'py>,
+    params: Option<&Bound<'py, PyAny>>,
+    u_min: f64,
+    u_max: f64,
+) -> PyResult<Bound<'py, PyAny>> {
+    let model = Model::new(params_of(params)?);
+    let opts = DiagramOptions {
+        u_min,
+        u_max,
+        ..Default::default()
+    };
+    opts.validate().map_err(|e| from_bif(py, e))?;
+    let d = detached(py, move || {
+        let d = rotor_bifurcation::diagram(&model, &opts)?;
+        d.check_finite()?;
+        Ok::<_, BifError>(d)
+    })?
+    .map_err(|e| from_bif(py, e))?;
+    to_py(py, &d)
+}
+
+/// Events given to `check`: dicts ``{"t", "disc", "kind"}`` (as ``simulate`` returns them)
+/// or tuples ``(t, disc, kind)``.
+fn events_of(events: &Bound<'_, PyAny>) -> PyResult<EventsFile> {
+    let mut rows: Vec<(f64, String, String)> = Vec::new();
+    for (i, item) in events.try_iter()?.enumerate() {
+        let item = item?;
+        let shape_error = || {
+            PyTypeError::new_err(format!(
+                "events[{i}]: expected a dict with keys t, disc, kind or a tuple (t, disc, \
+                 kind), got {}",
+                type_name(&item)
+            ))
+        };
+        let row = if let Ok(d) = item.cast::<PyDict>() {
+            let get = |k: &str| d.get_item(k).ok().flatten().ok_or_else(shape_error);
+            (
+                get("t")?.extract().map_err(|_| shape_error())?,
+                get("disc")?.extract().map_err(|_| shape_error())?,
+                get("kind")?.extract().map_err(|_| shape_error())?,
+            )
+        } else {
+            item.extract().map_err(|_| shape_error())?
+        };
+        rows.push(row);
+    }
+    let refs: Vec<(f64, &str, &str)> = rows
+        .iter()
+        .map(|(t, d, k)| (*t, d.as_str(), k.as_str()))
+        .collect();
+    EventsFile::from_rows(&refs).map_err(value_error)
+}
+
+/// Grades a trace against the benchmark's reference, as ``rotor check --json`` does.
+///
+/// ``scenario`` is a scenario file's path or its name (``"t1-u1.5-rest"``; see
+/// ``rotorbench.scenario``); the trace is the four arrays on the scenario's grid
+/// (``scenario(...)["dt"]``, from 0 to ``t_end``); ``gate`` is ``"loose"`` (the Moreau–Jean
+/// tolerances) or ``"strict"`` (the switch model's); ``events`` optionally the trace's events
+/// (as ``simulate`` returns them) to grade the event times. Returns a dict: ``scenario``,
+/// ``passed``, ``gate`` and ``quantities`` (each with ``name``, ``difference``,
+/// ``tolerance``, ``passed`` and ``digits``, the correct significant digits). A trace that
+/// cannot be graded (off the grid, too short, a NaN) raises ValueError naming the index.
+#[pyfunction]
+#[pyo3(signature = (scenario, t, alpha, omega_u, omega_l, gate="loose", events=None))]
+fn check<'py>(
+    py: Python<'py>,
+    scenario: &Bound<'py, PyAny>,
+    t: PyArrayLike1<'py, f64, AllowTypeChange>,
+    alpha: PyArrayLike1<'py, f64, AllowTypeChange>,
+    omega_u: PyArrayLike1<'py, f64, AllowTypeChange>,
+    omega_l: PyArrayLike1<'py, f64, AllowTypeChange>,
+    gate: &str,
+    events: Option<&Bound<'py, PyAny>>,
+) -> PyResult<Bound<'py, PyAny>> {
+    let strictness = Strictness::parse(gate).map_err(bad)?;
+    let path = resolve("scenario", scenario, "scenarios")?;
+    let cols = [&t, &alpha, &omega_u, &omega_l].map(|c| c.as_array().to_vec());
+    let trace =
+        Trace::from_columns([&cols[0], &cols[1], &cols[2], &cols[3]]).map_err(value_error)?;
+    let events = events.filter(|e| !e.is_none()).map(events_of).transpose()?;
+    let report = detached(py, move || {
+        rotor_compare::check::grade(&path, &trace, events.as_ref(), strictness)
+    })?
+    .map_err(from_grade)?;
+    to_py(py, &report)
+}
+
+/// A parameter set as a dict of its file's keys: Table 1 (``None``), or a parameter file's
+/// path or name (``"stribeck"``). Change a value and pass the dict as ``params``.
+#[pyfunction]
+#[pyo3(signature = (source=None))]
+fn params<'py>(py: Python<'py>, source: Option<&Bound<'py, PyAny>>) -> PyResult<Bound<'py, PyAny>> {
+    to_py(py, &params_of(source)?)
+}
+
+/// A benchmark scenario as a dict: ``name``, ``description``, ``path``, ``params`` (a dict),
+/// ``u``, ``x0``, ``t_end``, ``dt`` (the grid a trace is graded on), ``transient`` (the
+/// compared window ``[t0, t1]`` or None) and ``steady_from`` (where the steady-state metrics
+/// start, or None). ``source`` is a scenario file's path or name (``"t1-u1.5-rest"``).
+#[pyfunction]
+fn scenario<'py>(py: Python<'py>, source: &Bound<'py, PyAny>) -> PyResult<Bound<'py, PyDict>> {
+    let path = resolve("scenario", source, "scenarios")?;
+    let sc = rotor_compare::load_scenario(&path).map_err(value_error)?;
+    let d = PyDict::new(py);
+    d.set_item("name", &sc.name)?;
+    d.set_item("description", &sc.description)?;
+    d.set_item("path", sc.path.to_string_lossy().into_owned())?;
+    d.set_item("params", to_py(py, &sc.model.params)?)?;
+    d.set_item("u", sc.u)?;
+    d.set_item("x0", (sc.x0[0], sc.x0[1], sc.x0[2]))?;
+    d.set_item("t_end", sc.t_end)?;
+    d.set_item("dt", sc.compare.dt)?;
+    d.set_item("transient", sc.compare.transient)?;
+    d.set_item("steady_from", sc.compare.steady_from)?;
+    Ok(d)
+}
+
+/// Seconds of each of ``repeat`` runs of the Rust solve alone (no argument conversion, no
+/// numpy): what ``simulate``'s overhead is measured against (bench/python/bench_package.py).
+#[pyfunction]
+#[pyo3(signature = (solver="event", u=1.5, t_end=100.0, dt=0.01, tol=None, h=None, repeat=1))]
+fn _solve_seconds(
+    py: Python<'_>,
+    solver: &str,
+    u: f64,
+    t_end: f64,
+    dt: f64,
+    tol: Option<f64>,
+    h: Option<f64>,
+    repeat: usize,
+) -> PyResult<Vec<f64>> {
+    let req = Request {
+        solver,
+        u,
+        x0: [0.0; 3],
+        tol,
+        h,
+    };
+    let (kind, scene) = req.simulation(t_end, dt).map_err(bad)?;
+    let model = Model::new(Params::table1());
+    detached(py, move || {
+        let solver = kind.solver();
+        (0..repeat)
+            .map(|_| {
+                let t0 = Instant::now();
+                let tr = solver.simulate_finite(&model, &scene)?;
+                let s = t0.elapsed().as_secs_f64();
+                drop(tr);
+                Ok(s)
+            })
+            .collect::<Result<Vec<f64>, rotor_model::SolveError>>()
+    })?
+    .map_err(|e| from_solve(py, e))
+}
+
+/// Panics inside the guarded, GIL-free region every run goes through: shows (in the tests)
+/// that a panic reaches Python as ``rotorbench.InternalError``, not as an unwinding crash.
+#[pyfunction]
+fn _panic(py: Python<'_>, message: String) -> PyResult<()> {
+    detached(py, move || -> () { panic!("{message}") })
+}
+
+#[pymodule]
+fn _rotorbench(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    let py = m.py();
+    m.add_function(wrap_pyfunction!(simulate, m)?)?;
+    m.add_function(wrap_pyfunction!(steady, m)?)?;
+    m.add_function(wrap_pyfunction!(sweep, m)?)?;
+    m.add_function(wrap_pyfunction!(bifurcation, m)?)?;
+    m.add_function(wrap_pyfunction!(check, m)?)?;
+    m.add_function(wrap_pyfunction!(params, m)?)?;
+    m.add_function(wrap_pyfunction!(scenario, m)?)?;
+    m.add_function(wrap_pyfunction!(_solve_seconds, m)?)?;
+    m.add_function(wrap_pyfunction!(_panic, m)?)?;
+    m.add("SolveError", py.get_type::<SolveError>())?;
+    m.add("InternalError", py.get_type::<InternalError>())?;
+    m.add("__version__", env!("CARGO_PKG_VERSION"))?;
+    m.add(
+        "FIXTURES",
+        fixtures().map(|p| p.to_string_lossy().into_owned()),
+    )?;
+    Ok(())
+}
