@@ -21,7 +21,9 @@
 //! ends that derivative is the field (the interpolant is Hermite). A located terminal root
 //! is refined by re-taking the RK step exactly to it (8th-order state) plus a Newton
 //! correction in time; an extremum, bracketed on the dense output's derivative, is moved by
-//! Newton's method to the root of the field's acceleration along the dense output.
+//! Newton's method to the root of the field's acceleration along the dense output, its state
+//! re-taken by an RK step to that time (the dense output's error is not controlled) and
+//! polished once more from there. A section crossing is refined as a terminal root.
 
 use rotor_model::{
     Disc, DiscMode, Event, EventKind, Mode, Model, OMEGA_L, SolveError, State, Stats, check_finite,
@@ -389,7 +391,7 @@ impl<'a> Integrator<'a> {
                     illinois(&f, a, b, fa, fb)
                 };
                 let is_max = matches!(kind, Guard::Extremum(_, true));
-                let te = self.polish_extremum(disc, is_max, d, r, step, mode);
+                let te = self.polish_extremum(disc, is_max, &|t| d.eval(t), r, step, mode);
                 // The interpolant's root may lie after the polished one: a search resumed
                 // before it would find this extremum again.
                 Detected {
@@ -490,17 +492,18 @@ impl<'a> Integrator<'a> {
         None
     }
 
-    /// An extremum of a disc's velocity located as a root of the dense output's derivative
-    /// (exact for the interpolant, whose derivative is of one order less than its state)
-    /// moved to the root of the field's acceleration along the dense output, a(t) =
-    /// ω̇(x(t)), by Newton's method with a'(t) = (J f)_d: from a start within the rate's
-    /// interpolation error, two or three iterations reach rounding level. A step that would
-    /// leave the searched interval `span`, or a vanishing a', keeps the current time.
+    /// An extremum of a disc's velocity, from a root `t` of the dense output's derivative
+    /// (exact for the interpolant, whose derivative is of one order less than its state),
+    /// moved to the root of the field's acceleration along `path` (the dense output, or a
+    /// short line from an exact state), a(t) = ω̇(x(t)), by Newton's method with
+    /// a'(t) = (J f)_d: from a start within the rate's interpolation error, two or three
+    /// iterations reach rounding level. A step that would leave the searched interval `span`,
+    /// or a vanishing a', keeps the current time.
     fn polish_extremum(
         &self,
         disc: Disc,
         is_max: bool,
-        d: &Dense<3>,
+        path: &impl Fn(f64) -> State,
         mut t: f64,
         span: (f64, f64),
         mode: Mode,
@@ -511,7 +514,7 @@ impl<'a> Integrator<'a> {
         let mut at = (t, f64::NAN);
         let mut dt_prev = f64::INFINITY;
         for _ in 0..4 {
-            let x = d.eval(t);
+            let x = path(t);
             let f = self.field(&x, mode);
             at = (t, f[i]);
             let ar = (self.model.jacobian(&x, self.u, mode) * f)[i];
@@ -537,7 +540,7 @@ impl<'a> Integrator<'a> {
             let a = if t == at.0 && !at.1.is_nan() {
                 at.1
             } else {
-                self.guard(Guard::Extremum(disc, is_max), &d.eval(t), mode)
+                self.guard(Guard::Extremum(disc, is_max), &path(t), mode)
             };
             if is_max { a <= 0.0 } else { a >= 0.0 }
         };
@@ -764,9 +767,10 @@ impl<'a> Integrator<'a> {
                 }
                 continue;
             }
-            let xe = refine_state(dense, te);
+            // Below resolution (judged on the dense output): skipped before paying for the
+            // exact state.
             if let Guard::Extremum(d, _) = g {
-                let w = xe[d.index()];
+                let w = dense.eval(te)[d.index()];
                 let resolvable = c.last_extremum[d as usize].replace(w).is_none_or(|w_prev| {
                     (w - w_prev).abs() > EXTREMUM_RESOLUTION * self.ctl.rtol * (1.0 + w.abs())
                 });
@@ -776,6 +780,10 @@ impl<'a> Integrator<'a> {
                     }
                     continue;
                 }
+            }
+            let (te, xe) = self.event_state(c, g, te, t1, end.0);
+            if let Guard::Extremum(d, _) = g {
+                c.last_extremum[d as usize] = Some(xe[d.index()]);
             }
             let stop = if g == Guard::Section {
                 sink.section(te, &xe)
@@ -801,10 +809,37 @@ impl<'a> Integrator<'a> {
         Scan::Through
     }
 
+    /// A non-terminal event found on the dense output at `te`: its time and state. The dense
+    /// output alone would be cheaper, but its error is not controlled: on long steps it was
+    /// found 300 tolerances off at an extremum of ω_u (tol 1e-10), where an RK step re-taken
+    /// from the step's start to `te` is within one. An extremum takes that one step and is
+    /// polished again on the field's acceleration, along the first-order path `x + f·(t − te)`
+    /// from the new state (the shift is the dense output's error in time, ~1e-10 s: the path's
+    /// error ½(t − te)²|ẍ| is far below rounding); a section crossing is refined as a
+    /// terminal root is ([`Integrator::refine`]), so that its state lies on the section.
+    fn event_state(&self, c: &Cursor, g: Guard, te: f64, t1: f64, y1: &State) -> (f64, State) {
+        let mode = c.mode;
+        let mut fm = |_t: f64, y: &State| self.field(y, mode);
+        match g {
+            Guard::Extremum(disc, is_max) => {
+                let x = if te > c.t {
+                    self.ctl.trial(&mut fm, c.t, &c.x, &c.f0, te - c.t).y1
+                } else {
+                    c.x
+                };
+                let f = self.field(&x, mode);
+                let path = |t: f64| x + f * (t - te);
+                let t = self.polish_extremum(disc, is_max, &path, te, (c.t, t1), mode);
+                (t, path(t))
+            }
+            _ => self.refine(c, g, te, t1, y1, &mut fm),
+        }
+    }
+
     /// A terminal guard's root located to rounding: an exact RK step from the step's start to
     /// the root found on the dense output, then Newton corrections along the guard's rate.
     fn refine(
-        &mut self,
+        &self,
         c: &Cursor,
         g: Guard,
         te: f64,
@@ -928,11 +963,6 @@ impl<'a> Integrator<'a> {
             _ => (m, None),
         }
     }
-}
-
-/// State at a non-terminal event: the dense output (7th order, within the tolerance).
-fn refine_state(d: &Dense<3>, t: f64) -> State {
-    d.eval(t)
 }
 
 /// A constant "dense output" for a frozen state.

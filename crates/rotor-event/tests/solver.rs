@@ -171,6 +171,63 @@ fn extrema_are_roots_of_the_fields_acceleration() {
     assert!(n > 40, "{n} extrema");
 }
 
+/// The velocity extremes of a cycle are as accurate as the integration (a few tolerances),
+/// not as the dense output between long steps: on this parameter set (found by the random
+/// metrics-only stress test) ω_u changes slowly and the steps are long, and the dense output
+/// put the minimum of ω_u 3.3e-7 rad/s (3300 tolerances) off at tol 1e-10. Against the same
+/// solver at tol 1e-13 the extremes now differ by ≤ 3e-10 (measured); gate 30 tolerances,
+/// relative to 1 + |ω|.
+#[test]
+fn cycle_extremes_are_as_accurate_as_the_steps() {
+    let p = Params {
+        j_u: 0.29252325934811246,
+        k_m: 4.397163406153452,
+        k_theta: 0.04075163718679795,
+        j_l: 0.06172862930643263,
+        upper: rotor_model::UpperFriction {
+            t_s: 0.0,
+            dt_s: 0.0,
+            b: 4.198962574070105,
+            db: 0.0,
+        },
+        lower: LowerFriction::Exponential {
+            t_s: 0.307519591788439,
+            t_1: 0.050441281232231114,
+            t_2: -0.19595216629636691,
+            w_1: 3.7941473926806477,
+            w_2: 0.45419671959950114,
+            b: 0.017727205793723486,
+        },
+    };
+    let m = Model::new(p);
+    let run = |tol: f64| {
+        let scene = Scene {
+            u: 1.5 * 0.6466672309136015,
+            t_end: 100.0,
+            tol,
+            output: Output::Final,
+            metrics_from: Some(50.0),
+            ..Scene::default()
+        };
+        EventSolver::default()
+            .simulate(&m, &scene)
+            .unwrap()
+            .metrics
+            .unwrap()
+    };
+    let tol = 1e-10;
+    let (a, b) = (run(tol), run(1e-13));
+    assert!(matches!(a, SteadyState::LimitCycle { .. }), "{a:?}");
+    for ((name, va), (_, vb)) in a.values().into_iter().zip(b.values()) {
+        if name.starts_with("omega") {
+            assert!(
+                (va - vb).abs() <= 30.0 * tol * (1.0 + vb.abs()),
+                "{name}: {va} at tol 1e-10 vs {vb} at 1e-13"
+            );
+        }
+    }
+}
+
 #[test]
 fn output_levels_keep_only_what_is_asked() {
     let m = Model::table1();
