@@ -812,27 +812,43 @@ impl<'a> Integrator<'a> {
     /// A non-terminal event found on the dense output at `te`: its time and state. The dense
     /// output alone would be cheaper, but its error is not controlled: on long steps it was
     /// found 300 tolerances off at an extremum of ω_u (tol 1e-10), where an RK step re-taken
-    /// from the step's start to `te` is within one. An extremum takes that one step and is
+    /// from the step's start to `te` is within one. An extremum takes that step and is
     /// polished again on the field's acceleration, along the first-order path `x + f·(t − te)`
-    /// from the new state (the shift is the dense output's error in time, ~1e-10 s: the path's
-    /// error ½(t − te)²|ẍ| is far below rounding); a section crossing is refined as a
-    /// terminal root is ([`Integrator::refine`]), so that its state lies on the section.
+    /// from the new state. The shift is the dense output's error in time, usually ~1e-10 s,
+    /// where the path's error ½(t − te)²|ẍ| is far below rounding; on a flat extremum it can
+    /// reach 1e-3 s, and while the error bound (|ẍ| from the field's change over the step, as
+    /// in [`Integrator::refine`]) exceeds a thousandth of the tolerance the step is re-taken to
+    /// the new time, at most twice more. A section crossing is refined as a terminal root is,
+    /// so that its state lies on the section.
     fn event_state(&self, c: &Cursor, g: Guard, te: f64, t1: f64, y1: &State) -> (f64, State) {
         let mode = c.mode;
         let mut fm = |_t: f64, y: &State| self.field(y, mode);
-        match g {
-            Guard::Extremum(disc, is_max) => {
-                let x = if te > c.t {
-                    self.ctl.trial(&mut fm, c.t, &c.x, &c.f0, te - c.t).y1
-                } else {
-                    c.x
-                };
-                let f = self.field(&x, mode);
-                let path = |t: f64| x + f * (t - te);
-                let t = self.polish_extremum(disc, is_max, &path, te, (c.t, t1), mode);
-                (t, path(t))
+        let Guard::Extremum(disc, is_max) = g else {
+            return self.refine(c, g, te, t1, y1, &mut fm);
+        };
+        let mut te = te;
+        let mut round = 0;
+        loop {
+            let hh = te - c.t;
+            let x = if hh > 0.0 {
+                self.ctl.trial(&mut fm, c.t, &c.x, &c.f0, hh).y1
+            } else {
+                c.x
+            };
+            let f = self.field(&x, mode);
+            let path = |t: f64| x + f * (t - te);
+            let t = self.polish_extremum(disc, is_max, &path, te, (c.t, t1), mode);
+            let small = hh <= 0.0
+                || (0..3).all(|i| {
+                    let acc = (f[i] - c.f0[i]).abs() / hh;
+                    0.5 * (t - te).powi(2) * acc
+                        <= 1e-3 * self.ctl.rtol.min(self.ctl.atol) * (1.0 + x[i].abs())
+                });
+            if small || round == 2 {
+                return (t, path(t));
             }
-            _ => self.refine(c, g, te, t1, y1, &mut fm),
+            te = t;
+            round += 1;
         }
     }
 
