@@ -838,12 +838,16 @@ impl<'a> Integrator<'a> {
             let f = self.field(&x, mode);
             let path = |t: f64| x + f * (t - te);
             let t = self.polish_extremum(disc, is_max, &path, te, (c.t, t1), mode);
-            let small = hh <= 0.0
-                || (0..3).all(|i| {
+            // At the step's start (no step to bound |ẍ| by) only a polish that stays is small.
+            let small = if hh > 0.0 {
+                (0..3).all(|i| {
                     let acc = (f[i] - c.f0[i]).abs() / hh;
                     0.5 * (t - te).powi(2) * acc
                         <= 1e-3 * self.ctl.rtol.min(self.ctl.atol) * (1.0 + x[i].abs())
-                });
+                })
+            } else {
+                t == te
+            };
             if small || round == 2 {
                 return (t, path(t));
             }
