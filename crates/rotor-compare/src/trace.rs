@@ -237,17 +237,8 @@ impl EventsFile {
                     expected: "the finite numbers",
                 });
             }
-            let disc = match disc {
-                "upper" => Disc::Upper,
-                "lower" => Disc::Lower,
-                _ => return Err(bad("disc", disc, "upper, lower")),
-            };
-            let kind = match kind {
-                "stick_start" => EventKind::StickStart(disc),
-                "stick_end" => EventKind::StickEnd(disc),
-                "reversal" => EventKind::Reversal(disc),
-                _ => return Err(bad("kind", kind, "stick_start, stick_end, reversal")),
-            };
+            let disc = disc_of(disc).ok_or_else(|| bad("disc", disc, DISC_WORDS))?;
+            let kind = kind_of(kind, disc).ok_or_else(|| bad("kind", kind, KIND_WORDS))?;
             events.push(Event {
                 t,
                 x: State::zeros(),
@@ -264,15 +255,79 @@ impl EventsFile {
 
 /// Reads a trace file.
 pub fn read_trace(path: &Path) -> Result<Trace, TraceError> {
-    let bytes = std::fs::read(path).map_err(|e| TraceError::Io {
-        path: path.to_owned(),
-        message: e.to_string(),
-    })?;
-    parse_trace(&bytes, path)
+    parse_trace(&read_bytes(path)?, path)
 }
 
 /// Parses trace bytes; `path` names the file in messages.
 pub fn parse_trace(bytes: &[u8], path: &Path) -> Result<Trace, TraceError> {
+    let mut samples = Vec::new();
+    let mut lines = Vec::new();
+    let layout = Layout {
+        header: &TRACE_HEADER,
+        joined: "t,alpha,omega_u,omega_l",
+        fields: "4 (t,alpha,omega_u,omega_l)",
+    };
+    csv_rows(bytes, path, layout, |line, rec| {
+        let mut v = [0.0; 4];
+        for (k, field) in rec.iter().enumerate() {
+            v[k] = number(field).ok_or_else(|| TraceError::Value {
+                path: path.to_owned(),
+                line,
+                column: k + 1,
+                name: TRACE_HEADER[k],
+                value: field.to_owned(),
+            })?;
+        }
+        samples.push(Sample {
+            t: v[0],
+            x: State::new(v[1], v[2], v[3]),
+        });
+        lines.push(line);
+        Ok(())
+    })?;
+    if samples.is_empty() {
+        return Err(TraceError::NoRows {
+            path: path.to_owned(),
+        });
+    }
+    Ok(Trace {
+        path: path.to_owned(),
+        samples,
+        lines,
+    })
+}
+
+/// A finite number, or `None`.
+fn number(field: &str) -> Option<f64> {
+    field.parse::<f64>().ok().filter(|x| x.is_finite())
+}
+
+/// The bytes of a file, or an error naming it.
+fn read_bytes(path: &Path) -> Result<Vec<u8>, TraceError> {
+    std::fs::read(path).map_err(|e| TraceError::Io {
+        path: path.to_owned(),
+        message: e.to_string(),
+    })
+}
+
+/// The shape of a CSV file: its header, the header as written in messages, and the field
+/// count as written in messages.
+#[derive(Clone, Copy)]
+struct Layout {
+    header: &'static [&'static str],
+    joined: &'static str,
+    fields: &'static str,
+}
+
+/// Hands each data row of a CSV file laid out as `layout` to `row` with its file line
+/// (1-based; the header is line 1), after checking the header and the row's field count. A
+/// blank line (a trailing newline) is no row. `path` names the file in messages.
+fn csv_rows(
+    bytes: &[u8],
+    path: &Path,
+    layout: Layout,
+    mut row: impl FnMut(u64, &csv::StringRecord) -> Result<(), TraceError>,
+) -> Result<(), TraceError> {
     let p = || path.to_owned();
     if bytes.iter().all(|b| b.is_ascii_whitespace()) {
         return Err(TraceError::Empty { path: p() });
@@ -293,60 +348,31 @@ pub fn parse_trace(bytes: &[u8], path: &Path) -> Result<Trace, TraceError> {
         .next()
         .ok_or_else(|| TraceError::Empty { path: p() })?
         .map_err(csv_err)?;
-    if header.iter().collect::<Vec<_>>() != TRACE_HEADER {
+    if !header.iter().eq(layout.header.iter().copied()) {
         return Err(TraceError::Header {
             path: p(),
             line: line_of(&header),
             found: header.iter().collect::<Vec<_>>().join(","),
-            expected: "t,alpha,omega_u,omega_l",
+            expected: layout.joined,
         });
     }
-    let mut samples = Vec::new();
-    let mut lines = Vec::new();
     for rec in records {
         let rec = rec.map_err(csv_err)?;
         let line = line_of(&rec);
-        // A blank line (a trailing newline) is no row.
         if rec.len() == 1 && rec[0].is_empty() {
             continue;
         }
-        if rec.len() != 4 {
+        if rec.len() != layout.header.len() {
             return Err(TraceError::Fields {
                 path: p(),
                 line,
                 found: rec.len(),
-                expected: "4 (t,alpha,omega_u,omega_l)",
+                expected: layout.fields,
             });
         }
-        let mut v = [0.0; 4];
-        for (k, field) in rec.iter().enumerate() {
-            v[k] = match field.parse::<f64>() {
-                Ok(x) if x.is_finite() => x,
-                _ => {
-                    return Err(TraceError::Value {
-                        path: p(),
-                        line,
-                        column: k + 1,
-                        name: TRACE_HEADER[k],
-                        value: field.to_owned(),
-                    });
-                }
-            };
-        }
-        samples.push(Sample {
-            t: v[0],
-            x: State::new(v[1], v[2], v[3]),
-        });
-        lines.push(line);
+        row(line, &rec)?;
     }
-    if samples.is_empty() {
-        return Err(TraceError::NoRows { path: p() });
-    }
-    Ok(Trace {
-        path: path.to_owned(),
-        samples,
-        lines,
-    })
+    Ok(())
 }
 
 /// The header of an events file.
@@ -400,98 +426,69 @@ pub struct EventsFile {
 
 /// Reads an events file.
 pub fn read_events(path: &Path) -> Result<EventsFile, TraceError> {
-    let bytes = std::fs::read(path).map_err(|e| TraceError::Io {
-        path: path.to_owned(),
-        message: e.to_string(),
-    })?;
-    parse_events(&bytes, path)
+    parse_events(&read_bytes(path)?, path)
+}
+
+/// The words of an events file's `disc` column, as written in messages.
+const DISC_WORDS: &str = "upper, lower";
+/// The words of an events file's `kind` column, as written in messages.
+const KIND_WORDS: &str = "stick_start, stick_end, reversal";
+
+/// The disc named `word` ([`disc_name`] read back).
+fn disc_of(word: &str) -> Option<Disc> {
+    match word {
+        "upper" => Some(Disc::Upper),
+        "lower" => Some(Disc::Lower),
+        _ => None,
+    }
+}
+
+/// The mode-switch event of `disc` named `word` ([`event_row`] read back).
+fn kind_of(word: &str, disc: Disc) -> Option<EventKind> {
+    match word {
+        "stick_start" => Some(EventKind::StickStart(disc)),
+        "stick_end" => Some(EventKind::StickEnd(disc)),
+        "reversal" => Some(EventKind::Reversal(disc)),
+        _ => None,
+    }
 }
 
 /// Parses an events file (the events' states are not in the file: they are zero). An empty
 /// list of events after the header is valid (a run without a stick or a reversal).
 pub fn parse_events(bytes: &[u8], path: &Path) -> Result<EventsFile, TraceError> {
-    let p = || path.to_owned();
-    if bytes.iter().all(|b| b.is_ascii_whitespace()) {
-        return Err(TraceError::Empty { path: p() });
-    }
-    let mut r = csv::ReaderBuilder::new()
-        .has_headers(false)
-        .flexible(true)
-        .trim(csv::Trim::All)
-        .from_reader(bytes);
-    let mut records = r.records();
-    let line_of = |rec: &csv::StringRecord| rec.position().map_or(0, |pos| pos.line());
-    let csv_err = |e: csv::Error| TraceError::Csv {
-        path: p(),
-        line: e.position().map_or(0, |pos| pos.line()),
-        message: e.to_string(),
-    };
-    let header = records
-        .next()
-        .ok_or_else(|| TraceError::Empty { path: p() })?
-        .map_err(csv_err)?;
-    if header.iter().collect::<Vec<_>>() != EVENTS_HEADER {
-        return Err(TraceError::Header {
-            path: p(),
-            line: line_of(&header),
-            found: header.iter().collect::<Vec<_>>().join(","),
-            expected: "t,disc,kind",
-        });
-    }
     let mut out = Vec::new();
     let mut lines = Vec::new();
-    for rec in records {
-        let rec = rec.map_err(csv_err)?;
-        let line = line_of(&rec);
-        if rec.len() == 1 && rec[0].is_empty() {
-            continue;
-        }
-        if rec.len() != 3 {
-            return Err(TraceError::Fields {
-                path: p(),
-                line,
-                found: rec.len(),
-                expected: "3 (t,disc,kind)",
-            });
-        }
-        let t = match rec[0].parse::<f64>() {
-            Ok(x) if x.is_finite() => x,
-            _ => {
-                return Err(TraceError::Value {
-                    path: p(),
-                    line,
-                    column: 1,
-                    name: "t",
-                    value: rec[0].to_owned(),
-                });
-            }
-        };
+    let layout = Layout {
+        header: &EVENTS_HEADER,
+        joined: "t,disc,kind",
+        fields: "3 (t,disc,kind)",
+    };
+    csv_rows(bytes, path, layout, |line, rec| {
+        let t = number(&rec[0]).ok_or_else(|| TraceError::Value {
+            path: path.to_owned(),
+            line,
+            column: 1,
+            name: "t",
+            value: rec[0].to_owned(),
+        })?;
         let word = |column: usize, name: &'static str, expected: &'static str| TraceError::Word {
-            path: p(),
+            path: path.to_owned(),
             line,
             column,
             name,
             value: rec[column - 1].to_owned(),
             expected,
         };
-        let disc = match &rec[1] {
-            "upper" => Disc::Upper,
-            "lower" => Disc::Lower,
-            _ => return Err(word(2, "disc", "upper, lower")),
-        };
-        let kind = match &rec[2] {
-            "stick_start" => EventKind::StickStart(disc),
-            "stick_end" => EventKind::StickEnd(disc),
-            "reversal" => EventKind::Reversal(disc),
-            _ => return Err(word(3, "kind", "stick_start, stick_end, reversal")),
-        };
+        let disc = disc_of(&rec[1]).ok_or_else(|| word(2, "disc", DISC_WORDS))?;
+        let kind = kind_of(&rec[2], disc).ok_or_else(|| word(3, "kind", KIND_WORDS))?;
         out.push(Event {
             t,
             x: State::zeros(),
             kind,
         });
         lines.push(line);
-    }
+        Ok(())
+    })?;
     Ok(EventsFile {
         path: path.to_owned(),
         events: out,
