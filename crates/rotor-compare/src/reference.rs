@@ -43,7 +43,7 @@ pub struct ReferenceJson {
     /// The steady state as `rotor steady` prints it (`kind` and its metrics), over the
     /// scenario's `[steady_from, t_end]`; absent when the scenario compares no steady state.
     #[serde(flatten)]
-    pub steady: Option<SteadyJson>,
+    pub steady: Option<SteadyState>,
     /// How the reference was computed.
     pub solver: String,
     pub tol: f64,
@@ -63,87 +63,6 @@ pub struct ReferenceJson {
     /// `null` where they cannot be compared (a different number of events or another kind of
     /// steady state).
     pub cross_check: BTreeMap<String, CrossCheck>,
-}
-
-/// A steady state's fields, as in `rotor steady`.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(tag = "kind", rename_all = "snake_case")]
-pub enum SteadyJson {
-    Equilibrium {
-        omega_u: f64,
-        omega_l: f64,
-        alpha: f64,
-    },
-    LimitCycle {
-        period: f64,
-        omega_l_max: f64,
-        omega_l_min: f64,
-        omega_u_max: f64,
-        omega_u_min: f64,
-        stick_time: f64,
-    },
-}
-
-impl From<SteadyState> for SteadyJson {
-    fn from(s: SteadyState) -> SteadyJson {
-        match s {
-            SteadyState::Equilibrium {
-                omega_u,
-                omega_l,
-                alpha,
-            } => SteadyJson::Equilibrium {
-                omega_u,
-                omega_l,
-                alpha,
-            },
-            SteadyState::LimitCycle {
-                period,
-                omega_l_max,
-                omega_l_min,
-                omega_u_max,
-                omega_u_min,
-                stick_time,
-            } => SteadyJson::LimitCycle {
-                period,
-                omega_l_max,
-                omega_l_min,
-                omega_u_max,
-                omega_u_min,
-                stick_time,
-            },
-        }
-    }
-}
-
-impl From<&SteadyJson> for SteadyState {
-    fn from(s: &SteadyJson) -> SteadyState {
-        match *s {
-            SteadyJson::Equilibrium {
-                omega_u,
-                omega_l,
-                alpha,
-            } => SteadyState::Equilibrium {
-                omega_u,
-                omega_l,
-                alpha,
-            },
-            SteadyJson::LimitCycle {
-                period,
-                omega_l_max,
-                omega_l_min,
-                omega_u_max,
-                omega_u_min,
-                stick_time,
-            } => SteadyState::LimitCycle {
-                period,
-                omega_l_max,
-                omega_l_min,
-                omega_u_max,
-                omega_u_min,
-                stick_time,
-            },
-        }
-    }
 }
 
 /// One solver's differences from the reference.
@@ -187,7 +106,7 @@ impl Reference {
             events: switches(&tr.events),
             json: ReferenceJson {
                 scenario: sc.name.clone(),
-                steady: sc.compare.steady_from.and(tr.metrics).map(SteadyJson::from),
+                steady: sc.compare.steady_from.and(tr.metrics),
                 solver: "event".into(),
                 tol,
                 dt: sc.compare.dt,
@@ -209,7 +128,7 @@ impl Reference {
 
     /// The steady state, if the scenario compares one.
     pub fn steady(&self) -> Option<SteadyState> {
-        self.json.steady.as_ref().map(SteadyState::from)
+        self.json.steady
     }
 }
 
@@ -407,34 +326,7 @@ pub fn compute(sc: &Scenario) -> Result<Reference, ReferenceError> {
             };
             round_sig(v, d)
         };
-        let mut m = m;
-        match &mut m {
-            SteadyState::Equilibrium {
-                omega_u,
-                omega_l,
-                alpha,
-            } => {
-                *omega_u = rounded("omega_u", *omega_u);
-                *omega_l = rounded("omega_l", *omega_l);
-                *alpha = rounded("alpha", *alpha);
-            }
-            SteadyState::LimitCycle {
-                period,
-                omega_l_max,
-                omega_l_min,
-                omega_u_max,
-                omega_u_min,
-                stick_time,
-            } => {
-                *period = rounded("period", *period);
-                *omega_l_max = rounded("omega_l_max", *omega_l_max);
-                *omega_l_min = rounded("omega_l_min", *omega_l_min);
-                *omega_u_max = rounded("omega_u_max", *omega_u_max);
-                *omega_u_min = rounded("omega_u_min", *omega_u_min);
-                *stick_time = rounded("stick_time", *stick_time);
-            }
-        }
-        SteadyJson::from(m)
+        m.map(rounded)
     });
     let error = error
         .into_iter()

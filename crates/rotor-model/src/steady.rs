@@ -5,13 +5,14 @@
 //! successive *anchors*: exits of the lower disc from stick when the orbit sticks, maxima of
 //! ω_l otherwise. The metrics of the last complete cycle are reported.
 
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 use crate::dynamics::{Disc, OMEGA_L, OMEGA_U, State};
 use crate::scene::{Event, EventKind};
 
-/// The steady state as `rotor steady` prints it (docs/design.md, "The CLI").
-#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+/// The steady state as `rotor steady` prints it (docs/design.md, "The CLI"), and as the
+/// reference data stores and reads it back.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(tag = "kind", rename_all = "snake_case")]
 pub enum SteadyState {
     /// An equilibrium (rad, rad/s).
@@ -55,6 +56,36 @@ impl SteadyState {
                 ("omega_u_min", omega_u_min),
                 ("stick_time", stick_time),
             ],
+        }
+    }
+
+    /// The same steady state with every metric `v` named `name` replaced by `f(name, v)`.
+    pub fn map(self, f: impl Fn(&'static str, f64) -> f64) -> SteadyState {
+        match self {
+            SteadyState::Equilibrium {
+                omega_u,
+                omega_l,
+                alpha,
+            } => SteadyState::Equilibrium {
+                omega_u: f("omega_u", omega_u),
+                omega_l: f("omega_l", omega_l),
+                alpha: f("alpha", alpha),
+            },
+            SteadyState::LimitCycle {
+                period,
+                omega_l_max,
+                omega_l_min,
+                omega_u_max,
+                omega_u_min,
+                stick_time,
+            } => SteadyState::LimitCycle {
+                period: f("period", period),
+                omega_l_max: f("omega_l_max", omega_l_max),
+                omega_l_min: f("omega_l_min", omega_l_min),
+                omega_u_max: f("omega_u_max", omega_u_max),
+                omega_u_min: f("omega_u_min", omega_u_min),
+                stick_time: f("stick_time", stick_time),
+            },
         }
     }
 
