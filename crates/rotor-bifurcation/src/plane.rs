@@ -910,23 +910,6 @@ pub fn classify(model: &Model, u: f64, x0: State) -> &'static str {
     }
 }
 
-/// The perturbed equilibrium at u: the slipping equilibrium nearest rest with ω_l raised by
-/// 1e-3 rad/s, or the middle of the stuck set with it.
-pub fn perturbed_equilibrium(model: &Model, u: f64) -> State {
-    let base = model
-        .slip_equilibria(u)
-        .into_iter()
-        .min_by(|a, b| a.omega.abs().total_cmp(&b.omega.abs()))
-        .map(|e| e.state())
-        .or_else(|| {
-            model
-                .stuck_equilibria(u)
-                .map(|s| State::new(0.5 * (s.alpha_min + s.alpha_max), 0.0, 0.0))
-        })
-        .unwrap_or_else(State::zeros);
-    base + State::new(0.0, 0.0, 1e-3)
-}
-
 /// The region's name from what rest and the perturbed equilibrium reach.
 pub fn region_name(from_rest: &str, from_eq: &str) -> String {
     match (from_rest, from_eq) {
@@ -951,7 +934,7 @@ fn regions(base: &Params, name: &str, opts: &PlaneOptions) -> Result<Vec<Region>
             let u = opts.u_min + (opts.u_max - opts.u_min) * (j as f64 + 0.5) / n as f64;
             let m = Model::new(params_at(base, name, p)?);
             let a = classify(&m, u, State::zeros());
-            let b = classify(&m, u, perturbed_equilibrium(&m, u));
+            let b = classify(&m, u, m.perturbed_equilibrium(u));
             cells.push((region_name(a, b), p, u));
         }
     }

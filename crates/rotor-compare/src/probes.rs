@@ -43,20 +43,7 @@ impl Start {
     pub fn state(self, model: &Model, u: f64) -> State {
         match self {
             Start::Rest => State::zeros(),
-            Start::PerturbedEquilibrium => {
-                let base = model
-                    .slip_equilibria(u)
-                    .into_iter()
-                    .min_by(|a, b| a.omega.abs().total_cmp(&b.omega.abs()))
-                    .map(|e| e.state())
-                    .or_else(|| {
-                        model
-                            .stuck_equilibria(u)
-                            .map(|s| State::new(0.5 * (s.alpha_min + s.alpha_max), 0.0, 0.0))
-                    })
-                    .unwrap_or_else(State::zeros);
-                base + State::new(0.0, 0.0, 1e-3)
-            }
+            Start::PerturbedEquilibrium => model.perturbed_equilibrium(u),
         }
     }
 }

@@ -210,9 +210,7 @@ impl Sweep {
             .expect("validated before the run");
         let x0 = match self.start {
             SweepStart::State(x) => x,
-            SweepStart::PerturbedEquilibrium => {
-                rotor_bifurcation::plane::perturbed_equilibrium(&model, u)
-            }
+            SweepStart::PerturbedEquilibrium => model.perturbed_equilibrium(u),
         };
         let scene = Scene {
             u,

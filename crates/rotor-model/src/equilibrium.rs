@@ -120,6 +120,23 @@ impl Model {
         self.equilibrium_eigenvalues(e).iter().all(|l| l.re < 0.0)
     }
 
+    /// The start "perturbed equilibrium" at input `u` (the sweeps, the region probes and the
+    /// plane's regions): the slipping equilibrium nearest rest with ω_l raised by 1e-3 rad/s,
+    /// or the middle of the stuck set (or rest) with it.
+    pub fn perturbed_equilibrium(&self, u: f64) -> State {
+        let base = self
+            .slip_equilibria(u)
+            .into_iter()
+            .min_by(|a, b| a.omega.abs().total_cmp(&b.omega.abs()))
+            .map(|e| e.state())
+            .or_else(|| {
+                self.stuck_equilibria(u)
+                    .map(|s| State::new(0.5 * (s.alpha_min + s.alpha_max), 0.0, 0.0))
+            })
+            .unwrap_or_else(State::zeros);
+        base + State::new(0.0, 0.0, 1e-3)
+    }
+
     /// The set of equilibria with both discs at rest, if non-empty.
     pub fn stuck_equilibria(&self, u: f64) -> Option<StuckSet> {
         let k = self.params.k_theta;
