@@ -126,6 +126,24 @@ pub struct ContOptions {
     pub multipliers: Multipliers,
 }
 
+impl ContOptions {
+    /// Settings for work at the single input `u` (a Newton solve for a cycle, or describing
+    /// one: multipliers by saltation matrices), not a continuation: every step and limit 0.
+    pub fn at(u: f64, newton_tol: f64) -> ContOptions {
+        ContOptions {
+            u_min: u,
+            u_max: u,
+            h_max: 0.0,
+            h_min: 0.0,
+            newton_tol,
+            amp_stop: 0.0,
+            max_nodes: 0,
+            fd_step: 0.0,
+            multipliers: Multipliers::Saltation,
+        }
+    }
+}
+
 /// The residual of the continuation and its Jacobian at one point.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Linearized {

@@ -10,7 +10,7 @@
 //! extremes), or a refusal that names its cause. A wrong or unstable cycle reported as the
 //! steady state is a failure.
 
-use rotor_bifurcation::continuation::{ContOptions, Continuer, Multipliers};
+use rotor_bifurcation::continuation::{ContOptions, Continuer};
 use rotor_bifurcation::periodic::Shooter;
 use rotor_bifurcation::{Diagram, PointKind};
 use rotor_model::{Model, Scene, State, SteadyState};
@@ -148,18 +148,8 @@ pub fn expected(model: &Model, d: &Diagram, u: f64) -> Vec<Attractor> {
     };
     let cont = Continuer {
         sh,
-        opts: ContOptions {
-            u_min: u,
-            u_max: u,
-            h_max: 0.0,
-            h_min: 0.0,
-            // The Hopf start's Newton solve (`hopf_cycle`) stops at this residual.
-            newton_tol: 1e-10,
-            amp_stop: 0.0,
-            max_nodes: 0,
-            fd_step: 0.0,
-            multipliers: Multipliers::Saltation,
-        },
+        // The Hopf start's Newton solve (`hopf_cycle`) stops at this residual.
+        opts: ContOptions::at(u, 1e-10),
     };
     // Newton starts: every branch point within 0.02 V of u, nearest first, and where two
     // neighbours bracket u the point between them; next to a Hopf point, on the side its

@@ -13,7 +13,7 @@
 //! different cycle.
 
 use nalgebra::Complex;
-use rotor_bifurcation::continuation::{ContOptions, Continuer, Multipliers};
+use rotor_bifurcation::continuation::{ContOptions, Continuer};
 use rotor_bifurcation::periodic::{Shooter, T_RETURN};
 use rotor_model::{Model, Scene, SolveError, State, Stats, SteadyState};
 use serde::Serialize;
@@ -199,17 +199,8 @@ fn saltation_multipliers(
     }
     let cont = Continuer {
         sh,
-        opts: ContOptions {
-            u_min: u,
-            u_max: u,
-            h_max: 0.0,
-            h_min: 0.0,
-            newton_tol: 0.0,
-            amp_stop: 0.0,
-            max_nodes: 0,
-            fd_step: 0.0,
-            multipliers: Multipliers::Saltation,
-        },
+        // Only describes the cycle (multipliers): no Newton solve.
+        opts: ContOptions::at(u, 0.0),
     };
     let info = cont
         .describe(u, c, [to_section.x[0], to_section.x[1]])
