@@ -839,21 +839,25 @@ impl<'a> Integrator<'a> {
             let path = |t: f64| x + f * (t - te);
             let t = self.polish_extremum(disc, is_max, &path, te, (c.t, t1), mode);
             // At the step's start (no step to bound |ẍ| by) only a polish that stays is small.
-            let small = if hh > 0.0 {
-                (0..3).all(|i| {
-                    let acc = (f[i] - c.f0[i]).abs() / hh;
-                    0.5 * (t - te).powi(2) * acc
-                        <= 1e-3 * self.ctl.rtol.min(self.ctl.atol) * (1.0 + x[i].abs())
-                })
-            } else {
-                t == te
-            };
+            let small = self.taylor_is_small(c, hh, &f, &x, t - te) || t == te;
             if small || round == 2 {
                 return (t, path(t));
             }
             te = t;
             round += 1;
         }
+    }
+
+    /// Whether the first-order move `x + f·dt` from the state `x` reached `hh` into the step
+    /// from the cursor (field `f` there) errs by less than a thousandth of the tolerance: its
+    /// error ½dt²|ẍ|, with |ẍ| bounded by the field's change over the step. `false` when
+    /// `hh ≤ 0` (no step to bound |ẍ| by).
+    fn taylor_is_small(&self, c: &Cursor, hh: f64, f: &State, x: &State, dt: f64) -> bool {
+        hh > 0.0
+            && (0..3).all(|i| {
+                let acc = (f[i] - c.f0[i]).abs() / hh;
+                0.5 * dt * dt * acc <= 1e-3 * self.ctl.rtol.min(self.ctl.atol) * (1.0 + x[i].abs())
+            })
     }
 
     /// A terminal guard's root located to rounding: an exact RK step from the step's start to
@@ -893,12 +897,7 @@ impl<'a> Integrator<'a> {
             // field's change over the step, must be below a thousandth of the tolerance
             // (typically dt ~ 1e-12 s, error ~1e-23). The terminal guards are linear in x, so
             // the moved state meets the guard to rounding.
-            let small = hh > 0.0
-                && (0..3).all(|i| {
-                    let acc = (fe[i] - c.f0[i]).abs() / hh;
-                    0.5 * dt * dt * acc
-                        <= 1e-3 * self.ctl.rtol.min(self.ctl.atol) * (1.0 + xe[i].abs())
-                });
+            let small = self.taylor_is_small(c, hh, &fe, &xe, dt);
             tev += dt;
             if small {
                 xe += fe * dt;
