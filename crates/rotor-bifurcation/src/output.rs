@@ -7,7 +7,7 @@ use crate::svg;
 
 /// A float as the csv writer prints it (the shortest form that reads back the same).
 fn num(v: f64) -> String {
-    ryu::Buffer::new().format(v).to_owned()
+    zmij::Buffer::new().format(v).to_owned()
 }
 use crate::{BifError, Diagram};
 

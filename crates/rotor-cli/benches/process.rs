@@ -8,6 +8,7 @@
 //! Scene: Table 1, u = 1.5 V from rest, 100 s, event-driven solver at tol 1e-12, the 0.01 s
 //! trace (10 001 rows) written as CSV. Medians of 41 runs each:
 //! * the solve in process (`EventSolver::simulate_finite`, the trace kept);
+//! * the solve plus formatting the CSV in memory (the text alone, no file);
 //! * the solve plus writing the CSV file in process (what the process does besides starting);
 //! * the whole process, `rotor simulate ... --csv FILE`, spawned and waited for;
 //! * an empty process, `rotor --version`: start-up and exit alone.
@@ -53,6 +54,10 @@ fn main() {
     let solve = time(n, || {
         std::hint::black_box(solver.simulate_finite(&model, &scene).unwrap());
     });
+    let solve_format = time(n, || {
+        let tr = solver.simulate_finite(&model, &scene).unwrap();
+        std::hint::black_box(rotor_compare::trace::write_trace(&tr.samples, 0.01));
+    });
     let solve_write = time(n, || {
         let tr = solver.simulate_finite(&model, &scene).unwrap();
         rotor_compare::report::write_output_with(&csv, |w| {
@@ -79,6 +84,7 @@ fn main() {
     let ms = |s: f64| s * 1e3;
     println!("rotor simulate --solver event --u 1.5 --t-end 100 --tol 1e-12 --csv FILE");
     println!("  in-process solve             {:7.3} ms", ms(solve));
+    println!("  in-process solve + CSV text  {:7.3} ms", ms(solve_format));
     println!("  in-process solve + CSV file  {:7.3} ms", ms(solve_write));
     println!("  whole process                {:7.3} ms", ms(whole));
     println!("  empty process (--version)    {:7.3} ms", ms(empty));

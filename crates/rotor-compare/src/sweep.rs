@@ -200,7 +200,7 @@ impl Sweep {
     /// The CSV row of point k.
     pub fn row(&self, k: usize) -> String {
         let (u, p) = self.point(k);
-        let mut b = ryu::Buffer::new();
+        let mut b = zmij::Buffer::new();
         let mut s = format!("{},", b.format(u));
         s.push_str(b.format(p));
         let model = self
@@ -220,7 +220,7 @@ impl Sweep {
             metrics_from: Some(0.5 * self.t_end),
             ..Scene::default()
         };
-        let f = |v: f64| ryu::Buffer::new().format(v).to_owned();
+        let f = |v: f64| zmij::Buffer::new().format(v).to_owned();
         match self.solver.solver().simulate_finite(&model, &scene) {
             Ok(tr) => match tr.metrics {
                 Some(SteadyState::Equilibrium {
@@ -266,7 +266,7 @@ impl Sweep {
     /// The shard file's record of this sweep.
     pub fn info(&self, shard: Shard) -> ShardInfo {
         let axis = |a: &Axis| {
-            let mut b = ryu::Buffer::new();
+            let mut b = zmij::Buffer::new();
             let mut s = format!("{}:", b.format(a.a));
             s.push_str(b.format(a.b));
             format!("{s}:{}", a.n)
@@ -396,10 +396,10 @@ fn resume_count(sweep: &Sweep, mine: &[usize], out: &Path) -> Result<usize, Swee
         }
     }
     let mut n = 0;
-    let mut b = ryu::Buffer::new();
+    let mut b = zmij::Buffer::new();
     for (line, &k) in lines.zip(mine) {
         let (u, p) = sweep.point(k);
-        let head = format!("{},{},", b.format(u), ryu::Buffer::new().format(p));
+        let head = format!("{},{},", b.format(u), zmij::Buffer::new().format(p));
         if !line.starts_with(&head) {
             return Err(SweepError::File {
                 path: out.to_owned(),

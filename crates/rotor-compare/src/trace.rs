@@ -62,7 +62,7 @@ fn write_rows(w: impl std::io::Write, samples: &[Sample], digits: i32) -> std::i
         .quote_style(csv::QuoteStyle::Never)
         .buffer_capacity(1 << 16)
         .from_writer(w);
-    let mut bufs = [(); 4].map(|_| ryu::Buffer::new());
+    let mut bufs = [(); 4].map(|_| zmij::Buffer::new());
     for s in samples {
         let [b0, b1, b2, b3] = &mut bufs;
         let row = [
@@ -401,7 +401,7 @@ pub fn event_row(kind: EventKind) -> Option<(Disc, &'static str)> {
 /// in time order (extrema are left out), times in the shortest round-trip form.
 pub fn write_events(events: &[Event]) -> Vec<u8> {
     let mut out = String::from("t,disc,kind\n");
-    let mut b = ryu::Buffer::new();
+    let mut b = zmij::Buffer::new();
     for e in events {
         if let Some((d, k)) = event_row(e.kind) {
             out.push_str(b.format(e.t));
