@@ -33,34 +33,20 @@ pub enum SteadyState {
 }
 
 impl SteadyState {
-    /// The metrics as named values, in a fixed order (for comparisons and reports).
+    /// The metrics as named values, in a fixed order (for comparisons and reports): the
+    /// order of [`SteadyState::map`]'s calls.
     pub fn values(&self) -> Vec<(&'static str, f64)> {
-        match *self {
-            SteadyState::Equilibrium {
-                omega_u,
-                omega_l,
-                alpha,
-            } => vec![("omega_u", omega_u), ("omega_l", omega_l), ("alpha", alpha)],
-            SteadyState::LimitCycle {
-                period,
-                omega_l_max,
-                omega_l_min,
-                omega_u_max,
-                omega_u_min,
-                stick_time,
-            } => vec![
-                ("period", period),
-                ("omega_l_max", omega_l_max),
-                ("omega_l_min", omega_l_min),
-                ("omega_u_max", omega_u_max),
-                ("omega_u_min", omega_u_min),
-                ("stick_time", stick_time),
-            ],
-        }
+        let mut out = Vec::with_capacity(6);
+        self.map(|name, v| {
+            out.push((name, v));
+            v
+        });
+        out
     }
 
-    /// The same steady state with every metric `v` named `name` replaced by `f(name, v)`.
-    pub fn map(self, f: impl Fn(&'static str, f64) -> f64) -> SteadyState {
+    /// The same steady state with every metric `v` named `name` replaced by `f(name, v)`,
+    /// called once per metric in the order of the fields.
+    pub fn map(self, mut f: impl FnMut(&'static str, f64) -> f64) -> SteadyState {
         match self {
             SteadyState::Equilibrium {
                 omega_u,
@@ -317,6 +303,43 @@ mod tests {
             x: State::new(x[0], x[1], x[2]),
             kind,
         }
+    }
+
+    #[test]
+    fn values_name_every_field_once_in_field_order() {
+        let eq = SteadyState::Equilibrium {
+            omega_u: 1.0,
+            omega_l: 2.0,
+            alpha: 3.0,
+        };
+        assert_eq!(
+            eq.values(),
+            [("omega_u", 1.0), ("omega_l", 2.0), ("alpha", 3.0)]
+        );
+        let lc = SteadyState::LimitCycle {
+            period: 1.0,
+            omega_l_max: 2.0,
+            omega_l_min: 3.0,
+            omega_u_max: 4.0,
+            omega_u_min: 5.0,
+            stick_time: 6.0,
+        };
+        let names = [
+            "period",
+            "omega_l_max",
+            "omega_l_min",
+            "omega_u_max",
+            "omega_u_min",
+            "stick_time",
+        ];
+        let expected: Vec<_> = names
+            .into_iter()
+            .zip(1..)
+            .map(|(n, k)| (n, f64::from(k)))
+            .collect();
+        assert_eq!(lc.values(), expected);
+        // map hands each metric to f under its own name and puts the result back there.
+        assert_eq!(lc.map(|_, v| 10.0 * v).values()[5], ("stick_time", 60.0));
     }
 
     #[test]
