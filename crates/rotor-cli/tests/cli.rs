@@ -336,6 +336,14 @@ fn check_grades_with_exit_codes_0_1_2() {
     assert!(err.contains("broken.csv: line 51"), "{err}");
     let o = run(&good, &["--gate", "lax"]);
     assert_eq!(o.status.code(), Some(2));
+    // A file that is not text (1 MB of zeros: what `/dev/zero` or a binary file gives) is
+    // refused at its first line, not read whole.
+    let zeros = dir.join("zeros.bin");
+    std::fs::write(&zeros, vec![0u8; 1 << 20]).unwrap();
+    let o = run(&zeros, &[]);
+    assert_eq!(o.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(err.contains("zeros.bin: cannot read: no line end"), "{err}");
     std::fs::remove_dir_all(&dir).ok();
 }
 

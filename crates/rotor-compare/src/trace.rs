@@ -9,6 +9,7 @@
 //! The events file of the benchmark (`t,disc,kind`, disc `upper|lower`, kind
 //! `stick_start|stick_end|reversal`) is written and read here as well.
 
+use std::io::Read;
 use std::path::{Path, PathBuf};
 
 use rotor_model::{Disc, Event, EventKind, Sample, State};
@@ -253,13 +254,20 @@ impl EventsFile {
     }
 }
 
-/// Reads a trace file.
+/// Reads a trace file, streaming: a file that is not a trace fails at its first line, and a
+/// file without line ends (a binary file, `/dev/zero`) fails after [`MAX_LINE`] bytes instead
+/// of being read into memory whole.
 pub fn read_trace(path: &Path) -> Result<Trace, TraceError> {
-    parse_trace(&read_bytes(path)?, path)
+    trace_from(open(path)?, path)
 }
 
 /// Parses trace bytes; `path` names the file in messages.
 pub fn parse_trace(bytes: &[u8], path: &Path) -> Result<Trace, TraceError> {
+    trace_from(bytes, path)
+}
+
+/// Parses a trace from `input`; `path` names it in messages.
+fn trace_from(input: impl Read, path: &Path) -> Result<Trace, TraceError> {
     let mut samples = Vec::new();
     let mut lines = Vec::new();
     let layout = Layout {
@@ -267,7 +275,7 @@ pub fn parse_trace(bytes: &[u8], path: &Path) -> Result<Trace, TraceError> {
         joined: "t,alpha,omega_u,omega_l",
         fields: "4 (t,alpha,omega_u,omega_l)",
     };
-    csv_rows(bytes, path, layout, |line, rec| {
+    csv_rows(input, path, layout, |line, rec| {
         let mut v = [0.0; 4];
         for (k, field) in rec.iter().enumerate() {
             v[k] = number(field).ok_or_else(|| TraceError::Value {
@@ -302,12 +310,69 @@ fn number(field: &str) -> Option<f64> {
     field.parse::<f64>().ok().filter(|x| x.is_finite())
 }
 
-/// The bytes of a file, or an error naming it.
-fn read_bytes(path: &Path) -> Result<Vec<u8>, TraceError> {
-    std::fs::read(path).map_err(|e| TraceError::Io {
+/// The file at `path` opened for reading, or an error naming it.
+fn open(path: &Path) -> Result<std::fs::File, TraceError> {
+    std::fs::File::open(path).map_err(|e| TraceError::Io {
         path: path.to_owned(),
         message: e.to_string(),
     })
+}
+
+/// The longest run of bytes without a line end that a trace or events file may hold. A row of
+/// four numbers in any float format is under 200 bytes; the cap is what keeps a file that is
+/// not text from being read into memory whole in search of a line end.
+pub const MAX_LINE: usize = 4096;
+
+/// Bytes the CSV reader takes from its input at a time. A line inside one chunk is bounded
+/// by the chunk; [`LineCap`] bounds a line that crosses chunks.
+const CHUNK: usize = 1 << 13;
+
+/// A reader that fails once more than `limit` bytes have passed without a line end (`\n` or
+/// `\r`), counted across reads. A line that lies inside one read is not measured: it is
+/// bounded by the read's size. So the CSV reader above never holds more than `limit` plus
+/// one chunk of a line.
+struct LineCap<R> {
+    inner: R,
+    limit: usize,
+    /// Bytes since the last line end.
+    run: usize,
+    /// Bytes read in all.
+    offset: u64,
+}
+
+impl<R: Read> LineCap<R> {
+    fn new(inner: R, limit: usize) -> LineCap<R> {
+        LineCap {
+            inner,
+            limit,
+            run: 0,
+            offset: 0,
+        }
+    }
+}
+
+impl<R: Read> Read for LineCap<R> {
+    fn read(&mut self, buf: &mut [u8]) -> std::io::Result<usize> {
+        let n = self.inner.read(buf)?;
+        let chunk = &buf[..n];
+        // Scanning from the end stops within one line's length of it.
+        self.run = match chunk.iter().rposition(|&b| b == b'\n' || b == b'\r') {
+            Some(i) => n - 1 - i,
+            None => self.run + n,
+        };
+        self.offset += n as u64;
+        if self.run > self.limit {
+            return Err(std::io::Error::new(
+                std::io::ErrorKind::InvalidData,
+                format!(
+                    "no line end in bytes {}..{}: not a CSV text file",
+                    self.offset - self.run as u64,
+                    self.offset
+                ),
+            ));
+        }
+        Ok(n)
+    }
 }
 
 /// The shape of a CSV file: its header, the header as written in messages, and the field
@@ -323,31 +388,50 @@ struct Layout {
 /// (1-based; the header is line 1), after checking the header and the row's field count. A
 /// blank line (a trailing newline) is no row. `path` names the file in messages.
 fn csv_rows(
-    bytes: &[u8],
+    input: impl Read,
     path: &Path,
     layout: Layout,
     mut row: impl FnMut(u64, &csv::StringRecord) -> Result<(), TraceError>,
 ) -> Result<(), TraceError> {
     let p = || path.to_owned();
-    if bytes.iter().all(|b| b.is_ascii_whitespace()) {
-        return Err(TraceError::Empty { path: p() });
-    }
     let mut r = csv::ReaderBuilder::new()
         .has_headers(false)
         .flexible(true)
         .trim(csv::Trim::All)
-        .from_reader(bytes);
+        .buffer_capacity(CHUNK)
+        .from_reader(LineCap::new(input, MAX_LINE));
     let mut records = r.records();
     let line_of = |rec: &csv::StringRecord| rec.position().map_or(0, |pos| pos.line());
-    let csv_err = |e: csv::Error| TraceError::Csv {
-        path: p(),
-        line: e.position().map_or(0, |pos| pos.line()),
-        message: e.to_string(),
+    let csv_err = |e: csv::Error| match e.kind() {
+        csv::ErrorKind::Io(io) => TraceError::Io {
+            path: p(),
+            message: io.to_string(),
+        },
+        _ => TraceError::Csv {
+            path: p(),
+            line: e.position().map_or(0, |pos| pos.line()),
+            message: e.to_string(),
+        },
     };
+    // A line of blanks (the csv reader skips empty lines but not lines of spaces).
+    let blank = |rec: &csv::StringRecord| rec.len() == 1 && rec[0].is_empty();
     let header = records
         .next()
         .ok_or_else(|| TraceError::Empty { path: p() })?
         .map_err(csv_err)?;
+    if blank(&header) {
+        // Blank lines to the end: the file is empty; else a blank line is a wrong header.
+        let mut only_blank = true;
+        for rec in records.by_ref() {
+            if !blank(&rec.map_err(csv_err)?) {
+                only_blank = false;
+                break;
+            }
+        }
+        if only_blank {
+            return Err(TraceError::Empty { path: p() });
+        }
+    }
     if !header.iter().eq(layout.header.iter().copied()) {
         return Err(TraceError::Header {
             path: p(),
@@ -424,9 +508,9 @@ pub struct EventsFile {
     pub lines: Vec<u64>,
 }
 
-/// Reads an events file.
+/// Reads an events file, streaming as [`read_trace`] does.
 pub fn read_events(path: &Path) -> Result<EventsFile, TraceError> {
-    parse_events(&read_bytes(path)?, path)
+    events_from(open(path)?, path)
 }
 
 /// The words of an events file's `disc` column, as written in messages.
@@ -456,6 +540,11 @@ fn kind_of(word: &str, disc: Disc) -> Option<EventKind> {
 /// Parses an events file (the events' states are not in the file: they are zero). An empty
 /// list of events after the header is valid (a run without a stick or a reversal).
 pub fn parse_events(bytes: &[u8], path: &Path) -> Result<EventsFile, TraceError> {
+    events_from(bytes, path)
+}
+
+/// Parses an events file from `input`; `path` names it in messages.
+fn events_from(input: impl Read, path: &Path) -> Result<EventsFile, TraceError> {
     let mut out = Vec::new();
     let mut lines = Vec::new();
     let layout = Layout {
@@ -463,7 +552,7 @@ pub fn parse_events(bytes: &[u8], path: &Path) -> Result<EventsFile, TraceError>
         joined: "t,disc,kind",
         fields: "3 (t,disc,kind)",
     };
-    csv_rows(bytes, path, layout, |line, rec| {
+    csv_rows(input, path, layout, |line, rec| {
         let t = number(&rec[0]).ok_or_else(|| TraceError::Value {
             path: path.to_owned(),
             line,
@@ -576,6 +665,63 @@ mod tests {
         assert!(e.contains("line 2: 5 fields"), "{e}");
         let e = err("t,alpha,omega_u,omega_l\n0,0,0,\n");
         assert!(e.contains("line 2, column 4"), "{e}");
+    }
+
+    #[test]
+    fn blank_lines_before_a_header_are_a_wrong_header_not_an_empty_file() {
+        let e = parse_trace(
+            b"  \nt,alpha,omega_u,omega_l\n0,0,0,0\n",
+            Path::new("x.csv"),
+        );
+        let e = e.unwrap_err().to_string();
+        assert!(e.contains("line 1: the header is \"\""), "{e}");
+        let e = parse_events(b" \n\t\n", Path::new("e.csv")).unwrap_err();
+        assert!(matches!(e, TraceError::Empty { .. }), "{e}");
+    }
+
+    /// A file without line ends is refused after at most [`MAX_LINE`] plus one chunk of bytes,
+    /// not read whole: 64 MiB of zeros (`/dev/zero`, cut short so that a reader that read it
+    /// whole would fail with another error instead of hanging).
+    #[test]
+    fn input_without_line_ends_is_refused_early() {
+        let zeros = std::io::repeat(0).take(64 << 20);
+        let mut counted = Counted(zeros, 0);
+        let e = trace_from(&mut counted, Path::new("zero")).unwrap_err();
+        assert!(
+            matches!(&e, TraceError::Io { message, .. } if message.contains("no line end")),
+            "{e}"
+        );
+        assert!(
+            counted.1 <= (MAX_LINE + 2 * CHUNK) as u64,
+            "read {} bytes",
+            counted.1
+        );
+        // A trace whose second row runs past the cap across chunks, and the same row padded
+        // to just under it, which reads.
+        let row = |pad: usize| {
+            format!(
+                "t,alpha,omega_u,omega_l\n0,0,0,0\n{}0.01,1,2,3\n",
+                " ".repeat(pad)
+            )
+        };
+        let long = row(3 * CHUNK);
+        let e = parse_trace(long.as_bytes(), Path::new("x.csv")).unwrap_err();
+        assert!(matches!(&e, TraceError::Io { .. }), "{e}");
+        let e = parse_events(long.as_bytes(), Path::new("e.csv")).unwrap_err();
+        assert!(matches!(&e, TraceError::Io { .. }), "{e}");
+        let fits = parse_trace(row(MAX_LINE - 20).as_bytes(), Path::new("x.csv")).unwrap();
+        assert_eq!(fits.samples[1].x, State::new(1.0, 2.0, 3.0));
+    }
+
+    /// A reader that counts the bytes it hands out.
+    struct Counted<R>(R, u64);
+
+    impl<R: Read> Read for Counted<R> {
+        fn read(&mut self, buf: &mut [u8]) -> std::io::Result<usize> {
+            let n = self.0.read(buf)?;
+            self.1 += n as u64;
+            Ok(n)
+        }
     }
 
     #[test]
