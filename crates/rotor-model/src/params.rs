@@ -200,7 +200,7 @@ impl Params {
 
     /// Reads and validates a parameter file.
     pub fn from_file(path: &Path) -> Result<Params, ParamsError> {
-        let bytes = std::fs::read(path).map_err(|e| ParamsError::Io {
+        let bytes = read_small(path).map_err(|e| ParamsError::Io {
             path: path.to_owned(),
             message: e.to_string(),
         })?;
@@ -632,6 +632,26 @@ fn escape_controls(s: &str) -> String {
             }
         })
         .collect()
+}
+
+/// The largest parameter or scenario file that is read: such a file is under 4 kB, and the
+/// cap keeps a wrong path (a binary file, `/dev/zero`) from being read into memory whole.
+pub(crate) const MAX_FILE: u64 = 1 << 20;
+
+/// The bytes of the file at `path`, refused once it runs past [`MAX_FILE`] bytes.
+pub(crate) fn read_small(path: &Path) -> std::io::Result<Vec<u8>> {
+    use std::io::Read;
+    let mut bytes = Vec::new();
+    std::fs::File::open(path)?
+        .take(MAX_FILE + 1)
+        .read_to_end(&mut bytes)?;
+    if bytes.len() as u64 > MAX_FILE {
+        return Err(std::io::Error::new(
+            std::io::ErrorKind::InvalidData,
+            format!("larger than {MAX_FILE} bytes: not a TOML file of this kind"),
+        ));
+    }
+    Ok(bytes)
 }
 
 /// The bytes of a file as text, or why it is not a text file: not UTF-8, or it holds a NUL

@@ -22,7 +22,7 @@ use serde::Deserialize;
 use thiserror::Error;
 
 use crate::dynamics::{Model, State};
-use crate::params::{Params, ParamsError, one_line, shown, text_of};
+use crate::params::{Params, ParamsError, one_line, read_small, shown, text_of};
 use crate::scene::{MAX_GRID_ROWS, MIN_TOL, Output, Scene};
 
 /// A scenario file could not be read or is not admissible.
@@ -253,7 +253,7 @@ impl Scenario {
 
     /// Reads and validates a scenario file and the parameter file it names.
     pub fn from_file(path: &Path) -> Result<Scenario, ScenarioError> {
-        let bytes = std::fs::read(path).map_err(|e| ScenarioError::Io {
+        let bytes = read_small(path).map_err(|e| ScenarioError::Io {
             path: path.to_owned(),
             message: e.to_string(),
         })?;

@@ -350,7 +350,18 @@ pub fn bad_params_cases() -> Vec<BadFile> {
             &b"j_u = 0.4\rk_m \x07= 1\n"[..],
             &["\\u{7}"],
         ),
+        too_large(),
     ]
+}
+
+/// 2 MB of comment lines: valid TOML, but no parameter or scenario file is that large, and
+/// the readers refuse it (at 1 MiB) before reading on.
+fn too_large() -> BadFile {
+    raw(
+        "2 MB of comments",
+        "# a comment line of thirty bytes\n".repeat(1 << 16),
+        &["larger than", "not a TOML file of this kind"],
+    )
 }
 
 /// Bad scenario files: mutations of [`local_scenario`] (horizon, step and tolerance out of
@@ -604,6 +615,7 @@ pub fn bad_scenario_cases() -> Vec<BadFile> {
             &b"name = \"a\"\n\x00"[..],
             &["NUL byte", "offset 11"],
         ),
+        too_large(),
     ]);
     v
 }
