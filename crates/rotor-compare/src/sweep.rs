@@ -13,7 +13,7 @@
 //! form a complete-looking grid of their own); without it, merge checks that the rows form a
 //! full grid.
 
-use std::io::{BufRead, Write};
+use std::io::{BufRead, Read, Write};
 use std::path::{Path, PathBuf};
 
 use rotor_model::{Model, Output, Params, Scene, State, SteadyState};
@@ -374,6 +374,23 @@ fn resume_count(sweep: &Sweep, mine: &[usize], out: &Path) -> Result<usize, Swee
         path: out.to_owned(),
         message: e.to_string(),
     };
+    // The file must start with the header, or be a cut-off start of it, before it is read
+    // on or cut: a wrong path is refused as it is.
+    let mut head = Vec::new();
+    std::fs::File::open(out)
+        .and_then(|f| f.take(HEADER.len() as u64 + 1).read_to_end(&mut head))
+        .map_err(io)?;
+    if !format!("{HEADER}\n").as_bytes().starts_with(&head) {
+        let first = head.split(|&b| b == b'\n').next().unwrap_or_default();
+        return Err(SweepError::File {
+            path: out.to_owned(),
+            message: format!(
+                "line 1 begins {:?}, not the sweep header {HEADER:?}; not resumed, the file is \
+                 left as it is",
+                String::from_utf8_lossy(first)
+            ),
+        });
+    }
     let bytes = std::fs::read(out).map_err(io)?;
     let complete = bytes.iter().rposition(|&b| b == b'\n').map_or(0, |i| i + 1);
     if complete < bytes.len() {
@@ -385,15 +402,9 @@ fn resume_count(sweep: &Sweep, mine: &[usize], out: &Path) -> Result<usize, Swee
     }
     let text = String::from_utf8_lossy(&bytes[..complete]);
     let mut lines = text.lines();
-    match lines.next() {
-        None => return Ok(0),
-        Some(h) if h == HEADER => {}
-        Some(h) => {
-            return Err(SweepError::File {
-                path: out.to_owned(),
-                message: format!("line 1: {h:?} is not the sweep header {HEADER:?}; not resumed"),
-            });
-        }
+    // The header, checked above; none when the file was cut inside it.
+    if lines.next().is_none() {
+        return Ok(0);
     }
     let mut n = 0;
     let mut b = zmij::Buffer::new();
@@ -432,6 +443,8 @@ pub fn merge(paths: &[PathBuf]) -> Result<Vec<u8>, SweepError> {
             message: e.to_string(),
         };
         let f = std::fs::File::open(path).map_err(io)?;
+        // Lines are capped: a file without line ends fails at once instead of being read whole.
+        let f = crate::trace::LineCap::new(f, crate::trace::MAX_LINE);
         let mut lines = std::io::BufReader::new(f).lines();
         match lines.next() {
             Some(Ok(h)) if h == HEADER => {}
@@ -739,6 +752,32 @@ mod tests {
             e.contains("another sweep") && e.contains("other.csv"),
             "{e}"
         );
+        std::fs::remove_dir_all(&dir).ok();
+    }
+    /// A file that is not a sweep's output, given to `--resume` or to merge by mistake, is
+    /// refused and left byte for byte as it was; one without line ends is not read whole.
+    #[test]
+    fn foreign_files_are_refused_untouched() {
+        let dir = std::env::temp_dir().join(format!("rotor-sweep-foreign-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let s = sweep();
+        // A text file ending without a newline (resume would cut a half-written row), a
+        // binary file without line ends, and a cut-off header (which resume does complete).
+        let text = dir.join("notes.txt");
+        let notes = b"keep these notes\nthe last line has no newline".to_vec();
+        let blob = dir.join("blob.bin");
+        let zeros = vec![0u8; 1 << 20];
+        for (path, bytes) in [(&text, &notes), (&blob, &zeros)] {
+            std::fs::write(path, bytes).unwrap();
+            let e = run(&s, Shard::ALL, path, true, |_, _, _| {}).unwrap_err();
+            assert!(e.to_string().contains("not the sweep header"), "{e}");
+            assert_eq!(&std::fs::read(path).unwrap(), bytes);
+        }
+        let e = merge(std::slice::from_ref(&blob)).unwrap_err().to_string();
+        assert!(e.contains("no line end"), "{e}");
+        let cut = dir.join("cut.csv");
+        std::fs::write(&cut, &HEADER.as_bytes()[..5]).unwrap();
+        assert_eq!(run_serial(&s, Shard::ALL, &cut, true), 12);
         std::fs::remove_dir_all(&dir).ok();
     }
 }

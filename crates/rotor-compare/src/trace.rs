@@ -331,7 +331,7 @@ const CHUNK: usize = 1 << 13;
 /// `\r`), counted across reads. A line that lies inside one read is not measured: it is
 /// bounded by the read's size. So the CSV reader above never holds more than `limit` plus
 /// one chunk of a line.
-struct LineCap<R> {
+pub(crate) struct LineCap<R> {
     inner: R,
     limit: usize,
     /// Bytes since the last line end.
@@ -341,7 +341,7 @@ struct LineCap<R> {
 }
 
 impl<R: Read> LineCap<R> {
-    fn new(inner: R, limit: usize) -> LineCap<R> {
+    pub(crate) fn new(inner: R, limit: usize) -> LineCap<R> {
         LineCap {
             inner,
             limit,
