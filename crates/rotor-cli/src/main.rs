@@ -4,6 +4,7 @@ use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 mod open;
+mod out;
 
 use anyhow::{Context, Result, anyhow, bail};
 use clap::{Parser, Subcommand};
@@ -229,11 +230,12 @@ fn kind_by_name(name: &str) -> Result<SolverKind> {
 
 /// Prints a command's summary: on standard output, unless one of its outputs goes there
 /// (`-`), then on standard error.
-fn say<const N: usize>(text: &str, outputs: [Option<&Path>; N]) {
+fn say<const N: usize>(text: &str, outputs: [Option<&Path>; N]) -> std::io::Result<()> {
     if outputs.iter().flatten().any(|p| p.as_os_str() == "-") {
         eprint!("{text}");
+        Ok(())
     } else {
-        print!("{text}");
+        out::print(text)
     }
 }
 
@@ -323,7 +325,7 @@ fn steady(common: &Common) -> Result<()> {
     let answer = rotor_compare::steady(kind, &model, &scene, &opts)
         .with_context(|| format!("solver {}", kind.name()))?;
     warn_inexact(&answer.stats);
-    println!("{}", steady_json(&answer));
+    out::line(format_args!("{}", steady_json(&answer)))?;
     Ok(())
 }
 
@@ -376,7 +378,7 @@ fn bifurcation(
     for p in &d.points {
         summary += &format!("  {}\n", serde_json::to_string(p)?);
     }
-    say(&summary, [Some(json), csv, svg]);
+    say(&summary, [Some(json), csv, svg])?;
     Ok(())
 }
 
@@ -437,7 +439,7 @@ fn bifurcation2(
             q.curves.join(", ")
         ));
     }
-    say(&summary, [Some(json), svg]);
+    say(&summary, [Some(json), svg])?;
     Ok(())
 }
 
@@ -566,7 +568,7 @@ fn bench(
             .collect::<Result<_, _>>()?;
     }
     let report = rotor_bench::run(&opts, |m| eprintln!("{m}"))?;
-    say(&report.table(), [json, svg, csv]);
+    say(&report.table(), [json, svg, csv])?;
     for (path, text) in [
         (json, report.to_json()?),
         (svg, report.to_svg()?),
@@ -927,10 +929,10 @@ fn compare(files: &[PathBuf], report: &Path, main_job: bool) -> Result<()> {
     ];
     let fails = rotor_compare::report::write_report(report, &results, &params, &sections)
         .with_context(|| format!("{}: cannot write the report", report.display()))?;
-    println!(
+    out::line(format_args!(
         "{:<18} {:<7} {:<12} {:>10} {:>12} {:>9}",
         "scenario", "solver", "steady", "period", "omega_l_max", "ms"
-    );
+    ))?;
     for r in &results {
         for run in &r.runs {
             let (kind, period, wmax) = match run.result.as_ref().ok().and_then(|t| t.metrics) {
@@ -944,7 +946,7 @@ fn compare(files: &[PathBuf], report: &Path, main_job: bool) -> Result<()> {
                 }
                 None => ("error", "-".into(), "-".into()),
             };
-            println!(
+            out::line(format_args!(
                 "{:<18} {:<7} {:<12} {:>10} {:>12} {:>9.1}",
                 r.scenario.name,
                 run.kind.name(),
@@ -952,16 +954,16 @@ fn compare(files: &[PathBuf], report: &Path, main_job: bool) -> Result<()> {
                 period,
                 wmax,
                 run.seconds * 1e3
-            );
+            ))?;
         }
     }
-    println!(
+    out::line(format_args!(
         "{} scenarios, {} solvers, {:.2} s wall; report in {}",
         results.len(),
         rotor_compare::SOLVERS.len(),
         wall,
         report.display()
-    );
+    ))?;
     let checks: Vec<&String> = sections.iter().flat_map(|s| &s.failures).collect();
     for f in &checks {
         eprintln!("CHECK FAILED: {f}");
@@ -971,7 +973,7 @@ fn compare(files: &[PathBuf], report: &Path, main_job: bool) -> Result<()> {
     }
     match (fails.len(), checks.len()) {
         (0, 0) => {
-            println!("all agreement gates pass");
+            out::line(format_args!("all agreement gates pass"))?;
             Ok(())
         }
         (g, c) => bail!("{g} agreement gate(s) and {c} report check(s) failed"),
@@ -1102,6 +1104,8 @@ fn main() -> ExitCode {
     };
     match res {
         Ok(()) => ExitCode::SUCCESS,
+        // The reader of standard output has gone: stop quietly, as a Unix tool does.
+        Err(e) if out::is_closed_pipe(&e) => ExitCode::SUCCESS,
         Err(e) => {
             eprintln!("error: {e:#}");
             ExitCode::FAILURE

@@ -31,7 +31,7 @@ pub fn write_reference(scenarios_dir: &Path, out: &Path) -> Result<()> {
                 .with_context(|| format!("{}: cannot write", path.display()))?;
         }
         let worst = |n: &str| r.error(n);
-        println!(
+        crate::out::line(format_args!(
             "{name}: {} samples, {} events, {} significant digits; stated error omega_l {:.1e} \
              rad/s, event times {:.1e} s",
             r.samples.len(),
@@ -39,9 +39,13 @@ pub fn write_reference(scenarios_dir: &Path, out: &Path) -> Result<()> {
             r.json.trace_digits,
             worst("omega_l"),
             worst("event_time"),
-        );
+        ))?;
     }
-    println!("{} references in {}", refs.len(), out.display());
+    crate::out::line(format_args!(
+        "{} references in {}",
+        refs.len(),
+        out.display()
+    ))?;
     Ok(())
 }
 
@@ -80,14 +84,15 @@ fn verdict(
     let report = grade(scenario, &t, ev.as_ref(), strictness)?;
     if let Some(path) = json {
         let text = serde_json::to_string_pretty(&report)? + "\n";
-        rotor_compare::report::write_output(path, text.as_bytes())
+        // A closed pipe on `--json -` does not hide the verdict's exit status.
+        crate::out::closed_is_fine(rotor_compare::report::write_output(path, text.as_bytes()))
             .with_context(|| format!("{}: cannot write", path.display()))?;
     }
     let table = report.table();
     if json.is_some_and(|p| p.as_os_str() == "-") {
         eprint!("{table}");
     } else {
-        print!("{table}");
+        crate::out::print(&table)?;
     }
     if !report.passed {
         eprintln!("failing: {}", report.failing().join(", "));

@@ -554,3 +554,71 @@ fn sweep_refuses_bad_shards_parameters_and_huge_grids() {
     let o = rotor(&args);
     assert!(String::from_utf8_lossy(&o.stderr).contains("--shard I/N"));
 }
+
+/// Standard output whose reader has gone (`rotor ... | head -1`): each command stops
+/// quietly, without a panic or an error message, and `rotor check` still exits with its
+/// verdict. The pipe's read end is closed before the start, so every write meets it.
+#[test]
+fn a_closed_standard_output_ends_quietly() {
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
+    let scenario = root.join("fixtures/scenarios/t1-u0.02-rest.toml");
+    let good = root.join("fixtures/reference/t1-u0.02-rest.csv");
+    let dir = std::env::temp_dir().join(format!("rotor-cli-pipe-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    // The reference with one ω_l value moved by 1 rad/s: a trace that fails its gate.
+    let text = std::fs::read_to_string(&good).unwrap();
+    let mut lines: Vec<String> = text.lines().map(str::to_owned).collect();
+    let mut f: Vec<String> = lines[101].split(',').map(str::to_owned).collect();
+    f[3] = (f[3].parse::<f64>().unwrap() + 1.0).to_string();
+    lines[101] = f.join(",");
+    let bad = dir.join("bad.csv");
+    std::fs::write(&bad, lines.join("\n") + "\n").unwrap();
+    let (sc, good, bad) = (
+        scenario.to_str().unwrap(),
+        good.to_str().unwrap(),
+        bad.to_str().unwrap(),
+    );
+    let cases: [(&[&str], i32); 6] = [
+        (&["steady", "--solver", "event", "--u", "1.5"], 0),
+        (
+            &[
+                "simulate", "--solver", "event", "--u", "1.5", "--t-end", "5", "--csv", "-",
+            ],
+            0,
+        ),
+        (
+            &[
+                "sweep",
+                "--u",
+                "0.5:1:2",
+                "--param",
+                "k_theta=0.1:0.2:2",
+                "--t-end",
+                "4",
+                "--csv",
+                "-",
+            ],
+            0,
+        ),
+        (&["check", sc, "--trace", good], 0),
+        (&["check", sc, "--trace", bad], 1),
+        (&["check", sc, "--trace", bad, "--json", "-"], 1),
+    ];
+    for (args, code) in cases {
+        let (reader, writer) = std::io::pipe().unwrap();
+        drop(reader);
+        let o = Command::new(env!("CARGO_BIN_EXE_rotor"))
+            .args(args)
+            .stdout(writer)
+            .stderr(std::process::Stdio::piped())
+            .output()
+            .unwrap();
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(code), "{args:?}: {err}");
+        assert!(
+            !err.contains("panicked") && !err.contains("error"),
+            "{args:?}: {err}"
+        );
+    }
+    std::fs::remove_dir_all(&dir).ok();
+}

@@ -15,6 +15,7 @@
 
 use std::io::{BufRead, Read, Write};
 use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicBool, Ordering};
 
 use rotor_model::{Model, Output, Params, Scene, State, SteadyState};
 
@@ -27,7 +28,7 @@ pub const HEADER: &str = "u,p,kind,period,omega_l_max,omega_l_min,stick_time";
 pub const MAX_POINTS: usize = 10_000_000;
 
 /// Why a sweep or a merge cannot run.
-#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[derive(Debug, thiserror::Error)]
 pub enum SweepError {
     #[error("{flag} {value:?}: {reason}")]
     Arg {
@@ -37,6 +38,13 @@ pub enum SweepError {
     },
     #[error("{}: {message}", .path.display())]
     File { path: PathBuf, message: String },
+    /// Writing the rows failed: a full disk, or a reader of standard output that has gone.
+    #[error("{}: cannot write: {source}", .path.display())]
+    Write {
+        path: PathBuf,
+        #[source]
+        source: std::io::Error,
+    },
     #[error("the shards do not fit together: {0}")]
     Merge(String),
 }
@@ -329,9 +337,14 @@ pub fn run(
     } else {
         Box::new(std::fs::File::create(out).map_err(io)?)
     };
+    let write_err = |source| SweepError::Write {
+        path: out.to_owned(),
+        source,
+    };
     if done == 0 {
-        writeln!(w, "{HEADER}").map_err(io)?;
-        w.flush().map_err(io)?;
+        writeln!(w, "{HEADER}")
+            .and_then(|()| w.flush())
+            .map_err(write_err)?;
     }
     if !stdout {
         let text = serde_json::to_string_pretty(&sweep.info(shard)).expect("plain fields");
@@ -343,10 +356,24 @@ pub fn run(
         })?;
     }
     let todo = &mine[done..];
+    write_rows(sweep, todo, &mut w, run_all).map_err(write_err)?;
+    Ok(todo.len())
+}
+
+/// Runs the grid points `todo` through `run_all` and writes their rows to `w` in grid order.
+/// Once a write fails (a full disk, a reader of standard output that has gone), the points
+/// not yet started are not run (no one would read them) and the error is returned.
+fn write_rows(
+    sweep: &Sweep,
+    todo: &[usize],
+    w: &mut dyn Write,
+    run_all: impl FnOnce(&[usize], &(dyn Fn(usize) -> String + Sync), &mut dyn FnMut(usize, String)),
+) -> std::io::Result<()> {
     // Reorder buffer: rows arrive in any order and leave in grid order.
     let mut pending = std::collections::BTreeMap::new();
     let mut next = 0usize;
     let mut failed: Option<std::io::Error> = None;
+    let stop = AtomicBool::new(false);
     let mut sink = |idx: usize, row: String| {
         pending.insert(idx, row);
         while let Some(r) = pending.remove(&next) {
@@ -354,17 +381,21 @@ pub fn run(
                 && let Err(e) = writeln!(w, "{r}").and_then(|_| w.flush())
             {
                 failed = Some(e);
+                stop.store(true, Ordering::Relaxed);
             }
             next += 1;
         }
     };
-    let row = |i: usize| sweep.row(todo[i]);
+    let row = |i: usize| {
+        if stop.load(Ordering::Relaxed) {
+            String::new()
+        } else {
+            sweep.row(todo[i])
+        }
+    };
     let indices: Vec<usize> = (0..todo.len()).collect();
     run_all(&indices, &row, &mut sink);
-    if let Some(e) = failed {
-        return Err(io(e));
-    }
-    Ok(todo.len())
+    failed.map_or(Ok(()), Err)
 }
 
 /// How many of `mine` are complete in an existing output; a half-written last row is cut
@@ -754,6 +785,45 @@ mod tests {
         );
         std::fs::remove_dir_all(&dir).ok();
     }
+    /// Once the output fails, the points not yet started are not run and the error comes
+    /// back: a sweep to a closed pipe or a full disk does not run on for hours.
+    #[test]
+    fn a_failed_write_stops_the_sweep() {
+        /// Takes two rows (a row ends with a flush), then fails as a closed pipe does.
+        struct TwoRows(usize);
+        impl Write for TwoRows {
+            fn write(&mut self, buf: &[u8]) -> std::io::Result<usize> {
+                if self.0 < 2 {
+                    Ok(buf.len())
+                } else {
+                    Err(std::io::ErrorKind::BrokenPipe.into())
+                }
+            }
+            fn flush(&mut self) -> std::io::Result<()> {
+                self.0 += 1;
+                Ok(())
+            }
+        }
+        let s = sweep();
+        let todo: Vec<usize> = (0..s.len()).collect();
+        let mut run = 0;
+        let e = write_rows(&s, &todo, &mut TwoRows(0), |idx, f, sink| {
+            for &i in idx {
+                let row = f(i);
+                run += usize::from(!row.is_empty());
+                sink(i, row);
+            }
+        })
+        .unwrap_err();
+        assert_eq!(e.kind(), std::io::ErrorKind::BrokenPipe);
+        assert_eq!(
+            run,
+            3,
+            "two rows written, the third failed, {} not run",
+            todo.len() - 3
+        );
+    }
+
     /// A file that is not a sweep's output, given to `--resume` or to merge by mistake, is
     /// refused and left byte for byte as it was; one without line ends is not read whole.
     #[test]
