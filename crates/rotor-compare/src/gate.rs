@@ -34,12 +34,18 @@ pub struct Failure {
 }
 
 impl std::fmt::Display for Failure {
+    /// A measured difference over its tolerance, or, where nothing could be measured (a run
+    /// that failed, steady states of different kinds: `diff` not finite), what went wrong.
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        write!(
-            f,
-            "{}: {}: {} differs by {:.3e} > tolerance {:.3e}",
-            self.scenario, self.pair, self.quantity, self.diff, self.tol
-        )
+        if self.diff.is_finite() {
+            write!(
+                f,
+                "{}: {}: {} differs by {:.3e} > tolerance {:.3e}",
+                self.scenario, self.pair, self.quantity, self.diff, self.tol
+            )
+        } else {
+            write!(f, "{}: {}: {}", self.scenario, self.pair, self.quantity)
+        }
     }
 }
 

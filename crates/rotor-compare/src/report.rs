@@ -12,6 +12,26 @@ use crate::snapshot::round_sig;
 use crate::solvers::{SolverKind, pair_name, pairs};
 use rotor_plot::{Panel, Series, render};
 
+/// One row of the report's gate table. A quantity that could not be measured (steady
+/// states of different kinds, or missing: `diff` not finite) has no numbers, only its FAIL.
+fn gate_row(scenario: &str, pair: &str, m: &crate::gate::Measured) -> String {
+    let numbers = if m.diff.is_finite() {
+        let margin = match (m.diff > 0.0, m.tol == 0.0) {
+            (true, _) => format!("{:.1}", m.tol / m.diff),
+            (false, true) => "exact".into(),
+            (false, false) => "—".into(),
+        };
+        format!("{:.2e} | {:.0e} | {margin}", m.diff, m.tol)
+    } else {
+        "— | — | —".into()
+    };
+    let verdict = if m.passes() { "ok" } else { "**FAIL**" };
+    format!(
+        "| {scenario} | {pair} | {} | {numbers} | {verdict} |",
+        m.quantity
+    )
+}
+
 /// Gates every pair of one scenario. A solver error, or a pair without a tolerance in the
 /// scenario file, is a failure too.
 pub fn gate_scenario(r: &ScenarioResult) -> (Vec<GateResult>, Vec<Failure>) {
@@ -362,21 +382,7 @@ pub fn write_report(
         let (gates, fails) = gate_scenario(r);
         for g in &gates {
             for m in &g.measured {
-                let _ = writeln!(
-                    md,
-                    "| {} | {} | {} | {:.2e} | {:.0e} | {} | {} |",
-                    r.scenario.name,
-                    g.pair,
-                    m.quantity,
-                    m.diff,
-                    m.tol,
-                    match (m.diff > 0.0, m.tol == 0.0) {
-                        (true, _) => format!("{:.1}", m.tol / m.diff),
-                        (false, true) => "exact".into(),
-                        (false, false) => "—".into(),
-                    },
-                    if m.passes() { "ok" } else { "**FAIL**" }
-                );
+                let _ = writeln!(md, "{}", gate_row(&r.scenario.name, &g.pair, m));
             }
         }
         for f in &fails {
@@ -418,6 +424,53 @@ pub fn write_report(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::gate::Measured;
+
+    /// Gate rows: a measurement shows its difference, tolerance and margin; a quantity that
+    /// could not be measured (a NaN or infinite difference) shows no numbers, never "NaN"
+    /// or a margin of "exact"; and the failures print as sentences, not "differs by inf".
+    #[test]
+    fn unmeasurable_gates_show_no_numbers() {
+        let m = |quantity: &str, diff: f64, tol: f64| Measured {
+            quantity: quantity.into(),
+            diff,
+            tol,
+        };
+        assert_eq!(
+            gate_row("s", "a-b", &m("period_rel", 2e-11, 1e-10)),
+            "| s | a-b | period_rel | 2.00e-11 | 1e-10 | 5.0 | ok |"
+        );
+        assert_eq!(
+            gate_row("s", "a-b", &m("stick_time", 0.0, 0.0)),
+            "| s | a-b | stick_time | 0.00e0 | 0e0 | exact | ok |"
+        );
+        for d in [f64::NAN, f64::INFINITY] {
+            let row = gate_row("s", "a-b", &m("steady kind (cycle vs equilibrium)", d, 0.0));
+            assert_eq!(
+                row,
+                "| s | a-b | steady kind (cycle vs equilibrium) | — | — | — | **FAIL** |"
+            );
+        }
+        let f = |diff: f64| {
+            Failure {
+                scenario: "s".into(),
+                pair: "event".into(),
+                quantity: "run failed: step size underflow".into(),
+                diff,
+                tol: 0.0,
+            }
+            .to_string()
+        };
+        assert_eq!(
+            f(f64::INFINITY),
+            "s: event: run failed: step size underflow"
+        );
+        assert_eq!(f(f64::NAN), "s: event: run failed: step size underflow");
+        assert_eq!(
+            f(1.0),
+            "s: event: run failed: step size underflow differs by 1.000e0 > tolerance 0.000e0"
+        );
+    }
 
     #[test]
     fn atomic_writes_replace_whole_files_and_stale_temporaries_go() {
