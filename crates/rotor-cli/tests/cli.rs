@@ -1,5 +1,6 @@
 //! The CLI contract (docs/design.md): CSV format, steady JSON, and clear errors (never a panic).
 
+use std::path::PathBuf;
 use std::process::Command;
 
 fn rotor(args: &[&str]) -> std::process::Output {
@@ -282,14 +283,26 @@ fn a_report_written_twice_is_the_same_bytes() {
     std::fs::remove_dir_all(&base).ok();
 }
 
+/// The scenario t1-u0.02-rest, its reference trace, and the lines of that trace with ω_l at
+/// t = 1 s moved by 1 rad/s (far beyond the transient gate).
+fn check_case() -> (PathBuf, PathBuf, Vec<String>) {
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
+    let scenario = root.join("fixtures/scenarios/t1-u0.02-rest.toml");
+    let good = root.join("fixtures/reference/t1-u0.02-rest.csv");
+    let text = std::fs::read_to_string(&good).unwrap();
+    let mut lines: Vec<String> = text.lines().map(str::to_owned).collect();
+    let mut f: Vec<String> = lines[101].split(',').map(str::to_owned).collect();
+    f[3] = (f[3].parse::<f64>().unwrap() + 1.0).to_string();
+    lines[101] = f.join(",");
+    (scenario, good, lines)
+}
+
 /// `rotor check`: exit 0 for the reference's own trace, 1 with the failing quantity named
 /// for a trace moved beyond a gate, 2 with the line named for a malformed one; `--json`
 /// writes the contract's fields.
 #[test]
 fn check_grades_with_exit_codes_0_1_2() {
-    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
-    let scenario = root.join("fixtures/scenarios/t1-u0.02-rest.toml");
-    let good = root.join("fixtures/reference/t1-u0.02-rest.csv");
+    let (scenario, good, mut lines) = check_case();
     let dir = std::env::temp_dir().join(format!("rotor-cli-check-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let run = |trace: &std::path::Path, extra: &[&str]| {
@@ -316,12 +329,6 @@ fn check_grades_with_exit_codes_0_1_2() {
     for key in ["name", "difference", "tolerance", "passed", "digits"] {
         assert!(v["quantities"][0].get(key).is_some(), "{key}: {v}");
     }
-    let text = std::fs::read_to_string(&good).unwrap();
-    let mut lines: Vec<String> = text.lines().map(str::to_owned).collect();
-    // ω_l at t = 1 s moved by 1 rad/s: far beyond the transient gate.
-    let mut f: Vec<String> = lines[101].split(',').map(str::to_owned).collect();
-    f[3] = (f[3].parse::<f64>().unwrap() + 1.0).to_string();
-    lines[101] = f.join(",");
     let bad = dir.join("bad.csv");
     std::fs::write(&bad, lines.join("\n") + "\n").unwrap();
     let o = run(&bad, &[]);
@@ -560,17 +567,9 @@ fn sweep_refuses_bad_shards_parameters_and_huge_grids() {
 /// verdict. The pipe's read end is closed before the start, so every write meets it.
 #[test]
 fn a_closed_standard_output_ends_quietly() {
-    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
-    let scenario = root.join("fixtures/scenarios/t1-u0.02-rest.toml");
-    let good = root.join("fixtures/reference/t1-u0.02-rest.csv");
+    let (scenario, good, lines) = check_case();
     let dir = std::env::temp_dir().join(format!("rotor-cli-pipe-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
-    // The reference with one ω_l value moved by 1 rad/s: a trace that fails its gate.
-    let text = std::fs::read_to_string(&good).unwrap();
-    let mut lines: Vec<String> = text.lines().map(str::to_owned).collect();
-    let mut f: Vec<String> = lines[101].split(',').map(str::to_owned).collect();
-    f[3] = (f[3].parse::<f64>().unwrap() + 1.0).to_string();
-    lines[101] = f.join(",");
     let bad = dir.join("bad.csv");
     std::fs::write(&bad, lines.join("\n") + "\n").unwrap();
     let (sc, good, bad) = (
