@@ -785,6 +785,7 @@ mod tests {
         );
         std::fs::remove_dir_all(&dir).ok();
     }
+
     /// Once the output fails, the points not yet started are not run and the error comes
     /// back: a sweep to a closed pipe or a full disk does not run on for hours.
     #[test]
