@@ -32,6 +32,17 @@ fn gate_row(scenario: &str, pair: &str, m: &crate::gate::Measured) -> String {
     )
 }
 
+/// The failures that have no row among the gates' measurements: runs that failed, pairs
+/// without a stated tolerance. (A measured quantity that failed has its row already.)
+fn unmeasured<'a>(gates: &[GateResult], fails: &'a [Failure]) -> Vec<&'a Failure> {
+    let measured = |f: &Failure| {
+        gates
+            .iter()
+            .any(|g| g.pair == f.pair && g.measured.iter().any(|m| m.quantity == f.quantity))
+    };
+    fails.iter().filter(|f| !measured(f)).collect()
+}
+
 /// Gates every pair of one scenario. A solver error, or a pair without a tolerance in the
 /// scenario file, is a failure too.
 pub fn gate_scenario(r: &ScenarioResult) -> (Vec<GateResult>, Vec<Failure>) {
@@ -385,14 +396,12 @@ pub fn write_report(
                 let _ = writeln!(md, "{}", gate_row(&r.scenario.name, &g.pair, m));
             }
         }
-        for f in &fails {
-            if f.diff.is_infinite() {
-                let _ = writeln!(
-                    md,
-                    "| {} | {} | {} | — | — | — | **FAIL** |",
-                    f.scenario, f.pair, f.quantity
-                );
-            }
+        for f in unmeasured(&gates, &fails) {
+            let _ = writeln!(
+                md,
+                "| {} | {} | {} | — | — | — | **FAIL** |",
+                f.scenario, f.pair, f.quantity
+            );
         }
         all_fails.extend(fails);
         write_atomic(
@@ -466,6 +475,24 @@ mod tests {
             "s: event: run failed: step size underflow"
         );
         assert_eq!(f(f64::NAN), "s: event: run failed: step size underflow");
+        // A failed measurement (here steady states of different kinds, an infinite
+        // difference) has its gate row; only the failures without one get another row.
+        let kinds = m("steady kind (cycle vs equilibrium)", f64::INFINITY, 0.0);
+        let gates = [GateResult {
+            pair: "a-b".into(),
+            measured: vec![m("period_rel", 2e-11, 1e-10), kinds],
+        }];
+        let mut fails = gates[0].failures("s");
+        assert_eq!(fails.len(), 1);
+        let run = Failure {
+            scenario: "s".into(),
+            pair: "a".into(),
+            quantity: "run failed: step size underflow".into(),
+            diff: f64::INFINITY,
+            tol: 0.0,
+        };
+        fails.push(run.clone());
+        assert_eq!(unmeasured(&gates, &fails), [&run]);
         assert_eq!(
             f(1.0),
             "s: event: run failed: step size underflow differs by 1.000e0 > tolerance 0.000e0"

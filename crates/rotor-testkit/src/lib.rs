@@ -354,12 +354,12 @@ pub fn bad_params_cases() -> Vec<BadFile> {
     ]
 }
 
-/// 2 MB of comment lines: valid TOML, but no parameter or scenario file is that large, and
+/// 2 MiB of comment lines: valid TOML, but no parameter or scenario file is that large, and
 /// the readers refuse it (at 1 MiB) before reading on.
 fn too_large() -> BadFile {
     raw(
-        "2 MB of comments",
-        "# a comment line of thirty bytes\n".repeat(1 << 16),
+        "2 MiB of comments",
+        format!("{}\n", "#".repeat(63)).repeat(1 << 15),
         &["larger than", "not a TOML file of this kind"],
     )
 }
