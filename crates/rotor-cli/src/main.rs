@@ -478,7 +478,7 @@ fn sweep(
     if resume && csv.as_os_str() == "-" {
         bail!("--resume needs an output file, not standard output");
     }
-    let total = (0..s.len()).filter(|&k| shard.owns(k)).count();
+    let total = shard.count(s.len());
     let bar = progress_bar(total as u64, "points");
     let t0 = std::time::Instant::now();
     let ran = run(&s, shard, csv, resume, |idx, f, sink| {
