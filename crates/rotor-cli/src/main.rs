@@ -514,8 +514,8 @@ fn merge(shards: &[PathBuf], csv: &Path) -> Result<()> {
     if shards.is_empty() {
         bail!("merge: no shard files given");
     }
-    let bytes = rotor_compare::sweep::merge(shards)?;
-    rotor_compare::report::write_output(csv, &bytes)
+    let merged = rotor_compare::sweep::merge(shards)?;
+    rotor_compare::report::write_output_with(csv, |w| merged.write_to(w))
         .with_context(|| format!("{}: cannot write", csv.display()))?;
     Ok(())
 }

@@ -485,18 +485,62 @@ fn resume_count(sweep: &Sweep, mine: &[usize], out: &Path) -> Result<usize, Swee
     Ok(n)
 }
 
-/// A row of a shard: u, p, the line's text, its file and line number.
-type Row = (f64, f64, String, PathBuf, usize);
+/// A row of a shard: its grid point, its text, and where it came from.
+struct Row {
+    u: f64,
+    p: f64,
+    line: String,
+    /// Index of its file in the merge's list.
+    file: usize,
+    lineno: usize,
+}
+
+/// Shards merged: the rows of the whole grid in the order one unsharded run writes them.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Merged {
+    lines: Vec<String>,
+}
+
+impl Merged {
+    /// The number of rows (grid points).
+    pub fn len(&self) -> usize {
+        self.lines.len()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.lines.is_empty()
+    }
+
+    /// Writes the header and the rows, buffered.
+    pub fn write_to(&self, w: &mut dyn Write) -> std::io::Result<()> {
+        let mut w = std::io::BufWriter::with_capacity(1 << 16, w);
+        writeln!(w, "{HEADER}")?;
+        for line in &self.lines {
+            w.write_all(line.as_bytes())?;
+            w.write_all(b"\n")?;
+        }
+        w.flush()
+    }
+
+    /// The bytes [`Merged::write_to`] writes.
+    pub fn to_bytes(&self) -> Vec<u8> {
+        let mut out = Vec::new();
+        self.write_to(&mut out).expect("writing to memory");
+        out
+    }
+}
 
 /// Merges shard files into the output of one unsharded run (row order included): the
 /// rows' u and p values must form a full grid, each point once. The row order is the grid
 /// order: p outer, u inner, each axis in the direction of the row of point 0 (the first row
-/// of the shard that holds it).
-pub fn merge(paths: &[PathBuf]) -> Result<Vec<u8>, SweepError> {
+/// of the shard that holds it). Each row's place is found by bisection on the sorted axes
+/// and the rows are put in order by one sort, so that a map of 10^8 points merges in
+/// O(n log n); a gap in the grid is counted without allocating the grid.
+pub fn merge(paths: &[PathBuf]) -> Result<Merged, SweepError> {
     check_records(paths)?;
     let mut rows: Vec<Row> = Vec::new();
     let mut first_rows: Vec<(f64, f64)> = Vec::new();
-    for path in paths {
+    for (file, path) in paths.iter().enumerate() {
         let io = |e: std::io::Error| SweepError::File {
             path: path.clone(),
             message: e.to_string(),
@@ -532,9 +576,12 @@ pub fn merge(paths: &[PathBuf]) -> Result<Vec<u8>, SweepError> {
                 message: format!("line {}: {m}", i + 2),
             };
             let mut it = line.splitn(3, ',');
+            // A sweep's grid values are finite; -0 and 0 are one value of an axis.
             let num = |t: Option<&str>, what: &str| {
                 t.and_then(|t| t.parse::<f64>().ok())
-                    .ok_or_else(|| bad(format!("{what} is not a number: {line:?}")))
+                    .filter(|v| v.is_finite())
+                    .map(|v| v + 0.0)
+                    .ok_or_else(|| bad(format!("{what} is not a finite number: {line:?}")))
             };
             let u = num(it.next(), "u")?;
             let p = num(it.next(), "p")?;
@@ -542,18 +589,24 @@ pub fn merge(paths: &[PathBuf]) -> Result<Vec<u8>, SweepError> {
                 first_rows.push((u, p));
                 first = false;
             }
-            rows.push((u, p, line, path.clone(), i + 2));
+            rows.push(Row {
+                u,
+                p,
+                line,
+                file,
+                lineno: i + 2,
+            });
         }
     }
-    // The grid: the distinct values of each axis, in the direction point 0 gives.
-    let distinct = |f: &dyn Fn(&Row) -> f64| {
+    // The grid: the distinct values of each axis, sorted upwards.
+    let distinct = |f: fn(&Row) -> f64| {
         let mut v: Vec<f64> = rows.iter().map(f).collect();
         v.sort_by(f64::total_cmp);
         v.dedup();
         v
     };
-    let mut us = distinct(&|r| r.0);
-    let mut ps = distinct(&|r| r.1);
+    let us = distinct(|r| r.u);
+    let ps = distinct(|r| r.p);
     let (Some(&umin), Some(&pmin)) = (us.first(), ps.first()) else {
         return Err(SweepError::Merge("no rows".into()));
     };
@@ -564,50 +617,74 @@ pub fn merge(paths: &[PathBuf]) -> Result<Vec<u8>, SweepError> {
         .find(|(u, p)| (*u == umin || Some(u) == us.last()) && (*p == pmin || Some(p) == ps.last()))
         .copied()
         .unwrap_or((umin, pmin));
-    if corner.0 != umin {
-        us.reverse();
-    }
-    if corner.1 != pmin {
-        ps.reverse();
-    }
-    let index = |v: &[f64], x: f64| v.iter().position(|&y| y == x).expect("a distinct value");
-    let mut slots: Vec<Option<(String, PathBuf, usize)>> = vec![None; us.len() * ps.len()];
-    for (u, p, line, path, lineno) in rows {
-        let k = index(&ps, p) * us.len() + index(&us, u);
-        if let Some((_, other, other_line)) = &slots[k] {
-            return Err(SweepError::Merge(format!(
-                "point u = {u}, p = {p} is in {}:{lineno} and in {}:{other_line}",
-                path.display(),
-                other.display()
-            )));
-        }
-        slots[k] = Some((line, path, lineno));
-    }
-    let missing: Vec<String> = slots
-        .iter()
-        .enumerate()
-        .filter(|(_, s)| s.is_none())
-        .map(|(k, _)| format!("u = {}, p = {}", us[k % us.len()], ps[k / us.len()]))
+    let u_axis = (us.as_slice(), corner.0 != umin);
+    let p_axis = (ps.as_slice(), corner.1 != pmin);
+    // The place of value x on an axis (sorted upwards; `down`: counted from its top end).
+    let place = |(v, down): (&[f64], bool), x: f64| {
+        let i = v
+            .binary_search_by(|y| y.total_cmp(&x))
+            .expect("every row's value is on its axis");
+        if down { v.len() - 1 - i } else { i }
+    };
+    let value = |(v, down): (&[f64], bool), i: usize| if down { v[v.len() - 1 - i] } else { v[i] };
+    let nu = us.len() as u128;
+    let cells = nu * ps.len() as u128;
+    let mut keyed: Vec<(u128, Row)> = rows
+        .into_iter()
+        .map(|r| {
+            (
+                place(p_axis, r.p) as u128 * nu + place(u_axis, r.u) as u128,
+                r,
+            )
+        })
         .collect();
-    if !missing.is_empty() {
+    // Stable: of two rows of one point, the one given first on the command line stays first.
+    keyed.sort_by_key(|(k, _)| *k);
+    if let Some(w) = keyed.windows(2).find(|w| w[0].0 == w[1].0) {
+        let (a, b) = (&w[0].1, &w[1].1);
         return Err(SweepError::Merge(format!(
-            "{} of the {} x {} grid's points are missing (a shard of another grid, or one not \
-             given): {}{}",
-            missing.len(),
-            us.len(),
-            ps.len(),
-            missing[..missing.len().min(5)].join("; "),
-            if missing.len() > 5 { "; ..." } else { "" }
+            "point u = {}, p = {} is in {}:{} and in {}:{}",
+            b.u,
+            b.p,
+            paths[b.file].display(),
+            b.lineno,
+            paths[a.file].display(),
+            a.lineno
         )));
     }
-    let mut out = Vec::new();
-    out.extend_from_slice(HEADER.as_bytes());
-    out.push(b'\n');
-    for (line, _, _) in slots.into_iter().flatten() {
-        out.extend_from_slice(line.as_bytes());
-        out.push(b'\n');
+    let missing = cells - keyed.len() as u128;
+    if missing > 0 {
+        // The first few grid points that no row holds, found between consecutive keys.
+        let mut examples = Vec::new();
+        let mut next = 0u128;
+        let keys = keyed.iter().map(|(k, _)| *k).chain([cells]);
+        for k in keys {
+            while next < k && examples.len() < 5 {
+                let (i, j) = ((next % nu) as usize, (next / nu) as usize);
+                examples.push(format!(
+                    "u = {}, p = {}",
+                    value(u_axis, i),
+                    value(p_axis, j)
+                ));
+                next += 1;
+            }
+            if examples.len() == 5 {
+                break;
+            }
+            next = k + 1;
+        }
+        return Err(SweepError::Merge(format!(
+            "{missing} of the {} x {} grid's points are missing (a shard of another grid, or \
+             one not given): {}{}",
+            us.len(),
+            ps.len(),
+            examples.join("; "),
+            if missing > 5 { "; ..." } else { "" }
+        )));
     }
-    Ok(out)
+    Ok(Merged {
+        lines: keyed.into_iter().map(|(_, r)| r.line).collect(),
+    })
 }
 
 /// With a record beside every shard: the same sweep in each, and shards 1..=N each once.
@@ -615,13 +692,25 @@ fn check_records(paths: &[PathBuf]) -> Result<(), SweepError> {
     let mut infos = Vec::new();
     for p in paths {
         let ip = info_path(p);
-        let Ok(text) = std::fs::read_to_string(&ip) else {
+        // A record is a few hundred bytes; the cap keeps a wrong file from being read whole.
+        let mut text = String::new();
+        let read = std::fs::File::open(&ip).and_then(|f| f.take(1 << 16).read_to_string(&mut text));
+        if read.is_err() {
             return Ok(());
-        };
+        }
         let info: ShardInfo = serde_json::from_str(&text).map_err(|e| SweepError::File {
             path: ip.clone(),
             message: format!("not a shard record: {e}"),
         })?;
+        if info.shard == 0 || info.shard > info.shards {
+            return Err(SweepError::File {
+                path: ip.clone(),
+                message: format!(
+                    "not a shard record: shard {}/{} is not one of 1..={}",
+                    info.shard, info.shards, info.shards
+                ),
+            });
+        }
         infos.push((p, info));
     }
     let Some((p0, first)) = infos.first() else {
@@ -650,24 +739,33 @@ fn check_records(paths: &[PathBuf]) -> Result<(), SweepError> {
         }
     }
     let n = first.shards;
-    let mut seen = vec![Vec::new(); n + 1];
+    // By shard number: a record may claim any number of shards, so nothing of size n is made.
+    let mut seen: std::collections::BTreeMap<usize, Vec<String>> = Default::default();
     for (p, i) in &infos {
-        seen[i.shard.min(n)].push(p.display().to_string());
+        seen.entry(i.shard)
+            .or_default()
+            .push(p.display().to_string());
     }
-    let missing: Vec<String> = (1..=n)
-        .filter(|&k| seen[k].is_empty())
-        .map(|k| format!("{k}/{n}"))
-        .collect();
-    if !missing.is_empty() {
+    if seen.len() < n {
+        let missing: Vec<String> = (1..=n)
+            .filter(|k| !seen.contains_key(k))
+            .take(5)
+            .map(|k| format!("{k}/{n}"))
+            .collect();
+        let more = if n - seen.len() > 5 {
+            format!(", ... ({} in all)", n - seen.len())
+        } else {
+            String::new()
+        };
         return Err(SweepError::Merge(format!(
-            "shard(s) {} of {n} are missing",
+            "shard(s) {}{more} of {n} are missing",
             missing.join(", ")
         )));
     }
-    if let Some(k) = (1..=n).find(|&k| seen[k].len() > 1) {
+    if let Some((k, files)) = seen.iter().find(|(_, f)| f.len() > 1) {
         return Err(SweepError::Merge(format!(
             "shard {k}/{n} is given twice: {}",
-            seen[k].join(" and ")
+            files.join(" and ")
         )));
     }
     Ok(())
@@ -796,7 +894,7 @@ mod tests {
             .collect();
         // In any order on the command line.
         let merged = merge(&[shards[2].clone(), shards[0].clone(), shards[1].clone()]).unwrap();
-        assert_eq!(merged, bytes);
+        assert_eq!(merged.to_bytes(), bytes);
         // Cut in the middle of a row: the resumed run completes it to the same bytes.
         let cut = dir.join("cut.csv");
         std::fs::write(&cut, &bytes[..bytes.len() * 2 / 3]).unwrap();
@@ -815,8 +913,18 @@ mod tests {
             std::fs::remove_file(info_path(p)).unwrap();
         }
         let e = merge(&shards[..2]).unwrap_err().to_string();
+        // The missing points are named in grid order: those of shard 3/3.
+        let named: Vec<String> = Shard { i: 3, n: 3 }
+            .indices(s.len())
+            .map(|k| s.point(k))
+            .map(|(u, p)| format!("u = {u}, p = {p}"))
+            .collect();
         assert!(
-            e.contains("4 of the 4 x 3 grid's points are missing"),
+            e.contains(&format!(
+                "4 of the 4 x 3 grid's points are missing (a shard of another grid, or one not \
+                 given): {}",
+                named.join("; ")
+            )),
             "{e}"
         );
         let e = merge(&[shards[0].clone(), shards[0].clone()])
@@ -824,7 +932,9 @@ mod tests {
             .to_string();
         assert!(e.contains("is in") && e.contains("s1.csv"), "{e}");
         assert_eq!(
-            merge(&[shards[2].clone(), shards[0].clone(), shards[1].clone()]).unwrap(),
+            merge(&[shards[2].clone(), shards[0].clone(), shards[1].clone()])
+                .unwrap()
+                .to_bytes(),
             bytes
         );
         let other = Sweep {
@@ -852,6 +962,99 @@ mod tests {
             e.contains("another sweep") && e.contains("other.csv"),
             "{e}"
         );
+        std::fs::remove_dir_all(&dir).ok();
+    }
+
+    /// Axes that run downwards merge in their own direction, as one unsharded run writes them.
+    #[test]
+    fn downward_axes_merge_in_their_direction() {
+        let dir = std::env::temp_dir().join(format!("rotor-sweep-down-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let s = Sweep {
+            u: Axis::parse("--u", "6:0.5:4").unwrap(),
+            p: Axis::parse("--param", "0.09:0.06:3").unwrap(),
+            ..sweep()
+        };
+        let whole = dir.join("whole.csv");
+        run_serial(&s, Shard::ALL, &whole, false);
+        let shards: Vec<PathBuf> = (1..=2)
+            .map(|i| {
+                let p = dir.join(format!("s{i}.csv"));
+                run_serial(&s, Shard { i, n: 2 }, &p, false);
+                std::fs::remove_file(info_path(&p)).unwrap();
+                p
+            })
+            .collect();
+        let merged = merge(&[shards[1].clone(), shards[0].clone()]).unwrap();
+        assert_eq!(merged.len(), 12);
+        assert_eq!(merged.to_bytes(), std::fs::read(&whole).unwrap());
+        std::fs::remove_dir_all(&dir).ok();
+    }
+
+    /// Rows and records that no sweep writes are refused by name, without a panic and without
+    /// building anything of the size they claim.
+    #[test]
+    fn merge_refuses_impossible_rows_and_records_cheaply() {
+        let dir = std::env::temp_dir().join(format!("rotor-merge-bad-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let file = |name: &str, rows: &str| {
+            let p = dir.join(name);
+            std::fs::write(&p, format!("{HEADER}\n{rows}")).unwrap();
+            p
+        };
+        // Values that are no grid's: NaN parses as a float but is on no axis.
+        for (u, what) in [("NaN", "u"), ("inf", "u"), ("1.0,-inf", "p")] {
+            let p = file(
+                "bad.csv",
+                &format!("0.5,0.06,equilibrium,,,,\n{u},0.06,stuck,,,,\n"),
+            );
+            let e = merge(&[p]).unwrap_err().to_string();
+            assert!(
+                e.contains(&format!("line 3: {what} is not a finite number")),
+                "{u}: {e}"
+            );
+        }
+        // 100 000 rows on a diagonal span a grid of 10^10 points: counted, not allocated
+        // (allocating it needs 560 GB).
+        let mut rows = String::new();
+        for i in 0..100_000 {
+            rows.push_str(&format!("{i},{i},stuck,,,,\n"));
+        }
+        let diag = file("diag.csv", &rows);
+        let e = merge(std::slice::from_ref(&diag)).unwrap_err().to_string();
+        assert!(
+            e.starts_with(
+                "the shards do not fit together: 9999900000 of the 100000 x 100000 grid's \
+                 points are missing (a shard of another grid, or one not given): u = 1, p = 0; \
+                 u = 2, p = 0;"
+            ),
+            "{e}"
+        );
+        // -0 and 0 are one grid value: a grid of one point holding it twice.
+        let zeros = file("zeros.csv", "-0.0,0.0,stuck,,,,\n0.0,-0.0,stuck,,,,\n");
+        let e = merge(&[zeros]).unwrap_err().to_string();
+        assert!(e.contains("point u = 0, p = 0 is in"), "{e}");
+        // A record claiming 10^18 shards, or a shard outside 1..=N.
+        let one = file("one.csv", "0.5,0.06,stuck,,,,\n");
+        let info = sweep().info(Shard::ALL);
+        for (shard, shards, want) in [
+            (
+                1,
+                1_000_000_000_000_000_000,
+                "shard(s) 2/1000000000000000000, 3/",
+            ),
+            (0, 3, "shard 0/3 is not one of 1..=3"),
+            (4, 3, "shard 4/3 is not one of 1..=3"),
+        ] {
+            let rec = ShardInfo {
+                shard,
+                shards,
+                ..info.clone()
+            };
+            std::fs::write(info_path(&one), serde_json::to_string(&rec).unwrap()).unwrap();
+            let e = merge(std::slice::from_ref(&one)).unwrap_err().to_string();
+            assert!(e.contains(want), "{shard}/{shards}: {e}");
+        }
         std::fs::remove_dir_all(&dir).ok();
     }
 
