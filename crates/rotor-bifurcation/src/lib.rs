@@ -60,7 +60,7 @@ pub enum BifError {
     NoReturn { u: f64 },
     #[error("no convergence at u = {u}: {detail}")]
     NoConvergence { u: f64, detail: String },
-    #[error("invalid option {field} = {value}: {reason}")]
+    #[error("invalid option {field} = {}: {reason}", rotor_model::Num(*.value))]
     InvalidOption {
         field: &'static str,
         value: f64,

@@ -171,18 +171,45 @@ pub fn validate(base: &Params, opts: &PlaneOptions) -> Result<(), BifError> {
     };
     base.get(&opts.param)
         .map_err(|e| BifError::Degenerate(e.to_string()))?;
-    if !(opts.p_min.is_finite() && opts.p_max.is_finite() && opts.p_max > opts.p_min) {
-        return bad("p_max", opts.p_max, "must be finite and greater than p_min");
+    // Each check names the option that is wrong.
+    if !opts.p_min.is_finite() {
+        return bad("p_min", opts.p_min, "must be finite");
     }
-    if !(opts.u_min >= 0.0 && opts.u_max > opts.u_min && opts.u_max <= crate::U_MAX) {
-        return bad("u_max", opts.u_max, "need 0 <= u_min < u_max <= 1000");
+    if !opts.p_max.is_finite() {
+        return bad("p_max", opts.p_max, "must be finite");
+    }
+    if opts.p_max <= opts.p_min {
+        return bad("p_max", opts.p_max, "must be greater than p_min");
+    }
+    if !(opts.u_min.is_finite() && opts.u_min >= 0.0) {
+        return bad("u_min", opts.u_min, "must be finite and >= 0");
+    }
+    if !(opts.u_max.is_finite() && opts.u_max <= crate::U_MAX) {
+        return bad("u_max", opts.u_max, "must be finite and <= 1000 V");
+    }
+    if opts.u_max <= opts.u_min {
+        return bad("u_max", opts.u_max, "must be greater than u_min");
+    }
+    // The flows' tolerance, as the one-parameter diagram's.
+    if !(1e-14..=1e-6).contains(&opts.tol) {
+        return bad("tol", opts.tol, "must lie in [1e-14, 1e-6]");
+    }
+    if opts.max_points < 2 {
+        return bad("max_points", opts.max_points as f64, "must be at least 2");
+    }
+    if let Some(p) = opts.p_start
+        && !(opts.p_min..=opts.p_max).contains(&p)
+    {
+        return bad("p_start", p, "must lie in [p_min, p_max]");
     }
     for k in 0..=64 {
         let p = opts.p_min + (opts.p_max - opts.p_min) * k as f64 / 64.0;
         base.with(&opts.param, p).map_err(|e| {
             BifError::Degenerate(format!(
                 "--param {} over [{}, {}]: {e}",
-                opts.param, opts.p_min, opts.p_max
+                opts.param,
+                rotor_model::Num(opts.p_min),
+                rotor_model::Num(opts.p_max)
             ))
         })?;
     }
@@ -1062,5 +1089,56 @@ impl Plane {
             });
         }
         render(&[panel], 760.0, 560.0)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Each bad option is refused with its own name, whatever else is wrong or right.
+    #[test]
+    fn options_are_validated_with_the_field_named() {
+        let base = Params::table1();
+        let ok = PlaneOptions::new("k_theta", 0.05, 0.1);
+        assert!(validate(&base, &ok).is_ok());
+        type Spoil = fn(&mut PlaneOptions);
+        let cases: [(Spoil, &str); 12] = [
+            (|o| o.p_min = f64::NAN, "p_min"),
+            (|o| o.p_max = f64::INFINITY, "p_max"),
+            (|o| o.p_max = o.p_min, "p_max"),
+            (|o| o.u_min = -5.0, "u_min"),
+            (|o| o.u_min = f64::NAN, "u_min"),
+            (|o| o.u_max = 1e300, "u_max"),
+            (|o| o.u_max = 0.0, "u_max"),
+            (|o| o.tol = 0.0, "tol"),
+            (|o| o.max_points = 1, "max_points"),
+            (|o| o.p_start = Some(1.0), "p_start"),
+            (|o| o.p_start = Some(f64::NAN), "p_start"),
+            (|o| o.p_min = -1.0, "k_theta"),
+        ];
+        for (spoil, field) in cases {
+            let mut o = ok.clone();
+            spoil(&mut o);
+            let e = validate(&base, &o).unwrap_err();
+            if let BifError::InvalidOption { field: f, .. } = e {
+                assert_eq!(f, field);
+            }
+            assert!(e.to_string().contains(field), "{field}: {e}");
+        }
+        // Numbers are written as one would type them back, not in 300 digits.
+        let mut o = ok.clone();
+        o.u_max = 1e300;
+        let e = validate(&base, &o).unwrap_err().to_string();
+        assert_eq!(
+            e,
+            "invalid option u_max = 1e300: must be finite and <= 1000 V"
+        );
+        o = PlaneOptions::new("k_theta", -1e-300, 0.1);
+        let e = validate(&base, &o).unwrap_err().to_string();
+        assert!(
+            e.starts_with("--param k_theta over [-1e-300, 0.1]: "),
+            "{e}"
+        );
     }
 }

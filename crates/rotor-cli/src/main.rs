@@ -400,7 +400,9 @@ fn bifurcation2(
         anyhow!(
             "{}",
             e.to_string()
+                .replace("p_min", "--p-min")
                 .replace("p_max", "--p-max")
+                .replace("u_min", "--u-min")
                 .replace("u_max", "--u-max")
         )
     })?;
