@@ -167,6 +167,11 @@ fn resolve(arg: &str, value: &Bound<'_, PyAny>, kind: &str) -> PyResult<PathBuf>
             return Ok(candidate);
         }
     }
+    // Something that is there but is no regular file (a directory, /dev/zero): the loader
+    // names what is wrong with it, as for the command line.
+    if path.exists() {
+        return Ok(path);
+    }
     let known = dir
         .as_deref()
         .and_then(|d| std::fs::read_dir(d).ok())

@@ -3,6 +3,7 @@ value, worded as the command line words it; solver failures as SolveError; panic
 InternalError, never a crash."""
 
 import math
+import os
 import warnings
 
 import numpy as np
@@ -47,6 +48,11 @@ def test_bad_params_name_the_field_and_value():
         rotorbench.simulate(params=dict(p, lower=dict(p["lower"], t_s=[1.0])))
     with pytest.raises(ValueError, match=r"^params = \"nope\": no such file, nor a name in .*table1"):
         rotorbench.simulate(params="nope")
+    # A path that is there but is no parameter file: what is wrong with it, not "no such file".
+    with pytest.raises(ValueError, match=r"cannot read parameter file: Is a directory"):
+        rotorbench.simulate(params=os.path.dirname(__file__))
+    with pytest.raises(ValueError, match=r"larger than 1048576 bytes"):
+        rotorbench.simulate(params="/dev/zero")
     with pytest.raises(TypeError, match=r"params: expected a path or a name, got int"):
         rotorbench.simulate(params=5)
     with pytest.raises(ValueError, match=r"params: k_theta = NaN: must be a finite number"):
