@@ -5,7 +5,7 @@ use std::process::ExitCode;
 
 use anyhow::{Context, Result};
 use rayon::prelude::*;
-use rotor_compare::check::{CheckError, Strictness, grade};
+use rotor_compare::check::{CheckError, Strictness, check};
 use rotor_compare::reference;
 
 /// `rotor reference [--out DIR]`: the reference files of every scenario.
@@ -76,12 +76,16 @@ fn verdict(
     json: Option<&Path>,
 ) -> Result<bool> {
     let strictness = Strictness::parse(gate).map_err(|e| anyhow::anyhow!(e.as_flag()))?;
-    let t = rotor_compare::trace::read_trace(trace).map_err(CheckError::from)?;
+    // The scenario and its reference first: the trace is read up to one row past their grid.
+    let sc = rotor_compare::load_scenario(scenario)?;
+    let r = reference::read(&reference::dir_for(scenario), &sc.name)?;
+    let t =
+        rotor_compare::trace::read_trace(trace, r.samples.len() + 1).map_err(CheckError::from)?;
     let ev = events
         .map(rotor_compare::trace::read_events)
         .transpose()
         .map_err(CheckError::from)?;
-    let report = grade(scenario, &t, ev.as_ref(), strictness)?;
+    let report = check(&sc, &r, &t, ev.as_ref(), strictness)?;
     if let Some(path) = json {
         let text = serde_json::to_string_pretty(&report)? + "\n";
         // A closed pipe on `--json -` does not hide the verdict's exit status.
