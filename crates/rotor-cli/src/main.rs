@@ -1004,8 +1004,40 @@ fn steady_json(st: &rotor_compare::SteadyAnswer) -> String {
     serde_json::to_string(st).expect("plain floats and strings serialize")
 }
 
+impl Command {
+    /// The output files the command writes, with their flags (directories it creates, as
+    /// `compare --report` and `reference --out`, are not listed).
+    fn outputs(&self) -> Vec<(&'static str, &Path)> {
+        use Command::*;
+        let (csv, json, svg) = match self {
+            Simulate { csv, .. } | Sweep { csv, .. } | Merge { csv, .. } => (Some(csv), None, None),
+            Bifurcation { json, svg, csv, .. } => (csv.as_ref(), Some(json), svg.as_ref()),
+            Bifurcation2 { json, svg, .. } => (None, Some(json), svg.as_ref()),
+            Bench { json, svg, csv, .. } => (csv.as_ref(), json.as_ref(), svg.as_ref()),
+            Check { json, .. } => (None, json.as_ref(), None),
+            Steady { .. } | Compare { .. } | Reference { .. } => (None, None, None),
+        };
+        [("--csv", csv), ("--json", json), ("--svg", svg)]
+            .into_iter()
+            .filter_map(|(flag, p)| Some((flag, p?.as_path())))
+            .collect()
+    }
+}
+
 fn main() -> ExitCode {
     let cli = Cli::parse();
+    // Outputs that cannot be written are refused before any work; for `check` that is
+    // unusable input (exit 2).
+    if let Some(cmd) = &cli.command
+        && let Err(e) = cmd
+            .outputs()
+            .into_iter()
+            .try_for_each(|(f, p)| out::writable(f, p))
+    {
+        eprintln!("error: {e:#}");
+        let unusable = matches!(cmd, Command::Check { .. });
+        return ExitCode::from(if unusable { 2 } else { 1 });
+    }
     let res = match &cli.command {
         Some(Command::Simulate {
             common,

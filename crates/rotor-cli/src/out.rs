@@ -45,3 +45,27 @@ pub fn is_closed_pipe(e: &anyhow::Error) -> bool {
             .is_some_and(|io| io.kind() == ErrorKind::BrokenPipe)
     })
 }
+
+/// Checks, before any work, that `path` (given to `flag`) can be an output: standard output
+/// (`-`), or a file whose directory exists and that is not itself a directory. A bench or a
+/// diagram that runs for minutes must not find this out at its last write.
+pub fn writable(flag: &str, path: &std::path::Path) -> anyhow::Result<()> {
+    if path.as_os_str() == "-" {
+        return Ok(());
+    }
+    if path.is_dir() {
+        anyhow::bail!("{flag} {}: is a directory, not a file", path.display());
+    }
+    let dir = match path.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d,
+        _ => std::path::Path::new("."),
+    };
+    if !dir.is_dir() {
+        anyhow::bail!(
+            "{flag} {}: the directory {} does not exist",
+            path.display(),
+            dir.display()
+        );
+    }
+    Ok(())
+}

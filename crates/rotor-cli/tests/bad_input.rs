@@ -185,6 +185,81 @@ fn bad_flags_name_the_flag_and_value() {
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
 }
 
+/// An output that cannot be written (its directory missing, or a directory itself) is
+/// refused before any work, by flag: a bench or a diagram does not run for minutes to fail at
+/// its last write, and no earlier output of the same command is left behind.
+#[test]
+fn unwritable_outputs_are_refused_before_any_work() {
+    let dir = tmp_dir();
+    let json = dir.join("b.json");
+    let (json_s, dir_s) = (json.to_str().unwrap(), dir.to_str().unwrap());
+    let missing = dir.join("no-such-dir").join("x");
+    let missing_s = missing.to_str().unwrap();
+    let scenario = fixtures().join("scenarios/t1-u1.5-rest.toml");
+    let trace = fixtures().join("reference/t1-u1.5-rest.csv");
+    let (scenario, trace) = (scenario.to_str().unwrap(), trace.to_str().unwrap());
+    let cases: [(&[&str], &[&str]); 6] = [
+        (
+            &["bifurcation", "--json", json_s, "--svg", missing_s],
+            &["--svg", "no-such-dir", "does not exist"],
+        ),
+        (
+            &["bench", "--quick", "--csv", dir_s],
+            &["--csv", "is a directory"],
+        ),
+        (
+            &[
+                "bifurcation2",
+                "--param",
+                "k_theta",
+                "--p-min",
+                "0.05",
+                "--p-max",
+                "0.1",
+                "--json",
+                missing_s,
+            ],
+            &["--json", "does not exist"],
+        ),
+        (
+            &[
+                "simulate", "--solver", "event", "--u", "1", "--csv", missing_s,
+            ],
+            &["--csv", "does not exist"],
+        ),
+        (
+            &[
+                "sweep",
+                "--u",
+                "1:2:2",
+                "--param",
+                "k_theta=0.05:0.1:2",
+                "--csv",
+                dir_s,
+            ],
+            &["--csv", "is a directory"],
+        ),
+        (
+            &["merge", "a.csv", "--csv", missing_s],
+            &["--csv", "does not exist"],
+        ),
+    ];
+    for (args, needles) in cases {
+        let o = rotor(args);
+        assert_clean_error(&o, &format!("{args:?}"), needles);
+        assert!(
+            o.stdout.is_empty(),
+            "{args:?}: no work done, nothing printed"
+        );
+        assert!(!json.exists(), "{args:?}: no other output written");
+    }
+    // For `check` an unwritable --json is unusable input: exit 2, before grading.
+    let o = rotor(&["check", scenario, "--trace", trace, "--json", missing_s]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(o.stdout.is_empty());
+    assert!(String::from_utf8_lossy(&o.stderr).contains("--json"));
+}
+
 /// Every non-hidden file of a directory with its bytes, sorted by name.
 fn files_of(dir: &Path) -> Vec<(String, Vec<u8>)> {
     let Ok(rd) = std::fs::read_dir(dir) else {
