@@ -43,7 +43,8 @@ enum Command {
     /// Bifurcation diagram over u: equilibria, periodic branches with Floquet multipliers,
     /// special points (Hopf, grazing, folds), as JSON, and optionally CSV and an SVG figure.
     Bifurcation {
-        /// Parameter file (default: the source's Table 1).
+        /// Parameter file, or the name of one in fixtures/params (`stribeck`; default: the
+        /// source's Table 1).
         #[arg(long)]
         params: Option<PathBuf>,
         /// Lower end of the input range [V] (>= 0; for a law odd in omega, u < 0 is the mirror).
@@ -77,7 +78,8 @@ enum Command {
         /// Upper end of the parameter's range.
         #[arg(long, allow_hyphen_values = true)]
         p_max: f64,
-        /// Parameter file (default: the source's Table 1).
+        /// Parameter file, or the name of one in fixtures/params (`stribeck`; default: the
+        /// source's Table 1).
         #[arg(long)]
         params: Option<PathBuf>,
         #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
@@ -100,7 +102,8 @@ enum Command {
         /// The parameter axis, NAME=A:B:N (NAME a field of the parameter file).
         #[arg(long)]
         param: String,
-        /// Parameter file (default: the source's Table 1).
+        /// Parameter file, or the name of one in fixtures/params (`stribeck`; default: the
+        /// source's Table 1).
         #[arg(long)]
         params: Option<PathBuf>,
         /// Initial state A,WU,WL (default rest), or `eq`: the perturbed equilibrium at each
@@ -161,8 +164,8 @@ enum Command {
         /// Seconds after which a client's run is killed (with its process group).
         #[arg(long, default_value_t = 60.0, allow_hyphen_values = true)]
         timeout: f64,
-        /// Benchmark these scenarios (their horizon, windows and grid) instead of the default
-        /// scenes. Repeatable.
+        /// Benchmark these scenarios (files, or names in fixtures/scenarios; their horizon,
+        /// windows and grid) instead of the default scenes. Repeatable.
         #[arg(long = "scenario", value_name = "SCENARIO.toml")]
         scenario: Vec<PathBuf>,
     },
@@ -177,7 +180,8 @@ enum Command {
     /// reference with the scenario's own gates. Exit 0: every gate passes; 1: a gate fails;
     /// 2: the input is unusable.
     Check {
-        /// Scenario file (its reference is read from fixtures/reference beside it).
+        /// Scenario file, or a name in fixtures/scenarios (`t1-u1.5-rest`); its reference is
+        /// read from the reference directory beside it.
         scenario: PathBuf,
         /// The trace to grade.
         #[arg(long)]
@@ -194,7 +198,7 @@ enum Command {
     },
     /// Run scenarios through the three solvers, gate their agreement, write the report.
     Compare {
-        /// Scenario files (default: every fixtures/scenarios/*.toml).
+        /// Scenario files or names in fixtures/scenarios (default: every one there).
         scenarios: Vec<PathBuf>,
         /// Report directory.
         #[arg(long, default_value = "reports")]
@@ -210,7 +214,8 @@ struct Common {
     /// Motor input voltage [V].
     #[arg(long, allow_hyphen_values = true)]
     u: f64,
-    /// Parameter file (default: the source's Table 1).
+    /// Parameter file, or the name of one in fixtures/params (`stribeck`; default: the
+    /// source's Table 1).
     #[arg(long)]
     params: Option<PathBuf>,
     /// Initial state alpha,omega_u,omega_l (default: rest).
@@ -239,12 +244,44 @@ fn say<const N: usize>(text: &str, outputs: [Option<&Path>; N]) -> std::io::Resu
     }
 }
 
+/// `--params`: a parameter file, or the name of one in `fixtures/params` (`stribeck`), as the
+/// Python package takes it; default Table 1.
 fn load_model(params: Option<&Path>) -> Result<Model> {
     let p = match params {
-        Some(p) => Params::from_file(p)?,
+        Some(p) => Params::from_file(&fixture_path("--params", p, "params")?)?,
         None => Params::table1(),
     };
     Ok(Model::new(p))
+}
+
+/// The file a path argument names: `p` itself if it is there, else `fixtures/KIND/<p>.toml`
+/// for a plain name (one path component, as `stribeck` or `t1-u1.5-rest`). A name that is
+/// neither is an error naming `flag` and listing the names there.
+fn fixture_path(flag: &str, p: &Path, kind: &str) -> Result<PathBuf> {
+    if p.exists() || p.components().count() != 1 {
+        return Ok(p.to_owned());
+    }
+    let dir = fixtures_dir().join(kind);
+    let named = dir.join(format!("{}.toml", p.display()));
+    if named.is_file() {
+        return Ok(named);
+    }
+    let mut names: Vec<String> = std::fs::read_dir(&dir)
+        .into_iter()
+        .flatten()
+        .flatten()
+        .filter_map(|e| {
+            let path = e.path();
+            (path.extension()? == "toml").then(|| path.file_stem()?.to_str().map(str::to_owned))?
+        })
+        .collect();
+    names.sort();
+    bail!(
+        "{flag} {}: no such file, nor a name in {} (names: {})",
+        p.display(),
+        dir.canonicalize().unwrap_or(dir).display(),
+        names.join(", ")
+    )
 }
 
 fn parse_x0(s: Option<&str>) -> Result<State> {
@@ -566,8 +603,11 @@ fn bench(
         opts.scenes = clients
             .scenarios
             .iter()
-            .map(|p| rotor_bench::SceneSpec::from_scenario(p))
-            .collect::<Result<_, _>>()?;
+            .map(|p| {
+                let p = fixture_path("--scenario", p, "scenarios")?;
+                Ok(rotor_bench::SceneSpec::from_scenario(&p)?)
+            })
+            .collect::<Result<_>>()?;
     }
     let report = rotor_bench::run(&opts, |m| eprintln!("{m}"))?;
     say(&report.table(), [json, svg, csv])?;
@@ -869,7 +909,10 @@ fn compare(files: &[PathBuf], report: &Path, main_job: bool) -> Result<()> {
         rotor_model::Scenario::list_dir(&dir)
             .with_context(|| format!("{}: cannot list scenarios", dir.display()))?
     } else {
-        files.to_vec()
+        files
+            .iter()
+            .map(|f| fixture_path("scenario", f, "scenarios"))
+            .collect::<Result<_>>()?
     };
     let scenarios = files
         .iter()
@@ -1132,7 +1175,14 @@ fn main() -> ExitCode {
             gate,
             json,
         }) => {
-            return open::check_trace(scenario, trace, events.as_deref(), gate, json.as_deref());
+            let scenario = match fixture_path("scenario", scenario, "scenarios") {
+                Ok(s) => s,
+                Err(e) => {
+                    eprintln!("error: {e:#}");
+                    return ExitCode::from(2);
+                }
+            };
+            return open::check_trace(&scenario, trace, events.as_deref(), gate, json.as_deref());
         }
         None => compare(&[], Path::new("reports"), true),
     };

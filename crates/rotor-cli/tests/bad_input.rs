@@ -260,6 +260,43 @@ fn unwritable_outputs_are_refused_before_any_work() {
     assert!(String::from_utf8_lossy(&o.stderr).contains("--json"));
 }
 
+/// A file of fixtures/params or fixtures/scenarios may be given by its name, as in the
+/// Python package: the same answer as its path. A name that is neither a file nor a fixture
+/// is an error listing the names.
+#[test]
+fn fixtures_may_be_named() {
+    let stribeck = fixtures().join("params/stribeck.toml");
+    let steady = |params: &str| {
+        rotor(&[
+            "steady", "--solver", "event", "--u", "1.5", "--params", params,
+        ])
+    };
+    let (by_name, by_path) = (steady("stribeck"), steady(stribeck.to_str().unwrap()));
+    assert!(
+        by_name.status.success(),
+        "{}",
+        String::from_utf8_lossy(&by_name.stderr)
+    );
+    assert_eq!(by_name.stdout, by_path.stdout);
+    // And differs from Table 1's: the name was not ignored.
+    assert_ne!(
+        by_name.stdout,
+        rotor(&["steady", "--solver", "event", "--u", "1.5"]).stdout
+    );
+    assert_clean_error(
+        &steady("stribek"),
+        "--params stribek",
+        &["--params stribek", "names: stribeck, table1"],
+    );
+    let trace = fixtures().join("reference/t1-u1.5-rest.csv");
+    let trace = trace.to_str().unwrap();
+    let o = rotor(&["check", "t1-u1.5-rest", "--trace", trace]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let o = rotor(&["check", "t1-u9-rest", "--trace", trace]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("t1-u1.5-rest,"));
+}
+
 /// Every non-hidden file of a directory with its bytes, sorted by name.
 fn files_of(dir: &Path) -> Vec<(String, Vec<u8>)> {
     let Ok(rd) = std::fs::read_dir(dir) else {
