@@ -181,19 +181,14 @@ pub fn validate(base: &Params, opts: &PlaneOptions) -> Result<(), BifError> {
     if opts.p_max <= opts.p_min {
         return bad("p_max", opts.p_max, "must be greater than p_min");
     }
-    if !(opts.u_min.is_finite() && opts.u_min >= 0.0) {
-        return bad("u_min", opts.u_min, "must be finite and >= 0");
+    // The u window and the flows' tolerance are the one-parameter diagram's.
+    DiagramOptions {
+        u_min: opts.u_min,
+        u_max: opts.u_max,
+        tol: opts.tol,
+        ..DiagramOptions::default()
     }
-    if !(opts.u_max.is_finite() && opts.u_max <= crate::U_MAX) {
-        return bad("u_max", opts.u_max, "must be finite and <= 1000 V");
-    }
-    if opts.u_max <= opts.u_min {
-        return bad("u_max", opts.u_max, "must be greater than u_min");
-    }
-    // The flows' tolerance, as the one-parameter diagram's.
-    if !(1e-14..=1e-6).contains(&opts.tol) {
-        return bad("tol", opts.tol, "must lie in [1e-14, 1e-6]");
-    }
+    .validate()?;
     if opts.max_points < 2 {
         return bad("max_points", opts.max_points as f64, "must be at least 2");
     }
@@ -1132,7 +1127,8 @@ mod tests {
         let e = validate(&base, &o).unwrap_err().to_string();
         assert_eq!(
             e,
-            "invalid option u_max = 1e300: must be finite and <= 1000 V"
+            "invalid option u_max = 1e300: must be <= 1000 V: the Hopf search samples omega up \
+             to 1e4 rad/s"
         );
         o = PlaneOptions::new("k_theta", -1e-300, 0.1);
         let e = validate(&base, &o).unwrap_err().to_string();

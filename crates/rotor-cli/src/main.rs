@@ -254,34 +254,19 @@ fn load_model(params: Option<&Path>) -> Result<Model> {
     Ok(Model::new(p))
 }
 
-/// The file a path argument names: `p` itself if it is there, else `fixtures/KIND/<p>.toml`
-/// for a plain name (one path component, as `stribeck` or `t1-u1.5-rest`). A name that is
-/// neither is an error naming `flag` and listing the names there.
-fn fixture_path(flag: &str, p: &Path, kind: &str) -> Result<PathBuf> {
-    if p.exists() || p.components().count() != 1 {
-        return Ok(p.to_owned());
-    }
+/// The file a path argument names: a path, or the name of a file in `fixtures/KIND`
+/// ([`rotor_compare::fixtures::resolve`]). A name that is neither is an error naming `flag`
+/// and listing the names there.
+pub(crate) fn fixture_path(flag: &str, p: &Path, kind: &str) -> Result<PathBuf> {
     let dir = fixtures_dir().join(kind);
-    let named = dir.join(format!("{}.toml", p.display()));
-    if named.is_file() {
-        return Ok(named);
-    }
-    let mut names: Vec<String> = std::fs::read_dir(&dir)
-        .into_iter()
-        .flatten()
-        .flatten()
-        .filter_map(|e| {
-            let path = e.path();
-            (path.extension()? == "toml").then(|| path.file_stem()?.to_str().map(str::to_owned))?
-        })
-        .collect();
-    names.sort();
-    bail!(
-        "{flag} {}: no such file, nor a name in {} (names: {})",
-        p.display(),
-        dir.canonicalize().unwrap_or(dir).display(),
-        names.join(", ")
-    )
+    rotor_compare::fixtures::resolve(p, Some(&dir)).ok_or_else(|| {
+        anyhow!(
+            "{flag} {}: no such file, nor a name in {} (names: {})",
+            p.display(),
+            dir.canonicalize().unwrap_or_else(|_| dir.clone()).display(),
+            rotor_compare::fixtures::names(&dir).join(", ")
+        )
+    })
 }
 
 fn parse_x0(s: Option<&str>) -> Result<State> {
@@ -1175,14 +1160,7 @@ fn main() -> ExitCode {
             gate,
             json,
         }) => {
-            let scenario = match fixture_path("scenario", scenario, "scenarios") {
-                Ok(s) => s,
-                Err(e) => {
-                    eprintln!("error: {e:#}");
-                    return ExitCode::from(2);
-                }
-            };
-            return open::check_trace(&scenario, trace, events.as_deref(), gate, json.as_deref());
+            return open::check_trace(scenario, trace, events.as_deref(), gate, json.as_deref());
         }
         None => compare(&[], Path::new("reports"), true),
     };

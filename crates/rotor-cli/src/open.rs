@@ -77,8 +77,9 @@ fn verdict(
 ) -> Result<bool> {
     let strictness = Strictness::parse(gate).map_err(|e| anyhow::anyhow!(e.as_flag()))?;
     // The scenario and its reference first: the trace is read up to one row past their grid.
-    let sc = rotor_compare::load_scenario(scenario)?;
-    let r = reference::read(&reference::dir_for(scenario), &sc.name)?;
+    let scenario = crate::fixture_path("scenario", scenario, "scenarios")?;
+    let sc = rotor_compare::load_scenario(&scenario)?;
+    let r = reference::read(&reference::dir_for(&scenario), &sc.name)?;
     let t =
         rotor_compare::trace::read_trace(trace, r.samples.len() + 1).map_err(CheckError::from)?;
     let ev = events

@@ -2,6 +2,7 @@
 //! gates on θ̇_u and θ̇_l, and the report.
 
 pub mod check;
+pub mod fixtures;
 pub mod gate;
 pub mod gridmetrics;
 pub mod probes;

@@ -808,6 +808,13 @@ mod tests {
         }
     }
 
+    /// A fresh directory for one test (tests run in parallel).
+    fn tmp_dir(tag: &str) -> PathBuf {
+        let dir = std::env::temp_dir().join(format!("{tag}-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        dir
+    }
+
     fn sweep() -> Sweep {
         Sweep {
             base: Params::table1(),
@@ -876,8 +883,7 @@ mod tests {
 
     #[test]
     fn shards_merge_to_the_unsharded_file_and_a_cut_file_resumes() {
-        let dir = std::env::temp_dir().join(format!("rotor-sweep-{}", std::process::id()));
-        std::fs::create_dir_all(&dir).unwrap();
+        let dir = tmp_dir("rotor-sweep");
         let s = sweep();
         let whole = dir.join("whole.csv");
         assert_eq!(run_serial(&s, Shard::ALL, &whole, false), 12);
@@ -968,8 +974,7 @@ mod tests {
     /// Axes that run downwards merge in their own direction, as one unsharded run writes them.
     #[test]
     fn downward_axes_merge_in_their_direction() {
-        let dir = std::env::temp_dir().join(format!("rotor-sweep-down-{}", std::process::id()));
-        std::fs::create_dir_all(&dir).unwrap();
+        let dir = tmp_dir("rotor-sweep-down");
         let s = Sweep {
             u: Axis::parse("--u", "6:0.5:4").unwrap(),
             p: Axis::parse("--param", "0.09:0.06:3").unwrap(),
@@ -995,8 +1000,7 @@ mod tests {
     /// building anything of the size they claim.
     #[test]
     fn merge_refuses_impossible_rows_and_records_cheaply() {
-        let dir = std::env::temp_dir().join(format!("rotor-merge-bad-{}", std::process::id()));
-        std::fs::create_dir_all(&dir).unwrap();
+        let dir = tmp_dir("rotor-merge-bad");
         let file = |name: &str, rows: &str| {
             let p = dir.join(name);
             std::fs::write(&p, format!("{HEADER}\n{rows}")).unwrap();
@@ -1101,8 +1105,7 @@ mod tests {
     /// refused and left byte for byte as it was; one without line ends is not read whole.
     #[test]
     fn foreign_files_are_refused_untouched() {
-        let dir = std::env::temp_dir().join(format!("rotor-sweep-foreign-{}", std::process::id()));
-        std::fs::create_dir_all(&dir).unwrap();
+        let dir = tmp_dir("rotor-sweep-foreign");
         let s = sweep();
         // A text file ending without a newline (resume would cut a half-written row), a
         // binary file without line ends, and a cut-off header (which resume does complete).

@@ -145,8 +145,9 @@ fn fixtures() -> Option<PathBuf> {
         .then(|| built.canonicalize().unwrap_or(built))
 }
 
-/// A file argument: an existing path, else the name of a file of `fixtures/<kind>/` (without
-/// `.toml`), else a `ValueError` naming the argument and what was looked for.
+/// A file argument: a path, or the name of a file of `fixtures/<kind>/` (without `.toml`;
+/// [`rotor_compare::fixtures::resolve`]), else a `ValueError` naming the argument and what
+/// was looked for.
 fn resolve(arg: &str, value: &Bound<'_, PyAny>, kind: &str) -> PyResult<PathBuf> {
     let path: PathBuf = value.extract().map_err(|_| {
         PyTypeError::new_err(format!(
@@ -154,39 +155,14 @@ fn resolve(arg: &str, value: &Bound<'_, PyAny>, kind: &str) -> PyResult<PathBuf>
             type_name(value)
         ))
     })?;
-    if path.is_file() {
-        return Ok(path);
+    let dir = fixtures().map(|f| f.join(kind));
+    if let Some(p) = rotor_compare::fixtures::resolve(&path, dir.as_deref()) {
+        return Ok(p);
     }
     let name = path.to_string_lossy().into_owned();
-    // Scenario names hold dots (`t1-u1.5-rest`): a single component is tried as a name.
-    let plain = path.components().count() == 1;
-    let dir = fixtures().map(|f| f.join(kind));
-    if plain && let Some(dir) = &dir {
-        let candidate = dir.join(format!("{name}.toml"));
-        if candidate.is_file() {
-            return Ok(candidate);
-        }
-    }
-    // Something that is there but is no regular file (a directory, /dev/zero): the loader
-    // names what is wrong with it, as for the command line.
-    if path.exists() {
-        return Ok(path);
-    }
     let known = dir
         .as_deref()
-        .and_then(|d| std::fs::read_dir(d).ok())
-        .map(|entries| {
-            let mut names: Vec<String> = entries
-                .flatten()
-                .filter_map(|e| {
-                    let p = e.path();
-                    (p.extension()? == "toml")
-                        .then(|| p.file_stem()?.to_str().map(str::to_owned))?
-                })
-                .collect();
-            names.sort();
-            names.join(", ")
-        });
+        .map(|d| rotor_compare::fixtures::names(d).join(", "));
     Err(PyValueError::new_err(match known {
         Some(known) => format!(
             "{arg} = {name:?}: no such file, nor a name in {} (names: {known})",
