@@ -259,9 +259,7 @@ impl Sweep {
         let f = |v: f64| zmij::Buffer::new().format(v).to_owned();
         match self.solver.solver().simulate_finite(&model, &scene) {
             Ok(tr) => match tr.metrics {
-                Some(SteadyState::Equilibrium {
-                    omega_u, omega_l, ..
-                }) if omega_u == 0.0 && omega_l == 0.0 => s.push_str(",stuck,,,,"),
+                Some(m) if m.is_stuck() => s.push_str(",stuck,,,,"),
                 Some(SteadyState::Equilibrium { .. }) => s.push_str(",equilibrium,,,,"),
                 Some(SteadyState::LimitCycle {
                     period,
@@ -803,6 +801,37 @@ mod tests {
                     let by_owns: Vec<usize> = (0..len).filter(|&k| s.owns(k)).collect();
                     assert_eq!(s.indices(len).collect::<Vec<_>>(), by_owns, "{len} {i}/{n}");
                     assert_eq!(s.count(len), by_owns.len(), "{len} {i}/{n}");
+                }
+            }
+        }
+    }
+
+    /// Below half the lower disc's static level over the motor constant, u < T_sl / (2 k_m),
+    /// the motor's whole torque, which the spring carries at rest, cannot break the lower
+    /// disc away: both discs end at rest. Every solver's sweep says `stuck` there, for Table 1
+    /// too, whose upper disc has no static friction and so only comes to rest asymptotically.
+    #[test]
+    fn below_the_breakaway_torque_every_solver_says_stuck() {
+        let stribeck = concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/../../fixtures/params/stribeck.toml"
+        );
+        for base in [
+            Params::table1(),
+            Params::from_file(std::path::Path::new(stribeck)).unwrap(),
+        ] {
+            let u = 0.5 * base.get("lower.t_s").unwrap() / base.get("k_m").unwrap();
+            for solver in crate::solvers::SOLVERS {
+                let sw = Sweep {
+                    base,
+                    u: Axis::parse("--u", &format!("{u}:{}:2", 0.5 * u)).unwrap(),
+                    solver,
+                    ..sweep()
+                };
+                for k in 0..sw.len() {
+                    let row = sw.row(k);
+                    let name = solver.name();
+                    assert_eq!(row.split(',').nth(2), Some("stuck"), "{name}: {row}");
                 }
             }
         }

@@ -75,6 +75,15 @@ impl SteadyState {
         }
     }
 
+    /// Both discs at rest with the lower one stuck: an equilibrium with ω_l = 0 exactly.
+    /// Every solver sets a stuck disc's velocity to 0 exactly, and at an equilibrium
+    /// α̇ = ω_u − ω_l = 0, so ω_u is 0 as well, up to how the run approached rest: an upper
+    /// disc with only viscous friction (Table 1) never sticks, and its velocity decays to the
+    /// rounding of α (1e-16 rad/s after 1500 s, 1e-10 in a Moreau–Jean run), never to 0.
+    pub fn is_stuck(&self) -> bool {
+        matches!(self, SteadyState::Equilibrium { omega_l, .. } if *omega_l == 0.0)
+    }
+
     /// An equilibrium or a limit cycle.
     pub fn kind(&self) -> SteadyKind {
         match self {
