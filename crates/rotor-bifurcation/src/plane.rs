@@ -123,10 +123,58 @@ pub struct Curve {
     pub ends: Vec<String>,
 }
 
+/// A kind of codimension-two point.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Codim2Kind {
+    /// The first Lyapunov coefficient changes sign along a Hopf curve.
+    Bautin,
+    /// A Hopf curve turns back in p: two Hopf points meet and vanish.
+    HopfMerge,
+    /// A fold curve turns back in p: two folds of cycles meet.
+    Cusp,
+    /// Another curve turns back in p.
+    Turning,
+    /// A Hopf curve reaches the stuck boundary (the equilibrium's velocity reaches 0).
+    StuckEnd,
+    /// A grazing curve turns into a discontinuous fold (a fold of cycles meets it).
+    GrazingFold,
+    /// Two curves cross.
+    CurvesCross,
+}
+
+impl Codim2Kind {
+    /// The name in the JSON and the report's table (`bautin`, `grazing_fold`, ...).
+    pub fn name(self) -> &'static str {
+        match self {
+            Codim2Kind::Bautin => "bautin",
+            Codim2Kind::HopfMerge => "hopf_merge",
+            Codim2Kind::Cusp => "cusp",
+            Codim2Kind::Turning => "turning",
+            Codim2Kind::StuckEnd => "stuck_end",
+            Codim2Kind::GrazingFold => "grazing_fold",
+            Codim2Kind::CurvesCross => "curves_cross",
+        }
+    }
+
+    /// The words on the figure.
+    pub fn title(self) -> &'static str {
+        match self {
+            Codim2Kind::Bautin => "Bautin",
+            Codim2Kind::HopfMerge => "Hopf points meet",
+            Codim2Kind::Cusp => "cusp",
+            Codim2Kind::Turning => "turning point",
+            Codim2Kind::StuckEnd => "Hopf meets stuck boundary",
+            Codim2Kind::GrazingFold => "grazing turns fold",
+            Codim2Kind::CurvesCross => "curves cross",
+        }
+    }
+}
+
 /// A codimension-two point.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Codim2 {
-    pub kind: &'static str,
+    pub kind: Codim2Kind,
     pub p: f64,
     pub u: f64,
     /// The curves involved.
@@ -134,12 +182,19 @@ pub struct Codim2 {
     pub detail: String,
 }
 
-/// A named region of the plane, at a representative point.
+/// A named region of the plane: one connected piece of it, named at the middle of its
+/// tallest band, `[u_lo, u_hi]` at `p`.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Region {
     pub name: String,
     pub p: f64,
     pub u: f64,
+    pub u_lo: f64,
+    pub u_hi: f64,
+    /// Every band of the region, `[p, u_lo, u_hi]`, this one first, then the others in
+    /// order of height (where the figure may write the name instead).
+    #[serde(skip)]
+    pub bands: Vec<[f64; 3]>,
 }
 
 /// The two-parameter picture (the JSON of `rotor bifurcation2`).
@@ -148,6 +203,9 @@ pub struct Plane {
     pub param: String,
     /// The parameter's value in the file.
     pub p_file: f64,
+    /// The window computed: `[p_min, p_max]` and `[u_min, u_max]`.
+    pub p_range: [f64; 2],
+    pub u_range: [f64; 2],
     pub curves: Vec<Curve>,
     pub points: Vec<Codim2>,
     pub regions: Vec<Region>,
@@ -550,10 +608,12 @@ pub fn plane(base: &Params, opts: &PlaneOptions) -> Result<Plane, BifError> {
         }
     }
     let points = codim2(base, name, &curves, opts);
-    let regions = regions(base, name, opts)?;
+    let regions = regions(base, name, opts, &curves)?;
     Ok(Plane {
         param: opts.param.clone(),
         p_file,
+        p_range: [opts.p_min, opts.p_max],
+        u_range: [opts.u_min, opts.u_max],
         curves,
         points,
         regions,
@@ -613,9 +673,9 @@ fn codim2(base: &Params, name: &str, curves: &[Curve], opts: &PlaneOptions) -> V
             let (a, b, cc) = (&w[0], &w[1], &w[2]);
             if (b.p - a.p) * (cc.p - b.p) < 0.0 {
                 let (kind, what) = match c.kind {
-                    CurveKind::Hopf => ("hopf_merge", "two Hopf points meet and vanish"),
-                    CurveKind::Fold => ("cusp", "two folds of cycles meet"),
-                    _ => ("turning", "the curve turns back in the parameter"),
+                    CurveKind::Hopf => (Codim2Kind::HopfMerge, "two Hopf points meet and vanish"),
+                    CurveKind::Fold => (Codim2Kind::Cusp, "two folds of cycles meet"),
+                    _ => (Codim2Kind::Turning, "the curve turns back in the parameter"),
                 };
                 out.push(Codim2 {
                     kind,
@@ -635,7 +695,7 @@ fn codim2(base: &Params, name: &str, curves: &[Curve], opts: &PlaneOptions) -> V
             for end in [pts.first(), pts.last()].into_iter().flatten() {
                 if end.omega.is_some_and(|w| w < 1e-3) {
                     out.push(Codim2 {
-                        kind: "stuck_end",
+                        kind: Codim2Kind::StuckEnd,
                         p: end.p,
                         u: end.u,
                         curves: vec![c.label.clone(), "S".into()],
@@ -661,7 +721,7 @@ fn codim2(base: &Params, name: &str, curves: &[Curve], opts: &PlaneOptions) -> V
             let (p, u) = grazing_fold(base, name, pa, pb, opts.tol)
                 .unwrap_or((b.points[0].p, b.points[0].u));
             out.push(Codim2 {
-                kind: "grazing_fold",
+                kind: Codim2Kind::GrazingFold,
                 p,
                 u,
                 curves: vec![a.label.clone()],
@@ -716,7 +776,7 @@ fn codim2(base: &Params, name: &str, curves: &[Curve], opts: &PlaneOptions) -> V
                         }
                     }
                     out.push(Codim2 {
-                        kind: "curves_cross",
+                        kind: Codim2Kind::CurvesCross,
                         p: at.0,
                         u: at.1,
                         curves: vec![a.label.clone(), b.label.clone()],
@@ -893,7 +953,7 @@ fn bautin(base: &Params, name: &str, a: &CurvePoint, b: &CurvePoint, label: &str
         }
     }
     Codim2 {
-        kind: "bautin",
+        kind: Codim2Kind::Bautin,
         p: best.0,
         u: best.1,
         curves: vec![label.to_owned()],
@@ -920,9 +980,7 @@ pub fn classify(model: &Model, u: f64, x0: State) -> &'static str {
         .simulate(model, &scene)
         .map(|t| t.metrics)
     {
-        Ok(Some(SteadyState::Equilibrium {
-            omega_u, omega_l, ..
-        })) if omega_u == 0.0 && omega_l == 0.0 => "stuck",
+        Ok(Some(m)) if m.is_stuck() => "stuck",
         Ok(Some(SteadyState::Equilibrium { .. })) => "equilibrium",
         Ok(Some(SteadyState::LimitCycle { stick_time, .. })) if stick_time > 0.0 => {
             "stick-slip cycle"
@@ -945,47 +1003,154 @@ pub fn region_name(from_rest: &str, from_eq: &str) -> String {
     }
 }
 
-/// Names the regions: the coarse grid's cells classified from rest and from the perturbed
-/// equilibrium, each name placed at the cell nearest the centroid of its cells.
-fn regions(base: &Params, name: &str, opts: &PlaneOptions) -> Result<Vec<Region>, BifError> {
+/// The u where the curves cross the vertical line at `p`, linear between curve points,
+/// in increasing order (a vertex on the line counts once).
+fn crossings(curves: &[Curve], p: f64) -> Vec<f64> {
+    let mut v: Vec<f64> = curves
+        .iter()
+        .flat_map(|c| c.points.windows(2))
+        .filter_map(|w| {
+            let (a, b) = (&w[0], &w[1]);
+            let hit = (a.p <= p && p < b.p) || (b.p <= p && p < a.p);
+            hit.then(|| a.u + (p - a.p) / (b.p - a.p) * (b.u - a.u))
+        })
+        .filter(|u| u.is_finite())
+        .collect();
+    v.sort_by(f64::total_cmp);
+    v
+}
+
+/// A band of one column of the plane with one name: column `col`, u from `lo` to `hi`.
+struct Piece {
+    col: usize,
+    lo: f64,
+    hi: f64,
+    name: String,
+}
+
+/// Names the regions. The curves cut each of `region_cells` columns (p at the cells'
+/// centres) into bands; each band is classified at its middle from rest and from the
+/// perturbed equilibrium, and a band taller than a cell (1/`region_cells` of the u-window)
+/// once per cell, so that a region no curve bounds is still found. A band thinner than
+/// 1/1000 of the u-window is not named: a simulation there, between two curves that nearly
+/// meet, says more about its transient than about the region. Bands of one name that
+/// overlap in neighbouring columns are one region, named once at its tallest band (the one
+/// nearest the middle column among those within 1 % of the tallest).
+fn regions(
+    base: &Params,
+    name: &str,
+    opts: &PlaneOptions,
+    curves: &[Curve],
+) -> Result<Vec<Region>, BifError> {
     let n = opts.region_cells.max(2);
-    let mut cells: Vec<(String, f64, f64)> = Vec::new();
-    for i in 0..n {
-        for j in 0..n {
-            let p = opts.p_min + (opts.p_max - opts.p_min) * (i as f64 + 0.5) / n as f64;
-            let u = opts.u_min + (opts.u_max - opts.u_min) * (j as f64 + 0.5) / n as f64;
-            let m = Model::new(params_at(base, name, p)?);
-            let a = classify(&m, u, State::zeros());
-            let b = classify(&m, u, m.perturbed_equilibrium(u));
-            cells.push((region_name(a, b), p, u));
+    let (u_min, u_max) = (opts.u_min, opts.u_max);
+    let cell = (u_max - u_min) / n as f64;
+    let thin = 1e-3 * (u_max - u_min);
+    let column = |j: usize| opts.p_min + (opts.p_max - opts.p_min) * (j as f64 + 0.5) / n as f64;
+    let mut pieces: Vec<Piece> = Vec::new();
+    for j in 0..n {
+        let p = column(j);
+        let m = Model::new(params_at(base, name, p)?);
+        let mut edges = vec![u_min];
+        edges.extend(
+            crossings(curves, p)
+                .into_iter()
+                .filter(|&u| u > u_min && u < u_max),
+        );
+        edges.push(u_max);
+        for w in edges.windows(2) {
+            let (lo, hi) = (w[0], w[1]);
+            if hi - lo < thin {
+                continue;
+            }
+            let k = ((hi - lo) / cell).ceil().max(1.0) as usize;
+            let at = |i: usize| lo + (hi - lo) * i as f64 / k as f64;
+            let mut start = lo;
+            let mut prev: Option<String> = None;
+            for i in 0..k {
+                let u = 0.5 * (at(i) + at(i + 1));
+                let here = region_name(
+                    classify(&m, u, State::zeros()),
+                    classify(&m, u, m.perturbed_equilibrium(u)),
+                );
+                match prev.take() {
+                    Some(before) if before != here => {
+                        pieces.push(Piece {
+                            col: j,
+                            lo: start,
+                            hi: at(i),
+                            name: before,
+                        });
+                        start = at(i);
+                    }
+                    _ => {}
+                }
+                prev = Some(here);
+            }
+            if let Some(last) = prev {
+                pieces.push(Piece {
+                    col: j,
+                    lo: start,
+                    hi,
+                    name: last,
+                });
+            }
         }
     }
-    let mut names: Vec<String> = cells.iter().map(|c| c.0.clone()).collect();
-    names.sort();
-    names.dedup();
-    Ok(names
-        .into_iter()
-        .filter_map(|nm| {
-            let mine: Vec<&(String, f64, f64)> = cells.iter().filter(|c| c.0 == nm).collect();
-            let k = mine.len() as f64;
-            let (cp, cu) = (
-                mine.iter().map(|c| c.1).sum::<f64>() / k,
-                mine.iter().map(|c| c.2).sum::<f64>() / k,
-            );
-            let sp = opts.p_max - opts.p_min;
-            let su = opts.u_max - opts.u_min;
-            let best = mine.iter().min_by(|a, b| {
-                let da = ((a.1 - cp) / sp).hypot((a.2 - cu) / su);
-                let db = ((b.1 - cp) / sp).hypot((b.2 - cu) / su);
-                da.total_cmp(&db)
-            })?;
-            Some(Region {
-                name: nm,
-                p: best.1,
-                u: best.2,
-            })
+    // Connected pieces: union-find over neighbours in adjacent columns.
+    let mut root: Vec<usize> = (0..pieces.len()).collect();
+    fn find(root: &mut [usize], mut i: usize) -> usize {
+        while root[i] != i {
+            root[i] = root[root[i]];
+            i = root[i];
+        }
+        i
+    }
+    for a in 0..pieces.len() {
+        for b in a + 1..pieces.len() {
+            let (x, y) = (&pieces[a], &pieces[b]);
+            if y.col == x.col + 1 && x.name == y.name && x.lo < y.hi && y.lo < x.hi {
+                let (ra, rb) = (find(&mut root, a), find(&mut root, b));
+                root[ra.max(rb)] = ra.min(rb);
+            }
+        }
+    }
+    let group: Vec<usize> = (0..pieces.len()).map(|i| find(&mut root, i)).collect();
+    let height = |q: &Piece| q.hi - q.lo;
+    // Each region's bands, tallest first (those within 1 % of the tallest: nearest the
+    // middle column first).
+    let mid = 0.5 * (n as f64 - 1.0);
+    let off_middle = |q: &Piece| (q.col as f64 - mid).abs();
+    let mut members: std::collections::BTreeMap<usize, Vec<&Piece>> = Default::default();
+    for (q, &g) in pieces.iter().zip(&group) {
+        members.entry(g).or_default().push(q);
+    }
+    let mut out: Vec<Region> = members
+        .into_values()
+        .map(|mut v| {
+            let tallest = v.iter().map(|q| height(q)).fold(0.0, f64::max);
+            let rank = |q: &Piece| (height(q) < 0.99 * tallest, -height(q), off_middle(q));
+            v.sort_by(|a, b| {
+                let (ra, rb) = (rank(a), rank(b));
+                ra.0.cmp(&rb.0).then(if ra.0 {
+                    ra.1.total_cmp(&rb.1)
+                } else {
+                    ra.2.total_cmp(&rb.2)
+                })
+            });
+            let q = v[0];
+            Region {
+                name: q.name.clone(),
+                p: column(q.col),
+                u: 0.5 * (q.lo + q.hi),
+                u_lo: q.lo,
+                u_hi: q.hi,
+                bands: v.iter().map(|q| [column(q.col), q.lo, q.hi]).collect(),
+            }
         })
-        .collect())
+        .collect();
+    out.sort_by(|a, b| a.u.total_cmp(&b.u).then(a.p.total_cmp(&b.p)));
+    Ok(out)
 }
 
 impl Plane {
@@ -1006,10 +1171,13 @@ impl Plane {
         serde_json::to_string_pretty(self).map_err(|e| BifError::Io(e.to_string()))
     }
 
-    /// The (p, u) plane as an SVG figure: the curves labelled, the codimension-two points
-    /// marked, the regions named, the file's value of p as a dashed line.
+    /// The (p, u) plane as an SVG figure over the computed window: each curve in its kind's
+    /// colour and named in the margin when it reaches the window's right edge, else at its
+    /// left end; the codimension-two points marked and named (those nearer than 3 % of the
+    /// window share a label); the file's value of p dashed, with a dot where each curve
+    /// crosses it (the one-parameter diagram's points); each region named in its band.
     pub fn to_svg(&self, title: &str) -> String {
-        use rotor_plot::{Label, Panel, Series, render};
+        use rotor_plot::{Band, EndLabel, Label, Panel, Series, merge_close, render};
         let color = |k: CurveKind| match k {
             CurveKind::Hopf => "#1f77b4",
             CurveKind::Grazing => "#2ca02c",
@@ -1017,25 +1185,18 @@ impl Plane {
             CurveKind::DiscontinuousFold => "#9467bd",
             CurveKind::StuckBoundary => "#7f7f7f",
         };
-        let (u_lo, u_hi) = self
+        let ([p_lo, p_hi], [u_lo, u_hi]) = (self.p_range, self.u_range);
+        let (span_p, span_u) = (p_hi - p_lo, u_hi - u_lo);
+        let drawn: Vec<Vec<(f64, f64)>> = self
             .curves
             .iter()
-            .flat_map(|c| c.points.iter().map(|q| q.u))
-            .chain(self.regions.iter().map(|r| r.u))
-            .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), u| {
-                (a.min(u), b.max(u))
-            });
+            .map(|c| clip_p(&c.points, p_lo, p_hi))
+            .collect();
         let mut series: Vec<Series> = self
             .curves
             .iter()
-            .map(|c| Series {
-                marker: None,
-                ..Series::line(
-                    "",
-                    color(c.kind),
-                    c.points.iter().map(|q| (q.p, q.u)).collect(),
-                )
-            })
+            .zip(&drawn)
+            .map(|(c, pts)| Series::line("", color(c.kind), pts.clone()))
             .collect();
         for (kind, text) in [
             (CurveKind::Hopf, "Hopf"),
@@ -1048,7 +1209,7 @@ impl Plane {
                 series.push(Series::line(text, color(kind), Vec::new()));
             }
         }
-        if u_lo.is_finite() {
+        if (p_lo..=p_hi).contains(&self.p_file) {
             series.push(Series {
                 dash: Some("4 4"),
                 width: 1.0,
@@ -1058,38 +1219,133 @@ impl Plane {
                     vec![(self.p_file, u_lo), (self.p_file, u_hi)],
                 )
             });
+            let dots = crossings(&self.curves, self.p_file)
+                .into_iter()
+                .filter(|u| (u_lo..=u_hi).contains(u))
+                .map(|u| (self.p_file, u))
+                .collect();
+            series.push(Series {
+                width: 0.0,
+                marker: Some(2.5),
+                ..Series::line("", "#000000", dots)
+            });
         }
         let mut panel = Panel::new(title.to_owned(), &self.param, "u [V]", series);
-        for c in &self.curves {
-            if let Some(q) = c.points.get(c.points.len() / 2) {
-                panel.labels.push(Label {
-                    x: q.p,
-                    y: q.u,
+        panel.clear_x.push(self.p_file);
+        for (c, pts) in self.curves.iter().zip(&drawn) {
+            let finite = || pts.iter().filter(|q| q.0.is_finite() && q.1.is_finite());
+            let right = finite().max_by(|a, b| a.0.total_cmp(&b.0));
+            let left = finite().min_by(|a, b| a.0.total_cmp(&b.0));
+            // Named in the margin if it reaches the right edge, else at its left end (its
+            // right end is often a codimension-two point, already named).
+            let (end, margin) = match right {
+                Some(&q) if p_hi - q.0 <= 1e-9 * span_p => (Some(q), true),
+                _ => (left.copied(), false),
+            };
+            if let Some((x, y)) = end {
+                panel.ends.push(EndLabel {
+                    x,
+                    y,
                     text: c.label.clone(),
+                    color: color(c.kind).to_owned(),
+                    margin,
                 });
             }
         }
-        for q in &self.points {
-            panel.labels.push(Label {
-                x: q.p,
-                y: q.u,
-                text: q.kind.to_owned(),
-            });
-        }
-        for r in &self.regions {
-            panel.notes.push(Label {
-                x: r.p,
-                y: r.u,
+        panel.labels = merge_close(
+            self.points
+                .iter()
+                .filter(|q| (p_lo..=p_hi).contains(&q.p))
+                .map(|q| Label {
+                    x: q.p,
+                    y: q.u,
+                    text: q.kind.title().to_owned(),
+                })
+                .collect(),
+            span_p,
+            span_u,
+            0.03,
+        );
+        panel.bands = self
+            .regions
+            .iter()
+            .map(|r| Band {
                 text: r.name.clone(),
-            });
-        }
+                places: r.bands.iter().map(|b| (b[0], b[1], b[2])).collect(),
+            })
+            .collect();
         render(&[panel], 760.0, 560.0)
     }
+}
+
+/// A curve's points with p in `[lo, hi]`, cut where it leaves and enters that window (the
+/// cut points interpolated on the edge, a NaN point between the pieces).
+fn clip_p(points: &[CurvePoint], lo: f64, hi: f64) -> Vec<(f64, f64)> {
+    let inside = |p: f64| (lo..=hi).contains(&p);
+    let mut out: Vec<(f64, f64)> = Vec::new();
+    let mut push = |q: (f64, f64)| {
+        if inside(q.0) {
+            out.push(q);
+        } else if out.last().is_some_and(|l| l.0.is_finite()) {
+            out.push((f64::NAN, f64::NAN));
+        }
+    };
+    for (i, b) in points.iter().enumerate() {
+        if let Some(a) = i.checked_sub(1).map(|k| &points[k]) {
+            let mut cuts: Vec<f64> = [lo, hi]
+                .into_iter()
+                .filter(|e| (a.p - e) * (b.p - e) < 0.0)
+                .map(|e| (e - a.p) / (b.p - a.p))
+                .collect();
+            cuts.sort_by(f64::total_cmp);
+            for s in cuts {
+                // The edge itself, not its value rounded through s.
+                let at = a.p + s * (b.p - a.p);
+                let edge = if (at - lo).abs() < (at - hi).abs() {
+                    lo
+                } else {
+                    hi
+                };
+                push((edge, a.u + s * (b.u - a.u)));
+            }
+        }
+        push((b.p, b.u));
+    }
+    if out.last().is_some_and(|l| l.0.is_nan()) {
+        out.pop();
+    }
+    out
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A curve is cut on the window's edges, the cut points on the edges exactly, with a pen
+    /// lift between the pieces; a segment that crosses the whole window keeps both cuts.
+    #[test]
+    fn curves_are_clipped_to_the_window() {
+        let pt = |p: f64, u: f64| CurvePoint {
+            p,
+            u,
+            residual: 0.0,
+            omega: None,
+            l1: None,
+            multiplier: None,
+            touch_omega_u: None,
+            section_state: None,
+        };
+        let c = [pt(-1.0, 0.0), pt(0.5, 1.5), pt(2.0, 3.0), pt(0.5, 4.5)];
+        let out = clip_p(&c, 0.0, 1.0);
+        let fin: Vec<(f64, f64)> = out.iter().copied().filter(|q| q.0.is_finite()).collect();
+        assert_eq!(
+            fin,
+            [(0.0, 1.0), (0.5, 1.5), (1.0, 2.0), (1.0, 4.0), (0.5, 4.5)]
+        );
+        assert!(out[3].0.is_nan() && out.len() == 6, "{out:?}");
+        let across = clip_p(&[pt(-1.0, 0.0), pt(3.0, 4.0)], 0.0, 1.0);
+        assert_eq!(across, [(0.0, 1.0), (1.0, 2.0)]);
+    }
 
     /// Each bad option is refused with its own name, whatever else is wrong or right.
     #[test]

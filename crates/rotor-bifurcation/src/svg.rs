@@ -12,7 +12,7 @@
 //!   source's name; others are D1, D2, ...) at the cycle's maximum of ω_l. Points closer than
 //!   2 % of the axis ranges share one label.
 
-use rotor_plot::{Label, Panel, Series, render as plot};
+use rotor_plot::{Label, Panel, Series, merge_close, render as plot};
 
 use crate::{Diagram, EquilibriumKind, PointKind};
 
@@ -131,27 +131,19 @@ pub(crate) fn render(d: &Diagram, title: &str) -> String {
         if hi > lo { hi - lo } else { 1.0 }
     };
     let (sx, sy) = (span(|p| p.0), span(|p| p.1));
-    let mut clusters: Vec<(f64, f64, Vec<String>)> = Vec::new();
-    for (x, y, text) in &marks {
-        match clusters
-            .iter_mut()
-            .find(|c| ((c.0 - x) / sx).abs() < 0.02 && ((c.1 - y) / sy).abs() < 0.02)
-        {
-            Some(c) => {
-                c.2.push(text.clone());
-                c.1 = c.1.max(*y);
-            }
-            None => clusters.push((*x, *y, vec![text.clone()])),
-        }
-    }
-    let labels: Vec<Label> = clusters
-        .into_iter()
-        .map(|(x, y, t)| Label {
-            x,
-            y,
-            text: t.join(" / "),
-        })
-        .collect();
+    let labels = merge_close(
+        marks
+            .iter()
+            .map(|(x, y, text)| Label {
+                x: *x,
+                y: *y,
+                text: text.clone(),
+            })
+            .collect(),
+        sx,
+        sy,
+        0.02,
+    );
     let markers = Series {
         width: 0.0,
         marker: Some(3.0),

@@ -457,7 +457,7 @@ fn bifurcation2(
     for q in &plane.points {
         summary.push_str(&format!(
             "  {} at {param} = {:.6}, u = {:.6}: {}\n",
-            q.kind,
+            q.kind.name(),
             q.p,
             q.u,
             q.curves.join(", ")
@@ -730,8 +730,9 @@ fn plane_section(sets: &[(&str, &str, Params)]) -> Result<rotor_compare::report:
          Every codimension-one point of the u-diagram continued in the plane of (p, u) for the \
          stiffness k_θ and the lower disc's static level T_sl, \
          with the codimension-two points located on the curves and the regions named from \
-         simulations from rest and from the perturbed equilibrium on a coarse grid \
-         (docs/methods.md, section 4a). The dashed line is the file's value.\n",
+         simulations from rest and from the perturbed equilibrium in every band the curves \
+         bound (docs/methods.md, section 4a). The dashed line is the file's value; its dots \
+         are the one-parameter diagram's points.\n",
     );
     for ((name, slug, _, param, a, b), (pl, secs)) in jobs.iter().zip(planes) {
         let pl = pl.with_context(|| format!("{name}: two-parameter analysis over {param}"))?;
@@ -755,7 +756,7 @@ fn plane_section(sets: &[(&str, &str, Params)]) -> Result<rotor_compare::report:
                 let _ = writeln!(
                     sec.markdown,
                     "| {} | {:.5} | {:.5} | {} | {} |",
-                    q.kind,
+                    q.kind.name(),
                     q.p,
                     q.u,
                     q.curves.join(", "),

@@ -77,4 +77,29 @@ fn a_sweep_classifies_every_point_as_the_curves_region() {
     }
     assert!(checked > 60, "{checked} points checked");
     assert!(bad.is_empty(), "{}", bad.join("\n"));
+
+    // The named regions: every band the curves bound is one region, named where the curves
+    // and the one-parameter diagram say (H1 supercritical: a slipping cycle above it, turned
+    // stick-slip at G1; H2 subcritical: the equilibrium stable again above it, beside the
+    // stick-slip cycle, which stops sticking at G2 and ends in the fold F1).
+    let (g1, g2) = (curve("G1"), curve("G2"));
+    let mut names = Vec::new();
+    for r in &pl.regions {
+        let at = |c| solve_u(&base, "k_theta", c, r.p, r.u, 1e-10).unwrap();
+        let edges = [at(s), at(h1), at(g1), at(h2), at(g2), at(f1)];
+        let expected = [
+            "both discs stuck",
+            "equilibrium only",
+            "slipping cycle only",
+            "stick-slip cycle only",
+            "bistable: equilibrium and stick-slip cycle",
+            "bistable: equilibrium and slipping cycle",
+            "equilibrium only",
+        ][edges.iter().filter(|&&e| e < r.u).count()];
+        assert_eq!(r.name, expected, "{r:?} between {edges:?}");
+        assert!(r.u_lo <= r.u && r.u <= r.u_hi, "{r:?}");
+        names.push(expected);
+    }
+    // Each of the seven bands, once (the equilibrium alone below H1 and above F1).
+    assert_eq!(names.len(), 7, "{:?}", pl.regions);
 }

@@ -38,6 +38,27 @@ pub struct Label {
     pub text: String,
 }
 
+/// A region's name, centred in one of its vertical bands: `places` holds `(x, y_lo, y_hi)`
+/// in order of preference, and the name goes to the first where it fits in 12 px text, covers
+/// no line of [`Panel::clear_x`] and no name placed before (then the first that covers no
+/// name, then the first). It is on a white halo, legible where it covers a curve; smaller
+/// where the band is narrower than a line of text; left out where every band is thinner than
+/// a pixel (it cannot be seen).
+pub struct Band {
+    pub text: String,
+    pub places: Vec<(f64, f64, f64)>,
+}
+
+/// A curve's name at one of its ends, in the curve's colour: in the right margin, joined to
+/// the end by a thin line, if `margin` (the curve reaches the right edge), else beside it.
+pub struct EndLabel {
+    pub x: f64,
+    pub y: f64,
+    pub text: String,
+    pub color: String,
+    pub margin: bool,
+}
+
 /// A panel: title, axis labels, series, and how each axis is scaled.
 pub struct Panel<'a> {
     pub title: String,
@@ -46,8 +67,12 @@ pub struct Panel<'a> {
     pub series: Vec<Series<'a>>,
     /// Labelled points (special points of a diagram, say).
     pub labels: Vec<Label>,
-    /// Text centred at a data point, without a mark (the name of a region, say).
-    pub notes: Vec<Label>,
+    /// Names of regions, each in its band.
+    pub bands: Vec<Band>,
+    /// Names of curves, at their ends.
+    pub ends: Vec<EndLabel>,
+    /// Vertical lines (at these x) that the names of regions are moved off.
+    pub clear_x: Vec<f64>,
     /// Logarithmic axes: points with a non-positive coordinate are skipped.
     pub x_log: bool,
     pub y_log: bool,
@@ -67,7 +92,9 @@ impl<'a> Panel<'a> {
             y_label,
             series,
             labels: Vec::new(),
-            notes: Vec::new(),
+            bands: Vec::new(),
+            ends: Vec::new(),
+            clear_x: Vec::new(),
             x_log: false,
             y_log: false,
         }
@@ -134,12 +161,18 @@ pub fn render(panels: &[Panel], width: f64, panel_height: f64) -> String {
         let oy = k as f64 * panel_height;
         let has_legend = p.series.iter().any(|s| !s.label.is_empty());
         let top = if has_legend { 50.0 } else { 30.0 };
-        let (l, r, t, b) = (70.0, width - 20.0, oy + top, oy + panel_height - 45.0);
+        let (l, t, b) = (70.0, oy + top, oy + panel_height - 45.0);
         let pts = p
             .series
             .iter()
             .flat_map(|s| s.points.iter().copied())
             .chain(p.labels.iter().map(|l| (l.x, l.y)))
+            .chain(p.ends.iter().map(|e| (e.x, e.y)))
+            .chain(
+                p.bands
+                    .iter()
+                    .flat_map(|n| n.places.iter().flat_map(|q| [(q.0, q.1), (q.0, q.2)])),
+            )
             .map(|(x, y)| (axis(x, p.x_log), axis(y, p.y_log)));
         let (mut x0, mut x1, mut y0, mut y1) = (
             f64::INFINITY,
@@ -168,9 +201,16 @@ pub fn render(panels: &[Panel], width: f64, panel_height: f64) -> String {
             x0 -= 0.5;
             x1 += 0.5;
         }
+        let ay = |y: f64| b - (y - y0) / (y1 - y0) * (b - t);
+        // Curve names whose curve reaches the right edge go into the margin.
+        let margin: Vec<&EndLabel> = p.ends.iter().filter(|e| e.margin).collect();
+        let margin_width = margin
+            .iter()
+            .map(|m| 12.0 + SMALL_CHAR * m.text.chars().count() as f64)
+            .fold(0.0, f64::max);
+        let r = width - 20.0 - margin_width;
         // Axis coordinate -> pixels.
         let ax = |x: f64| l + (x - x0) / (x1 - x0) * (r - l);
-        let ay = |y: f64| b - (y - y0) / (y1 - y0) * (b - t);
         // Data coordinate -> pixels.
         let sx = |x: f64| ax(axis(x, p.x_log));
         let sy = |y: f64| ay(axis(y, p.y_log));
@@ -321,19 +361,151 @@ pub fn render(panels: &[Panel], width: f64, panel_height: f64) -> String {
                 esc(&lab.text)
             );
         }
-        for note in &p.notes {
-            let (px, py) = (sx(note.x), sy(note.y));
+        // Boxes [x0, x1, y0, y1] of the region names placed so far.
+        let mut placed: Vec<[f64; 4]> = Vec::new();
+        let clear: Vec<f64> = p
+            .clear_x
+            .iter()
+            .map(|&x| sx(x))
+            .filter(|c| c.is_finite())
+            .collect();
+        for band in &p.bands {
+            // Each visible place: (x, text baseline, font size, text box).
+            let chars = band.text.chars().count() as f64;
+            let tries: Vec<(f64, f64, f64, [f64; 4])> = band
+                .places
+                .iter()
+                .filter_map(|&(x, y_lo, y_hi)| {
+                    let (lo, hi, px) = (sy(y_lo), sy(y_hi), sx(x));
+                    if !((lo - hi).is_finite() && px.is_finite()) || lo - hi < 1.0 {
+                        return None;
+                    }
+                    // A smaller font where a line of text does not fit the band.
+                    let size = if lo - hi >= LINE + 3.0 { 12.0 } else { 10.0 };
+                    let half = 0.5 * size / 12.0 * CHAR * chars;
+                    let px = px.clamp(l + half + 3.0, (r - half - 3.0).max(l + half + 3.0));
+                    let py = 0.5 * (lo + hi) + 0.35 * size;
+                    Some((
+                        px,
+                        py,
+                        size,
+                        [px - half, px + half, py - size, py + 0.3 * size],
+                    ))
+                })
+                .collect();
+            let covers_line =
+                |b: &[f64; 4]| clear.iter().any(|&c| b[0] - 4.0 < c && c < b[1] + 4.0);
+            let covers_name = |b: &[f64; 4]| {
+                placed
+                    .iter()
+                    .any(|q| b[0] < q[1] && q[0] < b[1] && b[2] < q[3] && q[2] < b[3])
+            };
+            let pick = tries
+                .iter()
+                .find(|t| t.2 == 12.0 && !covers_line(&t.3) && !covers_name(&t.3))
+                .or_else(|| {
+                    tries
+                        .iter()
+                        .find(|t| !covers_line(&t.3) && !covers_name(&t.3))
+                })
+                .or_else(|| tries.iter().find(|t| !covers_name(&t.3)))
+                .or(tries.first());
+            let Some(&(px, py, size, bx)) = pick else {
+                continue;
+            };
+            placed.push(bx);
+            let _ = writeln!(
+                s,
+                r#"<text x="{px:.2}" y="{py:.2}" text-anchor="middle" font-size="{size}" fill="{NOTE_COLOR}" stroke="white" stroke-width="3" stroke-linejoin="round" paint-order="stroke">{}</text>"#,
+                esc(&band.text)
+            );
+        }
+        for e in p.ends.iter().filter(|e| !e.margin) {
+            let (px, py) = (sx(e.x), sy(e.y));
             if px.is_finite() && py.is_finite() {
                 let _ = writeln!(
                     s,
-                    r##"<text x="{px:.2}" y="{py:.2}" text-anchor="middle" font-size="12" fill="#555">{}</text>"##,
-                    esc(&note.text)
+                    r#"<text x="{:.2}" y="{:.2}" font-size="11" fill="{}">{}</text>"#,
+                    px + 4.0,
+                    py - 4.0,
+                    e.color,
+                    esc(&e.text)
                 );
             }
+        }
+        let anchors: Vec<(f64, f64)> = margin.iter().map(|m| (sx(m.x), sy(m.y))).collect();
+        let rows = spread(&anchors.iter().map(|a| a.1).collect::<Vec<_>>(), t, b);
+        for ((m, (px, py)), ly) in margin.iter().zip(anchors).zip(rows) {
+            if !(px.is_finite() && py.is_finite()) {
+                continue;
+            }
+            let _ = writeln!(
+                s,
+                r#"<path d="M{px:.2},{py:.2} L{:.2},{ly:.2}" fill="none" stroke="{}" stroke-width="0.6"/><text x="{:.2}" y="{:.2}" font-size="11" fill="{}">{}</text>"#,
+                r + 6.0,
+                m.color,
+                r + 8.0,
+                ly + 4.0,
+                m.color,
+                esc(&m.text)
+            );
         }
     }
     s.push_str("</svg>\n");
     s
+}
+
+/// Height of a line of the 11 px text in the margin, and the widths of a character of the
+/// 12 px and 11 px sans-serif (estimates: the viewer picks the font).
+const LINE: f64 = 12.0;
+const CHAR: f64 = 6.7;
+const SMALL_CHAR: f64 = 6.2;
+/// Grey of the region names.
+const NOTE_COLOR: &str = "#555";
+
+/// Rows for margin labels that want to sit level with `want` (pixels, any order): each as
+/// near its wish as a line height between neighbours allows, all within `[top, bottom]` if
+/// they fit there. Returned in the order of `want`; a non-finite wish keeps its place.
+fn spread(want: &[f64], top: f64, bottom: f64) -> Vec<f64> {
+    let mut order: Vec<usize> = (0..want.len()).filter(|&i| want[i].is_finite()).collect();
+    order.sort_by(|&a, &b| want[a].total_cmp(&want[b]));
+    let mut y: Vec<f64> = order.iter().map(|&i| want[i]).collect();
+    // Down from the top, then back up from the bottom: no two rows closer than a line.
+    let mut floor = top + LINE / 2.0;
+    for v in y.iter_mut() {
+        *v = v.max(floor);
+        floor = *v + LINE;
+    }
+    let mut ceiling = bottom;
+    for v in y.iter_mut().rev() {
+        *v = v.min(ceiling);
+        ceiling = *v - LINE;
+    }
+    let mut out = want.to_vec();
+    for (k, &i) in order.iter().enumerate() {
+        out[i] = y[k];
+    }
+    out
+}
+
+/// Labels closer than `frac` of the spans `(span_x, span_y)` in both coordinates become one,
+/// their texts joined by " / ", at the first one's x and the highest y of the group.
+pub fn merge_close(labels: Vec<Label>, span_x: f64, span_y: f64, frac: f64) -> Vec<Label> {
+    let mut out: Vec<Label> = Vec::new();
+    for lab in labels {
+        let near = |c: &&mut Label| {
+            ((c.x - lab.x) / span_x).abs() < frac && ((c.y - lab.y) / span_y).abs() < frac
+        };
+        match out.iter_mut().find(near) {
+            Some(c) => {
+                c.text.push_str(" / ");
+                c.text.push_str(&lab.text);
+                c.y = c.y.max(lab.y);
+            }
+            None => out.push(lab),
+        }
+    }
+    out
 }
 
 fn fmt_tick(v: f64) -> String {
@@ -380,6 +552,89 @@ mod tests {
         assert!(svg.starts_with("<svg") && svg.ends_with("</svg>\n"));
         assert!(svg.contains("a &lt; b"));
         assert!(!svg.contains("NaN"));
+    }
+
+    /// Margin rows keep a line between neighbours, stay in the box when they fit, and move
+    /// no label that has room.
+    #[test]
+    fn margin_rows_are_spread_a_line_apart() {
+        let rows = spread(&[100.0, 101.0, 300.0, 99.0], 50.0, 400.0);
+        assert_eq!(rows[2], 300.0);
+        let mut near = [rows[0], rows[1], rows[3]];
+        near.sort_by(f64::total_cmp);
+        assert!(near[1] - near[0] >= LINE - 1e-9 && near[2] - near[1] >= LINE - 1e-9);
+        // The lowest wish is the top row: order is kept.
+        assert!(rows[3] < rows[0] && rows[0] < rows[1]);
+        // Crowded at the bottom edge: pushed up, none below it.
+        let rows = spread(&[399.0, 399.5, 400.0], 50.0, 400.0);
+        assert!(rows.iter().all(|&y| y <= 400.0) && rows[0] <= 400.0 - 2.0 * LINE + 1e-9);
+    }
+
+    #[test]
+    fn close_labels_merge_and_far_ones_do_not() {
+        let lab = |x: f64, y: f64, t: &str| Label {
+            x,
+            y,
+            text: t.into(),
+        };
+        let out = merge_close(
+            vec![
+                lab(0.0, 0.0, "a"),
+                lab(0.01, 0.015, "b"),
+                lab(0.5, 0.0, "c"),
+            ],
+            1.0,
+            1.0,
+            0.02,
+        );
+        assert_eq!(out.len(), 2);
+        assert_eq!((out[0].text.as_str(), out[0].y), ("a / b", 0.015));
+        assert_eq!(out[1].text, "c");
+    }
+
+    /// A region's name goes to its first band that keeps clear of the marked lines and of
+    /// names already placed; a band thinner than a pixel is not written.
+    #[test]
+    fn region_names_avoid_lines_and_each_other() {
+        let mut panel = Panel::new(
+            "p",
+            "x",
+            "y",
+            vec![Series::line("", "black", vec![(0.0, 0.0), (10.0, 10.0)])],
+        );
+        panel.clear_x.push(5.0);
+        let band = |text: &str, places: Vec<(f64, f64, f64)>| Band {
+            text: text.into(),
+            places,
+        };
+        panel.bands = vec![
+            // Its first place is on the line x = 5; the second is free.
+            band("first", vec![(5.0, 4.0, 6.0), (1.0, 4.0, 6.0)]),
+            // Its only free place is where "first" went; it takes the other one.
+            band("second", vec![(1.0, 4.0, 6.0), (9.0, 4.0, 6.0)]),
+            band("unseen", vec![(2.0, 1.0, 1.0 + 1e-9)]),
+        ];
+        panel.ends.push(EndLabel {
+            x: 10.0,
+            y: 10.0,
+            text: "C1".into(),
+            color: "red".into(),
+            margin: true,
+        });
+        let svg = render(&[panel], 600.0, 400.0);
+        let x_of = |text: &str| -> f64 {
+            let at = svg.find(&format!(">{text}</text>")).unwrap();
+            let tag = &svg[svg[..at].rfind("<text").unwrap()..at];
+            let x = tag.split("x=\"").nth(1).unwrap();
+            x[..x.find('"').unwrap()].parse().unwrap()
+        };
+        // x = 1, 5 and 9 in pixels: the box runs from 70 to 600 − 20 − the margin's width.
+        let r = 600.0 - 20.0 - (12.0 + SMALL_CHAR * 2.0);
+        let px = |x: f64| 70.0 + x / 10.0 * (r - 70.0);
+        assert!((x_of("first") - px(1.0)).abs() < 0.01, "{svg}");
+        assert!((x_of("second") - px(9.0)).abs() < 0.01, "{svg}");
+        assert!(!svg.contains(">unseen<"));
+        assert!(x_of("C1") > r);
     }
 
     #[test]

@@ -3,7 +3,9 @@
 //! points of the Stribeck set over its lower static level.
 
 use rotor_bifurcation::PointKind;
-use rotor_bifurcation::plane::{Curve, CurveKind, PlaneOptions, first_lyapunov, plane, solve_u};
+use rotor_bifurcation::plane::{
+    Codim2Kind, Curve, CurveKind, PlaneOptions, first_lyapunov, plane, solve_u,
+};
 
 use crate::common::{model, st_diagram, t1_diagram};
 
@@ -85,8 +87,12 @@ fn the_stribeck_set_has_its_codimension_two_points_where_the_curves_say() {
         ..PlaneOptions::new("lower.t_s", 0.1, 0.45)
     };
     let pl = plane(&base, &opts).unwrap();
-    let kinds: Vec<&str> = pl.points.iter().map(|q| q.kind).collect();
-    for k in ["bautin", "grazing_fold", "curves_cross"] {
+    let kinds: Vec<Codim2Kind> = pl.points.iter().map(|q| q.kind).collect();
+    for k in [
+        Codim2Kind::Bautin,
+        Codim2Kind::GrazingFold,
+        Codim2Kind::CurvesCross,
+    ] {
         assert!(kinds.contains(&k), "{kinds:?}");
     }
     let h1 = pl.curves.iter().find(|c| c.label == "H1").unwrap();
@@ -97,7 +103,7 @@ fn the_stribeck_set_has_its_codimension_two_points_where_the_curves_say() {
         .collect::<Vec<_>>();
     for q in &pl.points {
         match q.kind {
-            "bautin" => {
+            Codim2Kind::Bautin => {
                 let m = |p: f64| model_at(&base, p);
                 let l1 = |p: f64| {
                     let u = solve_u(&base, "lower.t_s", h1, p, q.u, 1e-11).unwrap();
@@ -111,7 +117,7 @@ fn the_stribeck_set_has_its_codimension_two_points_where_the_curves_say() {
                 };
                 assert!(l1(q.p - 1e-3) * l1(q.p + 1e-3) < 0.0, "{q:?}");
             }
-            "curves_cross" => {
+            Codim2Kind::CurvesCross => {
                 let uh = solve_u(&base, "lower.t_s", h1, q.p, q.u, 1e-11).unwrap();
                 let ug = g1
                     .iter()
