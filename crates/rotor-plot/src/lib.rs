@@ -361,65 +361,13 @@ pub fn render(panels: &[Panel], width: f64, panel_height: f64) -> String {
                 esc(&lab.text)
             );
         }
-        // Boxes [x0, x1, y0, y1] of the region names placed so far.
-        let mut placed: Vec<[f64; 4]> = Vec::new();
         let clear: Vec<f64> = p
             .clear_x
             .iter()
             .map(|&x| sx(x))
             .filter(|c| c.is_finite())
             .collect();
-        for band in &p.bands {
-            // Each visible place: (x, text baseline, font size, text box).
-            let chars = band.text.chars().count() as f64;
-            let tries: Vec<(f64, f64, f64, [f64; 4])> = band
-                .places
-                .iter()
-                .filter_map(|&(x, y_lo, y_hi)| {
-                    let (lo, hi, px) = (sy(y_lo), sy(y_hi), sx(x));
-                    if !((lo - hi).is_finite() && px.is_finite()) || lo - hi < 1.0 {
-                        return None;
-                    }
-                    // A smaller font where a line of text does not fit the band.
-                    let size = if lo - hi >= LINE + 3.0 { 12.0 } else { 10.0 };
-                    let half = 0.5 * size / 12.0 * CHAR * chars;
-                    let px = px.clamp(l + half + 3.0, (r - half - 3.0).max(l + half + 3.0));
-                    let py = 0.5 * (lo + hi) + 0.35 * size;
-                    Some((
-                        px,
-                        py,
-                        size,
-                        [px - half, px + half, py - size, py + 0.3 * size],
-                    ))
-                })
-                .collect();
-            let covers_line =
-                |b: &[f64; 4]| clear.iter().any(|&c| b[0] - 4.0 < c && c < b[1] + 4.0);
-            let covers_name = |b: &[f64; 4]| {
-                placed
-                    .iter()
-                    .any(|q| b[0] < q[1] && q[0] < b[1] && b[2] < q[3] && q[2] < b[3])
-            };
-            let pick = tries
-                .iter()
-                .find(|t| t.2 == 12.0 && !covers_line(&t.3) && !covers_name(&t.3))
-                .or_else(|| {
-                    tries
-                        .iter()
-                        .find(|t| !covers_line(&t.3) && !covers_name(&t.3))
-                })
-                .or_else(|| tries.iter().find(|t| !covers_name(&t.3)))
-                .or(tries.first());
-            let Some(&(px, py, size, bx)) = pick else {
-                continue;
-            };
-            placed.push(bx);
-            let _ = writeln!(
-                s,
-                r#"<text x="{px:.2}" y="{py:.2}" text-anchor="middle" font-size="{size}" fill="{NOTE_COLOR}" stroke="white" stroke-width="3" stroke-linejoin="round" paint-order="stroke">{}</text>"#,
-                esc(&band.text)
-            );
-        }
+        write_bands(&mut s, &p.bands, &clear, (l, r), sx, sy);
         for e in p.ends.iter().filter(|e| !e.margin) {
             let (px, py) = (sx(e.x), sy(e.y));
             if px.is_finite() && py.is_finite() {
@@ -453,6 +401,70 @@ pub fn render(panels: &[Panel], width: f64, panel_height: f64) -> String {
     }
     s.push_str("</svg>\n");
     s
+}
+
+/// Writes the names of regions (see [`Band`]) into the box from `l` to `r` in x, keeping
+/// clear of the vertical lines at pixels `clear`; `sx`, `sy` map data to pixels.
+fn write_bands(
+    s: &mut String,
+    bands: &[Band],
+    clear: &[f64],
+    (l, r): (f64, f64),
+    sx: impl Fn(f64) -> f64,
+    sy: impl Fn(f64) -> f64,
+) {
+    // Boxes [x0, x1, y0, y1] of the region names placed so far.
+    let mut placed: Vec<[f64; 4]> = Vec::new();
+    for band in bands {
+        // Each visible place: (x, text baseline, font size, text box).
+        let chars = band.text.chars().count() as f64;
+        let tries: Vec<(f64, f64, f64, [f64; 4])> = band
+            .places
+            .iter()
+            .filter_map(|&(x, y_lo, y_hi)| {
+                let (lo, hi, px) = (sy(y_lo), sy(y_hi), sx(x));
+                if !((lo - hi).is_finite() && px.is_finite()) || lo - hi < 1.0 {
+                    return None;
+                }
+                // A smaller font where a line of text does not fit the band.
+                let size = if lo - hi >= LINE + 3.0 { 12.0 } else { 10.0 };
+                let half = 0.5 * size / 12.0 * CHAR * chars;
+                let px = px.clamp(l + half + 3.0, (r - half - 3.0).max(l + half + 3.0));
+                let py = 0.5 * (lo + hi) + 0.35 * size;
+                Some((
+                    px,
+                    py,
+                    size,
+                    [px - half, px + half, py - size, py + 0.3 * size],
+                ))
+            })
+            .collect();
+        let covers_line = |b: &[f64; 4]| clear.iter().any(|&c| b[0] - 4.0 < c && c < b[1] + 4.0);
+        let covers_name = |b: &[f64; 4]| {
+            placed
+                .iter()
+                .any(|q| b[0] < q[1] && q[0] < b[1] && b[2] < q[3] && q[2] < b[3])
+        };
+        let pick = tries
+            .iter()
+            .find(|t| t.2 == 12.0 && !covers_line(&t.3) && !covers_name(&t.3))
+            .or_else(|| {
+                tries
+                    .iter()
+                    .find(|t| !covers_line(&t.3) && !covers_name(&t.3))
+            })
+            .or_else(|| tries.iter().find(|t| !covers_name(&t.3)))
+            .or(tries.first());
+        let Some(&(px, py, size, bx)) = pick else {
+            continue;
+        };
+        placed.push(bx);
+        let _ = writeln!(
+            s,
+            r#"<text x="{px:.2}" y="{py:.2}" text-anchor="middle" font-size="{size}" fill="{NOTE_COLOR}" stroke="white" stroke-width="3" stroke-linejoin="round" paint-order="stroke">{}</text>"#,
+            esc(&band.text)
+        );
+    }
 }
 
 /// Height of a line of the 11 px text in the margin, and the widths of a character of the
@@ -631,6 +643,7 @@ mod tests {
         // x = 1, 5 and 9 in pixels: the box runs from 70 to 600 − 20 − the margin's width.
         let r = 600.0 - 20.0 - (12.0 + SMALL_CHAR * 2.0);
         let px = |x: f64| 70.0 + x / 10.0 * (r - 70.0);
+        // Positions are written with two decimals: equal to within 0.005 px.
         assert!((x_of("first") - px(1.0)).abs() < 0.01, "{svg}");
         assert!((x_of("second") - px(9.0)).abs() < 0.01, "{svg}");
         assert!(!svg.contains(">unseen<"));
