@@ -5,7 +5,7 @@
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-use rotor_compare::check::{Strictness, check};
+use rotor_compare::check::{Level, check};
 use rotor_compare::gridmetrics::{StickExit, grid_metrics};
 use rotor_compare::trace::{read_events, read_trace};
 use rotor_model::SteadyState;
@@ -268,8 +268,8 @@ fn grade(l: &Loaded, job: &Job) -> Result<(Errors, bool, bool, Vec<String>, f64)
         None
     };
     let verdict = |gate| check(sc, r, &trace, events.as_ref(), gate);
-    let loose = verdict(Strictness::Loose).map_err(|e| unusable(e.to_string()))?;
-    let strict = verdict(Strictness::Strict).map_err(|e| unusable(e.to_string()))?;
+    let loose = verdict(Level::Loose).map_err(|e| unusable(e.to_string()))?;
+    let strict = verdict(Level::Strict).map_err(|e| unusable(e.to_string()))?;
     let exit = StickExit {
         model: &sc.model,
         u: sc.u,

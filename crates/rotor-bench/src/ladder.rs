@@ -1,7 +1,7 @@
 //! The reference run of a scene and each solver's ladder of settings, every point timed and
 //! measured against the reference.
 
-use rotor_compare::check::{Strictness, check};
+use rotor_compare::check::{Level, check};
 use rotor_compare::gridmetrics::{StickExit, grid_metrics};
 use rotor_compare::reference::Reference;
 use rotor_model::{Output, Scenario, Scene, Stats, SteadyState};
@@ -247,11 +247,12 @@ fn passes_loose(l: &Loaded, tr: &rotor_model::Trajectory) -> bool {
         path: "run".into(),
         samples: tr.samples.clone(),
         lines: (2..tr.samples.len() as u64 + 2).collect(),
+        digits: rotor_compare::trace::FULL_DIGITS,
     };
     let events = rotor_compare::trace::EventsFile {
         path: "run".into(),
         events: tr.events.clone(),
         lines: (2..tr.events.len() as u64 + 2).collect(),
     };
-    check(sc, r, &trace, Some(&events), Strictness::Loose).is_ok_and(|c| c.passed)
+    check(sc, r, &trace, Some(&events), Level::Loose).is_ok_and(|c| c.passed)
 }

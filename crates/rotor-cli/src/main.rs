@@ -186,12 +186,17 @@ enum Command {
         /// The trace to grade.
         #[arg(long)]
         trace: PathBuf,
-        /// The trace's events (CSV t,disc,kind), to grade the event times.
+        /// The trace's events (CSV t,disc,kind). Without them the verdict says "events not
+        /// graded".
         #[arg(long)]
         events: Option<PathBuf>,
-        /// strict (the event-switch tolerances) or loose (event-moreau).
-        #[arg(long, default_value = "loose")]
+        /// The level: strict (7 significant digits on every quantity: a well-converged
+        /// adaptive integrator) or loose (3: engineering accuracy).
+        #[arg(long, default_value = "loose", conflicts_with = "digits")]
         gate: String,
+        /// Pass when every graded quantity reaches N significant digits (instead of --gate).
+        #[arg(long, value_name = "N")]
+        digits: Option<String>,
         /// Write the verdict as JSON (`-`: standard output).
         #[arg(long)]
         json: Option<PathBuf>,
@@ -1159,9 +1164,17 @@ fn main() -> ExitCode {
             trace,
             events,
             gate,
+            digits,
             json,
         }) => {
-            return open::check_trace(scenario, trace, events.as_deref(), gate, json.as_deref());
+            return open::check_trace(
+                scenario,
+                trace,
+                events.as_deref(),
+                gate,
+                digits.as_deref(),
+                json.as_deref(),
+            );
         }
         None => compare(&[], Path::new("reports"), true),
     };

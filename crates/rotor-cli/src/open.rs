@@ -5,7 +5,7 @@ use std::process::ExitCode;
 
 use anyhow::{Context, Result};
 use rayon::prelude::*;
-use rotor_compare::check::{CheckError, Strictness, check};
+use rotor_compare::check::{CheckError, Level, check};
 use rotor_compare::reference;
 
 /// `rotor reference [--out DIR]`: the reference files of every scenario.
@@ -49,15 +49,16 @@ pub fn write_reference(scenarios_dir: &Path, out: &Path) -> Result<()> {
     Ok(())
 }
 
-/// `rotor check`: 0 when every gate passes, 1 when one fails, 2 when the input is unusable.
+/// `rotor check`: 0 when the level is reached, 1 when not, 2 when the input is unusable.
 pub fn check_trace(
     scenario: &Path,
     trace: &Path,
     events: Option<&Path>,
     gate: &str,
+    digits: Option<&str>,
     json: Option<&Path>,
 ) -> ExitCode {
-    match verdict(scenario, trace, events, gate, json) {
+    match verdict(scenario, trace, events, gate, digits, json) {
         Ok(true) => ExitCode::SUCCESS,
         Ok(false) => ExitCode::from(1),
         Err(e) => {
@@ -73,9 +74,14 @@ fn verdict(
     trace: &Path,
     events: Option<&Path>,
     gate: &str,
+    digits: Option<&str>,
     json: Option<&Path>,
 ) -> Result<bool> {
-    let strictness = Strictness::parse(gate).map_err(|e| anyhow::anyhow!(e.as_flag()))?;
+    let level = match digits {
+        Some(n) => Level::with_digits(n),
+        None => Level::parse(gate),
+    }
+    .map_err(|e| anyhow::anyhow!(e.as_flag()))?;
     // The scenario and its reference first: the trace is read up to one row past their grid.
     let scenario = crate::fixture_path("scenario", scenario, "scenarios")?;
     let sc = rotor_compare::load_scenario(&scenario)?;
@@ -86,7 +92,7 @@ fn verdict(
         .map(rotor_compare::trace::read_events)
         .transpose()
         .map_err(CheckError::from)?;
-    let report = check(&sc, &r, &t, ev.as_ref(), strictness)?;
+    let report = check(&sc, &r, &t, ev.as_ref(), level)?;
     if let Some(path) = json {
         let text = serde_json::to_string_pretty(&report)? + "\n";
         // A closed pipe on `--json -` does not hide the verdict's exit status.

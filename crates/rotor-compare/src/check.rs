@@ -1,73 +1,143 @@
-//! Grading one external trace against the reference (`rotor check`).
+//! Grading one external trace against the reference (`rotor check`), in significant digits.
 //!
-//! The trace must hold one row per time of the scenario's grid (the reference's times, within
-//! 1e-9 s). It is compared with the reference under the scenario's own gates, `strict` (the
-//! event-switch tolerances) or `loose` (event-moreau):
+//! The grade covers everything the scenario defines, each as a *quantity* with its
+//! difference from the reference, the scale it is measured against, and its significant
+//! correct digits `−log10(difference / scale)`:
 //!
-//! * **transient**: the largest |Δω_u| and |Δω_l| over the scenario's transient window, sample
-//!   by sample, against `transient_max`; their joint RMS against `transient_rms`;
-//! * **steady state**: the kind, and each metric against its own tolerance, both read off the
-//!   grid by the same reconstruction ([`crate::gridmetrics`]), so that its own error cancels;
-//! * **event times** (when an events file is given): every stick onset, stick exit and
-//!   reversal of either disc in the transient window, matched in order with the reference's,
-//!   against `event_time`.
+//! * **`alpha`, `omega_u`, `omega_l`**: the largest difference over every sample of the run,
+//!   `[0, t_end]`, at equal times. Scale: the variable's largest |value| in the reference run,
+//!   at least [`FLOOR`] (a variable that stays near 0, as both discs stuck).
+//! * **`events`** (when an events file is given): every stick onset, stick exit and reversal
+//!   of either disc over `[0, t_end]`, matched one to one with the reference's by disc, kind
+//!   and time; a missing, extra or unmatched event is named and fails the quantity. Scale:
+//!   the motion's time scale [`time_scale`] (the reference cycle's period, else 1 s).
+//! * **`stick_lower`, `stick_upper`**: the stick intervals visible in the trace (samples with
+//!   |ω| ≤ [`STUCK`]) matched one to one with the reference's, for every trace, with or without
+//!   an events file. A sample grid shows an onset only to within one step, so the difference
+//!   is how far the reference's exact onset (or exit) lies outside the step in which the trace
+//!   shows it: a lower bound of the trace's own error, never blame for the grid.
+//! * **steady state** over `[steady_from, t_end]`: the kind, each metric read off the grid by
+//!   the same reconstruction for the trace and the reference ([`crate::gridmetrics`]; scale:
+//!   the period for times, the disc's scale for speeds), and **`orbit`**, the orbit's shape
+//!   compared phase-free: the largest distance of a steady sample of the trace from the
+//!   reference's steady orbit ([`crate::orbit`]), in scaled coordinates.
 //!
-//! Each quantity also gets its number of correct significant digits: `−log10` of its
-//! difference relative to the reference value's scale.
+//! **Phase drift.** A stable cycle's phase is neutral, so a method whose period is off by a
+//! relative ε drifts by ε·t: at time t its samples are off by up to `ε·t·max|ẋ|`. The
+//! grade does not excuse this: at equal times it is an error of the trace, and a
+//! converging method's drift vanishes with its error. The levels allow for it instead: at
+//! the 1.5 V cycle `max|ω̇_l| ≈ 8 S_l/s`, so over 200 s the samples' digits are about
+//! `log10(8·200) ≈ 3.2` fewer than the period's; the levels below were set knowing this
+//! (`docs/methods.md`, section "The grade"), and the phase-free quantities (`orbit`, the
+//! steady metrics) say how much of a trace's error is phase.
+//!
+//! The trace's `digits` are the fewest of any quantity. A **level** passes when every
+//! quantity reaches its digits ([`Level`]); a quantity passes when `difference ≤ tolerance`,
+//! with `tolerance = scale·10^−digits`.
+//!
+//! **The file's precision.** A trace written with fewer significant digits than a level
+//! needs cannot show that the solver reaches it: [`check`] refuses it ([`CheckError::Precision`],
+//! exit 2) and names the file's precision, instead of failing the solver. Grading at N digits
+//! needs N + 1 written digits (a value rounded to P digits is off by up to half a unit in its
+//! P-th digit, 10^(1−P)/2 of itself).
 
 use std::path::PathBuf;
 
-use rotor_model::{Event, PairTolerance, Sample, Scenario, SteadyState};
-use serde::Serialize;
+use rotor_model::{Disc, Event, EventKind, Sample, Scenario, SteadyState};
+use serde::{Serialize, Serializer};
 
-use crate::gate::steady_differences;
-use crate::gridmetrics::{StickExit, grid_metrics};
-use crate::reference::{Reference, ReferenceError};
+use crate::gridmetrics::{STUCK, StickExit, grid_metrics};
+use crate::orbit::Orbit;
+use crate::reference::Reference;
 use crate::request::BadInput;
-use crate::trace::{At, EventsFile, Trace};
+use crate::trace::{At, EventsFile, Trace, disc_name, event_row};
 
-/// Which of the scenario's tolerance tables grades the trace.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
-#[serde(rename_all = "snake_case")]
-pub enum Strictness {
-    /// The event-switch tolerances: what an adaptive integrator with exact sliding reaches.
+/// The benchmark's version: named in every verdict.
+pub const BENCHMARK: &str = "rotorbench-1.0";
+
+/// Digits of the `loose` level: engineering accuracy, 0.1 % of each quantity's scale. What
+/// any converging method reaches at a reasonable cost: a first-order time-stepper at
+/// h = 1e-5 on the 1.5 V cycle (`bench/clients/first_order.c`, tested in
+/// `tests/grade_levels.rs`).
+pub const LOOSE_DIGITS: u32 = 3;
+/// Digits of the `strict` level: what a well-converged adaptive integrator reaches (the
+/// event-driven solver at tol 1e-11, scipy's DOP853 at rtol 1e-11 restarted at each mode
+/// switch). No level is tighter than 10× the reference's stated error on any quantity of
+/// any scenario (one digit below the reference's own; `tests/grade_levels.rs`): the worst is
+/// t1-u2.5-eq-pert's ω_l, 8.2 digits, whose start from an unstable equilibrium amplifies
+/// every error until the cycle.
+pub const STRICT_DIGITS: u32 = 7;
+
+/// Absolute floor of the scale of α [rad] and of ω_u, ω_l [rad/s]: for a variable that
+/// stays near 0 over the whole run (both discs stuck), digits are counted against this.
+pub const FLOOR: f64 = 1e-3;
+
+/// A level: the significant digits every graded quantity must reach.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Level {
+    /// [`STRICT_DIGITS`].
     Strict,
-    /// The event-moreau tolerances: what a first-order time-stepping scheme at h = 1e-3
-    /// reaches.
+    /// [`LOOSE_DIGITS`].
     Loose,
+    /// `--digits N`.
+    Digits(u32),
 }
 
-impl Strictness {
-    pub fn as_str(self) -> &'static str {
+impl Level {
+    /// The digits the level asks of every quantity.
+    pub fn digits(self) -> u32 {
         match self {
-            Strictness::Strict => "strict",
-            Strictness::Loose => "loose",
+            Level::Strict => STRICT_DIGITS,
+            Level::Loose => LOOSE_DIGITS,
+            Level::Digits(n) => n,
         }
     }
 
-    /// The tolerance table's pair name.
-    pub fn pair(self) -> &'static str {
+    /// `strict`, `loose` or `digits=N`.
+    pub fn name(self) -> String {
         match self {
-            Strictness::Strict => "event-switch",
-            Strictness::Loose => "event-moreau",
+            Level::Strict => "strict".into(),
+            Level::Loose => "loose".into(),
+            Level::Digits(n) => format!("digits={n}"),
         }
     }
 
-    /// The gate of a name, or a [`BadInput`] naming `gate` and the value.
-    pub fn parse(s: &str) -> Result<Strictness, BadInput> {
-        Strictness::by_name(s).ok_or_else(|| BadInput {
-            name: "gate",
-            value: format!("{s:?}"),
-            reason: "expected strict (event-switch tolerances) or loose (event-moreau)".into(),
-        })
-    }
-
-    pub fn by_name(s: &str) -> Option<Strictness> {
+    /// The level of a name (`strict`, `loose`, or `digits=N` with N in 1..=15), or a
+    /// [`BadInput`] naming `gate` and the value.
+    pub fn parse(s: &str) -> Result<Level, BadInput> {
         match s {
-            "strict" => Some(Strictness::Strict),
-            "loose" => Some(Strictness::Loose),
-            _ => None,
+            "strict" => Ok(Level::Strict),
+            "loose" => Ok(Level::Loose),
+            _ => match s.strip_prefix("digits=") {
+                Some(n) => Level::with_digits(n).map_err(|e| BadInput { name: "gate", ..e }),
+                None => Err(BadInput {
+                    name: "gate",
+                    value: format!("{s:?}"),
+                    reason: format!(
+                        "expected strict ({STRICT_DIGITS} significant digits), loose \
+                         ({LOOSE_DIGITS}) or digits=N"
+                    ),
+                }),
+            },
         }
+    }
+
+    /// `--digits N`: N in 1..=15 (a double holds 15 to 17), or a [`BadInput`] naming `digits`.
+    pub fn with_digits(n: &str) -> Result<Level, BadInput> {
+        match n.trim().parse::<u32>() {
+            Ok(d) if (1..=15).contains(&d) => Ok(Level::Digits(d)),
+            _ => Err(BadInput {
+                name: "digits",
+                value: format!("{n:?}"),
+                reason: "expected a whole number of significant digits from 1 to 15".into(),
+            }),
+        }
+    }
+}
+
+impl Serialize for Level {
+    fn serialize<S: Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        s.serialize_str(&self.name())
     }
 }
 
@@ -75,19 +145,39 @@ impl Strictness {
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Graded {
     pub name: String,
+    /// The difference from the reference, in the quantity's unit (∞ when it cannot be
+    /// measured: a missing event, another kind of steady state).
     pub difference: f64,
+    /// What the difference is measured against (same unit).
+    pub scale: f64,
+    /// The largest difference the level allows: `scale·10^−digits`.
     pub tolerance: f64,
     pub passed: bool,
-    /// Correct significant digits (0 … 16, one decimal).
+    /// Significant correct digits, `−log10(difference/scale)` (0 … 16, one decimal).
     pub digits: f64,
+    /// Where the difference is largest [s], when it is at one time.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub at: Option<f64>,
+    /// What went wrong, when the difference alone does not say (missing or extra events).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub note: Option<String>,
 }
 
 /// The verdict on one trace (the JSON of `rotor check --json`).
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct CheckReport {
     pub scenario: String,
+    /// The benchmark's version ([`BENCHMARK`]).
+    pub benchmark: &'static str,
     pub passed: bool,
-    pub gate: Strictness,
+    /// The level's name: `strict`, `loose` or `digits=N`.
+    pub gate: Level,
+    /// The fewest digits of any graded quantity.
+    pub digits: f64,
+    /// What the scenario defines that was not graded (`events` without an events file).
+    pub not_graded: Vec<String>,
+    /// Significant digits the trace file is written with (17 for arrays).
+    pub file_digits: u32,
     pub quantities: Vec<Graded>,
 }
 
@@ -101,27 +191,49 @@ impl CheckReport {
             .collect()
     }
 
+    /// The verdict line: `PASSED`, `FAILED`, and what was not graded, if anything (never a
+    /// plain `PASSED` for a partial grade).
+    pub fn verdict(&self) -> String {
+        let mut v = format!(
+            "{}: {} at {} ({} digits), {:.1} digits",
+            self.scenario,
+            if self.passed { "PASSED" } else { "FAILED" },
+            self.gate.name(),
+            self.gate.digits(),
+            self.digits,
+        );
+        for n in &self.not_graded {
+            v.push_str(&format!("; {n} not graded"));
+            if n == "events" {
+                v.push_str(" (no events file)");
+            }
+        }
+        v + &format!(" [{BENCHMARK}]")
+    }
+
     /// A table for the terminal.
     pub fn table(&self) -> String {
         let mut out = format!(
-            "{} ({} gate): {}\n{:<20} {:>12} {:>12} {:>7}  {}\n",
-            self.scenario,
-            self.gate.as_str(),
-            if self.passed { "PASSED" } else { "FAILED" },
+            "{}\n{:<20} {:>12} {:>12} {:>12} {:>7}  {}\n",
+            self.verdict(),
             "quantity",
             "difference",
+            "scale",
             "tolerance",
             "digits",
             "verdict"
         );
         for q in &self.quantities {
             out.push_str(&format!(
-                "{:<20} {:>12.3e} {:>12.3e} {:>7.1}  {}\n",
+                "{:<20} {:>12.3e} {:>12.3e} {:>12.3e} {:>7.1}  {}{}{}\n",
                 q.name,
                 q.difference,
+                q.scale,
                 q.tolerance,
                 q.digits,
-                if q.passed { "pass" } else { "FAIL" }
+                if q.passed { "pass" } else { "FAIL" },
+                q.at.map_or(String::new(), |t| format!(" (at t = {t} s)")),
+                q.note.as_ref().map_or(String::new(), |n| format!(": {n}")),
             ));
         }
         out
@@ -164,10 +276,29 @@ pub enum CheckError {
         t: f64,
         t_end: f64,
     },
-    #[error("scenario {scenario} has no [tolerance.{pair}] table to grade with")]
-    NoGate {
+    #[error(
+        "{}: the trace is written with {digits} significant digits (printf's %g writes 6); \
+         grading at {level} ({needed_digits} digits) needs at least {needed}: write every value \
+         with %.17g or a shortest round-trip format",
+        .path.display(), needed_digits = .needed - 1
+    )]
+    Precision {
+        path: PathBuf,
+        digits: u32,
+        level: String,
+        needed: u32,
+    },
+    #[error(
+        "{level} asks {asked} digits of {quantity}, but the reference of {scenario} is verified \
+         to {verified:.1} digits there: it cannot grade more than {most} (one digit below its own)"
+    )]
+    BeyondReference {
         scenario: String,
-        pair: &'static str,
+        level: String,
+        asked: u32,
+        quantity: String,
+        verified: f64,
+        most: u32,
     },
 }
 
@@ -227,8 +358,8 @@ pub fn check_events(f: &EventsFile, t_end: f64) -> Result<(), CheckError> {
     Ok(())
 }
 
-/// `−log10(diff/scale)`, one decimal, within [0, 16].
-fn digits(diff: f64, scale: f64) -> f64 {
+/// `−log10(diff/scale)`, one decimal (rounded down), within [0, 16].
+pub fn digits(diff: f64, scale: f64) -> f64 {
     if !diff.is_finite() {
         return 0.0;
     }
@@ -239,126 +370,468 @@ fn digits(diff: f64, scale: f64) -> f64 {
     (d.clamp(0.0, 16.0) * 10.0).floor() / 10.0 + 0.0
 }
 
-fn graded(name: &str, difference: f64, tolerance: f64, scale: f64) -> Graded {
+/// A quantity graded at `level`.
+fn graded(name: &str, difference: f64, scale: f64, level: Level) -> Graded {
+    let tolerance = scale * 10f64.powi(-(level.digits() as i32));
     Graded {
         name: name.to_owned(),
         difference,
+        scale,
         tolerance,
         // `!(d > tol)` would pass a NaN: written so that a NaN fails.
         passed: difference <= tolerance,
         digits: digits(difference, scale),
+        at: None,
+        note: None,
     }
 }
 
-/// Grades a trace (and optionally its events) against the reference of scenario `sc`.
+/// The scale of each state variable in the reference run: its largest |value|, at least
+/// [`FLOOR`].
+pub fn state_scales(reference: &[Sample]) -> [f64; 3] {
+    let mut s = [FLOOR; 3];
+    for r in reference {
+        for (i, si) in s.iter_mut().enumerate() {
+            *si = si.max(r.x[i].abs());
+        }
+    }
+    s
+}
+
+/// The motion's time scale [s]: the period of the reference's steady cycle, else 1 s (a
+/// transient to an equilibrium has no period to measure event times against).
+pub fn time_scale(reference: &Reference) -> f64 {
+    match reference.steady() {
+        Some(SteadyState::LimitCycle { period, .. }) => period,
+        _ => 1.0,
+    }
+}
+
+/// The reference's stated error that bounds a quantity's (trace errors for the samples and
+/// the orbit, event times for events and stick intervals, each metric's own), if stated.
+pub fn reference_error(reference: &Reference, quantity: &str) -> Option<f64> {
+    let e = |k: &str| reference.json.error.get(k).copied();
+    match quantity {
+        "alpha" | "omega_u" | "omega_l" => e(quantity),
+        "events" | "stick_lower" | "stick_upper" => e("event_time"),
+        "orbit" => None,
+        "steady_kind" => None,
+        q => {
+            let m = q.strip_prefix("steady_")?;
+            e(m)
+        }
+    }
+}
+
+/// Checks that a level asks no more digits of any quantity than the reference is verified
+/// to, less one: `digits(reference error, scale) − 1`.
+fn within_reference(
+    sc: &Scenario,
+    reference: &Reference,
+    quantities: &[Graded],
+    level: Level,
+) -> Result<(), CheckError> {
+    for q in quantities {
+        let Some(err) = reference_error(reference, &q.name) else {
+            continue;
+        };
+        let verified = -(err / q.scale).log10();
+        let most = (verified - 1.0).floor().max(0.0) as u32;
+        if level.digits() > most {
+            return Err(CheckError::BeyondReference {
+                scenario: sc.name.clone(),
+                level: level.name(),
+                asked: level.digits(),
+                quantity: q.name.clone(),
+                verified,
+                most,
+            });
+        }
+    }
+    Ok(())
+}
+
+/// The largest |Δ| of each state variable over every sample, and where.
+fn sample_differences(trace: &[Sample], reference: &[Sample]) -> [(f64, f64); 3] {
+    let mut d = [(0.0f64, 0.0f64); 3];
+    for (a, r) in trace.iter().zip(reference) {
+        for (i, di) in d.iter_mut().enumerate() {
+            let e = (a.x[i] - r.x[i]).abs();
+            if !(e <= di.0) {
+                *di = (e, r.t);
+            }
+        }
+    }
+    d
+}
+
+/// An event as the files name it: `lower stick_start at 4.7677 s`.
+fn describe(e: &Event) -> String {
+    let (disc, kind) = event_row(e.kind).map_or(("?", "?"), |(d, k)| (disc_name(d), k));
+    format!("{disc} {kind} at {} s", e.t)
+}
+
+/// Names the first few of `events`, and how many more there are.
+fn name_some(what: &str, events: &[Event]) -> Option<String> {
+    if events.is_empty() {
+        return None;
+    }
+    let shown: Vec<String> = events.iter().take(3).map(describe).collect();
+    let more = if events.len() > 3 {
+        format!(" and {} more", events.len() - 3)
+    } else {
+        String::new()
+    };
+    Some(format!(
+        "{} {what}: {}{more}",
+        events.len(),
+        shown.join(", ")
+    ))
+}
+
+/// Matches two time-ordered lists one to one: each reference time with the next unused
+/// trace time within `window` of it, in order. Returns the matched pairs' largest |Δt| and
+/// the unmatched of each list (missing from the trace, extra in it).
+fn match_in_order(reference: &[f64], trace: &[f64], window: f64) -> (f64, Vec<usize>, Vec<usize>) {
+    let (mut i, mut j) = (0, 0);
+    let (mut worst, mut missing, mut extra) = (0.0f64, Vec::new(), Vec::new());
+    while i < reference.len() && j < trace.len() {
+        let d = trace[j] - reference[i];
+        if d.abs() <= window {
+            worst = worst.max(d.abs());
+            i += 1;
+            j += 1;
+        } else if d < 0.0 {
+            extra.push(j);
+            j += 1;
+        } else {
+            missing.push(i);
+            i += 1;
+        }
+    }
+    missing.extend(i..reference.len());
+    extra.extend(j..trace.len());
+    (worst, missing, extra)
+}
+
+/// The `events` quantity: every mode switch of either disc over the run, matched one to one
+/// by disc and kind, each within half the shortest gap between two reference events of its
+/// class (so that a match is never ambiguous).
+fn grade_events(reference: &[Event], trace: &[Event], t_scale: f64, level: Level) -> Graded {
+    let switches = |ev: &[Event]| -> Vec<Event> {
+        ev.iter()
+            .filter(|e| event_row(e.kind).is_some())
+            .copied()
+            .collect()
+    };
+    let (reference, trace) = (switches(reference), switches(trace));
+    let mut classes: Vec<EventKind> = reference.iter().chain(&trace).map(|e| e.kind).collect();
+    classes.sort_by_key(|k| format!("{k:?}"));
+    classes.dedup();
+    let (mut worst, mut missing, mut extra) = (0.0f64, Vec::new(), Vec::new());
+    for kind in classes {
+        let of = |ev: &[Event]| -> Vec<Event> {
+            ev.iter().filter(|e| e.kind == kind).copied().collect()
+        };
+        let (r, a) = (of(&reference), of(&trace));
+        let gap = r
+            .windows(2)
+            .map(|w| w[1].t - w[0].t)
+            .fold(t_scale, f64::min);
+        let times = |ev: &[Event]| ev.iter().map(|e| e.t).collect::<Vec<_>>();
+        let (w, m, x) = match_in_order(&times(&r), &times(&a), 0.5 * gap);
+        worst = worst.max(w);
+        missing.extend(m.into_iter().map(|k| r[k]));
+        extra.extend(x.into_iter().map(|k| a[k]));
+    }
+    missing.sort_by(|a, b| a.t.total_cmp(&b.t));
+    extra.sort_by(|a, b| a.t.total_cmp(&b.t));
+    let unmatched = !missing.is_empty() || !extra.is_empty();
+    let mut g = graded(
+        "events",
+        if unmatched { f64::INFINITY } else { worst },
+        t_scale,
+        level,
+    );
+    let notes: Vec<String> = [
+        name_some("missing from the trace's events", &missing),
+        name_some("extra (not in the reference)", &extra),
+    ]
+    .into_iter()
+    .flatten()
+    .collect();
+    if !notes.is_empty() {
+        g.note = Some(notes.join("; "));
+    }
+    g
+}
+
+/// Runs of consecutive stuck samples of velocity `i` (|x_i| ≤ [`STUCK`]), as index pairs.
+fn stuck_runs(samples: &[Sample], i: usize) -> Vec<(usize, usize)> {
+    let mut runs = Vec::new();
+    let mut start = None;
+    for (k, s) in samples.iter().enumerate() {
+        match (s.x[i].abs() <= STUCK, start) {
+            (true, None) => start = Some(k),
+            (false, Some(a)) => {
+                runs.push((a, k - 1));
+                start = None;
+            }
+            _ => {}
+        }
+    }
+    if let Some(a) = start {
+        runs.push((a, samples.len() - 1));
+    }
+    runs
+}
+
+/// The stick intervals of one disc visible on the grid, graded against the reference's
+/// exact ones (`None` when neither shows a stuck sample of that disc).
+fn grade_stick(
+    disc: Disc,
+    trace: &[Sample],
+    reference: &Reference,
+    t_scale: f64,
+    level: Level,
+) -> Option<Graded> {
+    let i = match disc {
+        Disc::Upper => 1,
+        Disc::Lower => 2,
+    };
+    let name = format!("stick_{}", disc_name(disc));
+    let rs = &reference.samples;
+    let (ref_runs, runs) = (stuck_runs(rs, i), stuck_runs(trace, i));
+    if ref_runs.is_empty() && runs.is_empty() {
+        return None;
+    }
+    let last = rs.len() - 1;
+    // The reference's exact onset and exit of a run: its events in the steps that bracket
+    // the run's first and last stuck sample (0 and t_end at the run's ends).
+    let exact = |(a, b): (usize, usize)| -> (f64, f64) {
+        let find = |kind: EventKind, lo: f64, hi: f64, fallback: f64| {
+            reference
+                .events
+                .iter()
+                .find(|e| e.kind == kind && e.t > lo - 1e-12 && e.t <= hi + 1e-12)
+                .map_or(fallback, |e| e.t)
+        };
+        let on = if a == 0 {
+            0.0
+        } else {
+            find(EventKind::StickStart(disc), rs[a - 1].t, rs[a].t, rs[a].t)
+        };
+        let off = if b == last {
+            rs[last].t
+        } else {
+            find(EventKind::StickEnd(disc), rs[b].t, rs[b + 1].t, rs[b].t)
+        };
+        (on, off)
+    };
+    // The steps in which the trace shows its onset and its exit.
+    let bracket = |(a, b): (usize, usize)| -> ((f64, f64), (f64, f64)) {
+        let on = if a == 0 {
+            (0.0, 0.0)
+        } else {
+            (trace[a - 1].t, trace[a].t)
+        };
+        let off = if b + 1 >= trace.len() {
+            (trace[b].t, trace[b].t)
+        } else {
+            (trace[b].t, trace[b + 1].t)
+        };
+        (on, off)
+    };
+    let outside = |t: f64, (lo, hi): (f64, f64)| (lo - t).max(t - hi).max(0.0);
+    let (mut k, mut m) = (0, 0);
+    let (mut worst, mut at, mut missing, mut extra) = (0.0f64, None, Vec::new(), Vec::new());
+    while k < ref_runs.len() && m < runs.len() {
+        let (ra, rb) = ref_runs[k];
+        let (ta, tb) = runs[m];
+        if ta <= rb + 1 && ra <= tb + 1 {
+            let (on, off) = exact(ref_runs[k]);
+            let (b_on, b_off) = bracket(runs[m]);
+            for (d, t) in [(outside(on, b_on), on), (outside(off, b_off), off)] {
+                if d > worst {
+                    (worst, at) = (d, Some(t));
+                }
+            }
+            k += 1;
+            m += 1;
+        } else if tb < ra {
+            extra.push(trace[ta].t);
+            m += 1;
+        } else {
+            missing.push(exact(ref_runs[k]).0);
+            k += 1;
+        }
+    }
+    missing.extend(ref_runs[k..].iter().map(|&r| exact(r).0));
+    extra.extend(runs[m..].iter().map(|&(a, _)| trace[a].t));
+    let unmatched = !missing.is_empty() || !extra.is_empty();
+    let mut g = graded(
+        &name,
+        if unmatched { f64::INFINITY } else { worst },
+        t_scale,
+        level,
+    );
+    g.at = if unmatched { None } else { at };
+    let list = |v: &[f64]| {
+        let shown: Vec<String> = v.iter().take(3).map(|t| format!("{t} s")).collect();
+        let more = if v.len() > 3 {
+            format!(" and {} more", v.len() - 3)
+        } else {
+            String::new()
+        };
+        format!("{}{more}", shown.join(", "))
+    };
+    let mut notes = Vec::new();
+    if !missing.is_empty() {
+        notes.push(format!(
+            "{} stick interval(s) of the reference not in the trace (|omega| <= {STUCK:e} rad/s), \
+             from {}",
+            missing.len(),
+            list(&missing)
+        ));
+    }
+    if !extra.is_empty() {
+        notes.push(format!(
+            "{} stick interval(s) in the trace not in the reference, from {}",
+            extra.len(),
+            list(&extra)
+        ));
+    }
+    if !notes.is_empty() {
+        g.note = Some(notes.join("; "));
+    }
+    Some(g)
+}
+
+/// The steady state: kind, metrics and the orbit's shape.
+fn grade_steady(
+    sc: &Scenario,
+    reference: &Reference,
+    trace: &[Sample],
+    from: f64,
+    scale: [f64; 3],
+    level: Level,
+) -> Vec<Graded> {
+    let exit = StickExit {
+        model: &sc.model,
+        u: sc.u,
+    };
+    let mut q = Vec::new();
+    let (sa, sr) = (
+        grid_metrics(trace, from, exit),
+        grid_metrics(&reference.samples, from, exit),
+    );
+    let (Ok(a), Ok(r)) = (sa, sr) else {
+        q.push(graded("steady_kind", f64::INFINITY, 1.0, level));
+        return q;
+    };
+    if a.kind() != r.kind() {
+        let mut g = graded("steady_kind", f64::INFINITY, 1.0, level);
+        g.note = Some(format!(
+            "the trace settles to {}, the reference to {}",
+            a.kind().as_str(),
+            r.kind().as_str()
+        ));
+        q.push(g);
+        return q;
+    }
+    q.push(graded("steady_kind", 0.0, 1.0, level));
+    let period = match r {
+        SteadyState::LimitCycle { period, .. } => period,
+        SteadyState::Equilibrium { .. } => 1.0,
+    };
+    for ((name, va), (_, vr)) in a.values().into_iter().zip(r.values()) {
+        let s = match name {
+            "period" | "stick_time" => period,
+            "omega_l_max" | "omega_l_min" | "omega_l" => scale[2],
+            "omega_u_max" | "omega_u_min" | "omega_u" => scale[1],
+            _ => scale[0],
+        };
+        q.push(graded(&format!("steady_{name}"), (va - vr).abs(), s, level));
+    }
+    // The orbit's shape, phase-free (a cycle only: the equilibrium's samples are graded at
+    // equal times above, and a slow focus is still on its way there at `steady_from`).
+    let SteadyState::LimitCycle { period, .. } = reference.steady().unwrap_or(r) else {
+        return q;
+    };
+    let window = &trace[trace.partition_point(|s| s.t < from - TIME_TOL)..];
+    let rs = &reference.samples;
+    let start = &rs[rs.partition_point(|s| s.t < from - TIME_TOL).min(rs.len() - 1)];
+    let mut g = match Orbit::cycle(sc, start.x, period, reference.json.tol, scale) {
+        Ok(o) => {
+            let (d, at) = o.largest_distance(window);
+            let mut g = graded("orbit", d, 1.0, level);
+            g.at = Some(at).filter(|t| t.is_finite());
+            g
+        }
+        Err(e) => {
+            let mut g = graded("orbit", f64::INFINITY, 1.0, level);
+            g.note = Some(format!("the reference orbit could not be computed: {e}"));
+            g
+        }
+    };
+    if g.difference.is_nan() {
+        g.difference = f64::INFINITY;
+    }
+    q.push(g);
+    q
+}
+
+/// Grades a trace (and optionally its events) against the reference of scenario `sc` at
+/// `level` (see the module docs for what is graded and how).
 pub fn check(
     sc: &Scenario,
     reference: &Reference,
     trace: &Trace,
     events: Option<&EventsFile>,
-    gate: Strictness,
+    level: Level,
 ) -> Result<CheckReport, CheckError> {
-    let tol: PairTolerance = *sc
-        .tolerance
-        .get(gate.pair())
-        .ok_or_else(|| CheckError::NoGate {
-            scenario: sc.name.clone(),
-            pair: gate.pair(),
-        })?;
     check_grid(trace, &reference.samples, sc.compare.dt, sc.t_end)?;
     if let Some(f) = events {
         check_events(f, sc.t_end)?;
     }
-    let events = events.map(|f| f.events.as_slice());
+    let needed = level.digits() + 1;
+    if trace.digits < needed {
+        return Err(CheckError::Precision {
+            path: trace.path.clone(),
+            digits: trace.digits,
+            level: level.name(),
+            needed,
+        });
+    }
+    let scale = state_scales(&reference.samples);
+    let t_scale = time_scale(reference);
     let mut q = Vec::new();
-    if let Some([t0, t1]) = sc.compare.transient {
-        let inside = |t: f64| t >= t0 - TIME_TOL && t <= t1 + TIME_TOL;
-        let (mut du, mut dl, mut sq, mut n) = (0.0f64, 0.0f64, 0.0, 0usize);
-        let (mut su, mut sl) = (0.0f64, 0.0f64);
-        for (a, r) in trace.samples.iter().zip(&reference.samples) {
-            if !inside(r.t) {
-                continue;
-            }
-            let (eu, el) = ((a.x[1] - r.x[1]).abs(), (a.x[2] - r.x[2]).abs());
-            du = du.max(eu);
-            dl = dl.max(el);
-            sq += eu * eu + el * el;
-            n += 2;
-            su = su.max(r.x[1].abs());
-            sl = sl.max(r.x[2].abs());
-        }
-        if let Some(t) = tol.transient_max {
-            q.push(graded("transient_omega_u", du, t, su));
-            q.push(graded("transient_omega_l", dl, t, sl));
-        }
-        if let Some(t) = tol.transient_rms {
-            let rms = if n > 0 {
-                (sq / n as f64).sqrt()
-            } else {
-                f64::NAN
-            };
-            q.push(graded("transient_rms", rms, t, su.max(sl)));
-        }
-        if let (Some(events), Some(t)) = (events, tol.event_time) {
-            let pick = |ev: &[Event]| -> Vec<Event> {
-                ev.iter()
-                    .filter(|e| inside(e.t) && crate::trace::event_row(e.kind).is_some())
-                    .copied()
-                    .collect()
-            };
-            let (a, r) = (pick(events), pick(&reference.events));
-            let d = if a.len() != r.len() || a.iter().zip(&r).any(|(x, y)| x.kind != y.kind) {
-                f64::INFINITY
-            } else {
-                a.iter()
-                    .zip(&r)
-                    .map(|(x, y)| (x.t - y.t).abs())
-                    .fold(0.0, f64::max)
-            };
-            q.push(graded("event_times", d, t, t1.max(1.0)));
-        }
+    let d = sample_differences(&trace.samples, &reference.samples);
+    for (i, name) in ["alpha", "omega_u", "omega_l"].into_iter().enumerate() {
+        let mut g = graded(name, d[i].0, scale[i], level);
+        g.at = Some(d[i].1);
+        q.push(g);
     }
-    if let Some(from) = sc.compare.steady_from
-        && tol.gates_steady()
-    {
-        let exit = StickExit {
-            model: &sc.model,
-            u: sc.u,
-        };
-        let sa = grid_metrics(&trace.samples, from, exit);
-        let sr = grid_metrics(&reference.samples, from, exit);
-        match (sa, sr) {
-            (Ok(a), Ok(r)) if a.kind() == r.kind() => {
-                q.push(graded("steady_kind", 0.0, 0.0, 1.0));
-                let floor = tol.steady_abs.unwrap_or(0.0);
-                for (m, (name, vr)) in steady_differences(&a, &r, &tol, floor)
-                    .into_iter()
-                    .zip(r.values())
-                {
-                    let metric = m.quantity.trim_start_matches("steady ").to_owned();
-                    // Relative metrics are already relative (scale 1); the stick time is in s.
-                    let scale = if name == "stick_time" {
-                        match r {
-                            SteadyState::LimitCycle { period, .. } => vr.max(1e-3 * period),
-                            SteadyState::Equilibrium { .. } => 1.0,
-                        }
-                    } else {
-                        1.0
-                    };
-                    let mut g = graded(&metric, m.diff, m.tol, scale);
-                    if name == "stick_time" {
-                        g.digits = digits(m.diff, scale);
-                    }
-                    q.push(g);
-                }
-            }
-            _ => q.push(graded("steady_kind", f64::INFINITY, 0.0, 1.0)),
-        }
+    let mut not_graded = Vec::new();
+    match events {
+        Some(f) => q.push(grade_events(&reference.events, &f.events, t_scale, level)),
+        None => not_graded.push("events".to_owned()),
     }
+    for disc in [Disc::Lower, Disc::Upper] {
+        q.extend(grade_stick(disc, &trace.samples, reference, t_scale, level));
+    }
+    if let Some(from) = sc.compare.steady_from {
+        q.extend(grade_steady(sc, reference, &trace.samples, from, scale, level));
+    }
+    within_reference(sc, reference, &q, level)?;
     Ok(CheckReport {
         scenario: sc.name.clone(),
+        benchmark: BENCHMARK,
         passed: q.iter().all(|g| g.passed),
-        gate,
+        gate: level,
+        digits: q.iter().map(|g| g.digits).fold(16.0, f64::min),
+        not_graded,
+        file_digits: trace.digits,
         quantities: q,
     })
 }
@@ -370,7 +843,7 @@ pub enum GradeError {
     #[error(transparent)]
     Scenario(#[from] rotor_model::ScenarioError),
     #[error(transparent)]
-    Reference(#[from] ReferenceError),
+    Reference(#[from] crate::reference::ReferenceError),
     #[error(transparent)]
     Check(#[from] CheckError),
 }
@@ -381,9 +854,9 @@ pub fn grade(
     scenario: &std::path::Path,
     trace: &Trace,
     events: Option<&EventsFile>,
-    gate: Strictness,
+    level: Level,
 ) -> Result<CheckReport, GradeError> {
     let sc = crate::load_scenario(scenario)?;
     let r = crate::reference::read(&crate::reference::dir_for(scenario), &sc.name)?;
-    Ok(check(&sc, &r, trace, events, gate)?)
+    Ok(check(&sc, &r, trace, events, level)?)
 }

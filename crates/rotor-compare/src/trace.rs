@@ -178,6 +178,10 @@ pub struct Trace {
     pub samples: Vec<Sample>,
     /// The file line of each sample (1-based; the header is line 1).
     pub lines: Vec<u64>,
+    /// Significant digits the values are written with: for each of α, ω_u, ω_l the most
+    /// digits any of its values shows, and of those the fewest (17 for arrays and exact
+    /// zeros only). A `%g` writer shows at most 6, a shortest round-trip one up to 17.
+    pub digits: u32,
 }
 
 impl Trace {
@@ -222,8 +226,29 @@ impl Trace {
                 })
                 .collect(),
             lines: (0..n as u64).collect(),
+            digits: FULL_DIGITS,
         })
     }
+}
+
+/// Significant digits of a double written in full (17 always round-trip).
+pub const FULL_DIGITS: u32 = 17;
+
+/// The significant digits a number is written with: the mantissa's digits from the first
+/// nonzero one (`0.00125` has 3, `1.50` has 3, `2.5e-7` has 2, `0` has none).
+pub fn written_digits(field: &str) -> u32 {
+    let mantissa = field.split(['e', 'E']).next().unwrap_or("");
+    let digits = mantissa
+        .bytes()
+        .filter(u8::is_ascii_digit)
+        .skip_while(|&b| b == b'0');
+    digits.count() as u32
+}
+
+/// The precision of a trace whose value columns show at most `most[i]` digits: the fewest
+/// of the columns that show any ([`FULL_DIGITS`] when every value is 0).
+fn file_digits(most: [u32; 3]) -> u32 {
+    most.into_iter().filter(|&d| d > 0).min().unwrap_or(FULL_DIGITS)
 }
 
 impl EventsFile {
@@ -284,6 +309,7 @@ pub fn parse_trace(bytes: &[u8], path: &Path) -> Result<Trace, TraceError> {
 fn trace_from(input: impl Read, path: &Path, max_rows: usize) -> Result<Trace, TraceError> {
     let mut samples = Vec::new();
     let mut lines = Vec::new();
+    let mut most = [0u32; 3];
     let layout = Layout {
         header: &TRACE_HEADER,
         joined: "t,alpha,omega_u,omega_l",
@@ -299,6 +325,9 @@ fn trace_from(input: impl Read, path: &Path, max_rows: usize) -> Result<Trace, T
                 name: TRACE_HEADER[k],
                 value: field.to_owned(),
             })?;
+            if k > 0 {
+                most[k - 1] = most[k - 1].max(written_digits(field));
+            }
         }
         samples.push(Sample {
             t: v[0],
@@ -316,6 +345,7 @@ fn trace_from(input: impl Read, path: &Path, max_rows: usize) -> Result<Trace, T
         path: path.to_owned(),
         samples,
         lines,
+        digits: file_digits(most),
     })
 }
 

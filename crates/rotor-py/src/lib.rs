@@ -22,7 +22,7 @@ use pyo3::prelude::*;
 use pyo3::types::{PyBool, PyDict, PyList, PyString};
 use rayon::prelude::*;
 use rotor_bifurcation::{BifError, DiagramOptions};
-use rotor_compare::check::{GradeError, Strictness};
+use rotor_compare::check::{GradeError, Level};
 use rotor_compare::request::{BadInput, Request};
 use rotor_compare::trace::{EventsFile, Trace, disc_name, event_row, round_to, time_digits};
 use rotor_compare::{SettleError, SteadyAnswer, SteadyError};
@@ -568,14 +568,14 @@ fn check<'py>(
     gate: &str,
     events: Option<&Bound<'py, PyAny>>,
 ) -> PyResult<Bound<'py, PyAny>> {
-    let strictness = Strictness::parse(gate).map_err(bad)?;
+    let level = Level::parse(gate).map_err(bad)?;
     let path = resolve("scenario", scenario, "scenarios")?;
     let cols = [&t, &alpha, &omega_u, &omega_l].map(|c| c.as_array().to_vec());
     let trace =
         Trace::from_columns([&cols[0], &cols[1], &cols[2], &cols[3]]).map_err(value_error)?;
     let events = events.filter(|e| !e.is_none()).map(events_of).transpose()?;
     let report = detached(py, move || {
-        rotor_compare::check::grade(&path, &trace, events.as_ref(), strictness)
+        rotor_compare::check::grade(&path, &trace, events.as_ref(), level)
     })?
     .map_err(from_grade)?;
     to_py(py, &report)

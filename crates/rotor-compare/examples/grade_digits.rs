@@ -1,0 +1,109 @@
+//! The digits `rotor check` gives honest solvers of every kind on every fixture: the
+//! event-driven solver at several tolerances, the switch model, Moreau–Jean at several steps.
+//! Each run's grid trace and events are graded as an external trace is. This is how the
+//! levels' digits (`check::STRICT_DIGITS`, `check::LOOSE_DIGITS`) were chosen:
+//!
+//! ```sh
+//! cargo run --release -p rotor-compare --example grade_digits
+//! ```
+
+use std::path::Path;
+
+use rotor_compare::check::{Level, check, reference_error};
+use rotor_compare::solvers::SolverKind;
+use rotor_compare::trace::{EventsFile, FULL_DIGITS, Trace};
+use rotor_model::{Output, Scenario, Scene};
+
+fn main() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
+    let runs: Vec<(SolverKind, f64)> = vec![
+        (SolverKind::EVENT, 1e-12),
+        (SolverKind::EVENT, 1e-11),
+        (SolverKind::EVENT, 1e-10),
+        (SolverKind::EVENT, 1e-8),
+        (SolverKind::SWITCH, 1e-10),
+        (SolverKind::MOREAU, 1e-3),
+        (SolverKind::MOREAU, 1e-4),
+    ];
+    for f in Scenario::list_dir(&root.join("fixtures/scenarios")).expect("fixtures") {
+        let sc = rotor_compare::load_scenario(&f).unwrap_or_else(|e| panic!("{e}"));
+        let r = rotor_compare::reference::read(&root.join("fixtures/reference"), &sc.name)
+            .unwrap_or_else(|e| panic!("{e}"));
+        println!("== {}", sc.name);
+        for &(kind, setting) in &runs {
+            let mut scene = sc.scene(Output::Grid {
+                dt: sc.compare.dt,
+            });
+            if kind.is_fixed_step() {
+                scene.h = setting;
+            } else {
+                scene.tol = setting;
+            }
+            let scene = Scene { ..scene };
+            let tr = match kind.solver().simulate_finite(&sc.model, &scene) {
+                Ok(tr) => tr,
+                Err(e) => {
+                    println!("{:>8} {setting:e}: {e}", kind.name());
+                    continue;
+                }
+            };
+            let trace = Trace {
+                path: "run".into(),
+                lines: (2..tr.samples.len() as u64 + 2).collect(),
+                samples: tr.samples,
+                digits: FULL_DIGITS,
+            };
+            let events = EventsFile {
+                path: "run".into(),
+                lines: (2..tr.events.len() as u64 + 2).collect(),
+                events: tr.events,
+            };
+            match check(&sc, &r, &trace, Some(&events), Level::Digits(1)) {
+                Ok(rep) => {
+                    let cols: Vec<String> = rep
+                        .quantities
+                        .iter()
+                        .map(|q| format!("{}={:.1}", q.name.trim_start_matches("steady_"), q.digits))
+                        .collect();
+                    println!(
+                        "{:>8} {setting:e}: digits {:.1}  {}{}",
+                        kind.name(),
+                        rep.digits,
+                        cols.join(" "),
+                        rep.quantities
+                            .iter()
+                            .filter_map(|q| q.note.as_ref())
+                            .map(|n| format!("\n      {n}"))
+                            .collect::<String>()
+                    );
+                }
+                Err(e) => println!("{:>8} {setting:e}: {e}", kind.name()),
+            }
+        }
+        // The reference's own verified digits per quantity.
+        if let Ok(rep) = check(
+            &sc,
+            &r,
+            &Trace {
+                path: "ref".into(),
+                lines: (2..r.samples.len() as u64 + 2).collect(),
+                samples: r.samples.clone(),
+                digits: FULL_DIGITS,
+            },
+            None,
+            Level::Digits(1),
+        ) {
+            let cols: Vec<String> = rep
+                .quantities
+                .iter()
+                .filter_map(|q| {
+                    let e = reference_error(&r, &q.name)?;
+                    Some(format!("{}={:.1}", q.name, -(e / q.scale).log10()))
+                })
+                .collect();
+            println!("  reference verified: {}", cols.join(" "));
+            let orbit = rep.quantities.iter().find(|q| q.name == "orbit");
+            println!("  reference's own orbit distance: {:?}", orbit.map(|q| q.difference));
+        }
+    }
+}

@@ -1,0 +1,187 @@
+//! The reference's steady orbit as a dense curve, and the phase-free distance of a state
+//! from it (the `orbit` quantity of [`crate::check`]).
+//!
+//! The committed reference trace samples the orbit every 0.01 s, far too coarsely for a
+//! distance good to 1e-9: a chord of a 0.01 s step misses the curve by up to
+//! `dt²·|ÿ|/8 ≈ 1e-4` of the scale where ω_l turns fastest. So the orbit is computed again, by
+//! the reference solver itself (the event-driven solver at the reference's tolerance), over
+//! one period from the reference's state at `steady_from`, sampled every [`ORBIT_DT`] with its
+//! mode switches inserted as vertices (the kinks of a stick onset or exit lie exactly on
+//! the polyline). Between vertices the curve is smooth, so the polyline is within
+//! `ORBIT_DT²·max|ÿ|/8` of it: below 1e-9 of the scale for the fixtures (`max|ÿ|` ≈ 4e4 of the
+//! scale per s², measured at the Stribeck set's stick exits).
+//!
+//! The distance is measured in coordinates scaled by each variable's scale
+//! (`α/S_α, ω_u/S_u, ω_l/S_l`), so it is a relative error like the others.
+
+use rotor_model::{Output, Sample, Scenario, Scene, SolveError, State};
+
+use crate::solvers::SolverKind;
+
+/// Sampling step of the dense orbit [s].
+pub const ORBIT_DT: f64 = 2e-5;
+
+/// A closed orbit as a polyline in scaled coordinates, with the time of
+/// each vertex along it.
+#[derive(Debug, Clone)]
+pub struct Orbit {
+    /// Vertex times from the orbit's start, increasing.
+    times: Vec<f64>,
+    /// Vertices, scaled.
+    points: Vec<[f64; 3]>,
+    /// The period.
+    period: f64,
+    scale: [f64; 3],
+}
+
+fn scaled(x: &State, s: &[f64; 3]) -> [f64; 3] {
+    [x[0] / s[0], x[1] / s[1], x[2] / s[2]]
+}
+
+/// Distance from `p` to the segment `a b`, and the segment parameter of the nearest point.
+fn to_segment(p: &[f64; 3], a: &[f64; 3], b: &[f64; 3]) -> (f64, f64) {
+    let d = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
+    let w = [p[0] - a[0], p[1] - a[1], p[2] - a[2]];
+    let dd = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
+    let s = if dd > 0.0 {
+        ((w[0] * d[0] + w[1] * d[1] + w[2] * d[2]) / dd).clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    let e = [w[0] - s * d[0], w[1] - s * d[1], w[2] - s * d[2]];
+    ((e[0] * e[0] + e[1] * e[1] + e[2] * e[2]).sqrt(), s)
+}
+
+impl Orbit {
+    /// The orbit of scenario `sc` through `x_start` (a state on the cycle) over one `period`
+    /// and a little more (so that a search wraps around), computed by the reference solver
+    /// at `tol`.
+    pub fn cycle(
+        sc: &Scenario,
+        x_start: State,
+        period: f64,
+        tol: f64,
+        scale: [f64; 3],
+    ) -> Result<Orbit, SolveError> {
+        let span = period * 1.05;
+        let scene = Scene {
+            u: sc.u,
+            x0: x_start,
+            t_end: span,
+            tol,
+            output: Output::Grid { dt: ORBIT_DT },
+            metrics_from: None,
+            ..Scene::default()
+        };
+        let tr = SolverKind::EVENT
+            .solver()
+            .simulate_finite(&sc.model, &scene)?;
+        let mut all: Vec<Sample> = tr.samples;
+        all.extend(tr.events.iter().map(|e| Sample { t: e.t, x: e.x }));
+        all.sort_by(|a, b| a.t.total_cmp(&b.t));
+        Ok(Orbit {
+            times: all.iter().map(|s| s.t).collect(),
+            points: all.iter().map(|s| scaled(&s.x, &scale)).collect(),
+            period,
+            scale,
+        })
+    }
+
+    /// The distances of each of `samples` (consecutive trace samples on the cycle) from the
+    /// orbit: the largest, and the time of the sample where it is.
+    ///
+    /// Each sample is looked for near where the previous one was found, advanced by the time
+    /// between them (a window of ±[`WINDOW`] s along the orbit); when the nearest vertex lies
+    /// at the window's edge, the whole orbit is searched.
+    pub fn largest_distance(&self, samples: &[Sample]) -> (f64, f64) {
+        let mut worst = (0.0f64, f64::NAN);
+        let mut guess: Option<f64> = None;
+        let mut prev_t = f64::NAN;
+        for s in samples {
+            let p = scaled(&s.x, &self.scale);
+            let found = match guess {
+                Some(tau) => {
+                    let mut tau = tau + (s.t - prev_t);
+                    if tau > self.period {
+                        tau -= self.period;
+                    }
+                    let lo = self.times.partition_point(|&t| t < tau - WINDOW);
+                    let hi = self.times.partition_point(|&t| t <= tau + WINDOW);
+                    let (d, k) = self.nearest(&p, lo, hi);
+                    if k == lo || k + 2 >= hi {
+                        self.nearest(&p, 0, self.points.len())
+                    } else {
+                        (d, k)
+                    }
+                }
+                None => self.nearest(&p, 0, self.points.len()),
+            };
+            let (d, k) = found;
+            guess = Some(self.times[k]);
+            prev_t = s.t;
+            if !(d <= worst.0) {
+                worst = (d, s.t);
+            }
+        }
+        worst
+    }
+
+    /// The distance from `p` to the polyline's segments `lo..hi`, and the first vertex of the
+    /// nearest segment.
+    fn nearest(&self, p: &[f64; 3], lo: usize, hi: usize) -> (f64, usize) {
+        let hi = hi.min(self.points.len());
+        let mut best = (f64::INFINITY, lo);
+        for k in lo..hi.saturating_sub(1) {
+            let (d, _) = to_segment(p, &self.points[k], &self.points[k + 1]);
+            if d < best.0 {
+                best = (d, k);
+            }
+        }
+        best
+    }
+}
+
+/// Half-width of the search window along the orbit [s]: a trace's phase error may grow by
+/// its period error per period, far less than this between two samples.
+const WINDOW: f64 = 2e-3;
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn segment_distance_is_the_perpendicular_or_the_nearest_end() {
+        let (d, s) = to_segment(&[0.5, 1.0, 0.0], &[0.0, 0.0, 0.0], &[1.0, 0.0, 0.0]);
+        assert_eq!((d, s), (1.0, 0.5));
+        let (d, s) = to_segment(&[2.0, 0.0, 0.0], &[0.0, 0.0, 0.0], &[1.0, 0.0, 0.0]);
+        assert_eq!((d, s), (1.0, 1.0));
+    }
+
+    #[test]
+    fn a_circle_sampled_densely_is_found_from_any_phase() {
+        // The unit circle in (α, ω_u) traversed in 2π s: a point at radius 1 + e is e away.
+        let n = 20_000;
+        let period = std::f64::consts::TAU;
+        let times: Vec<f64> = (0..=n).map(|k| period * k as f64 / n as f64).collect();
+        let orbit = Orbit {
+            points: times.iter().map(|t| [t.cos(), t.sin(), 0.0]).collect(),
+            times,
+            period,
+            scale: [1.0; 3],
+        };
+        let trace: Vec<Sample> = (0..500)
+            .map(|k| {
+                let t = 0.01 * k as f64 + 1.0;
+                let r = if k == 321 { 1.0 + 1e-3 } else { 1.0 };
+                Sample {
+                    t,
+                    x: State::new(r * t.cos(), r * t.sin(), 0.0),
+                }
+            })
+            .collect();
+        let (d, at) = orbit.largest_distance(&trace);
+        // The chord sagitta of a step 2π/2e4 on the unit circle is (π/2e4)²/2 ≈ 1.2e-8.
+        assert!((d - 1e-3).abs() < 2e-8, "{d}");
+        assert!((at - 4.21).abs() < 1e-12, "{at}");
+    }
+}
