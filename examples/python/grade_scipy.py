@@ -4,10 +4,11 @@
 The quickest way to a solution in scipy is to smooth the friction law's sign function,
 sgn(w) ~ tanh(w / eps), and hand the now smooth (but stiff) system to an implicit integrator.
 This script does that for a benchmark scenario and asks rotorbench how good the answer is:
-every quantity the scenario grades (the transient sample by sample, the steady-state period,
-extrema and stick time), its difference from the reference, the tolerance of the gate and the
-correct digits. A smoothed model creeps where the true one sticks, so expect the stick time
-and the extrema to be what fails first; shrink EPS and watch the run time grow.
+every quantity the scenario grades (every sample, the stick intervals, the steady-state period,
+extrema, stick time and orbit), its difference from the reference, the tolerance of the level
+and the correct digits. A smoothed model creeps where the true one sticks, so expect its stick
+intervals to be missing and the samples near stick to be what fails first; shrink EPS and
+watch the run time grow.
 
 Run after `pip install ./crates/rotor-py scipy`:
 

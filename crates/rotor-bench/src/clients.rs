@@ -54,7 +54,10 @@ pub struct ClientPoint {
     pub errors: Errors,
     pub steps: Option<u64>,
     pub rhs_evals: Option<u64>,
-    /// Whether the trace passes the scenario's strict and loose gates (as `rotor check`).
+    /// The trace's significant correct digits, as `rotor check` counts them (the fewest of
+    /// any graded quantity).
+    pub digits: Option<f64>,
+    /// Whether the trace passes the strict and loose levels (as `rotor check`).
     pub passes_strict: Option<bool>,
     pub passes_loose: Option<bool>,
     /// The quantities failing the loose gate.
@@ -253,7 +256,7 @@ fn run_once(
 
 /// Grades a run's files: the errors against the reference (as the Rust points), the gates
 /// (as `rotor check`), and the seconds it took.
-fn grade(l: &Loaded, job: &Job) -> Result<(Errors, bool, bool, Vec<String>, f64), Failure> {
+fn grade(l: &Loaded, job: &Job) -> Result<(Errors, f64, bool, bool, Vec<String>, f64), Failure> {
     let t0 = Instant::now();
     let unusable = |detail: String| Failure {
         kind: FailureKind::Unusable,
@@ -296,6 +299,7 @@ fn grade(l: &Loaded, job: &Job) -> Result<(Errors, bool, bool, Vec<String>, f64)
     let failing = loose.failing().iter().map(|s| s.to_string()).collect();
     Ok((
         errors,
+        loose.digits,
         strict.passed,
         loose.passed,
         failing,
@@ -320,6 +324,7 @@ fn point(
         errors: Errors::default(),
         steps: None,
         rhs_evals: None,
+        digits: None,
         passes_strict: None,
         passes_loose: None,
         failing: Vec::new(),
@@ -333,7 +338,7 @@ fn point(
             return p;
         }
     };
-    let (errors, strict, loose, failing, grade_s) = match grade(l, &job) {
+    let (errors, digits, strict, loose, failing, grade_s) = match grade(l, &job) {
         Ok(g) => g,
         Err(f) => {
             p.failure = Some(f);
@@ -342,6 +347,7 @@ fn point(
     };
     let first_says = ClientSays::from_stdout(&first.stdout);
     p.errors = errors;
+    p.digits = Some(digits);
     p.passes_strict = Some(strict);
     p.passes_loose = Some(loose);
     p.protocol_s = Some(write_s + grade_s);
@@ -596,6 +602,7 @@ fn skipped_point(setting: f64) -> ClientPoint {
         errors: Errors::default(),
         steps: None,
         rhs_evals: None,
+        digits: None,
         passes_strict: None,
         passes_loose: None,
         failing: Vec::new(),

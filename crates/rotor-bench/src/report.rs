@@ -493,8 +493,16 @@ fn client_table(s: &mut String, p: &ClientReport) {
         let _ = writeln!(s, "  scene {}:", sc.scene);
         let _ = writeln!(
             s,
-            "{:>11} {:>10} {:>10} {:>4} {:>10} {:>10} {:>9} {:>9}  failure",
-            "setting", "solve ms", "wall ms", "runs", "steady rel", "transient", "steps", "gates"
+            "{:>11} {:>10} {:>10} {:>4} {:>10} {:>10} {:>9} {:>6} {:>9}  failure",
+            "setting",
+            "solve ms",
+            "wall ms",
+            "runs",
+            "steady rel",
+            "transient",
+            "steps",
+            "digits",
+            "level"
         );
         for q in &sc.points {
             let gates = match (q.passes_strict, q.passes_loose) {
@@ -505,7 +513,7 @@ fn client_table(s: &mut String, p: &ClientReport) {
             };
             let _ = writeln!(
                 s,
-                "{:>11} {:>10} {:>10} {:>4} {:>10} {:>10} {:>9} {:>9}  {}",
+                "{:>11} {:>10} {:>10} {:>4} {:>10} {:>10} {:>9} {:>6} {:>9}  {}",
                 format!("{} {:.0e}", p.setting_name, q.setting),
                 q.solve.map_or("-".into(), |t| ms(t.median_s)),
                 q.wall.map_or("-".into(), |t| ms(t.median_s)),
@@ -513,6 +521,7 @@ fn client_table(s: &mut String, p: &ClientReport) {
                 e(q.errors.steady_rel),
                 e(q.errors.transient_max),
                 q.steps.map_or("-".into(), |v| v.to_string()),
+                q.digits.map_or("-".into(), |d| format!("{d:.1}")),
                 gates,
                 q.failure.as_ref().map_or(String::new(), |f| {
                     let kind = serde_json::to_value(f.kind)

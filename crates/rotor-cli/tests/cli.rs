@@ -284,7 +284,7 @@ fn a_report_written_twice_is_the_same_bytes() {
 }
 
 /// The scenario t1-u0.02-rest, its reference trace, and the lines of that trace with ω_l at
-/// t = 1 s moved by 1 rad/s (far beyond the transient gate).
+/// t = 1 s moved by 1 rad/s (far beyond any level).
 fn check_case() -> (PathBuf, PathBuf, Vec<String>) {
     let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
     let scenario = root.join("fixtures/scenarios/t1-u0.02-rest.toml");
@@ -326,14 +326,29 @@ fn check_grades_with_exit_codes_0_1_2() {
     assert_eq!(v["scenario"], "t1-u0.02-rest");
     assert_eq!(v["passed"], true);
     assert_eq!(v["gate"], "strict");
-    for key in ["name", "difference", "tolerance", "passed", "digits"] {
+    for key in ["name", "difference", "scale", "tolerance", "passed", "digits"] {
         assert!(v["quantities"][0].get(key).is_some(), "{key}: {v}");
     }
+    assert!(v["digits"].as_f64().unwrap() >= 7.0, "{v}");
+    assert!(v["benchmark"].as_str().unwrap().starts_with("rotorbench-"), "{v}");
+    // Without an events file the verdict says what it did not grade.
+    assert_eq!(v["not_graded"][0], "events", "{v}");
+    assert!(String::from_utf8_lossy(&o.stderr).contains("events not graded"));
+    // --digits N is a level of its own; beyond the reference's own digits it is refused.
+    let o = run(&good, &["--digits", "5", "--json", "-"]);
+    assert_eq!(o.status.code(), Some(0));
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert_eq!(v["gate"], "digits=5");
+    let o = run(&good, &["--digits", "15"]);
+    assert_eq!(o.status.code(), Some(2));
+    let o = run(&good, &["--digits", "x"]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("--digits \"x\""));
     let bad = dir.join("bad.csv");
     std::fs::write(&bad, lines.join("\n") + "\n").unwrap();
     let o = run(&bad, &[]);
     assert_eq!(o.status.code(), Some(1));
-    assert!(String::from_utf8_lossy(&o.stderr).contains("failing: transient_omega_l"));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("failing: omega_l"));
     lines.remove(50);
     let broken = dir.join("broken.csv");
     std::fs::write(&broken, lines.join("\n") + "\n").unwrap();

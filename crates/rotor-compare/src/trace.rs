@@ -178,9 +178,10 @@ pub struct Trace {
     pub samples: Vec<Sample>,
     /// The file line of each sample (1-based; the header is line 1).
     pub lines: Vec<u64>,
-    /// Significant digits the values are written with: for each of α, ω_u, ω_l the most
-    /// digits any of its values shows, and of those the fewest (17 for arrays and exact
-    /// zeros only). A `%g` writer shows at most 6, a shortest round-trip one up to 17.
+    /// Significant digits the values are written with: the most that any value of α, ω_u or
+    /// ω_l shows (17 for arrays, and for a file of exact zeros). A writer uses one format:
+    /// `%g` shows at most 6, a shortest round-trip one up to 17, though it writes a round
+    /// number short (`1`).
     pub digits: u32,
 }
 
@@ -245,10 +246,10 @@ pub fn written_digits(field: &str) -> u32 {
     digits.count() as u32
 }
 
-/// The precision of a trace whose value columns show at most `most[i]` digits: the fewest
-/// of the columns that show any ([`FULL_DIGITS`] when every value is 0).
-fn file_digits(most: [u32; 3]) -> u32 {
-    most.into_iter().filter(|&d| d > 0).min().unwrap_or(FULL_DIGITS)
+/// The precision of a trace whose values show at most `most` digits ([`FULL_DIGITS`] when
+/// every value is 0).
+fn file_digits(most: u32) -> u32 {
+    if most == 0 { FULL_DIGITS } else { most }
 }
 
 impl EventsFile {
@@ -309,7 +310,7 @@ pub fn parse_trace(bytes: &[u8], path: &Path) -> Result<Trace, TraceError> {
 fn trace_from(input: impl Read, path: &Path, max_rows: usize) -> Result<Trace, TraceError> {
     let mut samples = Vec::new();
     let mut lines = Vec::new();
-    let mut most = [0u32; 3];
+    let mut most = 0u32;
     let layout = Layout {
         header: &TRACE_HEADER,
         joined: "t,alpha,omega_u,omega_l",
@@ -326,7 +327,7 @@ fn trace_from(input: impl Read, path: &Path, max_rows: usize) -> Result<Trace, T
                 value: field.to_owned(),
             })?;
             if k > 0 {
-                most[k - 1] = most[k - 1].max(written_digits(field));
+                most = most.max(written_digits(field));
             }
         }
         samples.push(Sample {

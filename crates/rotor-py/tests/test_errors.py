@@ -96,9 +96,9 @@ def test_gate_and_trace_errors_name_what_is_wrong(cli):
     cols = [r[c] for c in ("t", "alpha", "omega_u", "omega_l")]
     with pytest.raises(ValueError) as e:
         rotorbench.check(sc["name"], *cols, gate="medium")
-    assert str(e.value) == 'gate = "medium": expected strict (event-switch tolerances) or loose (event-moreau)'
+    assert str(e.value) == 'gate = "medium": expected strict (7 significant digits), loose (3) or digits=N'
     p = cli("check", sc["path"], "--trace", "/dev/null", "--gate", "medium", check=False)
-    assert p.returncode == 2 and 'expected strict (event-switch tolerances) or loose (event-moreau)' in p.stderr
+    assert p.returncode == 2 and 'expected strict (7 significant digits), loose (3) or digits=N' in p.stderr
     bad = cols[3].copy()
     bad[5] = np.nan
     with pytest.raises(ValueError, match=r"^omega_l\[5\] = NaN: not a finite number$"):
