@@ -174,7 +174,16 @@ fn half_unit(v: f64, digits: u32) -> f64 {
     0.5 * 10f64.powi(v.abs().log10().floor() as i32 + 1 - digits as i32)
 }
 
-fn verify(name: &str) -> (Vec<Check>, Vec<String>, f64) {
+/// A scenario, its committed reference, and the two independent runs.
+struct Case {
+    sc: Scenario,
+    r: reference::Reference,
+    coarse: Result,
+    fine: Result,
+    secs: f64,
+}
+
+fn case(name: &str) -> Case {
     let started = std::time::Instant::now();
     let sc = Scenario::from_file(&fixtures().join(format!("scenarios/{name}.toml"))).unwrap();
     let r = reference::read(&fixtures().join("reference"), name).unwrap();
@@ -182,6 +191,23 @@ fn verify(name: &str) -> (Vec<Check>, Vec<String>, f64) {
     let dt = sc.compare.dt;
     let coarse = solve(&sc, &tab, dt * STEPS[0]);
     let fine = solve(&sc, &tab, dt * STEPS[1]);
+    Case {
+        sc,
+        r,
+        coarse,
+        fine,
+        secs: started.elapsed().as_secs_f64(),
+    }
+}
+
+/// The checks of a reference `r` against the independent runs of its case, and what could
+/// not be compared.
+fn verify(case: &Case, r: &reference::Reference) -> (Vec<Check>, Vec<String>) {
+    let Case {
+        sc, coarse, fine, ..
+    } = case;
+    let name = &sc.name;
+    let dt = sc.compare.dt;
     // Rounding of an event time (≤ ulp(t)/2 ≤ ε·t/2): ε·t; of a difference of two: 2ε·t.
     let t_round = f64::EPSILON * sc.t_end;
     let mut problems = Vec::new();
@@ -311,7 +337,7 @@ fn verify(name: &str) -> (Vec<Check>, Vec<String>, f64) {
             problems.push(format!("stated error of {q} not verified"));
         }
     }
-    (checks, problems, started.elapsed().as_secs_f64())
+    (checks, problems)
 }
 
 #[test]
@@ -348,15 +374,17 @@ fn the_tableau_is_gauss_legendre_of_order_2s() {
 fn every_stated_error_of_the_reference_holds_against_an_independent_solution() {
     let names = rotor_compare::fixtures::names(&fixtures().join("scenarios"));
     assert_eq!(names.len(), 14, "{names:?}");
-    let results: Vec<_> = names.par_iter().map(|n| (n.clone(), verify(n))).collect();
+    let cases: Vec<Case> = names.par_iter().map(|n| case(n)).collect();
     let mut failures = Vec::new();
-    for (name, (checks, problems, secs)) in &results {
+    for c in &cases {
+        let (name, secs) = (&c.sc.name, c.secs);
+        let (checks, problems) = verify(c, &c.r);
         println!("{name} ({secs:.1} s)");
         println!(
             "  {:<20} {:>9} {:>9} {:>9} {:>8}",
             "quantity", "stated", "|ref-ind|", "ind err", "stated/verified"
         );
-        for c in checks {
+        for c in &checks {
             let verified = c.difference.max(c.own);
             println!(
                 "  {:<20} {:>9.2e} {:>9.2e} {:>9.2e} {:>8.1}{}{}{}",
@@ -381,10 +409,52 @@ fn every_stated_error_of_the_reference_holds_against_an_independent_solution() {
                 failures.push(format!("{name} {}: {c:?}", c.name));
             }
         }
-        for p in problems {
+        for p in &problems {
             println!("  {p}");
             failures.push(format!("{name}: {p}"));
         }
     }
     assert!(failures.is_empty(), "{failures:#?}");
+}
+
+/// The check can fail: the committed reference of t1-u1.5-rest with one quantity moved by
+/// 1.5× its stated error away from the independent solution (one trace sample, one event
+/// time, the period) fails on that quantity alone; unmoved, it passes.
+#[test]
+fn a_reference_moved_by_more_than_its_stated_error_fails() {
+    let c = case("t1-u1.5-rest");
+    let failing = |r: &reference::Reference| -> Vec<String> {
+        let (checks, problems) = verify(&c, r);
+        assert!(problems.is_empty(), "{problems:?}");
+        checks
+            .iter()
+            .filter(|k| !k.passes())
+            .map(|k| k.name.clone())
+            .collect()
+    };
+    assert!(failing(&c.r).is_empty());
+    let moved = |q: &str| 1.5 * c.r.error(q);
+
+    let mut r = c.r.clone();
+    let i = 15_000;
+    let here = (r.samples[i].x[2] - c.fine.run.samples[i].1[2]).signum();
+    r.samples[i].x[2] += here * moved("omega_l");
+    assert_eq!(failing(&r), ["trace omega_l"]);
+
+    let mut r = c.r.clone();
+    let e = r.events.len() - 1;
+    let here = (r.events[e].t - c.fine.run.switches[e].t).signum();
+    r.events[e].t += here * moved("event_time");
+    assert_eq!(failing(&r), ["event_time"]);
+
+    let mut r = c.r.clone();
+    let period = |s: Option<SteadyState>| s.unwrap().values()[0].1;
+    assert_eq!(c.r.json.steady.unwrap().values()[0].0, "period");
+    let here = (period(r.json.steady) - period(c.fine.steady)).signum();
+    let by = here * moved("period");
+    r.json.steady = r
+        .json
+        .steady
+        .map(|s| s.map(|n, v| if n == "period" { v + by } else { v }));
+    assert_eq!(failing(&r), ["steady period"]);
 }

@@ -11,7 +11,7 @@
 //! * **Modes** (Filippov, with exact sliding): a slipping disc follows the branch torque of
 //!   its direction; a stuck disc has ω ≡ 0 and friction equal to the applied torque.
 //! * **Events**: located by re-taking the step from its start with a fraction θ of it and a
-//!   root finder (Illinois, then bisection) on θ ↦ g(step(θ)), to the last bits of t. Guards:
+//!   root finder (Illinois with bisection) on θ ↦ g(step(θ)), to 1e-15 of the step. Guards:
 //!   a slipping disc's velocity reaching 0 (stick if the applied torque lies in the stick
 //!   interval, else a reversal); a stuck disc's applied torque reaching a bound of the
 //!   interval (exit). Guards are checked at the step's end and at its stage points.
