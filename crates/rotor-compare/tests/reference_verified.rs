@@ -342,8 +342,9 @@ fn verify(case: &Case, r: &reference::Reference) -> (Vec<Check>, Vec<String>) {
 
 #[test]
 fn the_tableau_is_gauss_legendre_of_order_2s() {
-    // y' = [y2, −y1] (a rotation), exact solution known: the global error at t = 1 falls as
-    // h^{2s}. Steps 1/4 and 1/8: ratio 2^{2s}; measured within 5 % for s = 2..5.
+    // y' = [y2, −y1] (a rotation), exact solution known: the global error at t = 2 falls as
+    // h^{2s}, so halving the step divides it by 2^{2s}; measured within 2.2 % for s = 2..5.
+    // 10 % tells order 2s from 2s ± 1 (a factor 2 off).
     let f = |x: &State| State::new(x[1], -x[0], 0.0);
     for s in 2..=5 {
         let tab = Tableau::gauss_legendre(s);
