@@ -250,6 +250,30 @@ fn graded(name: &str, difference: f64, tolerance: f64, scale: f64) -> Graded {
     }
 }
 
+/// Stop-gap while this grader still reuses the cross-validation tables (issue 28 replaces
+/// it): the tables hold one gate per quantity, each 5-10x what two solvers' exact metrics
+/// differ by, while this grader reads the metrics off the output grid, whose reconstruction
+/// error is not in that measurement (1.2e-12 on t1-u4.5-rest's omega_u_min against its
+/// 8e-13). So each metric is graded against the widest gate of the group one shared key
+/// covered until then (the extremes of ω_l, those of ω_u, the equilibrium's three values):
+/// the gates this grader used before the keys were split.
+fn shared_gates(t: &PairTolerance) -> PairTolerance {
+    let widest = |keys: &[&str]| keys.iter().filter_map(|k| t.get(k)).reduce(f64::max);
+    let omega_l = widest(&["omega_l_max_rel", "omega_l_min_rel"]);
+    let omega_u = widest(&["omega_u_max_rel", "omega_u_min_rel"]);
+    let eq = widest(&rotor_model::EQUILIBRIUM_KEYS);
+    PairTolerance {
+        omega_l_max_rel: omega_l,
+        omega_l_min_rel: omega_l,
+        omega_u_max_rel: omega_u,
+        omega_u_min_rel: omega_u,
+        equilibrium_omega_u_rel: eq,
+        equilibrium_omega_l_rel: eq,
+        equilibrium_alpha_rel: eq,
+        ..*t
+    }
+}
+
 /// Grades a trace (and optionally its events) against the reference of scenario `sc`.
 pub fn check(
     sc: &Scenario,
@@ -258,13 +282,15 @@ pub fn check(
     events: Option<&EventsFile>,
     gate: Strictness,
 ) -> Result<CheckReport, CheckError> {
-    let tol: PairTolerance = *sc
-        .tolerance
-        .get(gate.pair())
-        .ok_or_else(|| CheckError::NoGate {
-            scenario: sc.name.clone(),
-            pair: gate.pair(),
-        })?;
+    let tol: PairTolerance =
+        shared_gates(
+            sc.tolerance
+                .get(gate.pair())
+                .ok_or_else(|| CheckError::NoGate {
+                    scenario: sc.name.clone(),
+                    pair: gate.pair(),
+                })?,
+        );
     check_grid(trace, &reference.samples, sc.compare.dt, sc.t_end)?;
     if let Some(f) = events {
         check_events(f, sc.t_end)?;
