@@ -1,7 +1,9 @@
 //! Every gate of every fixture beside what it measures: the measured difference, the gate
-//! stated in the scenario file, their ratio (the margin), and the gate the fixtures' rule
-//! gives (5 × the measured difference, rounded up to one digit; the rounding floor below it).
-//! Run it after a solver change to re-derive the `[tolerance.*]` tables:
+//! stated in the scenario file, their ratio (the margin), the gate the fixtures' rule gives
+//! (5 × the measured difference, rounded up to one digit; the rounding floor below it; 0 where
+//! the solvers agree exactly) and whether the gate is within what the test enforces
+//! (`rotor_compare::margins`). Run it after a solver change to re-derive the `[tolerance.*]`
+//! tables:
 //!
 //! ```sh
 //! cargo run --release -p rotor-compare --example gate_margins
@@ -9,52 +11,44 @@
 
 use std::path::Path;
 
-use rotor_compare::report::gate_scenario;
+use rotor_compare::margins::{floor_violations, margins};
 use rotor_compare::run_scenario;
 use rotor_model::Scenario;
-
-/// The fixtures' rule: 5 × the measured difference rounded up to one significant digit, at
-/// least the rounding floor; an exact 0 stays 0.
-fn suggested(measured: f64, relative: bool) -> f64 {
-    if measured == 0.0 {
-        return 0.0;
-    }
-    let floor = if relative { 1e-13 } else { 1e-12 };
-    let x = 5.0 * measured;
-    let e = x.log10().floor();
-    let g = (x / 10f64.powf(e) - 1e-9).ceil() * 10f64.powf(e);
-    g.max(floor)
-}
 
 fn main() {
     let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../fixtures/scenarios");
     println!(
-        "{:<16} {:<13} {:<42} {:>9} {:>9} {:>7} {:>9}",
-        "scenario", "pair", "quantity", "measured", "gate", "margin", "rule"
+        "{:<16} {:<13} {:<24} {:>10} {:>9} {:>7} {:>9}  verdict",
+        "scenario", "pair", "key", "measured", "gate", "margin", "rule"
     );
+    let (mut rows, mut bad) = (0, Vec::new());
     for f in Scenario::list_dir(&dir).expect("fixtures/scenarios") {
         let sc = rotor_compare::load_scenario(&f).unwrap_or_else(|e| panic!("{e}"));
+        bad.extend(floor_violations(&sc));
         let r = run_scenario(&sc);
-        for g in gate_scenario(&r).0 {
-            for m in &g.measured {
-                let relative =
-                    m.quantity.starts_with("steady ") && !m.quantity.contains("stick_time");
-                let margin = if m.diff > 0.0 {
-                    m.tol / m.diff
+        for m in margins(&r) {
+            rows += 1;
+            let verdict = m.violation();
+            println!(
+                "{:<16} {:<13} {:<24} {:>10.3e} {:>9.0e} {:>7} {:>9.0e}  {}",
+                m.scenario,
+                m.pair,
+                m.key.unwrap_or(&m.quantity),
+                m.measured,
+                m.gate,
+                if m.measured == 0.0 && m.gate == 0.0 {
+                    "exact".to_owned()
                 } else {
-                    f64::INFINITY
-                };
-                println!(
-                    "{:<16} {:<13} {:<42} {:>9.2e} {:>9.0e} {:>7.1} {:>9.0e}",
-                    sc.name,
-                    g.pair,
-                    m.quantity,
-                    m.diff,
-                    m.tol,
-                    margin,
-                    suggested(m.diff, relative)
-                );
-            }
+                    format!("{:.1}", m.margin())
+                },
+                m.rule(),
+                if verdict.is_some() { "OUTSIDE" } else { "ok" }
+            );
+            bad.extend(verdict);
         }
+    }
+    println!("\n{rows} gates, {} outside the rule", bad.len());
+    for b in &bad {
+        println!("  {b}");
     }
 }

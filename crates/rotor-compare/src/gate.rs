@@ -2,8 +2,9 @@
 //!
 //! (a) the transient window, sample by sample on the common grid: max and RMS of the
 //! difference in ω_u and ω_l; (b) the steady state: kind, and each metric within its own
-//! tolerance (period, ω_l extremes, ω_u extremes and the equilibrium relative with `steady_abs`
-//! as a floor, the stick time in seconds); (c) events: lower-disc stick onsets and exits in
+//! tolerance, one key per metric (period, each extreme of ω_l and ω_u, and each of the
+//! equilibrium's ω_u, ω_l and α relative with `steady_abs` as a floor, the stick time in
+//! seconds); (c) events: lower-disc stick onsets and exits in
 //! the transient window matched one to one within `event_time`.
 //! Every comparison is written `!(diff <= tol)` so that a NaN fails.
 
@@ -13,6 +14,9 @@ use rotor_model::{Disc, EventKind, PairTolerance, SteadyState, Trajectory};
 #[derive(Debug, Clone, PartialEq, serde::Serialize)]
 pub struct Measured {
     pub quantity: String,
+    /// The scenario file's key that states `tol` (`tolerance.<pair>.<key>`); `None` for the
+    /// checks that no key states (steady states of different kinds, or missing).
+    pub key: Option<&'static str>,
     pub diff: f64,
     pub tol: f64,
 }
@@ -116,6 +120,7 @@ pub fn check_pair(
         if let Some(t) = tol.transient_max {
             m.push(Measured {
                 quantity: "transient max abs d_omega".into(),
+                key: Some("transient_max"),
                 diff: max,
                 tol: t,
             });
@@ -123,6 +128,7 @@ pub fn check_pair(
         if let Some(t) = tol.transient_rms {
             m.push(Measured {
                 quantity: "transient rms d_omega".into(),
+                key: Some("transient_rms"),
                 diff: rms,
                 tol: t,
             });
@@ -154,6 +160,7 @@ pub fn check_pair(
             };
             m.push(Measured {
                 quantity: format!("stick event times ({} vs {} events)", ea.len(), eb.len()),
+                key: Some("event_time"),
                 diff,
                 tol: t,
             });
@@ -166,6 +173,7 @@ pub fn check_pair(
             let which = |tr: &Trajectory| if tr.metrics.is_some() { "yes" } else { "none" };
             m.push(Measured {
                 quantity: format!("steady metrics ({} vs {})", which(a), which(b)),
+                key: None,
                 diff: f64::NAN,
                 tol: 0.0,
             });
@@ -177,6 +185,7 @@ pub fn check_pair(
         if sa.kind() != sb.kind() {
             m.push(Measured {
                 quantity: format!("steady kind ({} vs {})", sa.kind(), sb.kind()),
+                key: None,
                 diff: f64::INFINITY,
                 tol: 0.0,
             });
@@ -226,6 +235,7 @@ pub fn steady_differences(
             };
             Measured {
                 quantity: format!("steady {name}{missing}"),
+                key: Some(q.key),
                 diff: if missing.is_empty() {
                     diff
                 } else {
@@ -283,7 +293,9 @@ mod tests {
     fn tol() -> PairTolerance {
         PairTolerance {
             transient_max: Some(1e-9),
-            equilibrium_rel: Some(1e-9),
+            equilibrium_omega_u_rel: Some(1e-9),
+            equilibrium_omega_l_rel: Some(1e-9),
+            equilibrium_alpha_rel: Some(1e-9),
             ..PairTolerance::default()
         }
     }
@@ -329,8 +341,10 @@ mod tests {
     fn each_steady_metric_has_its_own_gate() {
         let tol = PairTolerance {
             period_rel: Some(1e-10),
-            omega_l_rel: Some(1e-9),
-            omega_u_rel: Some(1e-11),
+            omega_l_max_rel: Some(1e-9),
+            omega_l_min_rel: Some(3e-9),
+            omega_u_max_rel: Some(1e-11),
+            omega_u_min_rel: Some(3e-11),
             stick_time: Some(1e-8),
             steady_abs: Some(1e-12),
             ..PairTolerance::default()
@@ -338,7 +352,7 @@ mod tests {
         let a = traj(Some(CYCLE));
         assert!(check_pair("p", &a, &a, None, &tol).failures("s").is_empty());
         type Shift = fn(&mut SteadyState, f64);
-        let shifts: [(&str, Shift, f64); 5] = [
+        let shifts: [(&str, Shift, f64); 6] = [
             (
                 "period",
                 |m, f| {
@@ -367,13 +381,23 @@ mod tests {
                 1e-9,
             ),
             (
+                "omega_u_max",
+                |m, f| {
+                    if let SteadyState::LimitCycle { omega_u_max, .. } = m {
+                        *omega_u_max *= 1.0 + f
+                    }
+                },
+                1e-11,
+            ),
+            // Its own gate, 3x omega_u_max's: 1.5e-11 passes here and would fail there.
+            (
                 "omega_u_min",
                 |m, f| {
                     if let SteadyState::LimitCycle { omega_u_min, .. } = m {
                         *omega_u_min *= 1.0 + f
                     }
                 },
-                1e-11,
+                3e-11,
             ),
             (
                 "stick_time",
@@ -390,8 +414,8 @@ mod tests {
                 let mut b = a.clone();
                 shift(b.metrics.as_mut().unwrap(), factor * gate);
                 let f = check_pair("p", &a, &b, None, &tol).failures("s");
-                // ω_l's minimum is 0: the floor 1e-12 gates it absolutely, so a shift of
-                // 2e-12 fails and 5e-13 passes.
+                // ω_l's minimum is 0: the floor 1e-12 gates it absolutely (not its own
+                // 3e-9), so a shift of 2e-12 fails and 5e-13 passes.
                 assert_eq!(!f.is_empty(), fails, "{name} x{factor}: {f:?}");
                 if fails {
                     assert!(
@@ -405,7 +429,10 @@ mod tests {
         let e = traj(Some(EQ));
         let f = check_pair("p", &e, &e, None, &tol).failures("s");
         assert_eq!(f.len(), 3, "{f:?}");
-        assert!(f[0].quantity.contains("no equilibrium_rel stated"), "{f:?}");
+        assert!(
+            f[0].quantity.contains("no equilibrium_omega_u_rel stated"),
+            "{f:?}"
+        );
     }
 
     /// The transient gates: max, RMS, and the stick event times (count and kind too).
@@ -477,7 +504,9 @@ mod tests {
     fn a_zero_gate_demands_exact_agreement() {
         let tol = PairTolerance {
             transient_max: Some(0.0),
-            equilibrium_rel: Some(0.0),
+            equilibrium_omega_u_rel: Some(0.0),
+            equilibrium_omega_l_rel: Some(0.0),
+            equilibrium_alpha_rel: Some(0.0),
             ..PairTolerance::default()
         };
         let a = traj(Some(EQ));

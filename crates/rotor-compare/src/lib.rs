@@ -5,6 +5,7 @@ pub mod check;
 pub mod fixtures;
 pub mod gate;
 pub mod gridmetrics;
+pub mod margins;
 pub mod orbit;
 pub mod probes;
 pub mod reference;

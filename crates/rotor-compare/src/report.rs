@@ -26,8 +26,9 @@ fn gate_row(scenario: &str, pair: &str, m: &crate::gate::Measured) -> String {
         "— | — | —".into()
     };
     let verdict = if m.passes() { "ok" } else { "**FAIL**" };
+    let key = m.key.map_or("—".into(), |k| format!("`{k}`"));
     format!(
-        "| {scenario} | {pair} | {} | {numbers} | {verdict} |",
+        "| {scenario} | {pair} | {} | {key} | {numbers} | {verdict} |",
         m.quantity
     )
 }
@@ -384,10 +385,13 @@ pub fn write_report(
     }
     md.push_str(
         "\n## Gates (measured difference, tolerance from the scenario file, margin)\n\n\
-         Each gate is about 5x (5-10x) what it measures on its scenario, or 0 where every \
-         solver agrees exactly (the scenario files give each one's origin); relative for the \
-         steady metrics except the stick time (s), rad/s for the transient, s for events.\n\n\
-         | scenario | pair | quantity | difference | tolerance | margin | |\n|---|---|---|---|---|---|---|\n",
+         One key of the scenario file per quantity. Each gate is 5x what it measures on its \
+         scenario rounded up to one digit (margin 5-10x), at least the rounding floor (1e-13 \
+         relative, 1e-12 s or rad/s), or 0 where every solver agrees exactly (the scenario \
+         files give each one's origin); a test holds every gate between its measurement and \
+         10x it (tests/fixtures.rs). Relative for the steady metrics except the stick time \
+         (s), rad/s for the transient, s for events.\n\n\
+         | scenario | pair | quantity | key | difference | tolerance | margin | |\n|---|---|---|---|---|---|---|---|\n",
     );
     for r in results {
         let (gates, fails) = gate_scenario(r);
@@ -399,7 +403,7 @@ pub fn write_report(
         for f in unmeasured(&gates, &fails) {
             let _ = writeln!(
                 md,
-                "| {} | {} | {} | — | — | — | **FAIL** |",
+                "| {} | {} | {} | — | — | — | — | **FAIL** |",
                 f.scenario, f.pair, f.quantity
             );
         }
@@ -442,22 +446,23 @@ mod tests {
     fn unmeasurable_gates_show_no_numbers() {
         let m = |quantity: &str, diff: f64, tol: f64| Measured {
             quantity: quantity.into(),
+            key: quantity.ends_with("_rel").then_some("period_rel"),
             diff,
             tol,
         };
         assert_eq!(
             gate_row("s", "a-b", &m("period_rel", 2e-11, 1e-10)),
-            "| s | a-b | period_rel | 2.00e-11 | 1e-10 | 5.0 | ok |"
+            "| s | a-b | period_rel | `period_rel` | 2.00e-11 | 1e-10 | 5.0 | ok |"
         );
         assert_eq!(
             gate_row("s", "a-b", &m("stick_time", 0.0, 0.0)),
-            "| s | a-b | stick_time | 0.00e0 | 0e0 | exact | ok |"
+            "| s | a-b | stick_time | — | 0.00e0 | 0e0 | exact | ok |"
         );
         for d in [f64::NAN, f64::INFINITY] {
             let row = gate_row("s", "a-b", &m("steady kind (cycle vs equilibrium)", d, 0.0));
             assert_eq!(
                 row,
-                "| s | a-b | steady kind (cycle vs equilibrium) | — | — | — | **FAIL** |"
+                "| s | a-b | steady kind (cycle vs equilibrium) | — | — | — | — | **FAIL** |"
             );
         }
         let f = |diff: f64| {

@@ -5,6 +5,7 @@ use std::path::Path;
 
 use std::sync::OnceLock;
 
+use rotor_compare::margins::{MAX_LOOSENESS, floor_violations, margins};
 use rotor_compare::report::gate_scenario;
 use rotor_compare::snapshot::snapshot;
 use rotor_compare::{SOLVERS, ScenarioResult, SolverKind, pair_name, pairs, run_scenario};
@@ -108,6 +109,72 @@ fn every_fixture_agrees_across_the_three_solvers_and_a_perturbation_is_caught() 
     );
 }
 
+/// `gate_margins` as a test: every gate of every fixture is within the rule that
+/// `rotor_compare::margins` enforces (a measured 0 has a gate of 0; otherwise
+/// measured <= gate <= 10 x max(measured, rounding floor); `steady_abs` at most 1e-12). So a
+/// gate cannot drift wider than its measurement justifies (a real regression would pass), nor
+/// narrower than it (the previous test fails then too).
+#[test]
+fn gate_margins_every_gate_is_within_its_rule() {
+    let results = all();
+    let rows: Vec<_> = results.iter().flat_map(margins).collect();
+    let mut bad: Vec<String> = rows.iter().filter_map(|m| m.violation()).collect();
+    for r in &results {
+        bad.extend(floor_violations(&r.scenario));
+    }
+    assert!(
+        bad.is_empty(),
+        "{} of {} gates outside the rule (re-measure: cargo run --release -p rotor-compare \
+         --example gate_margins):\n{}",
+        bad.len(),
+        rows.len(),
+        bad.join("\n")
+    );
+    // 14 fixtures x 2 pairs x (3 transient + 3 equilibrium or 6 cycle metrics), each its own
+    // key: no gate left unchecked.
+    assert!(rows.len() >= 14 * 2 * 6, "{}", rows.len());
+    assert!(rows.iter().all(|m| m.key.is_some()));
+
+    // Negative controls on the fixtures themselves: each stated gate in turn, made 2x wider
+    // than the test allows, or half its measurement, is reported, and only that gate.
+    let mut checked = 0;
+    for r in &results {
+        for m in margins(r) {
+            let key = m.key.unwrap();
+            let too_wide = MAX_LOOSENESS * m.measured.max(m.floor()) * 2.0;
+            let wide = if m.measured == 0.0 {
+                "must be 0"
+            } else {
+                "wider"
+            };
+            let mut bad_gates = vec![(too_wide, wide)];
+            if m.measured > 0.0 {
+                bad_gates.push((0.5 * m.measured, "narrower"));
+            }
+            for (gate, what) in bad_gates {
+                let mut p = r.clone();
+                let tol = p.scenario.tolerance.get_mut(&m.pair).unwrap();
+                *tol.slot(key).unwrap() = Some(gate);
+                let v: Vec<String> = margins(&p).iter().filter_map(|m| m.violation()).collect();
+                assert!(
+                    v.len() == 1 && v[0].contains(what) && v[0].contains(key),
+                    "{} {} {key} at {gate:e}: {v:?}",
+                    m.scenario,
+                    m.pair
+                );
+                checked += 1;
+            }
+        }
+    }
+    assert!(checked > rows.len(), "{checked}");
+    // A floor above the rounding floor is reported too.
+    let mut sc = results[0].scenario.clone();
+    for t in sc.tolerance.values_mut() {
+        t.steady_abs = Some(1e-10);
+    }
+    assert_eq!(floor_violations(&sc).len(), sc.tolerance.len());
+}
+
 /// Moves one metric of a steady state by `by` (absolute).
 fn shift_metric(m: &mut SteadyState, name: &str, by: f64) {
     let v = match (m, name) {
@@ -184,6 +251,7 @@ fn every_gate_of_every_fixture_fails_its_negative_control() {
                         .unwrap()
                         .1;
                     let (quantity, gate) = tol.for_metric(name).unwrap();
+                    assert_eq!(m.key, Some(quantity.key), "{q}");
                     let gate = gate.unwrap();
                     let by = if quantity.relative {
                         3.0 * (gate * v.abs()).max(tol.steady_abs.unwrap_or(0.0))

@@ -26,7 +26,8 @@ pub use num::Num;
 pub use params::{LowerFriction, Params, ParamsError, UpperFriction};
 pub use record::{Integration, Recorder};
 pub use scenario::{
-    CompareSpec, PairTolerance, STEADY_QUANTITIES, Scenario, ScenarioError, SteadyQuantity,
+    CYCLE_KEYS, CompareSpec, EQUILIBRIUM_KEYS, PairTolerance, RETIRED_KEYS, STEADY_QUANTITIES,
+    Scenario, ScenarioError, SteadyQuantity, TOLERANCE_KEYS,
 };
 pub use scene::{
     Event, EventKind, Output, OutputGrid, Sample, Scene, SolveError, Solver, Stats, Trajectory,

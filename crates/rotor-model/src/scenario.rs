@@ -10,10 +10,16 @@
 //! transient = [0.0, 20.0]            # s, compared sample by sample
 //! steady_from = 100.0                # s, steady-state metrics over [steady_from, t_end]
 //! [tolerance.event-switch]           # per solver pair and quantity, each with its origin
-//! transient_max = 3e-8               # rad/s
-//! period_rel = 2e-10                 # relative; also omega_l_rel, omega_u_rel,
-//! stick_time = 1e-7                  # s                   equilibrium_rel, steady_abs
+//! transient_max = 3e-8               # rad/s; also transient_rms, event_time (s)
+//! period_rel = 2e-10                 # relative; also omega_l_max_rel, omega_l_min_rel,
+//!                                    # omega_u_max_rel, omega_u_min_rel
+//! stick_time = 1e-7                  # s
+//! steady_abs = 1e-12                 # absolute floor of the relative ones
 //! ```
+//!
+//! An equilibrium is gated by `equilibrium_omega_u_rel`, `equilibrium_omega_l_rel` and
+//! `equilibrium_alpha_rel` instead of the cycle's keys. One key gates one quantity
+//! ([`STEADY_QUANTITIES`]); the shared keys of old ([`RETIRED_KEYS`]) are refused.
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -77,12 +83,11 @@ impl Default for CompareSpec {
     }
 }
 
-/// Agreement tolerances for one solver pair, one per quantity, each with its origin in a
+/// Agreement tolerances for one solver pair: one key per quantity, each with its origin in a
 /// comment in the file. The steady-state ones are relative (with `steady_abs` as the floor for
 /// values near 0), except `stick_time`, which is in seconds: a stick phase is located to an
 /// absolute time, whatever its length.
-#[derive(Debug, Clone, Copy, Default, PartialEq, Deserialize)]
-#[serde(deny_unknown_fields)]
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
 pub struct PairTolerance {
     /// Max |Δω| (both discs) over the transient window [rad/s].
     pub transient_max: Option<f64>,
@@ -92,91 +97,209 @@ pub struct PairTolerance {
     pub event_time: Option<f64>,
     /// Period of a limit cycle, relative.
     pub period_rel: Option<f64>,
-    /// Max and min of ω_l over a cycle, relative.
-    pub omega_l_rel: Option<f64>,
-    /// Max and min of ω_u over a cycle, relative.
-    pub omega_u_rel: Option<f64>,
+    /// Max of ω_l over a cycle, relative.
+    pub omega_l_max_rel: Option<f64>,
+    /// Min of ω_l over a cycle, relative.
+    pub omega_l_min_rel: Option<f64>,
+    /// Max of ω_u over a cycle, relative.
+    pub omega_u_max_rel: Option<f64>,
+    /// Min of ω_u over a cycle, relative.
+    pub omega_u_min_rel: Option<f64>,
     /// Time per period with ω_l = 0 [s].
     pub stick_time: Option<f64>,
-    /// The equilibrium's ω_u, ω_l and α, relative.
-    pub equilibrium_rel: Option<f64>,
+    /// The equilibrium's ω_u, relative.
+    pub equilibrium_omega_u_rel: Option<f64>,
+    /// The equilibrium's ω_l, relative.
+    pub equilibrium_omega_l_rel: Option<f64>,
+    /// The equilibrium's α, relative.
+    pub equilibrium_alpha_rel: Option<f64>,
     /// Absolute floor of the relative steady-state tolerances [s or rad/s or rad]: a value
-    /// that is ~0 (ω_l's minimum on a stick-slip cycle) is compared absolutely.
+    /// that is ~0 is compared absolutely.
     pub steady_abs: Option<f64>,
 }
 
-/// The steady-state quantities a [`PairTolerance`] gates: the metric names of
-/// [`crate::SteadyState::values`] they cover, whether the tolerance is relative, and its
-/// key in the file.
-pub const STEADY_QUANTITIES: [SteadyQuantity; 5] = [
-    SteadyQuantity {
-        key: "period_rel",
-        metrics: &["period"],
-        relative: true,
-    },
-    SteadyQuantity {
-        key: "omega_l_rel",
-        metrics: &["omega_l_max", "omega_l_min"],
-        relative: true,
-    },
-    SteadyQuantity {
-        key: "omega_u_rel",
-        metrics: &["omega_u_max", "omega_u_min"],
-        relative: true,
-    },
-    SteadyQuantity {
-        key: "stick_time",
-        metrics: &["stick_time"],
-        relative: false,
-    },
-    SteadyQuantity {
-        key: "equilibrium_rel",
-        metrics: &["omega_u", "omega_l", "alpha"],
-        relative: true,
-    },
+/// Keys of `[tolerance.<pair>]` tables that one quantity's key each replaced: a file that
+/// still states one is refused with the keys to use instead (never read as one of them).
+pub const RETIRED_KEYS: [(&str, &str); 3] = [
+    ("omega_l_rel", "omega_l_max_rel and omega_l_min_rel"),
+    ("omega_u_rel", "omega_u_max_rel and omega_u_min_rel"),
+    (
+        "equilibrium_rel",
+        "equilibrium_omega_u_rel, equilibrium_omega_l_rel and equilibrium_alpha_rel",
+    ),
 ];
 
-/// One steady-state tolerance: its key in the file and the metrics it covers.
+/// A `[tolerance.<pair>]` table as written: [`PairTolerance`] and the [`RETIRED_KEYS`], so
+/// that a retired key gets its own message rather than serde's "unknown field".
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawPairTolerance {
+    transient_max: Option<f64>,
+    transient_rms: Option<f64>,
+    event_time: Option<f64>,
+    period_rel: Option<f64>,
+    omega_l_max_rel: Option<f64>,
+    omega_l_min_rel: Option<f64>,
+    omega_u_max_rel: Option<f64>,
+    omega_u_min_rel: Option<f64>,
+    stick_time: Option<f64>,
+    equilibrium_omega_u_rel: Option<f64>,
+    equilibrium_omega_l_rel: Option<f64>,
+    equilibrium_alpha_rel: Option<f64>,
+    steady_abs: Option<f64>,
+    omega_l_rel: Option<f64>,
+    omega_u_rel: Option<f64>,
+    equilibrium_rel: Option<f64>,
+}
+
+impl RawPairTolerance {
+    /// The tolerances, or the first retired key stated with its value.
+    fn current(&self) -> Result<PairTolerance, (&'static str, f64)> {
+        let retired = [self.omega_l_rel, self.omega_u_rel, self.equilibrium_rel];
+        if let Some((i, v)) = retired
+            .iter()
+            .enumerate()
+            .find_map(|(i, v)| v.map(|v| (i, v)))
+        {
+            return Err((RETIRED_KEYS[i].0, v));
+        }
+        Ok(PairTolerance {
+            transient_max: self.transient_max,
+            transient_rms: self.transient_rms,
+            event_time: self.event_time,
+            period_rel: self.period_rel,
+            omega_l_max_rel: self.omega_l_max_rel,
+            omega_l_min_rel: self.omega_l_min_rel,
+            omega_u_max_rel: self.omega_u_max_rel,
+            omega_u_min_rel: self.omega_u_min_rel,
+            stick_time: self.stick_time,
+            equilibrium_omega_u_rel: self.equilibrium_omega_u_rel,
+            equilibrium_omega_l_rel: self.equilibrium_omega_l_rel,
+            equilibrium_alpha_rel: self.equilibrium_alpha_rel,
+            steady_abs: self.steady_abs,
+        })
+    }
+}
+
+/// Every key of a [`PairTolerance`], in file order.
+pub const TOLERANCE_KEYS: [&str; 13] = [
+    "transient_max",
+    "transient_rms",
+    "event_time",
+    "period_rel",
+    "omega_l_max_rel",
+    "omega_l_min_rel",
+    "omega_u_max_rel",
+    "omega_u_min_rel",
+    "stick_time",
+    "equilibrium_omega_u_rel",
+    "equilibrium_omega_l_rel",
+    "equilibrium_alpha_rel",
+    "steady_abs",
+];
+
+/// The keys gating a limit cycle: a pair that states one must state all of them.
+pub const CYCLE_KEYS: [&str; 6] = [
+    "period_rel",
+    "omega_l_max_rel",
+    "omega_l_min_rel",
+    "omega_u_max_rel",
+    "omega_u_min_rel",
+    "stick_time",
+];
+
+/// The keys gating an equilibrium: a pair that states one must state all of them.
+pub const EQUILIBRIUM_KEYS: [&str; 3] = [
+    "equilibrium_omega_u_rel",
+    "equilibrium_omega_l_rel",
+    "equilibrium_alpha_rel",
+];
+
+/// The steady-state quantities a [`PairTolerance`] gates, one key per metric of
+/// [`crate::SteadyState::values`]: its key in the file, the metric, and whether the
+/// tolerance is relative.
+pub const STEADY_QUANTITIES: [SteadyQuantity; 9] = [
+    SteadyQuantity::relative("period_rel", "period"),
+    SteadyQuantity::relative("omega_l_max_rel", "omega_l_max"),
+    SteadyQuantity::relative("omega_l_min_rel", "omega_l_min"),
+    SteadyQuantity::relative("omega_u_max_rel", "omega_u_max"),
+    SteadyQuantity::relative("omega_u_min_rel", "omega_u_min"),
+    SteadyQuantity {
+        key: "stick_time",
+        metric: "stick_time",
+        relative: false,
+    },
+    SteadyQuantity::relative("equilibrium_omega_u_rel", "omega_u"),
+    SteadyQuantity::relative("equilibrium_omega_l_rel", "omega_l"),
+    SteadyQuantity::relative("equilibrium_alpha_rel", "alpha"),
+];
+
+/// One steady-state tolerance: its key in the file and the metric it gates.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct SteadyQuantity {
     pub key: &'static str,
-    pub metrics: &'static [&'static str],
+    pub metric: &'static str,
     pub relative: bool,
 }
 
+impl SteadyQuantity {
+    const fn relative(key: &'static str, metric: &'static str) -> SteadyQuantity {
+        SteadyQuantity {
+            key,
+            metric,
+            relative: true,
+        }
+    }
+}
+
 impl PairTolerance {
-    /// The tolerance stated under `key` (a [`SteadyQuantity::key`] or a transient key).
+    /// The tolerance stated under `key` (one of [`TOLERANCE_KEYS`]).
     pub fn get(&self, key: &str) -> Option<f64> {
         match key {
             "transient_max" => self.transient_max,
             "transient_rms" => self.transient_rms,
             "event_time" => self.event_time,
             "period_rel" => self.period_rel,
-            "omega_l_rel" => self.omega_l_rel,
-            "omega_u_rel" => self.omega_u_rel,
+            "omega_l_max_rel" => self.omega_l_max_rel,
+            "omega_l_min_rel" => self.omega_l_min_rel,
+            "omega_u_max_rel" => self.omega_u_max_rel,
+            "omega_u_min_rel" => self.omega_u_min_rel,
             "stick_time" => self.stick_time,
-            "equilibrium_rel" => self.equilibrium_rel,
+            "equilibrium_omega_u_rel" => self.equilibrium_omega_u_rel,
+            "equilibrium_omega_l_rel" => self.equilibrium_omega_l_rel,
+            "equilibrium_alpha_rel" => self.equilibrium_alpha_rel,
             "steady_abs" => self.steady_abs,
             _ => None,
         }
     }
 
+    /// The tolerance under `key`, to set or clear (`None` for a key that is not one of
+    /// [`TOLERANCE_KEYS`]).
+    pub fn slot(&mut self, key: &str) -> Option<&mut Option<f64>> {
+        Some(match key {
+            "transient_max" => &mut self.transient_max,
+            "transient_rms" => &mut self.transient_rms,
+            "event_time" => &mut self.event_time,
+            "period_rel" => &mut self.period_rel,
+            "omega_l_max_rel" => &mut self.omega_l_max_rel,
+            "omega_l_min_rel" => &mut self.omega_l_min_rel,
+            "omega_u_max_rel" => &mut self.omega_u_max_rel,
+            "omega_u_min_rel" => &mut self.omega_u_min_rel,
+            "stick_time" => &mut self.stick_time,
+            "equilibrium_omega_u_rel" => &mut self.equilibrium_omega_u_rel,
+            "equilibrium_omega_l_rel" => &mut self.equilibrium_omega_l_rel,
+            "equilibrium_alpha_rel" => &mut self.equilibrium_alpha_rel,
+            "steady_abs" => &mut self.steady_abs,
+            _ => return None,
+        })
+    }
+
     /// Every stated tolerance with its key, in file order.
     pub fn stated(&self) -> Vec<(&'static str, f64)> {
-        [
-            "transient_max",
-            "transient_rms",
-            "event_time",
-            "period_rel",
-            "omega_l_rel",
-            "omega_u_rel",
-            "stick_time",
-            "equilibrium_rel",
-            "steady_abs",
-        ]
-        .into_iter()
-        .filter_map(|k| self.get(k).map(|v| (k, v)))
-        .collect()
+        TOLERANCE_KEYS
+            .into_iter()
+            .filter_map(|k| self.get(k).map(|v| (k, v)))
+            .collect()
     }
 
     /// The steady-state quantity gating a metric of [`crate::SteadyState::values`], and its
@@ -184,7 +307,7 @@ impl PairTolerance {
     pub fn for_metric(&self, metric: &str) -> Option<(SteadyQuantity, Option<f64>)> {
         STEADY_QUANTITIES
             .into_iter()
-            .find(|q| q.metrics.contains(&metric))
+            .find(|q| q.metric == metric)
             .map(|q| (q, self.get(q.key)))
     }
 
@@ -214,7 +337,7 @@ struct RawScenario {
     #[serde(default)]
     compare: CompareSpec,
     #[serde(default)]
-    tolerance: BTreeMap<String, PairTolerance>,
+    tolerance: BTreeMap<String, RawPairTolerance>,
 }
 
 /// A loaded, validated scenario.
@@ -438,7 +561,8 @@ impl Scenario {
                 "must lie in [0, t_end)",
             ));
         }
-        for (pair, tol) in &raw.tolerance {
+        let mut tolerance = BTreeMap::new();
+        for (pair, raw_tol) in &raw.tolerance {
             // Which solvers exist is the runner's knowledge (`check_pairs`); the form is
             // checked here.
             let part = |p: &str| {
@@ -456,6 +580,18 @@ impl Scenario {
                     "a solver pair is named <reference>-<solver>, e.g. \"event-switch\"",
                 ));
             }
+            // One key per quantity: a retired shared key is named with the keys that replaced
+            // it, never read as one of them.
+            let tol = raw_tol.current().map_err(|(key, v)| {
+                let instead = RETIRED_KEYS.iter().find(|r| r.0 == key).map_or("", |r| r.1);
+                bad(
+                    &format!("tolerance.{pair}.{key}"),
+                    crate::Num(v).to_string(),
+                    &format!(
+                        "is retired: it gated several quantities, and each has its own key now: {instead}"
+                    ),
+                )
+            })?;
             // Non-negative: 0 is a gate of exact agreement (both discs stuck from rest, where
             // every solver must return x = 0 exactly).
             for (name, v) in tol.stated() {
@@ -498,25 +634,36 @@ impl Scenario {
                 ));
             }
             // A steady state is gated either as an equilibrium or as a cycle, with every
-            // metric of its kind: a cycle tolerance that is missing would leave that metric
-            // ungated (the gate fails a steady state whose kind has no tolerances).
+            // metric of its kind: a tolerance that is missing would leave that metric ungated
+            // (the gate fails a steady state whose kind has no tolerances).
             if steady && !tol.gates_steady() {
                 return Err(bad(
-                    &format!("tolerance.{pair}.equilibrium_rel"),
+                    &format!("tolerance.{pair}.{}", EQUILIBRIUM_KEYS[0]),
                     "(missing)".into(),
-                    "is required when compare.steady_from is set, unless the cycle tolerances (period_rel, omega_l_rel, omega_u_rel, stick_time) are given: the metrics would be ungated",
+                    &format!(
+                        "is required when compare.steady_from is set, with {}, unless the cycle tolerances ({}) are given: the metrics would be ungated",
+                        EQUILIBRIUM_KEYS[1..].join(" and "),
+                        CYCLE_KEYS.join(", ")
+                    ),
                 ));
             }
-            let cycle = ["period_rel", "omega_l_rel", "omega_u_rel", "stick_time"];
-            if cycle.iter().any(|k| tol.get(k).is_some())
-                && let Some(missing) = cycle.iter().find(|k| tol.get(k).is_none())
-            {
-                return Err(bad(
-                    &format!("tolerance.{pair}.{missing}"),
-                    "(missing)".into(),
-                    "is required with the other cycle tolerances: that metric would be ungated",
-                ));
+            for (group, what) in [
+                (&CYCLE_KEYS[..], "cycle"),
+                (&EQUILIBRIUM_KEYS[..], "equilibrium"),
+            ] {
+                if group.iter().any(|k| tol.get(k).is_some())
+                    && let Some(missing) = group.iter().find(|k| tol.get(k).is_none())
+                {
+                    return Err(bad(
+                        &format!("tolerance.{pair}.{missing}"),
+                        "(missing)".into(),
+                        &format!(
+                            "is required with the other {what} tolerances: that metric would be ungated"
+                        ),
+                    ));
+                }
             }
+            tolerance.insert(pair.clone(), tol);
         }
         Ok(Scenario {
             name: raw.name,
@@ -530,7 +677,7 @@ impl Scenario {
             tol: raw.tol,
             h: raw.h,
             compare: raw.compare,
-            tolerance: raw.tolerance,
+            tolerance,
         })
     }
 
@@ -602,5 +749,75 @@ mod tests {
         let e = err(&ok.replace("table1", "nothere"));
         assert!(e.contains("nothere.toml") && e.contains("params"), "{e}");
         assert!(err("").contains("empty"));
+    }
+
+    /// A retired shared key is refused, naming itself, its value and the keys that replaced
+    /// it; a misspelt key is an unknown field; a group with one key missing names that key.
+    #[test]
+    fn retired_and_unknown_tolerance_keys_are_refused() {
+        let ok = std::fs::read_to_string(fixtures().join("t1-u1.5-rest.toml")).unwrap();
+        assert!(Scenario::from_toml_str(&ok, &fixtures().join("x.toml")).is_ok());
+        let table = "[tolerance.event-switch]\n";
+        assert!(ok.contains(table));
+        for (key, instead) in RETIRED_KEYS {
+            let e = err(&ok.replace(table, &format!("{table}{key} = 2e-10\n")));
+            assert!(
+                e.contains(&format!("tolerance.event-switch.{key} = 2e-10"))
+                    && e.contains("retired")
+                    && e.contains(instead),
+                "{e}"
+            );
+        }
+        let e = err(&ok.replace("omega_u_min_rel", "omega_u_mni_rel"));
+        assert!(
+            e.contains("unknown field") && e.contains("omega_u_mni_rel"),
+            "{e}"
+        );
+        let e = err(&ok.replacen("omega_l_min_rel", "# omega_l_min_rel", 1));
+        assert!(
+            e.contains("tolerance.event-moreau.omega_l_min_rel = (missing)")
+                || e.contains("tolerance.event-switch.omega_l_min_rel = (missing)"),
+            "{e}"
+        );
+        // An equilibrium's gates come as a set of three, too.
+        let eq = std::fs::read_to_string(fixtures().join("t1-u6.0-rest.toml")).unwrap();
+        assert!(Scenario::from_toml_str(&eq, &fixtures().join("x.toml")).is_ok());
+        let e = err(&eq.replacen("equilibrium_alpha_rel", "# equilibrium_alpha_rel", 1));
+        assert!(
+            e.contains(".equilibrium_alpha_rel = (missing)") && e.contains("equilibrium"),
+            "{e}"
+        );
+    }
+
+    /// Every metric of both kinds of steady state has exactly one key, and no key gates two.
+    #[test]
+    fn one_key_per_steady_metric() {
+        use crate::SteadyState;
+        let cycle = SteadyState::LimitCycle {
+            period: 1.0,
+            omega_l_max: 1.0,
+            omega_l_min: 0.0,
+            omega_u_max: 1.0,
+            omega_u_min: 1.0,
+            stick_time: 0.0,
+        };
+        let eq = SteadyState::Equilibrium {
+            omega_u: 1.0,
+            omega_l: 1.0,
+            alpha: 0.1,
+        };
+        let mut keys: Vec<&str> = Vec::new();
+        for (m, group) in [(cycle, &CYCLE_KEYS[..]), (eq, &EQUILIBRIUM_KEYS[..])] {
+            for (name, _) in m.values() {
+                let q = STEADY_QUANTITIES.iter().filter(|q| q.metric == name);
+                let q: Vec<_> = q.collect();
+                assert_eq!(q.len(), 1, "{name}");
+                assert!(group.contains(&q[0].key), "{name}");
+                keys.push(q[0].key);
+            }
+        }
+        keys.sort();
+        keys.dedup();
+        assert_eq!(keys.len(), STEADY_QUANTITIES.len());
     }
 }

@@ -118,13 +118,21 @@ pub fn bad_pair_cases() -> Vec<BadFile> {
 }
 
 /// The keys of a `[tolerance.*]` table that gate the steady state.
-const STEADY_KEYS: [&str; 6] = [
+const STEADY_KEYS: [&str; 13] = [
     "period_rel",
+    "omega_l_max_rel",
+    "omega_l_min_rel",
+    "omega_u_max_rel",
+    "omega_u_min_rel",
+    "stick_time",
+    "equilibrium_omega_u_rel",
+    "equilibrium_omega_l_rel",
+    "equilibrium_alpha_rel",
+    "steady_abs",
+    // Retired shared keys: none may be left in the file either.
     "omega_l_rel",
     "omega_u_rel",
-    "stick_time",
     "equilibrium_rel",
-    "steady_abs",
 ];
 
 /// [`local_scenario`] with the steady-state tolerances of its first pair commented out, except
@@ -552,6 +560,16 @@ pub fn bad_scenario_cases() -> Vec<BadFile> {
                 "other cycle tolerances",
             ],
         ),
+        // A retired shared key: refused with the keys that replaced it, never read as one.
+        sc(
+            "period_rel = ",
+            "omega_u_rel = 2e-11\nperiod_rel = ",
+            &[
+                "tolerance.event-switch.omega_u_rel = 2e-11",
+                "retired",
+                "omega_u_max_rel and omega_u_min_rel",
+            ],
+        ),
         raw(
             "the steady floor without a steady tolerance",
             without_steady_gates(&["steady_abs"]),
@@ -561,7 +579,7 @@ pub fn bad_scenario_cases() -> Vec<BadFile> {
             "no steady tolerance while compare.steady_from is set",
             without_steady_gates(&[]),
             &[
-                "tolerance.event-switch.equilibrium_rel = (missing)",
+                "tolerance.event-switch.equilibrium_omega_u_rel = (missing)",
                 "ungated",
             ],
         ),
