@@ -14,8 +14,9 @@
 //!   reported);
 //! * when a Poincaré section is asked: `g = ω_l − c`, upward.
 //!
-//! Guards are sampled at interior points of the dense output and, for the velocity guards,
-//! their derivative too, so that a shallow dip below zero inside one step is not missed. A scan fires a guard that goes from positive to ≤ 0; guards that are
+//! Guards are sampled at interior points of the dense output and, for the velocity and
+//! stick-exit guards, their derivative too, so that a shallow dip below zero inside one step
+//! is not missed. A scan fires a guard that goes from positive to ≤ 0; guards that are
 //! already at or past 0 at a switch or a run's start (simultaneous events, a disc stuck
 //! exactly on an edge) are handled there, before the next step ([`Integrator::settle`]).
 //! Guards are functions of the state along the dense output, so at interior samples their
@@ -338,30 +339,44 @@ impl<'a> Integrator<'a> {
         }
     }
 
-    /// A velocity guard's crossing that its samples at `ta` and `tb` do not show: a shallow
-    /// dip below 0 between two positive samples (found at the minimum, the root of the guard's
-    /// rate), or an excursion from exactly 0 at `ta` that returns to ≤ 0 by `tb` (a reversal
-    /// just past a stick boundary, whose short excursion ends in stick: the return root lies
-    /// between the guard's positive maximum and `tb`). `rates` are the velocity's rates at
-    /// the two samples. Returns the bracket, the guard's value at its start, and the guard.
+    /// A crossing of a velocity or stick-exit guard that its samples at `ta` and `tb` do not
+    /// show: a shallow dip below 0 between two positive samples (found at the minimum, the
+    /// root of the guard's rate), or, for a velocity guard, an excursion from exactly 0 at
+    /// `ta` that returns to ≤ 0 by `tb` (a reversal just past a stick boundary, whose short
+    /// excursion ends in stick: the return root lies between the guard's positive maximum
+    /// and `tb`). A stick-exit guard dips where the other disc's velocity turns through 0
+    /// (its rate is ±k_θ α̇ with α̇ the other disc's velocity), so a spring torque that
+    /// leaves the stick interval and comes back within one step, around the other disc's
+    /// reversal, is found before that reversal. `rates` are the state's rates at the two
+    /// samples. Returns the bracket, the guard's value at its start, and the guard.
+    #[allow(clippy::too_many_arguments)]
     fn hidden_crossing(
         &self,
         d: &Dense<3>,
-        disc: Disc,
+        g: Guard,
         mode: Mode,
         (ta, tb): (f64, f64),
         (ga, gb): (f64, f64),
-        rates: (f64, f64),
+        (xa, xb): (&State, &State),
+        (fa, fb): (&State, &State),
     ) -> Option<(f64, f64, f64, Guard)> {
-        let g = Guard::Velocity(disc);
-        let s = mode.of(disc).branch().unwrap_or(1.0);
-        let (ra, rb) = (s * rates.0, s * rates.1);
-        let rate = |t: f64| s * d.eval_with_rate(t).1[disc.index()];
+        if !matches!(g, Guard::Velocity(_) | Guard::ExitHi(_) | Guard::ExitLo(_)) {
+            return None;
+        }
+        let (ra, rb) = (
+            self.guard_rate(g, xa, fa, mode),
+            self.guard_rate(g, xb, fb, mode),
+        );
+        let rate = |t: f64| {
+            let (x, r) = d.eval_with_rate(t);
+            self.guard_rate(g, &x, &r, mode)
+        };
         if ga > 0.0 && gb > 0.0 && ra < 0.0 && rb > 0.0 {
             let tm = illinois(&rate, ta, tb, ra, rb);
             let gm = self.guard(g, &d.eval(tm), mode);
             (gm <= 0.0).then_some((ta, tm, ga, g))
-        } else if ga == 0.0 && ra > 0.0 && gb <= 0.0 && rb < 0.0 {
+        } else if matches!(g, Guard::Velocity(_)) && ga == 0.0 && ra > 0.0 && gb <= 0.0 && rb < 0.0
+        {
             let tm = illinois(&rate, ta, tb, ra, rb);
             let gm = self.guard(g, &d.eval(tm), mode);
             (gm > 0.0).then_some((tm, tb, gm, g))
@@ -458,10 +473,10 @@ impl<'a> Integrator<'a> {
         };
         // Sample intervals in time order; the first one where any guard fires holds the
         // earliest event (the earliest root among the guards firing there).
-        let (mut ta, x0, mut fa_rate) = sample(0);
+        let (mut ta, mut xa, mut fa_rate) = sample(0);
         let mut ga = [0.0; 8];
         for (j, &g) in gs[..n].iter().enumerate() {
-            ga[j] = value(g, &x0, &fa_rate);
+            ga[j] = value(g, &xa, &fa_rate);
         }
         for i in 1..=m {
             let (tb, xb, fb_rate) = sample(i);
@@ -470,12 +485,16 @@ impl<'a> Integrator<'a> {
                 let gb = value(g, &xb, &fb_rate);
                 let hit = Self::fires(g, ga[j], gb)
                     .map(|kind| (ta, tb, ga[j], kind))
-                    .or_else(|| match g {
-                        Guard::Velocity(disc) => {
-                            let rates = (fa_rate[disc.index()], fb_rate[disc.index()]);
-                            self.hidden_crossing(d, disc, mode, (ta, tb), (ga[j], gb), rates)
-                        }
-                        _ => None,
+                    .or_else(|| {
+                        self.hidden_crossing(
+                            d,
+                            g,
+                            mode,
+                            (ta, tb),
+                            (ga[j], gb),
+                            (&xa, &xb),
+                            (&fa_rate, &fb_rate),
+                        )
                     });
                 ga[j] = gb;
                 let Some((a, b, fa, kind)) = hit else {
@@ -489,7 +508,7 @@ impl<'a> Integrator<'a> {
             if best.is_some() {
                 return best;
             }
-            (ta, fa_rate) = (tb, fb_rate);
+            (ta, xa, fa_rate) = (tb, xb, fb_rate);
         }
         None
     }

@@ -4,7 +4,7 @@
 
 use std::path::Path;
 
-use rotor_event::{EventSolver, StopAt, flow};
+use rotor_event::{EventOptions, EventSolver, StopAt, flow};
 use rotor_model::{
     Disc, DiscMode, EventKind, LowerFriction, Mode, Model, Output, Params, Scene, Solver, State,
     UpperFriction,
@@ -46,6 +46,77 @@ fn exact_edge(hi: f64, k: f64) -> f64 {
         c = f64::from_bits(c.to_bits() - 1);
     }
     panic!("no float a with {k}·a == {hi}");
+}
+
+/// A stick-exit guard that dips below zero and back inside one step, at a reversal of the
+/// other disc. Table 1, lower disc stuck, upper disc slipping forward: with ω_l = 0 the upper
+/// disc obeys the linear J_u α̈ + b_u α̇ + k_θ α = k_m u (T_su = 0, so its friction is b_u ω),
+/// overdamped, and α rises to a maximum where ω_u = 0 (the upper disc's reversal) and falls
+/// back. The initial speed is chosen so that the maximum passes the lower disc's stick edge
+/// T_sl/k_θ by 1e-8 rad: the spring torque leaves the stick interval for ~0.7 ms around the
+/// reversal, far inside one step and one guard-sample interval. The lower disc must leave
+/// stick at the closed-form root of α(t) = T_sl/k_θ, before the reversal. (Before the fix
+/// the exit guard was never tested for a dip: the run stayed stuck through the excursion,
+/// and the first switch was the reversal.)
+#[test]
+fn a_stick_exit_guard_dipping_inside_one_step_is_found() {
+    let m = Model::table1();
+    let p = m.params;
+    let u = 0.02;
+    let (jj, b, k) = (p.j_u, p.upper.b, p.k_theta);
+    let a_star = p.k_m * u / k;
+    let edge = m.friction(Disc::Lower).static_interval().1 / k;
+    // y = α − α*: y'' + (b/J) y' + (k/J) y = 0, y(0) = 0, y'(0) = v.
+    let disc = (b * b - 4.0 * jj * k).sqrt();
+    let (r1, r2) = ((-b + disc) / (2.0 * jj), (-b - disc) / (2.0 * jj));
+    let shape = |t: f64| ((r1 * t).exp() - (r2 * t).exp()) / (r1 - r2);
+    let slope = |t: f64| (r1 * (r1 * t).exp() - r2 * (r2 * t).exp()) / (r1 - r2);
+    let t_max = (r2 / r1).ln() / (r1 - r2);
+    let overshoot = 1e-8;
+    let v = (edge - a_star + overshoot) / shape(t_max);
+    // The exit: y(t) = edge − α* on the rising side, by Newton from the parabola's root.
+    let curv = v * (r1 * r1 * (r1 * t_max).exp() - r2 * r2 * (r2 * t_max).exp()) / (r1 - r2);
+    let mut t_exit = t_max - (2.0 * overshoot / curv.abs()).sqrt();
+    for _ in 0..50 {
+        t_exit -= (v * shape(t_exit) - (edge - a_star)) / (v * slope(t_exit));
+    }
+    let alpha_dot = v * slope(t_exit);
+    assert!(t_exit < t_max && alpha_dot > 0.0);
+    let tol = 1e-12;
+    let scene = Scene {
+        u,
+        x0: State::new(a_star, v, 0.0),
+        t_end: 3.0,
+        tol,
+        output: Output::Events,
+        ..Scene::default()
+    };
+    for samples in [1, 4] {
+        let solver = EventSolver {
+            options: EventOptions {
+                guard_samples: samples,
+                ..EventOptions::default()
+            },
+        };
+        let tr = solver.simulate(&m, &scene).unwrap();
+        let sw = switches(&tr.events);
+        let first = sw.first().expect("no switch");
+        assert_eq!(
+            first.kind,
+            EventKind::StickEnd(Disc::Lower),
+            "{samples} samples: {sw:?}"
+        );
+        // The event's error in time is the state's error in α over α̇ at the root: the
+        // integration error ~ tol·(1 + |α|) per unit time, times a 100 margin for its growth
+        // over the 1 s run and the closed form's own rounding (~1e-16/α̇).
+        let gate = 100.0 * tol * (1.0 + edge) / alpha_dot;
+        assert!(
+            (first.t - t_exit).abs() < gate,
+            "{samples} samples: exit at {} s, closed form {t_exit} s (gate {gate:e} s; the \
+             reversal is at {t_max} s)",
+            first.t
+        );
+    }
 }
 
 /// A disc stuck exactly on an edge of its stick interval after a switch. Stribeck set at
