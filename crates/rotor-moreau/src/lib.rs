@@ -78,12 +78,16 @@
 //! With the default (θ = 1/2, implicit level) the scheme is second order on stick-slip and
 //! slipping cycles: friction events keep the velocity continuous (no impacts), so the O(h²)
 //! local error of a step containing a stick onset or exit does not spoil the global order.
-//! The explicit level and θ = 1 are first order. **Not across a velocity reversal:** a disc
-//! whose velocity passes through zero without sticking is held at rest for the one step that
-//! contains the reversal (reported as a Reversal, see below), a local error O(h) that makes
-//! the global error first order. The measured orders and constants, and the cost per step,
-//! are in `reports/measurements.md` (measured by `rotor-compare/tests/moreau_order.rs` and
-//! the stress case "far from rest").
+//! The explicit level and θ = 1 are first order. **Not across a velocity reversal:** in the
+//! step that contains the zero crossing of a disc that does not stick, the friction's sign
+//! jumps inside the step, which the step's end-point weighting cannot place: a local error
+//! O(h) that makes the global error first order. Depending on whether the friction cone can
+//! absorb that step's impulse, the one-step problem either takes the disc from slip+ to slip−
+//! within the step, or holds it at rest for one step (reported as a Reversal, see below).
+//! The measured orders and constants (of the cycle metrics, and at the state level: the
+//! trace's L∞ error over a cycle and the stick onsets, all second order), and the cost per
+//! step, are in `reports/measurements.md` (measured by `rotor-compare/tests/moreau_order.rs`
+//! and the stress case "far from rest").
 //!
 //! **Very large steps.** Up to h = 0.25 s every step problem of the fixtures is solved
 //! exactly. At h = 0.5 s a level falling faster than `M̂` can absorb (`θh|N'| > J_l`) makes
