@@ -739,10 +739,12 @@ fn stress_random_parameters_metrics_only_matches_the_full_run() {
     }
 }
 
-/// A cycle whose lower disc reverses without sticking (drawn by the proptest above). Moreau–Jean
-/// holds the disc at rest for the one step that contains the reversal; reported as a stick
-/// phase, its exit anchored a spurious 2.0 s "cycle" in the metrics of this 7.4 s one. It must
-/// be reported as a reversal, as the event-driven solver sees it.
+/// A cycle whose lower disc reverses without sticking (drawn by the proptest above). Here
+/// Moreau–Jean holds the disc at rest for the one step that contains the reversal (elsewhere
+/// it can go from slip+ to slip− within one step, when the cone cannot absorb the step's
+/// impulse); reported as a stick phase, its exit anchored a spurious 2.0 s "cycle" in the
+/// metrics of this 7.4 s one. It must be reported as a reversal, as the event-driven solver
+/// sees it.
 #[test]
 fn stress_moreau_reports_a_one_step_hold_between_opposite_slips_as_a_reversal() {
     let p = Params {

@@ -14,8 +14,11 @@
 //!   reported);
 //! * when a Poincaré section is asked: `g = ω_l − c`, upward.
 //!
-//! Guards are sampled at interior points of the dense output and, for the velocity guards,
-//! their derivative too, so that a shallow dip below zero inside one step is not missed.
+//! Guards are sampled at interior points of the dense output and, for the velocity and
+//! stick-exit guards, their derivative too, so that a shallow dip below zero inside one step
+//! is not missed. A scan fires a guard that goes from positive to ≤ 0; guards that are
+//! already at or past 0 at a switch or a run's start (simultaneous events, a disc stuck
+//! exactly on an edge) are handled there, before the next step ([`Integrator::settle`]).
 //! Guards are functions of the state along the dense output, so at interior samples their
 //! rates come from the dense output's own derivative (no field evaluation); at the step's
 //! ends that derivative is the field (the interpolant is Hermite). A located terminal root
@@ -336,30 +339,44 @@ impl<'a> Integrator<'a> {
         }
     }
 
-    /// A velocity guard's crossing that its samples at `ta` and `tb` do not show: a shallow
-    /// dip below 0 between two positive samples (found at the minimum, the root of the guard's
-    /// rate), or an excursion from exactly 0 at `ta` that returns to ≤ 0 by `tb` (a reversal
-    /// just past a stick boundary, whose short excursion ends in stick: the return root lies
-    /// between the guard's positive maximum and `tb`). `rates` are the velocity's rates at
-    /// the two samples. Returns the bracket, the guard's value at its start, and the guard.
+    /// A crossing of a velocity or stick-exit guard that its samples at `ta` and `tb` do not
+    /// show: a shallow dip below 0 between two positive samples (found at the minimum, the
+    /// root of the guard's rate), or, for a velocity guard, an excursion from exactly 0 at
+    /// `ta` that returns to ≤ 0 by `tb` (a reversal just past a stick boundary, whose short
+    /// excursion ends in stick: the return root lies between the guard's positive maximum
+    /// and `tb`). A stick-exit guard dips where the other disc's velocity turns through 0
+    /// (its rate is ±k_θ α̇ with α̇ the other disc's velocity), so a spring torque that
+    /// leaves the stick interval and comes back within one step, around the other disc's
+    /// reversal, is found before that reversal. `rates` are the state's rates at the two
+    /// samples. Returns the bracket, the guard's value at its start, and the guard.
+    #[allow(clippy::too_many_arguments)]
     fn hidden_crossing(
         &self,
         d: &Dense<3>,
-        disc: Disc,
+        g: Guard,
         mode: Mode,
         (ta, tb): (f64, f64),
         (ga, gb): (f64, f64),
-        rates: (f64, f64),
+        (xa, xb): (&State, &State),
+        (fa, fb): (&State, &State),
     ) -> Option<(f64, f64, f64, Guard)> {
-        let g = Guard::Velocity(disc);
-        let s = mode.of(disc).branch().unwrap_or(1.0);
-        let (ra, rb) = (s * rates.0, s * rates.1);
-        let rate = |t: f64| s * d.eval_with_rate(t).1[disc.index()];
+        if !matches!(g, Guard::Velocity(_) | Guard::ExitHi(_) | Guard::ExitLo(_)) {
+            return None;
+        }
+        let (ra, rb) = (
+            self.guard_rate(g, xa, fa, mode),
+            self.guard_rate(g, xb, fb, mode),
+        );
+        let rate = |t: f64| {
+            let (x, r) = d.eval_with_rate(t);
+            self.guard_rate(g, &x, &r, mode)
+        };
         if ga > 0.0 && gb > 0.0 && ra < 0.0 && rb > 0.0 {
             let tm = illinois(&rate, ta, tb, ra, rb);
             let gm = self.guard(g, &d.eval(tm), mode);
             (gm <= 0.0).then_some((ta, tm, ga, g))
-        } else if ga == 0.0 && ra > 0.0 && gb <= 0.0 && rb < 0.0 {
+        } else if matches!(g, Guard::Velocity(_)) && ga == 0.0 && ra > 0.0 && gb <= 0.0 && rb < 0.0
+        {
             let tm = illinois(&rate, ta, tb, ra, rb);
             let gm = self.guard(g, &d.eval(tm), mode);
             (gm > 0.0).then_some((tm, tb, gm, g))
@@ -456,10 +473,10 @@ impl<'a> Integrator<'a> {
         };
         // Sample intervals in time order; the first one where any guard fires holds the
         // earliest event (the earliest root among the guards firing there).
-        let (mut ta, x0, mut fa_rate) = sample(0);
+        let (mut ta, mut xa, mut fa_rate) = sample(0);
         let mut ga = [0.0; 8];
         for (j, &g) in gs[..n].iter().enumerate() {
-            ga[j] = value(g, &x0, &fa_rate);
+            ga[j] = value(g, &xa, &fa_rate);
         }
         for i in 1..=m {
             let (tb, xb, fb_rate) = sample(i);
@@ -468,12 +485,16 @@ impl<'a> Integrator<'a> {
                 let gb = value(g, &xb, &fb_rate);
                 let hit = Self::fires(g, ga[j], gb)
                     .map(|kind| (ta, tb, ga[j], kind))
-                    .or_else(|| match g {
-                        Guard::Velocity(disc) => {
-                            let rates = (fa_rate[disc.index()], fb_rate[disc.index()]);
-                            self.hidden_crossing(d, disc, mode, (ta, tb), (ga[j], gb), rates)
-                        }
-                        _ => None,
+                    .or_else(|| {
+                        self.hidden_crossing(
+                            d,
+                            g,
+                            mode,
+                            (ta, tb),
+                            (ga[j], gb),
+                            (&xa, &xb),
+                            (&fa_rate, &fb_rate),
+                        )
                     });
                 ga[j] = gb;
                 let Some((a, b, fa, kind)) = hit else {
@@ -487,7 +508,7 @@ impl<'a> Integrator<'a> {
             if best.is_some() {
                 return best;
             }
-            (ta, fa_rate) = (tb, fb_rate);
+            (ta, xa, fa_rate) = (tb, xb, fb_rate);
         }
         None
     }
@@ -589,39 +610,12 @@ impl<'a> Integrator<'a> {
                 x[d.index()] = 0.0;
             }
         }
-        // A disc stuck exactly on an edge of its stick interval, its applied torque moving
-        // out, leaves at once: its exit guard starts at 0, and a crossing from 0 is never
-        // seen (the disc would stay stuck while the spring winds up without bound).
-        for d in Disc::BOTH {
-            if mode.of(d) != DiscMode::Stick {
-                continue;
-            }
-            for g in [Guard::ExitHi(d), Guard::ExitLo(d)] {
-                // The field only where a guard is on its edge (rarely: a start exactly there).
-                if self.guard(g, &x, mode) <= 0.0
-                    && self.guard_rate(g, &x, &field(&x, mode), mode) < 0.0
-                {
-                    let (m, kind) = self.transition(g, &mut x, mode);
-                    mode = m;
-                    if let Some(kind) = kind {
-                        self.stats.events += 1;
-                        let ev = Event {
-                            t: t_start,
-                            x,
-                            kind,
-                        };
-                        sink.event(&ev);
-                        if sink.stop_after(&ev) {
-                            return Ok(RunEnd {
-                                t: t_start,
-                                x,
-                                mode,
-                            });
-                        }
-                    }
-                    break;
-                }
-            }
+        let mut recent = Recent::new((self.opts.zeno_count as usize).clamp(2, 64));
+        // Guards already at or past 0 at the start (a disc stuck exactly on an edge of its
+        // interval with the applied torque moving out, a start in an inconsistent mode):
+        // handled here, as after every switch.
+        if let Some(end) = self.settle(t_start, &mut x, &mut mode, [false; 2], &mut recent, sink)? {
+            return Ok(end);
         }
         let f0 = field(&x, mode);
         let h = self
@@ -637,7 +631,6 @@ impl<'a> Integrator<'a> {
             t_switch: t_start,
             last_extremum: [None; 2],
         };
-        let mut recent = Recent::new((self.opts.zeno_count as usize).clamp(2, 64));
         let mut steps_total = 0u64;
         while c.t < t_end {
             // Both discs stuck: the state is frozen and the exit guards are constant.
@@ -937,7 +930,114 @@ impl<'a> Integrator<'a> {
         c.mode = new_mode;
         c.t_switch = c.t;
         c.last_extremum = [None; 2];
+        let mut fresh = [false; 2];
+        if let Guard::Velocity(d) | Guard::ExitHi(d) | Guard::ExitLo(d) = g {
+            fresh[d as usize] = true;
+        }
+        self.settle(c.t, &mut c.x, &mut c.mode, fresh, recent, sink)
+    }
+
+    /// Guards that are already at or past 0 at a switch or a run's start, handled there: a
+    /// scan only fires a guard that goes from positive to ≤ 0, so one that starts ≤ 0 would
+    /// never fire. Such a guard is another disc's that crossed at the same instant, to
+    /// rounding (both discs reaching ω = 0 together, a stick exit at the other disc's
+    /// reversal), a disc that sticks exactly on an edge of its interval, or a start in an
+    /// inconsistent mode. A guard below 0 fires at once. A guard exactly at 0 fires if it
+    /// moves out: its rate is negative, or the rate is at rounding level and the second
+    /// derivative is negative (a disc stuck on its edge while the other disc turns, α̇ = 0
+    /// and α̈ outward). The velocity guard of a disc this switch has just put at ω = 0 in slip
+    /// (`fresh`: a stick exit or a reversal) is left to the scan: the transition chose its
+    /// branch from the applied torque, and its guard's rate is that branch's (rounding-level
+    /// at a located exit; a scan sees an excursion that returns). Repeated until no guard
+    /// fires (each disc switches at most twice at one instant); each switch is an event.
+    fn settle(
+        &mut self,
+        t: f64,
+        x: &mut State,
+        mode: &mut Mode,
+        mut fresh: [bool; 2],
+        recent: &mut Recent,
+        sink: &mut impl Sink,
+    ) -> Result<Option<RunEnd>, SolveError> {
+        for _ in 0..4 {
+            let mut gs = [Guard::Section; 8];
+            let n = self.guards(*mode, &mut gs);
+            let mut f: Option<State> = None;
+            let mut hit = None;
+            for &g in &gs[..n] {
+                let (Guard::Velocity(d) | Guard::ExitHi(d) | Guard::ExitLo(d)) = g else {
+                    continue;
+                };
+                let v = self.guard(g, x, *mode);
+                let out = if v < 0.0 {
+                    true
+                } else if v > 0.0 || (matches!(g, Guard::Velocity(_)) && fresh[d as usize]) {
+                    false
+                } else {
+                    let f = *f.get_or_insert_with(|| self.field(x, *mode));
+                    self.moves_out(g, x, &f, *mode)
+                };
+                if out {
+                    hit = Some((g, d));
+                    break;
+                }
+            }
+            let Some((g, d)) = hit else {
+                return Ok(None);
+            };
+            let (m, kind) = self.transition(g, x, *mode);
+            let Some(kind) = kind else {
+                // A velocity guard at a grazing contact from the side the applied torque
+                // pushes back to: the disc stays (its velocity is now exactly 0).
+                *mode = m;
+                fresh[d as usize] = true;
+                continue;
+            };
+            *mode = m;
+            fresh[d as usize] = true;
+            self.stats.events += 1;
+            let ev = Event { t, x: *x, kind };
+            sink.event(&ev);
+            recent.record(t, self.opts.zeno_window)?;
+            if sink.stop_after(&ev) {
+                return Ok(Some(RunEnd {
+                    t,
+                    x: *x,
+                    mode: *mode,
+                }));
+            }
+        }
         Ok(None)
+    }
+
+    /// Whether a guard at exactly 0 moves out (below 0) along the mode's field `f` at `x`:
+    /// its rate is negative beyond rounding, or at rounding level with a negative second
+    /// derivative. The rate's rounding level is that of the quantity it is computed from: a
+    /// velocity guard's rate is (T_ex − T_f)/J, rounded at EPS·(|T_ex| + |T_f|)/J; an exit
+    /// guard's is ±k_θ α̇ with α̇ = ω_u − ω_l, rounded at EPS·k_θ(|ω_u| + |ω_l|). A margin of
+    /// 64 covers the few operations behind each (a located stick exit leaves T_ex within a
+    /// few ulps of the edge). The second derivative is the rate along J·f (the guards are
+    /// linear in the state: a velocity, or the spring torque).
+    fn moves_out(&self, g: Guard, x: &State, f: &State, mode: Mode) -> bool {
+        const MARGIN: f64 = 64.0 * f64::EPSILON;
+        let r = self.guard_rate(g, x, f, mode);
+        let noise = match g {
+            Guard::Velocity(d) => {
+                let s = mode.of(d).branch().unwrap_or(1.0);
+                let tf = self.model.friction(d).torque(x[d.index()], s);
+                MARGIN * (self.model.applied_torque(d, x, self.u).abs() + tf.abs())
+                    / self.model.inertia(d)
+            }
+            _ => MARGIN * self.model.params.k_theta * (x[1].abs() + x[2].abs()),
+        };
+        if r < -noise {
+            return true;
+        }
+        if r > noise {
+            return false;
+        }
+        let jf = self.model.jacobian(x, self.u, mode) * *f;
+        self.guard_rate(g, x, &jf, mode) < 0.0
     }
 
     /// The mode after a terminal guard, and the event to report.

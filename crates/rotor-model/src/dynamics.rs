@@ -294,6 +294,47 @@ mod tests {
         vec![Model::table1(), Model::new(st)]
     }
 
+    /// docs/model.md §3.1: Table 1 has T_su = ΔT_su = 0. With upper static friction c =
+    /// T_su + ΔT_su (and Δb_u = 0) the upper law is c + b_u ω while ω_u > 0, so the field of
+    /// every mode with the upper disc slipping forward is Table 1's at u − c/k_m: every
+    /// u-location moves up by c/k_m. Checked on the fields (to rounding: the two sides add
+    /// the same terms in another order) and on the slipping equilibria.
+    #[test]
+    fn upper_static_friction_shifts_every_u_location_by_its_level_over_k_m() {
+        let t1 = Model::table1();
+        let mut p = Params::table1();
+        (p.upper.t_s, p.upper.dt_s) = (0.37975, -0.00575); // the Stribeck set's values
+        let with = Model::new(p);
+        let shift = (p.upper.t_s + p.upper.dt_s) / p.k_m;
+        for u in [0.5, 1.5, 2.5, 4.5] {
+            for x in [
+                State::new(0.3, 2.0, 1.0),
+                State::new(-1.0, 0.7, -3.0),
+                State::new(2.5, 5.0, 0.0),
+            ] {
+                for lower in [DiscMode::SlipPos, DiscMode::SlipNeg, DiscMode::Stick] {
+                    let m = Mode {
+                        upper: DiscMode::SlipPos,
+                        lower,
+                    };
+                    let (a, b) = (with.rhs(&x, u, m), t1.rhs(&x, u - shift, m));
+                    // 1e-14: a few ulps of the O(1) accelerations.
+                    assert!(
+                        (a - b).amax() < 1e-14,
+                        "u={u} x={x:?} {m:?}: {a:?} vs {b:?}"
+                    );
+                }
+            }
+            let (e, f) = (with.slip_equilibria(u), t1.slip_equilibria(u - shift));
+            assert_eq!(e.len(), f.len(), "u={u}");
+            for (e, f) in e.iter().zip(&f) {
+                // The same cubic-like root found from shifted data: 1e-12 relative.
+                assert_relative_eq!(e.omega, f.omega, max_relative = 1e-12);
+                assert_relative_eq!(e.alpha, f.alpha, max_relative = 1e-12);
+            }
+        }
+    }
+
     fn all_modes() -> Vec<Mode> {
         let ms = [DiscMode::SlipPos, DiscMode::SlipNeg, DiscMode::Stick];
         let mut v = Vec::new();

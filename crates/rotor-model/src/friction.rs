@@ -367,8 +367,13 @@ mod tests {
     }
 
     #[test]
-    fn exponential_matches_source_form() {
-        // The tanh form against the source's 1 − 2/(1+e^x) form, evaluated literally.
+    fn exponential_matches_reconstructed_form() {
+        // The tanh form against the 1 − 2/(1+e^x) form, evaluated literally. That form is not
+        // in the source (which gives only eq. (5), the Stribeck law): it is a reconstruction
+        // that Table 1's parameters T_1, T_2, w_1, w_2 require, after N. Mihajlović, PhD
+        // thesis, TU Eindhoven 2005, and Mihajlović, van Veggel, van de Wouw, Nijmeijer,
+        // "Analysis of friction-induced limit cycling in an experimental drill-string
+        // system", J. Dyn. Sys. Meas. Control 126 (2004) 709–720.
         let LowerFriction::Exponential {
             t_s,
             t_1,

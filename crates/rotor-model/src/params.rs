@@ -79,7 +79,9 @@ pub struct UpperFriction {
 #[serde(tag = "family", rename_all = "lowercase")]
 pub enum LowerFriction {
     /// `T_cl(ω) = T_sl + T_1(1 − 2/(1+e^{w_1|ω|})) + T_2(1 − 2/(1+e^{w_2|ω|})) + b_l|ω|`
-    /// (the family of Table 1).
+    /// (the family of Table 1; not in the source, which gives only eq. (5): a reconstruction
+    /// after Mihajlović's thesis (TU Eindhoven 2005) and Mihajlović et al., J. Dyn. Sys. Meas.
+    /// Control 126 (2004) 709–720, see docs/model.md §2.4).
     Exponential {
         t_s: f64,
         t_1: f64,
@@ -584,8 +586,9 @@ impl Params {
 }
 
 /// The smallest value of the exponential law for slip, `min_{ω>0} T_cl(ω)` with
-/// `T_cl(ω) = t_s + t_1 tanh(w_1 ω/2) + t_2 tanh(w_2 ω/2) + b ω` (the form of eq. (5) with
-/// `1 − 2/(1+e^x) = tanh(x/2)`), and where it is taken: `(ω, T_cl)`.
+/// `T_cl(ω) = t_s + t_1 tanh(w_1 ω/2) + t_2 tanh(w_2 ω/2) + b ω` (the reconstructed
+/// exponential law of docs/model.md §2.4 with `1 − 2/(1+e^x) = tanh(x/2)`), and where it is
+/// taken: `(ω, T_cl)`.
 ///
 /// Past `ω_max = 40/min(w_1, w_2)` both tanh terms are within e^{−40} of their limits, so the
 /// law is `t_s + t_1 + t_2 + b ω` there, non-decreasing: the minimum lies in `(0, ω_max]`. It

@@ -57,9 +57,14 @@
 //! `μ r_N = hN_θ`) and the smooth friction forces are θ-weighted between the two ends of the
 //! step and solved *together* with the one-step problem by Newton on the step
 //! ([`stepper`]); with [`FrictionLevel::Explicit`] the level is taken at the start of the step
-//! (the step problem is then piecewise linear and solved in one pass). The one-step problem
-//! (Signorini + Coulomb on both contacts) is solved exactly by enumerating the nine
-//! stick/slip± modes ([`onestep`]), never by an iteration with a tolerance.
+//! (the step problem is then piecewise linear and solved in one pass). What is exact and what
+//! is iterated: with the bounds and smooth forces frozen (the explicit level, or one
+//! linearised Newton problem, or one Picard problem) the one-step problem (Signorini + Coulomb
+//! on both contacts) is piecewise linear and solved exactly by enumerating the nine
+//! stick/slip± modes ([`onestep`]), with no tolerance. The implicit level (the default) makes
+//! the step problem nonlinear: it is solved by semi-smooth Newton over those exact solves,
+//! stopped at a tolerance (`1e-12·(1 + |v|)`, [`stepper`]), with a Picard fallback when Newton
+//! fails; a Picard run that does not converge is flagged (below).
 //!
 //! **Skipping the complementarity solve.** When both discs' frozen-bound free velocities
 //! `v_free,i` satisfy `|v_free,i| > 2 Σ_j |W_ij| P_j` (W = M̂⁻¹, P_j the cone bounds), no
@@ -73,12 +78,16 @@
 //! With the default (θ = 1/2, implicit level) the scheme is second order on stick-slip and
 //! slipping cycles: friction events keep the velocity continuous (no impacts), so the O(h²)
 //! local error of a step containing a stick onset or exit does not spoil the global order.
-//! The explicit level and θ = 1 are first order. **Not across a velocity reversal:** a disc
-//! whose velocity passes through zero without sticking is held at rest for the one step that
-//! contains the reversal (reported as a Reversal, see below), a local error O(h) that makes
-//! the global error first order. The measured orders and constants, and the cost per step,
-//! are in `reports/measurements.md` (measured by `rotor-compare/tests/moreau_order.rs` and
-//! the stress case "far from rest").
+//! The explicit level and θ = 1 are first order. **Not across a velocity reversal:** in the
+//! step that contains the zero crossing of a disc that does not stick, the friction's sign
+//! jumps inside the step, which the step's end-point weighting cannot place: a local error
+//! O(h) that makes the global error first order. Depending on whether the friction cone can
+//! absorb that step's impulse, the one-step problem either takes the disc from slip+ to slip−
+//! within the step, or holds it at rest for one step (reported as a Reversal, see below).
+//! The measured orders and constants (of the cycle metrics, and at the state level: the
+//! trace's L∞ error over a cycle and the stick onsets, all second order), and the cost per
+//! step, are in `reports/measurements.md` (measured by `rotor-compare/tests/moreau_order.rs`
+//! and the stress case "far from rest").
 //!
 //! **Very large steps.** Up to h = 0.25 s every step problem of the fixtures is solved
 //! exactly. At h = 0.5 s a level falling faster than `M̂` can absorb (`θh|N'| > J_l`) makes
@@ -86,7 +95,11 @@
 //! then falls back to a Picard iteration whose frozen problems are strictly convex, and if
 //! that does not converge takes its last (bounded) iterate ([`StepOutcome::exact`] =
 //! `false`): 29 of 6100 steps over all fixtures at h = 0.5 (`cargo run --release -p
-//! rotor-moreau --example exactness`). The state stays bounded at any h.
+//! rotor-moreau --example exactness`). The state stays bounded at any h. Such a step is not
+//! hidden: it is counted in [`rotor_model::Stats::inexact_steps`], which the CLI and the
+//! Python module turn into a warning. `tests/integration/fallback.rs` checks at h = 0.5 on
+//! every fixture that each step the fallback solved satisfies the step problem (its residual
+//! computed independently of the stepper) and that each other step is flagged and counted.
 //!
 //! # Output and events
 //!

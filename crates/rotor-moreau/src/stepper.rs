@@ -43,6 +43,9 @@ pub struct StepOutcome {
     /// only for very large h with a falling friction level, where the step problem may have
     /// no or several solutions; the last Picard iterate is then taken.
     pub exact: bool,
+    /// Whether Newton failed and the Picard fallback ran (`exact` then says whether it
+    /// converged).
+    pub picard: bool,
     /// Newton iterations (one linearised solve each).
     pub newton_iters: u32,
     /// Evaluations of the smooth friction forces and levels (one per disc and branch).
@@ -252,13 +255,14 @@ impl Stepper {
         if self.skip_free && self.no_contact_can_change(&ctx, st.b, &w_inv, &mut n) {
             result = self.newton_in_slip_mode(&ctx, &base, &mut n);
         }
-        let (used_enumeration, mut exact) = (result.is_none(), true);
+        let (used_enumeration, mut exact, mut picard) = (result.is_none(), true, false);
         if result.is_none() {
             result = match self.semi_smooth_newton(&ctx, &base, &mut n) {
                 Ok(sol) => Some(sol),
                 Err(w) => {
                     let (sol, converged) = self.picard(&base, w, h, &st.p_start, t, &mut n)?;
                     exact = converged;
+                    picard = true;
                     sol
                 }
             };
@@ -280,6 +284,7 @@ impl Stepper {
             p: sol.p,
             used_enumeration,
             exact,
+            picard,
             newton_iters: n.newton,
             evals: n.evals,
         })

@@ -1,5 +1,6 @@
 //! Integration tests of the Moreau–Jean solver (one test binary).
 
+mod fallback;
 mod output;
 mod properties;
 mod scenarios;
