@@ -12,6 +12,10 @@
 //! * the solve plus writing the CSV file in process (what the process does besides starting);
 //! * the whole process, `rotor simulate ... --csv FILE`, spawned and waited for;
 //! * an empty process, `rotor --version`: start-up and exit alone.
+//!
+//! And `rotor check` of a correct 200 s trace with its events (t1-u1.5-rest, 20 001 rows: the
+//! reference's own files), as a whole process (target: under 50 ms), beside its grading in
+//! process (reading the files, the grade, the dense reference orbit).
 
 use std::path::Path;
 use std::process::{Command, Stdio};
@@ -93,5 +97,36 @@ fn main() {
         "  (whole - empty) / solve      {:7.2}",
         (whole - empty) / solve
     );
+    // rotor check on a 200 s trace.
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
+    let sc_path = root.join("fixtures/scenarios/t1-u1.5-rest.toml");
+    let trace = root.join("fixtures/reference/t1-u1.5-rest.csv");
+    let events = root.join("fixtures/reference/t1-u1.5-rest.events.csv");
+    let (s, t, e) = (
+        sc_path.to_str().unwrap(),
+        trace.to_str().unwrap(),
+        events.to_str().unwrap(),
+    );
+    let check_whole = time(n, || {
+        run(&["check", s, "--trace", t, "--events", e, "--gate", "strict"])
+    });
+    let sc = rotor_compare::load_scenario(&sc_path).unwrap();
+    let r = rotor_compare::reference::read(&root.join("fixtures/reference"), &sc.name).unwrap();
+    let check_in = time(n, || {
+        let tr = rotor_compare::trace::read_trace(&trace, usize::MAX).unwrap();
+        let ev = rotor_compare::trace::read_events(&events).unwrap();
+        let rep = rotor_compare::check::check(
+            &sc,
+            &r,
+            &tr,
+            Some(&ev),
+            rotor_compare::check::Level::Strict,
+        )
+        .unwrap();
+        assert!(rep.passed);
+    });
+    println!("rotor check t1-u1.5-rest --trace (200 s, 20 001 rows) --events --gate strict");
+    println!("  whole process                {:7.3} ms", ms(check_whole));
+    println!("  in process (read + grade)    {:7.3} ms", ms(check_in));
     std::fs::remove_dir_all(&dir).ok();
 }
