@@ -28,6 +28,7 @@ pub mod arc;
 pub mod continuation;
 mod diagram;
 pub mod equilibria;
+pub mod feigin;
 pub mod grazing;
 pub mod monodromy;
 mod output;

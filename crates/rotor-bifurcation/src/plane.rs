@@ -35,6 +35,7 @@ use serde::Serialize;
 
 use crate::arc::{ArcEnd, ArcOptions, follow};
 use crate::continuation::{ContOptions, Continuer, Multipliers};
+use crate::feigin::{Feigin, GrazingType};
 use crate::periodic::Shooter;
 use crate::{BifError, DiagramOptions, PointKind, diagram, grazing};
 
@@ -99,10 +100,22 @@ pub struct CurvePoint {
     /// Hopf: the first Lyapunov coefficient (< 0: supercritical).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub l1: Option<f64>,
-    /// Grazing: the leading multiplier of the slipping cycle that ends at the grazing orbit
-    /// (> 1: a discontinuous fold).
+    /// Grazing: the largest modulus of the slipping cycle's nontrivial multipliers at the
+    /// grazing orbit (for information: the type is Feigin's, `grazing_type`).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub multiplier: Option<f64>,
+    /// Grazing: Feigin's type (`persistence` or `nonsmooth_fold`, [`crate::feigin`]).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub grazing_type: Option<GrazingType>,
+    /// Grazing: a period-two orbit is born at the grazing orbit too (σ⁻ odd).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub period_doubling: Option<bool>,
+    /// Grazing: σ⁺ of the slipping and of the stick-slip cycle.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub sigma_plus: Option<[usize; 2]>,
+    /// Grazing: σ⁻ of the slipping and of the stick-slip cycle.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub sigma_minus: Option<[usize; 2]>,
     /// Grazing: ω_u at the touch point \[rad/s\].
     #[serde(skip_serializing_if = "Option::is_none")]
     pub touch_omega_u: Option<f64>,
@@ -496,6 +509,10 @@ pub fn plane(base: &Params, opts: &PlaneOptions) -> Result<Plane, BifError> {
                             omega: Some(y[1]),
                             l1: first_lyapunov(&m, y[1]),
                             multiplier: None,
+                            grazing_type: None,
+                            period_doubling: None,
+                            sigma_plus: None,
+                            sigma_minus: None,
                             touch_omega_u: None,
                             section_state: None,
                         })
@@ -525,13 +542,24 @@ pub fn plane(base: &Params, opts: &PlaneOptions) -> Result<Plane, BifError> {
                     .filter_map(|y| {
                         let m = Model::new(params_at(base, name, y[0]).ok()?);
                         let g = h(y).ok()?;
+                        let f = grazing::classify(&m, y[1], y[2], opts.tol).ok();
                         Some(CurvePoint {
                             p: y[0],
                             u: y[1],
                             residual: g[0].abs().max(g[1].abs()),
                             omega: None,
                             l1: None,
-                            multiplier: grazing::grazing_multiplier(&m, y[1], y[2], opts.tol).ok(),
+                            multiplier: f.map(|f| {
+                                f.slipping
+                                    .multipliers()
+                                    .iter()
+                                    .map(|z| z.norm())
+                                    .fold(0.0, f64::max)
+                            }),
+                            grazing_type: f.map(|f| f.kind),
+                            period_doubling: f.map(|f| f.period_doubling),
+                            sigma_plus: f.map(|f| f.sigma_plus),
+                            sigma_minus: f.map(|f| f.sigma_minus),
                             touch_omega_u: Some(y[2]),
                             section_state: None,
                         })
@@ -566,6 +594,10 @@ pub fn plane(base: &Params, opts: &PlaneOptions) -> Result<Plane, BifError> {
                             omega: None,
                             l1: None,
                             multiplier: None,
+                            grazing_type: None,
+                            period_doubling: None,
+                            sigma_plus: None,
+                            sigma_minus: None,
                             touch_omega_u: None,
                             section_state: Some([y[1], y[2]]),
                         })
@@ -592,6 +624,10 @@ pub fn plane(base: &Params, opts: &PlaneOptions) -> Result<Plane, BifError> {
                             omega: Some(0.0),
                             l1: None,
                             multiplier: None,
+                            grazing_type: None,
+                            period_doubling: None,
+                            sigma_plus: None,
+                            sigma_minus: None,
                             touch_omega_u: None,
                             section_state: None,
                         })
@@ -620,11 +656,11 @@ pub fn plane(base: &Params, opts: &PlaneOptions) -> Result<Plane, BifError> {
     })
 }
 
-/// A grazing curve split where it changes between a plain grazing orbit and a discontinuous
-/// fold (the slipping cycle's multiplier crosses 1); points whose multiplier could not be
-/// computed keep the kind of the point before.
+/// A grazing curve split where its Feigin type changes between persistence (a plain grazing
+/// curve) and a non-smooth fold ([`crate::feigin`]); points whose type could not be computed
+/// keep the kind of the point before.
 fn split_grazing(label: &str, points: Vec<CurvePoint>, ends: [ArcEnd; 2]) -> Vec<Curve> {
-    let fold = |p: &CurvePoint| p.multiplier.map(|m| m > 1.0);
+    let fold = |p: &CurvePoint| p.grazing_type.map(|t| t == GrazingType::NonsmoothFold);
     let mut out: Vec<Curve> = Vec::new();
     let mut current: Option<bool> = None;
     for p in points {
@@ -726,8 +762,9 @@ fn codim2(base: &Params, name: &str, curves: &[Curve], opts: &PlaneOptions) -> V
                 u,
                 curves: vec![a.label.clone()],
                 detail: format!(
-                    "the grazing orbit changes from {} to {}: the slipping cycle ending there has \
-                     a multiplier 1, so a fold of cycles meets the grazing curve",
+                    "the grazing orbit changes from {} to {}: a multiplier of the slipping or the \
+                     stick-slip cycle at grazing crosses +1 (Feigin's sigma+ changes parity), so \
+                     a fold of cycles meets the grazing curve",
                     kind_name(a.kind),
                     kind_name(b.kind)
                 ),
@@ -879,8 +916,10 @@ fn kind_name(k: CurveKind) -> &'static str {
     }
 }
 
-/// The point between two grazing points whose slipping multipliers lie on either side of
-/// 1: bisection in p, the grazing orbit located at each p from the linear interpolation.
+/// The point between two grazing points of different Feigin type: bisection in p on the sign
+/// of Feigin's fold indicator `det(I − A)·det(I − B)` ([`Feigin::fold_indicator`]; it changes
+/// sign where a multiplier of either side crosses +1), the grazing orbit located at each p
+/// from the linear interpolation.
 fn grazing_fold(
     base: &Params,
     name: &str,
@@ -888,25 +927,24 @@ fn grazing_fold(
     b: &CurvePoint,
     tol: f64,
 ) -> Option<(f64, f64)> {
-    let at = |p: f64, s: f64| -> Option<(f64, f64, f64)> {
+    let at = |p: f64, s: f64| -> Option<(f64, Feigin)> {
         let m = Model::new(params_at(base, name, p).ok()?);
         let (u0, w0) = (
             a.u + s * (b.u - a.u),
             a.touch_omega_u? + s * (b.touch_omega_u? - a.touch_omega_u?),
         );
         let g = grazing::locate(&m, u0, w0, tol, 1e-11).ok()?;
-        let mu = grazing::grazing_multiplier(&m, g.u, g.w, tol).ok()?;
-        Some((g.u, mu - 1.0, p))
+        Some((g.u, grazing::classify(&m, g.u, g.w, tol).ok()?))
     };
-    let sign_a = a.multiplier? - 1.0;
+    let sign_a = at(a.p, 0.0)?.1.fold_indicator();
     let (mut lo, mut hi) = (0.0, 1.0);
     let mut best = (a.p, a.u);
     for _ in 0..30 {
         let s = 0.5 * (lo + hi);
         let p = a.p + s * (b.p - a.p);
-        let (u, f, _) = at(p, s)?;
+        let (u, f) = at(p, s)?;
         best = (p, u);
-        if f * sign_a > 0.0 {
+        if f.fold_indicator() * sign_a > 0.0 {
             lo = s;
         } else {
             hi = s;
@@ -1332,6 +1370,10 @@ mod tests {
             omega: None,
             l1: None,
             multiplier: None,
+            grazing_type: None,
+            period_doubling: None,
+            sigma_plus: None,
+            sigma_minus: None,
             touch_omega_u: None,
             section_state: None,
         };
