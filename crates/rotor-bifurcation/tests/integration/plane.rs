@@ -53,24 +53,40 @@ fn curves_started_elsewhere_pass_through_the_one_parameter_points() {
     }
 }
 
-/// The first Lyapunov coefficient agrees with the direction of the small cycles the
-/// one-parameter diagram finds by shooting: Table 1's H1 supercritical (l1 < 0), H2 and both
-/// Hopf points of the Stribeck set subcritical (l1 > 0).
+/// The u-diagram's Hopf points carry their first Lyapunov coefficient, and its sign (their
+/// criticality) agrees with the direction of the small cycles the diagram finds by shooting:
+/// Table 1's H1 supercritical (l1 < 0), H2 and both Hopf points of the Stribeck set
+/// subcritical (l1 > 0). Table 1's H2 has l1 ≈ 1.7e-3 (issue 33, from independent code).
 #[test]
 fn the_lyapunov_coefficient_agrees_with_the_cycles_direction() {
     for (name, d) in [("table1", t1_diagram()), ("stribeck", st_diagram())] {
         let m = model(name);
         for sp in d.points.iter().filter(|p| p.kind == PointKind::Hopf) {
             let l1 = first_lyapunov(&m, sp.omega.unwrap()).unwrap();
+            assert_eq!(sp.l1, Some(l1), "{name} {sp:?}");
             let sup = sp.detail.starts_with("supercritical");
             assert!(
-                sup == (l1 < 0.0) && sp.detail.contains("critical"),
+                sup == (l1 < 0.0)
+                    && sp
+                        .detail
+                        .starts_with(if sup { "super" } else { "subcritical" }),
                 "{name} at {}: l1 = {l1}, {}",
                 sp.u,
                 sp.detail
             );
+            // The witness from shooting, in the same detail: stable small cycles ⇔ l1 < 0.
+            let stable = sp.detail.contains("are stable)");
+            assert!(
+                stable || sp.detail.contains("are unstable)"),
+                "{}",
+                sp.detail
+            );
+            assert_eq!(stable, l1 < 0.0, "{name} at {}: {}", sp.u, sp.detail);
         }
     }
+    let h2 = crate::common::points(t1_diagram(), "hopf")[1].l1.unwrap();
+    // Two significant digits, as the issue quotes it.
+    assert!((h2 - 1.7e-3).abs() < 0.05e-3, "{h2}");
 }
 
 /// Over the Stribeck set's lower static level T_sl ∈ [0.1, 0.45] the curves meet in a
