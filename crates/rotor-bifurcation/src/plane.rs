@@ -11,10 +11,12 @@
 //!   its first Lyapunov coefficient `l1` (Kuznetsov's formula on the smooth slip field; `l1 < 0`
 //!   supercritical), so a change of criticality is found as a sign change.
 //! * **Grazing** (`grazing`, `discontinuous_fold`): `y = (p, u, w)`, the grazing system of
-//!   [`crate::grazing`] (the cycle touches `ω_l = 0` at `(T_sl/k_θ, w, 0)` with `ω̇_l = 0`). A
-//!   grazing orbit is a discontinuous fold where the slipping cycle that ends there is unstable
-//!   (its leading multiplier exceeds 1: the stick-slip branch then turns back to the same side,
-//!   as at the source's point E on the Stribeck set); the curve is split where that changes.
+//!   [`crate::grazing`] (the cycle touches `ω_l = 0` at `(T_sl/k_θ, w, 0)` with `ω̇_l = 0`). Each
+//!   point is classified by the one classifier of the u-diagram, Feigin's rule
+//!   ([`crate::grazing::classify`], [`crate::feigin`]): a discontinuous fold where the real
+//!   multipliers above 1 of the slipping and the stick-slip cycle at grazing add up to an odd
+//!   number (as at the source's point E on the Stribeck set), persistence where even; the curve
+//!   is split where that changes.
 //! * **Smooth fold of cycles** (`fold`): `y = (p, α, ω_u, u)`, the cycle's fixed point on the
 //!   section `ω_l = ω*(u)` and `det(∂P/∂z − I) = 0` (a multiplier 1).
 //! * **Stuck boundary** (`stuck_boundary`): where the slipping branch meets the stuck set,
@@ -23,8 +25,9 @@
 //! Codimension-two points, located on the curves: a Hopf point changing criticality (`bautin`,
 //! a sign change of l1, by bisection), a curve turning back in p (`hopf_merge` where two Hopf
 //! points meet and vanish, `cusp` where two folds do), a grazing curve changing between
-//! grazing and discontinuous fold (`grazing_fold`: the slipping cycle at grazing has a
-//! multiplier 1, where a fold curve meets the grazing curve), a curve ending at the stuck
+//! grazing and discontinuous fold (`grazing_fold`: a multiplier of one side at grazing crosses
+//! 1, so Feigin's fold indicator `det(I − A)·det(I − B)` changes sign and a fold curve meets the
+//! grazing curve), a curve ending at the stuck
 //! boundary (`stuck_end`), and two curves meeting (`curves_meet`). Where the theory of such a
 //! nonsmooth point is not settled the point only records where the curves meet and what was
 //! seen; no normal form is claimed.
@@ -643,7 +646,9 @@ pub fn plane(base: &Params, opts: &PlaneOptions) -> Result<Plane, BifError> {
             _ => {}
         }
     }
-    let points = codim2(base, name, &curves, opts);
+    let mut points = split_at_type_changes(base, name, &mut curves, opts.tol);
+    points.extend(codim2(base, name, &curves, opts));
+    points.sort_by(|a, b| a.p.total_cmp(&b.p));
     let regions = regions(base, name, opts, &curves)?;
     Ok(Plane {
         param: opts.param.clone(),
@@ -687,6 +692,68 @@ fn split_grazing(label: &str, points: Vec<CurvePoint>, ends: [ArcEnd; 2]) -> Vec
     }
     if let Some(last) = out.last_mut() {
         last.ends.push(end_text(&ends[1]));
+    }
+    out
+}
+
+/// Where a grazing curve changes Feigin type (two consecutive pieces of one label and
+/// different kinds): the point located by [`grazing_fold`] between the last vertex of one piece
+/// and the second of the next (the first is shared and has the old type), made the end of the
+/// first piece and the start of the second, so that each piece holds only points of its type
+/// and the drawn type at any p is the classifier's. Returns the `grazing_fold` points.
+fn split_at_type_changes(base: &Params, name: &str, curves: &mut [Curve], tol: f64) -> Vec<Codim2> {
+    let mut out = Vec::new();
+    for i in 1..curves.len() {
+        let (head, tail) = curves.split_at_mut(i);
+        let (a, b) = (&mut head[i - 1], &mut tail[0]);
+        if a.label != b.label || a.kind == b.kind {
+            continue;
+        }
+        let (Some(pa), Some(pb)) = (
+            a.points.iter().rev().nth(1).or(a.points.last()).cloned(),
+            b.points.get(1).cloned(),
+        ) else {
+            continue;
+        };
+        let located = grazing_fold(base, name, &pa, &pb, tol).and_then(|(p, u, w)| {
+            let m = Model::new(params_at(base, name, p).ok()?);
+            let (g, _, _) = grazing::residual(&m, u, w, tol).ok()?;
+            Some((p, u, w, g[0].abs().max(g[1].abs())))
+        });
+        let (p, u) = match located {
+            Some((p, u, w, residual)) => {
+                let q = CurvePoint {
+                    p,
+                    u,
+                    residual,
+                    touch_omega_u: Some(w),
+                    // On the border between the types: neither.
+                    multiplier: None,
+                    grazing_type: None,
+                    period_doubling: None,
+                    sigma_plus: None,
+                    sigma_minus: None,
+                    ..b.points[0].clone()
+                };
+                a.points.push(q.clone());
+                b.points[0] = q;
+                (p, u)
+            }
+            None => (b.points[0].p, b.points[0].u),
+        };
+        out.push(Codim2 {
+            kind: Codim2Kind::GrazingFold,
+            p,
+            u,
+            curves: vec![a.label.clone()],
+            detail: format!(
+                "the grazing orbit changes from {} to {}: a multiplier of the slipping or the \
+                 stick-slip cycle at grazing crosses +1 (Feigin's sigma+ changes parity), so a \
+                 fold of cycles meets the grazing curve",
+                kind_name(a.kind),
+                kind_name(b.kind)
+            ),
+        });
     }
     out
 }
@@ -741,34 +808,6 @@ fn codim2(base: &Params, name: &str, curves: &[Curve], opts: &PlaneOptions) -> V
                     });
                 }
             }
-        }
-    }
-    // Where a grazing curve changes type: between the last point of one piece and the second
-    // of the next (the first is shared), by bisection in p on the multiplier's distance from 1.
-    for w in curves.windows(2) {
-        let (a, b) = (&w[0], &w[1]);
-        if a.label == b.label
-            && a.kind != b.kind
-            && let (Some(pa), Some(pb)) = (
-                a.points.iter().rev().nth(1).or(a.points.last()),
-                b.points.get(1),
-            )
-        {
-            let (p, u) = grazing_fold(base, name, pa, pb, opts.tol)
-                .unwrap_or((b.points[0].p, b.points[0].u));
-            out.push(Codim2 {
-                kind: Codim2Kind::GrazingFold,
-                p,
-                u,
-                curves: vec![a.label.clone()],
-                detail: format!(
-                    "the grazing orbit changes from {} to {}: a multiplier of the slipping or the \
-                     stick-slip cycle at grazing crosses +1 (Feigin's sigma+ changes parity), so \
-                     a fold of cycles meets the grazing curve",
-                    kind_name(a.kind),
-                    kind_name(b.kind)
-                ),
-            });
         }
     }
     // Curves of different labels that cross: at each point of one curve inside the other's
@@ -926,24 +965,24 @@ fn grazing_fold(
     a: &CurvePoint,
     b: &CurvePoint,
     tol: f64,
-) -> Option<(f64, f64)> {
-    let at = |p: f64, s: f64| -> Option<(f64, Feigin)> {
+) -> Option<(f64, f64, f64)> {
+    let at = |p: f64, s: f64| -> Option<(f64, f64, Feigin)> {
         let m = Model::new(params_at(base, name, p).ok()?);
         let (u0, w0) = (
             a.u + s * (b.u - a.u),
             a.touch_omega_u? + s * (b.touch_omega_u? - a.touch_omega_u?),
         );
         let g = grazing::locate(&m, u0, w0, tol, 1e-11).ok()?;
-        Some((g.u, grazing::classify(&m, g.u, g.w, tol).ok()?))
+        Some((g.u, g.w, grazing::classify(&m, g.u, g.w, tol).ok()?))
     };
-    let sign_a = at(a.p, 0.0)?.1.fold_indicator();
+    let sign_a = at(a.p, 0.0)?.2.fold_indicator();
     let (mut lo, mut hi) = (0.0, 1.0);
-    let mut best = (a.p, a.u);
+    let mut best = (a.p, a.u, a.touch_omega_u?);
     for _ in 0..30 {
         let s = 0.5 * (lo + hi);
         let p = a.p + s * (b.p - a.p);
-        let (u, f) = at(p, s)?;
-        best = (p, u);
+        let (u, w, f) = at(p, s)?;
+        best = (p, u, w);
         if f.fold_indicator() * sign_a > 0.0 {
             lo = s;
         } else {

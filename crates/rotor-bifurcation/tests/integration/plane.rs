@@ -3,6 +3,7 @@
 //! points of the Stribeck set over its lower static level.
 
 use rotor_bifurcation::PointKind;
+use rotor_bifurcation::feigin::GrazingType;
 use rotor_bifurcation::plane::{
     Codim2Kind, Curve, CurveKind, PlaneOptions, first_lyapunov, plane, solve_u,
 };
@@ -158,6 +159,46 @@ fn the_stribeck_set_has_its_codimension_two_points_where_the_curves_say() {
     };
     assert_eq!(at_file("G1"), CurveKind::DiscontinuousFold);
     assert_eq!(at_file("G2"), CurveKind::DiscontinuousFold);
+    // The pieces of a grazing curve meet exactly at their grazing_fold point, and every typed
+    // point of a piece has the piece's type: the plane draws the classifier's type at every p.
+    for w in pl.curves.windows(2) {
+        let (a, b) = (&w[0], &w[1]);
+        if a.label == b.label && a.kind != b.kind {
+            let (end, start) = (a.points.last().unwrap(), b.points.first().unwrap());
+            assert_eq!((end.p, end.u), (start.p, start.u));
+            assert!(
+                pl.points
+                    .iter()
+                    .any(|q| q.kind == Codim2Kind::GrazingFold && q.p == end.p && q.u == end.u),
+                "{:?}",
+                pl.points
+            );
+        }
+    }
+    for c in pl.curves.iter().filter(|c| c.label.starts_with('G')) {
+        let want = if c.kind == CurveKind::DiscontinuousFold {
+            GrazingType::NonsmoothFold
+        } else {
+            GrazingType::Persistence
+        };
+        for q in c.points.iter().filter(|q| q.grazing_type.is_some()) {
+            assert_eq!(q.grazing_type, Some(want), "{} {q:?}", c.label);
+        }
+    }
+    // At T_sl = 0.128 the upper grazing curve is persistence, as the u-diagram says there
+    // (points.rs: a_persistence_through_grazing_is_not_a_fold).
+    let g2_at = |p: f64| {
+        pl.curves
+            .iter()
+            .filter(|c| c.label == "G2")
+            .find(|c| {
+                let (lo, hi) = (c.points.first().unwrap().p, c.points.last().unwrap().p);
+                lo.min(hi) <= p && p <= lo.max(hi)
+            })
+            .unwrap()
+            .kind
+    };
+    assert_eq!(g2_at(0.128), CurveKind::Grazing);
 }
 
 fn model_at(base: &rotor_model::Params, p: f64) -> rotor_model::Model {
