@@ -51,7 +51,8 @@ impl Side {
         }
     }
 
-    /// The two roots; a complex pair as `(re, ±im)`, real roots larger first.
+    /// The two roots, larger modulus first (as the diagram orders multipliers); a complex pair
+    /// as `(re, +im), (re, −im)`.
     pub fn multipliers(&self) -> [Complex<f64>; 2] {
         let (s, p) = (self.trace, self.det);
         let disc = s * s - 4.0 * p;
@@ -64,8 +65,7 @@ impl Side {
             let sg = if s >= 0.0 { 1.0 } else { -1.0 };
             let q = 0.5 * (s + sg * disc.sqrt());
             let (r1, r2) = if q != 0.0 { (q, p / q) } else { (0.0, 0.0) };
-            let (hi, lo) = if r1 >= r2 { (r1, r2) } else { (r2, r1) };
-            [Complex::new(hi, 0.0), Complex::new(lo, 0.0)]
+            [Complex::new(r1, 0.0), Complex::new(r2, 0.0)]
         }
     }
 
@@ -324,6 +324,42 @@ mod tests {
         for (g, w) in got.iter().zip(&want) {
             assert!((g - w).abs() < 1e-12, "{got:?} vs {want:?}");
         }
+    }
+
+    /// Constructed monodromy matrices (trivial multiplier 1 with an eigenvector free of ω_l):
+    /// a complex pair of modulus 1.25 is persistence, not a fold; a slipping multiplier −1.4 with
+    /// a stick-slip limit inside (−1, 1) is a period-doubling-type grazing. The modulus rule
+    /// (`max |λ| > 1` ⇒ fold) called both folds.
+    #[test]
+    fn constructed_monodromies_with_a_complex_pair_and_a_minus_one_crossing() {
+        let v = Matrix3::new(1.0, 0.2, 0.1, 0.4, 1.0, -0.3, 0.0, 0.5, 1.0);
+        let vi = v.try_inverse().unwrap();
+        // Complex pair r e^{±iθ}: a rotation block scaled by r = 1.25.
+        let (r, th) = (1.25f64, 1.1f64);
+        let mut d = Matrix3::zeros();
+        d[(0, 0)] = 1.0;
+        d[(1, 1)] = r * th.cos();
+        d[(1, 2)] = -r * th.sin();
+        d[(2, 1)] = r * th.sin();
+        d[(2, 2)] = r * th.cos();
+        let f = from_monodromy(&(v * d * vi), 2);
+        let z = f.slipping.multipliers();
+        assert!((z[0].norm() - r).abs() < 1e-12 && z[0].im != 0.0, "{z:?}");
+        assert!(
+            f.stick_slip.multipliers()[0].norm() < 1.0,
+            "{:?}",
+            f.stick_slip
+        );
+        assert_eq!((f.kind, f.sigma_plus), (GrazingType::Persistence, [0, 0]));
+        assert!(!f.period_doubling);
+        // A −1 crossing: diag(1, −1.2, 0.5); the stick-slip limit is then −0.935 (inside).
+        let d = Matrix3::from_diagonal(&nalgebra::Vector3::new(1.0, -1.2, 0.5));
+        let f = from_monodromy(&(v * d * vi), 2);
+        let lb = f.stick_slip.multipliers();
+        assert!(lb[1].re == 0.0 && lb[0].re.abs() < 1.0, "{lb:?}");
+        assert_eq!(f.sigma_minus, [1, 0]);
+        assert_eq!(f.kind, GrazingType::Persistence);
+        assert!(f.period_doubling && f.flip_indicator() < 0.0);
     }
 
     /// Feigin's rule checked against the piecewise-linear map itself: for random A, a rank-one
