@@ -419,7 +419,19 @@ pub fn diagram(model: &Model, opts: &DiagramOptions) -> Result<Diagram, BifError
             None => format!("{crit}; {}", p.detail),
         };
     }
-    points.extend(stuck_end_points(model, &branches, opts.point_tol));
+    // A grazing orbit found both inside a step and at a collapsed branch end is written once:
+    // the same kind within 1e-9 V (the two locations agree to the Newton solve's 1e-12 V, see
+    // `stuck_end_points`).
+    for p in stuck_end_points(model, &branches, opts.point_tol) {
+        let seen = points.iter().any(|q| {
+            q.kind == p.kind
+                && q.discontinuous == p.discontinuous
+                && (q.u - p.u).abs() < 1e-9 * p.u.abs().max(1.0)
+        });
+        if !seen {
+            points.push(p);
+        }
+    }
     let periodic = branches
         .iter()
         .enumerate()

@@ -170,6 +170,14 @@ fn grazing_point(g: &grazing::GrazingOrbit, detail: String) -> SpecialPoint {
     p
 }
 
+/// Whether a branch point at `u` is resolved from the grazing orbit at `u_g`: more than 1e-8 V
+/// (relative to max(1, |u_g|)) away, ten times the branches' own accuracy (1e-9 V at tol 1e-11).
+/// Closer points (the branch steps shrink next to a grazing orbit) may lie on either side of it
+/// by their error alone.
+fn resolved(u: f64, u_g: f64) -> bool {
+    (u - u_g).abs() > 1e-8 * u_g.abs().max(1.0)
+}
+
 /// Writes Feigin's classification into a grazing (or discontinuous fold) point.
 fn set_feigin(p: &mut SpecialPoint, f: &Feigin) {
     let pair = |s: &crate::feigin::Side| s.multipliers().map(|z| [z.re, z.im]);
@@ -213,17 +221,21 @@ fn stability(stable: bool, what: &str) -> String {
 }
 
 /// The grazing point at `g` classified by Feigin's rule `f`, and for a non-smooth fold the
-/// discontinuous fold point too. `sides` are the u of branch points on either side of the
-/// grazing orbit (one per branch part, each far enough from `g` to tell its side): a check of
-/// the classification, reported in the detail when the branch geometry disagrees.
+/// discontinuous fold point too. `sides` are the u of branch points of the two branch parts
+/// meeting at the grazing orbit, resolved from it ([`resolved`]), if any: a check of the
+/// classification, reported in the detail when the branch geometry disagrees.
 fn classified(
     g: &grazing::GrazingOrbit,
     f: &Feigin,
-    sides: [f64; 2],
+    sides: [Option<f64>; 2],
     how: &str,
 ) -> Vec<SpecialPoint> {
-    let below = sides.map(|u| u < g.u);
-    let same_side = below[0] == below[1];
+    // Whether the two branch parts lie on the same side of u_g, if both are resolved.
+    let below = sides.map(|u| u.map(|u| u < g.u));
+    let same_side = match below {
+        [Some(x), Some(y)] => Some(x == y),
+        _ => None,
+    };
     let slip = stability(f.slipping.stable(), "slipping");
     let stick = stability(f.stick_slip.stable(), "stick-slip");
     let pd = if f.period_doubling {
@@ -235,11 +247,15 @@ fn classified(
     match f.kind {
         GrazingType::Persistence => {
             let mut check = String::new();
-            if same_side {
+            if same_side == Some(true) {
                 check = format!(
                     "; NOTE: the branch points beside it both lie {} it, which the \
                      classification does not predict",
-                    if below[0] { "below" } else { "above" }
+                    if below[0] == Some(true) {
+                        "below"
+                    } else {
+                        "above"
+                    }
                 );
             }
             let mut p = grazing_point(
@@ -260,18 +276,26 @@ fn classified(
             );
             set_feigin(&mut p, f);
             out.push(p.clone());
-            let side = if same_side {
-                format!(
+            let side = match same_side {
+                Some(true) => format!(
                     "both lie {} u = {}",
-                    if below[0] { "below" } else { "above" },
+                    if below[0] == Some(true) {
+                        "below"
+                    } else {
+                        "above"
+                    },
                     g.u
-                )
-            } else {
-                format!(
+                ),
+                Some(false) => format!(
                     "NOTE: the branch points beside it lie on both sides of u = {}, which the \
                      classification does not predict",
                     g.u
-                )
+                ),
+                None => format!(
+                    "their side of u = {} is not resolved (no branch point beside it more than \
+                     1e-8 V away)",
+                    g.u
+                ),
             };
             p.kind = PointKind::Fold;
             p.discontinuous = Some(true);
@@ -294,7 +318,7 @@ pub(crate) fn special_points(
 ) -> Vec<SpecialPoint> {
     let model = cont.sh.model;
     let mut out = Vec::new();
-    for w in branch.windows(2) {
+    for (i, w) in branch.windows(2).enumerate() {
         let (a, b) = (&w[0], &w[1]);
         // The step from a to b: recompute it as the projection on a's tangent.
         let step = (0..3)
@@ -313,7 +337,17 @@ pub(crate) fn special_points(
                     explained = true;
                     let how = format!("(between branch points at u = {} and {})", a.y[0], b.y[0]);
                     match grazing::classify(model, g.u, g.w, point_tol) {
-                        Ok(f) => out.extend(classified(&g, &f, [a.y[0], b.y[0]], &how)),
+                        Ok(f) => {
+                            // The first branch points outward from the window that are resolved
+                            // from the grazing orbit (see `resolved`).
+                            let before = branch[..=i].iter().rev().map(|n| n.y[0]);
+                            let mut after = branch[i + 1..].iter().map(|n| n.y[0]);
+                            let sides = [
+                                before.clone().find(|&u| resolved(u, g.u)),
+                                after.find(|&u| resolved(u, g.u)),
+                            ];
+                            out.extend(classified(&g, &f, sides, &how));
+                        }
                         Err(e) => out.push(grazing_point(
                             &g,
                             format!("the cycle touches omega_l = 0 {how}; not classified: {e}"),
@@ -473,7 +507,8 @@ pub(crate) fn stuck_end_points(
         };
         match (grazing::classify(model, ga.u, ga.w, point_tol), b_back) {
             (Ok(f), Some(b_back)) => {
-                out.extend(classified(&ga, &f, [a_back.y[0], b_back.y[0]], &how));
+                let sides = [a_back.y[0], b_back.y[0]].map(|u| resolved(u, ga.u).then_some(u));
+                out.extend(classified(&ga, &f, sides, &how));
             }
             (Ok(f), None) => {
                 let mut p = grazing_point(&ga, format!("{how}; {}", counts(&f)));
