@@ -403,3 +403,45 @@ fn the_shipped_sets_keep_their_grazing_types_and_both_sides_agree_with_the_branc
         }
     }
 }
+
+/// Near the Stribeck set's codimension-two cluster (lower.t_s ≈ 0.12-0.13): with t_s = 0.125
+/// the low grazing orbit is a non-smooth fold (its slipping cycle, past the smooth fold 3.5e-6 V
+/// above, has a real multiplier 1.0009 > 1), and both branch parts lie above it once the
+/// branch points are resolved from it (> 1e-8 V away); the branch points of the step that
+/// crossed it lie 1e-10 V on either side, which the old geometric rule took for a plain
+/// grazing. With t_s = 0.131 a grazing orbit found both inside a step and at two collapsed
+/// branch ends is written once.
+#[test]
+fn near_the_cluster_grazing_points_are_typed_by_the_rule_and_written_once() {
+    let at = |ts: f64| {
+        let m = Model::new(model("stribeck").params.with("lower.t_s", ts).unwrap());
+        diagram(&m, &DiagramOptions::default()).unwrap()
+    };
+    let d = at(0.125);
+    let low = points(&d, "grazing")[0];
+    assert_eq!(
+        low.grazing_type,
+        Some(GrazingType::NonsmoothFold),
+        "{low:?}"
+    );
+    assert_eq!(low.sigma_plus, Some([1, 0]));
+    let fold = d
+        .points
+        .iter()
+        .find(|p| p.discontinuous == Some(true) && p.u == low.u)
+        .unwrap_or_else(|| panic!("{:?}", d.points));
+    assert!(fold.detail.contains("both lie above"), "{}", fold.detail);
+    assert!(!d.points.iter().any(|p| p.detail.contains("NOTE")));
+    for d in [&d, &at(0.131)] {
+        for (i, p) in d.points.iter().enumerate() {
+            for q in &d.points[i + 1..] {
+                assert!(
+                    !(p.kind == q.kind
+                        && p.discontinuous == q.discontinuous
+                        && (p.u - q.u).abs() < 1e-9),
+                    "{p:?} {q:?}"
+                );
+            }
+        }
+    }
+}
