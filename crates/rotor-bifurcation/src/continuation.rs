@@ -54,6 +54,9 @@ pub struct CycleInfo {
     pub period: f64,
     pub omega_l_max: f64,
     pub omega_l_min: f64,
+    /// Smallest upper-disc velocity over the cycle \[rad/s\] (the upper disc grazes ω_u = 0
+    /// where it reaches 0).
+    pub omega_u_min: f64,
     /// Time per period with the lower disc stuck \[s\].
     pub stick_time: f64,
     /// Whether the lower disc sticks on the cycle.
@@ -301,13 +304,14 @@ impl Continuer<'_> {
         z: [f64; 2],
         d: &SectionDerivs,
     ) -> Result<CycleInfo, BifError> {
-        let (wl_max, wl_min, stick_time) = self.metrics(u, c, z, d.ret.t)?;
+        let (wl_max, wl_min, wu_min, stick_time) = self.metrics(u, c, z, d.ret.t)?;
         let nontrivial = eig2(&d.dz);
         let multipliers = order_multipliers(d.var.multipliers()).to_vec();
         Ok(CycleInfo {
             period: d.ret.t,
             omega_l_max: wl_max,
             omega_l_min: wl_min,
+            omega_u_min: wu_min,
             stick_time,
             stick_slip: d.ret.stuck,
             multipliers,
@@ -316,7 +320,7 @@ impl Continuer<'_> {
         })
     }
 
-    /// Extrema of ω_l and stick time per period of the cycle through `[z0, z1, c]`, whose
+    /// Extrema of ω_l, the minimum of ω_u and stick time per period of the cycle through `[z0, z1, c]`, whose
     /// period is about `period`.
     fn metrics(
         &self,
@@ -324,7 +328,7 @@ impl Continuer<'_> {
         c: f64,
         z: [f64; 2],
         period: f64,
-    ) -> Result<(f64, f64, f64), BifError> {
+    ) -> Result<(f64, f64, f64, f64), BifError> {
         let x0 = State::new(z[0], z[1], c);
         // Metrics over two periods: the accumulator needs two anchors (stick exits or ω_l
         // maxima), and the first comes within one period.
@@ -340,16 +344,17 @@ impl Continuer<'_> {
         let traj = rotor_event::EventSolver::default()
             .simulate(self.sh.model, &scene)
             .map_err(BifError::Solve)?;
-        let (wl_max, wl_min, stick_time) = match traj.metrics {
+        let (wl_max, wl_min, wu_min, stick_time) = match traj.metrics {
             Some(SteadyState::LimitCycle {
                 omega_l_max,
                 omega_l_min,
+                omega_u_min,
                 stick_time,
                 ..
-            }) => (omega_l_max, omega_l_min, stick_time),
-            _ => (c, c, 0.0),
+            }) => (omega_l_max, omega_l_min, omega_u_min, stick_time),
+            _ => (c, c, z[1], 0.0),
         };
-        Ok((wl_max, wl_min, stick_time))
+        Ok((wl_max, wl_min, wu_min, stick_time))
     }
 
     /// [`Continuer::describe`] with the multipliers from central differences of the return
@@ -357,7 +362,7 @@ impl Continuer<'_> {
     /// 0 and 1 are structural, not computed), `[1, λ1, λ2]` from the section map otherwise.
     pub fn describe_fd(&self, u: f64, c: f64, z: [f64; 2]) -> Result<CycleInfo, BifError> {
         let ret = self.sh.section_map(u, c, z)?;
-        let (wl_max, wl_min, stick_time) = self.metrics(u, c, z, ret.t)?;
+        let (wl_max, wl_min, wu_min, stick_time) = self.metrics(u, c, z, ret.t)?;
         let x0 = State::new(z[0], z[1], c);
         let one = Complex::new(1.0, 0.0);
         let h = self.opts.fd_step;
@@ -377,6 +382,7 @@ impl Continuer<'_> {
             period: ret.t,
             omega_l_max: wl_max,
             omega_l_min: wl_min,
+            omega_u_min: wu_min,
             stick_time,
             stick_slip: ret.stuck,
             multipliers: vec![one, nontrivial[0], nontrivial[1]],

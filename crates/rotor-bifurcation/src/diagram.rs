@@ -151,6 +151,9 @@ pub struct PeriodicRow {
     pub period: f64,
     pub omega_l_max: f64,
     pub omega_l_min: f64,
+    /// Smallest ω_u over the cycle \[rad/s\]: the upper disc would graze ω_u = 0 (where the
+    /// Stribeck set has static friction) if it reached 0.
+    pub omega_u_min: f64,
     pub stable: bool,
     /// Floquet multipliers `[re, im]`, eigenvalues of the saltation monodromy matrix: the
     /// trivial one (≈ 1) first, then by decreasing modulus (`[≈1, λ, 0]` with a stick phase).
@@ -177,6 +180,7 @@ impl PeriodicRow {
             period: n.info.period,
             omega_l_max: n.info.omega_l_max,
             omega_l_min: n.info.omega_l_min,
+            omega_u_min: n.info.omega_u_min,
             stable: n.info.stable,
             multipliers: n.info.multipliers.iter().map(|l| [l.re, l.im]).collect(),
             stick_slip: n.info.stick_slip,
@@ -382,27 +386,52 @@ pub fn diagram(model: &Model, opts: &DiagramOptions) -> Result<Diagram, BifError
         orient(&mut b.nodes);
         points.extend(special_points(&cont, &b.nodes, opts.point_tol));
     }
-    // Criticality of each Hopf point: from the stability of the cycles at the branch end
-    // next to it.
+    // Criticality of each Hopf point: the sign of its first Lyapunov coefficient (Kuznetsov's
+    // formula, `plane::first_lyapunov`). The stability of the computed cycles at the branch end
+    // next to it is reported beside it: at amplitudes of 0.02-0.08 rad/s it is a weaker witness
+    // (Table 1's H2 has l1 = 1.7e-3), so it is shown, not used.
     for p in points.iter_mut().filter(|p| p.kind == PointKind::Hopf) {
-        if let Some(h) = hopfs.iter().find(|h| h.equilibrium.u == p.u)
-            && let Some(n) = nearest_hopf_end(&branches, &hopfs, h)
-        {
-            p.detail = format!(
-                "{}; {} (cycles of amplitude {:.3} rad/s at u = {} are {})",
-                if n.info.stable {
-                    "supercritical"
-                } else {
-                    "subcritical"
-                },
-                p.detail,
-                n.info.omega_l_max - n.info.omega_l_min,
-                n.y[0],
-                if n.info.stable { "stable" } else { "unstable" }
-            );
+        let l1 = p
+            .omega
+            .and_then(|w| crate::plane::first_lyapunov(model, w))
+            .filter(|l| l.is_finite());
+        p.l1 = l1;
+        let cycles = hopfs
+            .iter()
+            .find(|h| h.equilibrium.u == p.u)
+            .and_then(|h| nearest_hopf_end(&branches, &hopfs, h))
+            .map(|n| {
+                format!(
+                    "cycles of amplitude {:.3} rad/s at u = {} are {}",
+                    n.info.omega_l_max - n.info.omega_l_min,
+                    n.y[0],
+                    if n.info.stable { "stable" } else { "unstable" }
+                )
+            });
+        let crit = match l1 {
+            Some(l) if l < 0.0 => format!("supercritical (l1 = {l:.3e} < 0)"),
+            Some(l) if l > 0.0 => format!("subcritical (l1 = {l:.3e} > 0)"),
+            Some(_) => "degenerate (l1 = 0: a Bautin point)".to_owned(),
+            None => "criticality not computed (no first Lyapunov coefficient)".to_owned(),
+        };
+        p.detail = match cycles {
+            Some(c) => format!("{crit}; {} ({c})", p.detail),
+            None => format!("{crit}; {}", p.detail),
+        };
+    }
+    // A grazing orbit found both inside a step and at a collapsed branch end is written once:
+    // the same kind within 1e-9 V (the two locations agree to the Newton solve's 1e-12 V, see
+    // `stuck_end_points`).
+    for p in stuck_end_points(model, &branches, opts.point_tol) {
+        let seen = points.iter().any(|q| {
+            q.kind == p.kind
+                && q.discontinuous == p.discontinuous
+                && (q.u - p.u).abs() < 1e-9 * p.u.abs().max(1.0)
+        });
+        if !seen {
+            points.push(p);
         }
     }
-    points.extend(stuck_end_points(model, &branches, opts.point_tol));
     let periodic = branches
         .iter()
         .enumerate()

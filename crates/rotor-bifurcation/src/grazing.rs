@@ -17,16 +17,17 @@
 //! through 0; `G₂` closes the orbit (with `ω̇_l(t_m) = 0` and `ω_l(t_m) = 0`, α(t_m) is the
 //! start's α too). G is solved by Newton's method with a forward-difference Jacobian.
 //!
-//! A grazing orbit is where the stick phase of a stick-slip branch vanishes. If the branch
-//! also turns back in u there (the stick-slip side and the slipping side lie on the same side
-//! of the grazing u), it is a *discontinuous fold*: a stable and an unstable branch meet at
-//! the grazing orbit (point E of the source).
+//! A grazing orbit is where the stick phase of a stick-slip branch vanishes. What the branch
+//! does there (passes through: persistence; turns back: a discontinuous fold, point E; or sheds
+//! a period-two orbit) is decided by Feigin's rule on the multipliers of both sides
+//! ([`classify`], [`crate::feigin`]).
 
 use nalgebra::{Matrix2, Vector2};
 use rotor_event::dop853::{Dense, Dop853};
 use rotor_model::{Disc, DiscMode, Mode, Model, OMEGA_L, OMEGA_U, State};
 
 use crate::BifError;
+use crate::feigin::Feigin;
 
 /// The located grazing orbit.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -165,40 +166,39 @@ pub fn smooth_flow(
     Err(BifError::NoReturn { u })
 }
 
-/// The nontrivial Floquet multiplier of largest modulus of the grazing orbit at `(u, w)` as
-/// an orbit of the smooth slip–slip flow: the monodromy matrix over one period (touch to
-/// touch) by central differences (steps 1e-6 relative), its eigenvalue nearest 1 dropped
-/// (the flow direction). This is the multiplier of the slipping cycle that ends at the
-/// grazing orbit; above 1, the stick-slip branch born there turns back to the slipping
-/// branch's side (a discontinuous fold).
-pub fn grazing_multiplier(model: &Model, u: f64, w: f64, tol: f64) -> Result<f64, BifError> {
-    let (_, period, _) = touch_to_min(model, u, w, tol, 1e4)?;
+/// The monodromy matrix `M = ∂x(T)/∂x(0)` of the grazing orbit at `(u, w)` as an orbit of the
+/// smooth slip–slip flow, over one period `T` from its touch point `x_g(w)`: the variational
+/// equations `Ẋ = J X`, `X(0) = I` ([`crate::monodromy::along`] with no event). Returns `(M, T)`.
+pub fn touch_monodromy(
+    model: &Model,
+    u: f64,
+    w: f64,
+    tol: f64,
+) -> Result<(nalgebra::Matrix3<f64>, f64), BifError> {
+    let (_, period, _) = touch_to_min(model, u, w, tol, crate::periodic::T_RETURN)?;
     let t_sl = model.friction(Disc::Lower).static_interval().1;
     let x0 = State::new(t_sl / model.params.k_theta, w, 0.0);
     let mode = Mode {
         upper: DiscMode::slip_of(w),
         lower: DiscMode::SlipPos,
     };
-    let mut m = nalgebra::Matrix3::zeros();
-    for k in 0..3 {
-        let d = 1e-6 * x0[k].abs().max(1.0);
-        let mut xp = x0;
-        let mut xm = x0;
-        xp[k] += d;
-        xm[k] -= d;
-        let fp = smooth_flow(model, u, mode, xp, period, tol)?;
-        let fm = smooth_flow(model, u, mode, xm, period, tol)?;
-        for i in 0..3 {
-            m[(i, k)] = (fp[i] - fm[i]) / (2.0 * d);
-        }
+    let var = crate::monodromy::along(model, u, tol, x0, mode, &[], period)?;
+    Ok((var.phi, period))
+}
+
+/// Feigin's classification ([`crate::feigin`]) of the grazing orbit at `(u, w)`: the slipping
+/// cycle's nontrivial multipliers from [`touch_monodromy`] and the stick-slip cycle's as its
+/// limit at the grazing orbit ([`crate::feigin::from_monodromy`]). The one classifier of the
+/// u-diagram's grazing points and of the plane's grazing curves.
+pub fn classify(model: &Model, u: f64, w: f64, tol: f64) -> Result<Feigin, BifError> {
+    let (m, _) = touch_monodromy(model, u, w, tol)?;
+    if m.iter().any(|v| !v.is_finite()) {
+        return Err(BifError::NonFinite {
+            what: format!("monodromy of the grazing orbit at u = {u}"),
+            value: f64::NAN,
+        });
     }
-    let mut ev: Vec<nalgebra::Complex<f64>> = m.complex_eigenvalues().iter().copied().collect();
-    ev.sort_by(|a, b| {
-        (*a - nalgebra::Complex::new(1.0, 0.0))
-            .norm()
-            .total_cmp(&(*b - nalgebra::Complex::new(1.0, 0.0)).norm())
-    });
-    Ok(ev[1..].iter().map(|z| z.norm()).fold(0.0, f64::max))
+    Ok(crate::feigin::from_monodromy(&m, OMEGA_L))
 }
 
 /// Root of `ω̇_l` on `[a, b]` along the dense output (bisection then secant, to rounding).

@@ -16,8 +16,10 @@
 //! * **Special points**, each with the residual of its defining condition:
 //!   Hopf points (`Re λ = 0`, bisection in ω to the last bit), smooth folds
 //!   (`du/ds = 0 ⇔ det(∂P/∂z − I) = 0`, a multiplier 1; bisection in arclength), grazing
-//!   orbits (`min ω_l = 0` of the slipping cycle, a 2×2 Newton solve, [`grazing`]) and
-//!   discontinuous folds (a grazing orbit where the branch turns back in u: point E).
+//!   orbits (`min ω_l = 0` of the slipping cycle, a 2×2 Newton solve, [`grazing`]), each
+//!   classified by Feigin's rule on the multipliers of both sides ([`feigin`]): persistence,
+//!   or a discontinuous (non-smooth) fold where the branch turns back in u (point E), with or
+//!   without period doubling.
 //!
 //! [`diagram`] assembles everything into a [`Diagram`], which writes JSON (the CLI's contract), CSV and an SVG figure ([`Diagram::to_svg`]).
 //!
@@ -28,6 +30,7 @@ pub mod arc;
 pub mod continuation;
 mod diagram;
 pub mod equilibria;
+pub mod feigin;
 pub mod grazing;
 pub mod monodromy;
 mod output;

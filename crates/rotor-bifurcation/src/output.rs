@@ -30,6 +30,7 @@ fn numbers(d: &Diagram) -> impl Iterator<Item = (String, f64)> + '_ {
             (format!("periodic[{i}].period"), p.period),
             (format!("periodic[{i}].omega_l_max"), p.omega_l_max),
             (format!("periodic[{i}].omega_l_min"), p.omega_l_min),
+            (format!("periodic[{i}].omega_u_min"), p.omega_u_min),
             (format!("periodic[{i}].stick_time"), p.stick_time),
         ];
         for (k, m) in p.multipliers.iter().enumerate() {
@@ -49,10 +50,26 @@ fn numbers(d: &Diagram) -> impl Iterator<Item = (String, f64)> + '_ {
             ("omega_l_max", p.omega_l_max),
             ("omega_l_min", p.omega_l_min),
             ("residual", p.residual),
+            ("l1", p.l1),
         ];
+        let pairs = [
+            ("slipping_multipliers", p.slipping_multipliers),
+            ("stick_slip_multipliers", p.stick_slip_multipliers),
+        ];
+        let multipliers = pairs.into_iter().flat_map(move |(k, v)| {
+            v.into_iter().flat_map(move |m| {
+                (0..2).flat_map(move |j| {
+                    [
+                        (format!("points[{i}].{k}[{j}].re"), m[j][0]),
+                        (format!("points[{i}].{k}[{j}].im"), m[j][1]),
+                    ]
+                })
+            })
+        });
         std::iter::once((format!("points[{i}].u"), p.u)).chain(
             opt.into_iter()
-                .filter_map(move |(k, v)| v.map(|v| (format!("points[{i}].{k}"), v))),
+                .filter_map(move |(k, v)| v.map(|v| (format!("points[{i}].{k}"), v)))
+                .chain(multipliers),
         )
     });
     eq.chain(per).chain(pts)

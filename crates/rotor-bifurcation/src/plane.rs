@@ -11,10 +11,12 @@
 //!   its first Lyapunov coefficient `l1` (Kuznetsov's formula on the smooth slip field; `l1 < 0`
 //!   supercritical), so a change of criticality is found as a sign change.
 //! * **Grazing** (`grazing`, `discontinuous_fold`): `y = (p, u, w)`, the grazing system of
-//!   [`crate::grazing`] (the cycle touches `ω_l = 0` at `(T_sl/k_θ, w, 0)` with `ω̇_l = 0`). A
-//!   grazing orbit is a discontinuous fold where the slipping cycle that ends there is unstable
-//!   (its leading multiplier exceeds 1: the stick-slip branch then turns back to the same side,
-//!   as at the source's point E on the Stribeck set); the curve is split where that changes.
+//!   [`crate::grazing`] (the cycle touches `ω_l = 0` at `(T_sl/k_θ, w, 0)` with `ω̇_l = 0`). Each
+//!   point is classified by the one classifier of the u-diagram, Feigin's rule
+//!   ([`crate::grazing::classify`], [`crate::feigin`]): a discontinuous fold where the real
+//!   multipliers above 1 of the slipping and the stick-slip cycle at grazing add up to an odd
+//!   number (as at the source's point E on the Stribeck set), persistence where even; the curve
+//!   is split where that changes.
 //! * **Smooth fold of cycles** (`fold`): `y = (p, α, ω_u, u)`, the cycle's fixed point on the
 //!   section `ω_l = ω*(u)` and `det(∂P/∂z − I) = 0` (a multiplier 1).
 //! * **Stuck boundary** (`stuck_boundary`): where the slipping branch meets the stuck set,
@@ -23,8 +25,9 @@
 //! Codimension-two points, located on the curves: a Hopf point changing criticality (`bautin`,
 //! a sign change of l1, by bisection), a curve turning back in p (`hopf_merge` where two Hopf
 //! points meet and vanish, `cusp` where two folds do), a grazing curve changing between
-//! grazing and discontinuous fold (`grazing_fold`: the slipping cycle at grazing has a
-//! multiplier 1, where a fold curve meets the grazing curve), a curve ending at the stuck
+//! grazing and discontinuous fold (`grazing_fold`: a multiplier of one side at grazing crosses
+//! 1, so Feigin's fold indicator `det(I − A)·det(I − B)` changes sign and a fold curve meets the
+//! grazing curve), a curve ending at the stuck
 //! boundary (`stuck_end`), and two curves meeting (`curves_meet`). Where the theory of such a
 //! nonsmooth point is not settled the point only records where the curves meet and what was
 //! seen; no normal form is claimed.
@@ -35,6 +38,7 @@ use serde::Serialize;
 
 use crate::arc::{ArcEnd, ArcOptions, follow};
 use crate::continuation::{ContOptions, Continuer, Multipliers};
+use crate::feigin::{Feigin, GrazingType};
 use crate::periodic::Shooter;
 use crate::{BifError, DiagramOptions, PointKind, diagram, grazing};
 
@@ -99,10 +103,22 @@ pub struct CurvePoint {
     /// Hopf: the first Lyapunov coefficient (< 0: supercritical).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub l1: Option<f64>,
-    /// Grazing: the leading multiplier of the slipping cycle that ends at the grazing orbit
-    /// (> 1: a discontinuous fold).
+    /// Grazing: the largest modulus of the slipping cycle's nontrivial multipliers at the
+    /// grazing orbit (for information: the type is Feigin's, `grazing_type`).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub multiplier: Option<f64>,
+    /// Grazing: Feigin's type (`persistence` or `nonsmooth_fold`, [`crate::feigin`]).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub grazing_type: Option<GrazingType>,
+    /// Grazing: a period-two orbit is born at the grazing orbit too (σ⁻ odd).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub period_doubling: Option<bool>,
+    /// Grazing: σ⁺ of the slipping and of the stick-slip cycle.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub sigma_plus: Option<[usize; 2]>,
+    /// Grazing: σ⁻ of the slipping and of the stick-slip cycle.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub sigma_minus: Option<[usize; 2]>,
     /// Grazing: ω_u at the touch point \[rad/s\].
     #[serde(skip_serializing_if = "Option::is_none")]
     pub touch_omega_u: Option<f64>,
@@ -496,6 +512,10 @@ pub fn plane(base: &Params, opts: &PlaneOptions) -> Result<Plane, BifError> {
                             omega: Some(y[1]),
                             l1: first_lyapunov(&m, y[1]),
                             multiplier: None,
+                            grazing_type: None,
+                            period_doubling: None,
+                            sigma_plus: None,
+                            sigma_minus: None,
                             touch_omega_u: None,
                             section_state: None,
                         })
@@ -525,13 +545,24 @@ pub fn plane(base: &Params, opts: &PlaneOptions) -> Result<Plane, BifError> {
                     .filter_map(|y| {
                         let m = Model::new(params_at(base, name, y[0]).ok()?);
                         let g = h(y).ok()?;
+                        let f = grazing::classify(&m, y[1], y[2], opts.tol).ok();
                         Some(CurvePoint {
                             p: y[0],
                             u: y[1],
                             residual: g[0].abs().max(g[1].abs()),
                             omega: None,
                             l1: None,
-                            multiplier: grazing::grazing_multiplier(&m, y[1], y[2], opts.tol).ok(),
+                            multiplier: f.map(|f| {
+                                f.slipping
+                                    .multipliers()
+                                    .iter()
+                                    .map(|z| z.norm())
+                                    .fold(0.0, f64::max)
+                            }),
+                            grazing_type: f.map(|f| f.kind),
+                            period_doubling: f.map(|f| f.period_doubling),
+                            sigma_plus: f.map(|f| f.sigma_plus),
+                            sigma_minus: f.map(|f| f.sigma_minus),
                             touch_omega_u: Some(y[2]),
                             section_state: None,
                         })
@@ -566,6 +597,10 @@ pub fn plane(base: &Params, opts: &PlaneOptions) -> Result<Plane, BifError> {
                             omega: None,
                             l1: None,
                             multiplier: None,
+                            grazing_type: None,
+                            period_doubling: None,
+                            sigma_plus: None,
+                            sigma_minus: None,
                             touch_omega_u: None,
                             section_state: Some([y[1], y[2]]),
                         })
@@ -592,6 +627,10 @@ pub fn plane(base: &Params, opts: &PlaneOptions) -> Result<Plane, BifError> {
                             omega: Some(0.0),
                             l1: None,
                             multiplier: None,
+                            grazing_type: None,
+                            period_doubling: None,
+                            sigma_plus: None,
+                            sigma_minus: None,
                             touch_omega_u: None,
                             section_state: None,
                         })
@@ -607,7 +646,9 @@ pub fn plane(base: &Params, opts: &PlaneOptions) -> Result<Plane, BifError> {
             _ => {}
         }
     }
-    let points = codim2(base, name, &curves, opts);
+    let mut points = split_at_type_changes(base, name, &mut curves, opts.tol);
+    points.extend(codim2(base, name, &curves, opts));
+    points.sort_by(|a, b| a.p.total_cmp(&b.p));
     let regions = regions(base, name, opts, &curves)?;
     Ok(Plane {
         param: opts.param.clone(),
@@ -620,11 +661,11 @@ pub fn plane(base: &Params, opts: &PlaneOptions) -> Result<Plane, BifError> {
     })
 }
 
-/// A grazing curve split where it changes between a plain grazing orbit and a discontinuous
-/// fold (the slipping cycle's multiplier crosses 1); points whose multiplier could not be
-/// computed keep the kind of the point before.
+/// A grazing curve split where its Feigin type changes between persistence (a plain grazing
+/// curve) and a non-smooth fold ([`crate::feigin`]); points whose type could not be computed
+/// keep the kind of the point before.
 fn split_grazing(label: &str, points: Vec<CurvePoint>, ends: [ArcEnd; 2]) -> Vec<Curve> {
-    let fold = |p: &CurvePoint| p.multiplier.map(|m| m > 1.0);
+    let fold = |p: &CurvePoint| p.grazing_type.map(|t| t == GrazingType::NonsmoothFold);
     let mut out: Vec<Curve> = Vec::new();
     let mut current: Option<bool> = None;
     for p in points {
@@ -651,6 +692,68 @@ fn split_grazing(label: &str, points: Vec<CurvePoint>, ends: [ArcEnd; 2]) -> Vec
     }
     if let Some(last) = out.last_mut() {
         last.ends.push(end_text(&ends[1]));
+    }
+    out
+}
+
+/// Where a grazing curve changes Feigin type (two consecutive pieces of one label and
+/// different kinds): the point located by [`grazing_fold`] between the last vertex of one piece
+/// and the second of the next (the first is shared and has the old type), made the end of the
+/// first piece and the start of the second, so that each piece holds only points of its type
+/// and the drawn type at any p is the classifier's. Returns the `grazing_fold` points.
+fn split_at_type_changes(base: &Params, name: &str, curves: &mut [Curve], tol: f64) -> Vec<Codim2> {
+    let mut out = Vec::new();
+    for i in 1..curves.len() {
+        let (head, tail) = curves.split_at_mut(i);
+        let (a, b) = (&mut head[i - 1], &mut tail[0]);
+        if a.label != b.label || a.kind == b.kind {
+            continue;
+        }
+        let (Some(pa), Some(pb)) = (
+            a.points.iter().rev().nth(1).or(a.points.last()).cloned(),
+            b.points.get(1).cloned(),
+        ) else {
+            continue;
+        };
+        let located = grazing_fold(base, name, &pa, &pb, tol).and_then(|(p, u, w)| {
+            let m = Model::new(params_at(base, name, p).ok()?);
+            let (g, _, _) = grazing::residual(&m, u, w, tol).ok()?;
+            Some((p, u, w, g[0].abs().max(g[1].abs())))
+        });
+        let (p, u) = match located {
+            Some((p, u, w, residual)) => {
+                let q = CurvePoint {
+                    p,
+                    u,
+                    residual,
+                    touch_omega_u: Some(w),
+                    // On the border between the types: neither.
+                    multiplier: None,
+                    grazing_type: None,
+                    period_doubling: None,
+                    sigma_plus: None,
+                    sigma_minus: None,
+                    ..b.points[0].clone()
+                };
+                a.points.push(q.clone());
+                b.points[0] = q;
+                (p, u)
+            }
+            None => (b.points[0].p, b.points[0].u),
+        };
+        out.push(Codim2 {
+            kind: Codim2Kind::GrazingFold,
+            p,
+            u,
+            curves: vec![a.label.clone()],
+            detail: format!(
+                "the grazing orbit changes from {} to {}: a multiplier of the slipping or the \
+                 stick-slip cycle at grazing crosses +1 (Feigin's sigma+ changes parity), so a \
+                 fold of cycles meets the grazing curve",
+                kind_name(a.kind),
+                kind_name(b.kind)
+            ),
+        });
     }
     out
 }
@@ -705,33 +808,6 @@ fn codim2(base: &Params, name: &str, curves: &[Curve], opts: &PlaneOptions) -> V
                     });
                 }
             }
-        }
-    }
-    // Where a grazing curve changes type: between the last point of one piece and the second
-    // of the next (the first is shared), by bisection in p on the multiplier's distance from 1.
-    for w in curves.windows(2) {
-        let (a, b) = (&w[0], &w[1]);
-        if a.label == b.label
-            && a.kind != b.kind
-            && let (Some(pa), Some(pb)) = (
-                a.points.iter().rev().nth(1).or(a.points.last()),
-                b.points.get(1),
-            )
-        {
-            let (p, u) = grazing_fold(base, name, pa, pb, opts.tol)
-                .unwrap_or((b.points[0].p, b.points[0].u));
-            out.push(Codim2 {
-                kind: Codim2Kind::GrazingFold,
-                p,
-                u,
-                curves: vec![a.label.clone()],
-                detail: format!(
-                    "the grazing orbit changes from {} to {}: the slipping cycle ending there has \
-                     a multiplier 1, so a fold of cycles meets the grazing curve",
-                    kind_name(a.kind),
-                    kind_name(b.kind)
-                ),
-            });
         }
     }
     // Curves of different labels that cross: at each point of one curve inside the other's
@@ -879,34 +955,35 @@ fn kind_name(k: CurveKind) -> &'static str {
     }
 }
 
-/// The point between two grazing points whose slipping multipliers lie on either side of
-/// 1: bisection in p, the grazing orbit located at each p from the linear interpolation.
+/// The point between two grazing points of different Feigin type: bisection in p on the sign
+/// of Feigin's fold indicator `det(I − A)·det(I − B)` ([`Feigin::fold_indicator`]; it changes
+/// sign where a multiplier of either side crosses +1), the grazing orbit located at each p
+/// from the linear interpolation.
 fn grazing_fold(
     base: &Params,
     name: &str,
     a: &CurvePoint,
     b: &CurvePoint,
     tol: f64,
-) -> Option<(f64, f64)> {
-    let at = |p: f64, s: f64| -> Option<(f64, f64, f64)> {
+) -> Option<(f64, f64, f64)> {
+    let at = |p: f64, s: f64| -> Option<(f64, f64, Feigin)> {
         let m = Model::new(params_at(base, name, p).ok()?);
         let (u0, w0) = (
             a.u + s * (b.u - a.u),
             a.touch_omega_u? + s * (b.touch_omega_u? - a.touch_omega_u?),
         );
         let g = grazing::locate(&m, u0, w0, tol, 1e-11).ok()?;
-        let mu = grazing::grazing_multiplier(&m, g.u, g.w, tol).ok()?;
-        Some((g.u, mu - 1.0, p))
+        Some((g.u, g.w, grazing::classify(&m, g.u, g.w, tol).ok()?))
     };
-    let sign_a = a.multiplier? - 1.0;
+    let sign_a = at(a.p, 0.0)?.2.fold_indicator();
     let (mut lo, mut hi) = (0.0, 1.0);
-    let mut best = (a.p, a.u);
+    let mut best = (a.p, a.u, a.touch_omega_u?);
     for _ in 0..30 {
         let s = 0.5 * (lo + hi);
         let p = a.p + s * (b.p - a.p);
-        let (u, f, _) = at(p, s)?;
-        best = (p, u);
-        if f * sign_a > 0.0 {
+        let (u, w, f) = at(p, s)?;
+        best = (p, u, w);
+        if f.fold_indicator() * sign_a > 0.0 {
             lo = s;
         } else {
             hi = s;
@@ -1332,6 +1409,10 @@ mod tests {
             omega: None,
             l1: None,
             multiplier: None,
+            grazing_type: None,
+            period_doubling: None,
+            sigma_plus: None,
+            sigma_minus: None,
             touch_omega_u: None,
             section_state: None,
         };

@@ -8,6 +8,7 @@ use serde::Serialize;
 
 use crate::continuation::{Continuer, End, Node};
 use crate::diagram::Branch;
+use crate::feigin::{Feigin, GrazingType};
 use crate::{BifError, grazing};
 
 /// What a special point is (its JSON `kind`).
@@ -85,6 +86,32 @@ pub struct SpecialPoint {
     /// point for continuing the fold condition.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub section_state: Option<[f64; 3]>,
+    /// Hopf: the first Lyapunov coefficient (Kuznetsov's formula on the smooth slip field;
+    /// `l1 < 0` supercritical, `l1 > 0` subcritical).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub l1: Option<f64>,
+    /// Grazing orbits and discontinuous folds: Feigin's type, `persistence` (the cycle passes
+    /// through grazing) or `nonsmooth_fold` ([`crate::feigin`]).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub grazing_type: Option<GrazingType>,
+    /// Grazing orbits: whether a period-two orbit is born there too (σ⁻ odd).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub period_doubling: Option<bool>,
+    /// Grazing orbits: σ⁺, the real multipliers above +1, of the slipping cycle and of the
+    /// stick-slip cycle at the grazing orbit.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub sigma_plus: Option<[usize; 2]>,
+    /// Grazing orbits: σ⁻, the real multipliers below −1, in the same order.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub sigma_minus: Option<[usize; 2]>,
+    /// Grazing orbits: the slipping cycle's nontrivial multipliers at the grazing orbit,
+    /// `[[re, im], [re, im]]`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub slipping_multipliers: Option<[[f64; 2]; 2]>,
+    /// Grazing orbits: the stick-slip cycle's nontrivial multipliers at the grazing orbit (the
+    /// limit of its saltation monodromy; one of them is 0).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub stick_slip_multipliers: Option<[[f64; 2]; 2]>,
     pub detail: String,
 }
 
@@ -103,6 +130,13 @@ impl SpecialPoint {
             condition: None,
             touch_omega_u: None,
             section_state: None,
+            l1: None,
+            grazing_type: None,
+            period_doubling: None,
+            sigma_plus: None,
+            sigma_minus: None,
+            slipping_multipliers: None,
+            stick_slip_multipliers: None,
             detail,
         }
     }
@@ -136,36 +170,144 @@ fn grazing_point(g: &grazing::GrazingOrbit, detail: String) -> SpecialPoint {
     p
 }
 
-/// The discontinuous fold at grazing orbit `g` where the branches of nodes `a` and `b` meet;
-/// `side_u` is the u of a branch point far enough from `g` (several steps) to tell on which
-/// side of `g.u` the branches lie.
-fn discontinuous_fold(g: &grazing::GrazingOrbit, a: &Node, b: &Node, side_u: f64) -> SpecialPoint {
-    let side = |n: &Node| {
-        if n.info.stable {
-            if n.info.stick_slip {
-                "a stable stick-slip"
-            } else {
-                "a stable slipping"
-            }
-        } else if n.info.stick_slip {
-            "an unstable stick-slip"
+/// Whether a branch point at `u` is resolved from the grazing orbit at `u_g`: more than 1e-8 V
+/// (relative to max(1, |u_g|)) away, ten times the branches' own accuracy (1e-9 V at tol 1e-11).
+/// Closer points (the branch steps shrink next to a grazing orbit) may lie on either side of it
+/// by their error alone.
+fn resolved(u: f64, u_g: f64) -> bool {
+    (u - u_g).abs() > 1e-8 * u_g.abs().max(1.0)
+}
+
+/// Writes Feigin's classification into a grazing (or discontinuous fold) point.
+fn set_feigin(p: &mut SpecialPoint, f: &Feigin) {
+    let pair = |s: &crate::feigin::Side| s.multipliers().map(|z| [z.re, z.im]);
+    p.grazing_type = Some(f.kind);
+    p.period_doubling = Some(f.period_doubling);
+    p.sigma_plus = Some(f.sigma_plus);
+    p.sigma_minus = Some(f.sigma_minus);
+    p.slipping_multipliers = Some(pair(&f.slipping));
+    p.stick_slip_multipliers = Some(pair(&f.stick_slip));
+}
+
+/// Feigin's counts in words: `sigma+ = 1 + 0, sigma- = 0 + 0 (slipping + stick-slip)`, and
+/// the multipliers of both sides.
+fn counts(f: &Feigin) -> String {
+    let m = |s: &crate::feigin::Side| {
+        let [a, b] = s.multipliers();
+        if a.im != 0.0 {
+            format!("{:.6} ± {:.6}i", a.re, a.im.abs())
         } else {
-            "an unstable slipping"
+            format!("{:.6}, {:.6}", a.re, b.re)
         }
     };
-    let mut p = grazing_point(
-        g,
-        format!(
-            "discontinuous fold: {} branch and {} branch meet at the grazing orbit and both lie {} u = {}",
-            side(a),
-            side(b),
-            if side_u > g.u { "above" } else { "below" },
-            g.u
-        ),
-    );
-    p.kind = PointKind::Fold;
-    p.discontinuous = Some(true);
-    p
+    format!(
+        "Feigin: sigma+ = {} + {}, sigma- = {} + {} (slipping + stick-slip); multipliers {} \
+         (slipping), {} (stick-slip)",
+        f.sigma_plus[0],
+        f.sigma_plus[1],
+        f.sigma_minus[0],
+        f.sigma_minus[1],
+        m(&f.slipping),
+        m(&f.stick_slip)
+    )
+}
+
+fn stability(stable: bool, what: &str) -> String {
+    if stable {
+        format!("a stable {what}")
+    } else {
+        format!("an unstable {what}")
+    }
+}
+
+/// The grazing point at `g` classified by Feigin's rule `f`, and for a non-smooth fold the
+/// discontinuous fold point too. `sides` are the u of branch points of the two branch parts
+/// meeting at the grazing orbit, resolved from it ([`resolved`]), if any: a check of the
+/// classification, reported in the detail when the branch geometry disagrees.
+fn classified(
+    g: &grazing::GrazingOrbit,
+    f: &Feigin,
+    sides: [Option<f64>; 2],
+    how: &str,
+) -> Vec<SpecialPoint> {
+    // Whether the two branch parts lie on the same side of u_g, if both are resolved.
+    let below = sides.map(|u| u.map(|u| u < g.u));
+    let same_side = match below {
+        [Some(x), Some(y)] => Some(x == y),
+        _ => None,
+    };
+    let slip = stability(f.slipping.stable(), "slipping");
+    let stick = stability(f.stick_slip.stable(), "stick-slip");
+    let pd = if f.period_doubling {
+        "; a period-two orbit is born here (period-doubling-type grazing)"
+    } else {
+        ""
+    };
+    let mut out = Vec::new();
+    match f.kind {
+        GrazingType::Persistence => {
+            let mut check = String::new();
+            if same_side == Some(true) {
+                check = format!(
+                    "; NOTE: the branch points beside it both lie {} it, which the \
+                     classification does not predict",
+                    if below[0] == Some(true) {
+                        "below"
+                    } else {
+                        "above"
+                    }
+                );
+            }
+            let mut p = grazing_point(
+                g,
+                format!(
+                    "persistence: the cycle passes through grazing ({stick} cycle on one side, \
+                     {slip} cycle on the other) {how}{pd}; {}{check}",
+                    counts(f)
+                ),
+            );
+            set_feigin(&mut p, f);
+            out.push(p);
+        }
+        GrazingType::NonsmoothFold => {
+            let mut p = grazing_point(
+                g,
+                format!("the cycle touches omega_l = 0 {how}; {}", counts(f)),
+            );
+            set_feigin(&mut p, f);
+            out.push(p.clone());
+            let side = match same_side {
+                Some(true) => format!(
+                    "both lie {} u = {}",
+                    if below[0] == Some(true) {
+                        "below"
+                    } else {
+                        "above"
+                    },
+                    g.u
+                ),
+                Some(false) => format!(
+                    "NOTE: the branch points beside it lie on both sides of u = {}, which the \
+                     classification does not predict",
+                    g.u
+                ),
+                None => format!(
+                    "their side of u = {} is not resolved (no branch point beside it more than \
+                     1e-8 V away)",
+                    g.u
+                ),
+            };
+            p.kind = PointKind::Fold;
+            p.discontinuous = Some(true);
+            p.detail = format!(
+                "discontinuous fold: {stick} branch and {slip} branch meet at the grazing orbit \
+                 and {side}{pd}; {}",
+                counts(f)
+            );
+            out.push(p);
+        }
+    }
+    out
 }
 
 /// Folds, grazing points and other stability changes along an ordered branch.
@@ -176,7 +318,7 @@ pub(crate) fn special_points(
 ) -> Vec<SpecialPoint> {
     let model = cont.sh.model;
     let mut out = Vec::new();
-    for w in branch.windows(2) {
+    for (i, w) in branch.windows(2).enumerate() {
         let (a, b) = (&w[0], &w[1]);
         // The step from a to b: recompute it as the projection on a's tangent.
         let step = (0..3)
@@ -193,15 +335,23 @@ pub(crate) fn special_points(
             match grazing_near(model, from, point_tol) {
                 Ok(g) => {
                     explained = true;
-                    out.push(grazing_point(
-                        &g,
-                        format!(
-                            "the cycle touches omega_l = 0 (between branch points at u = {} and {})",
-                            a.y[0], b.y[0]
-                        ),
-                    ));
-                    if (a.y[0] - g.u) * (b.y[0] - g.u) > 0.0 {
-                        out.push(discontinuous_fold(&g, a, b, a.y[0]));
+                    let how = format!("(between branch points at u = {} and {})", a.y[0], b.y[0]);
+                    match grazing::classify(model, g.u, g.w, point_tol) {
+                        Ok(f) => {
+                            // The first branch points outward from the window that are resolved
+                            // from the grazing orbit (see `resolved`).
+                            let before = branch[..=i].iter().rev().map(|n| n.y[0]);
+                            let mut after = branch[i + 1..].iter().map(|n| n.y[0]);
+                            let sides = [
+                                before.clone().find(|&u| resolved(u, g.u)),
+                                after.find(|&u| resolved(u, g.u)),
+                            ];
+                            out.extend(classified(&g, &f, sides, &how));
+                        }
+                        Err(e) => out.push(grazing_point(
+                            &g,
+                            format!("the cycle touches omega_l = 0 {how}; not classified: {e}"),
+                        )),
                     }
                 }
                 Err(e) => {
@@ -335,17 +485,37 @@ pub(crate) fn stuck_end_points(
                         && (gb.w - ga.w).abs() < 1e-6 * ga.w.abs().max(1.0)
                 })
         });
-        out.push(grazing_point(
-            &ga,
-            format!(
-                "a branch ends at this grazing orbit (continuation step collapsed at u = {}, stick time {:e} s, min omega_l {:e})",
-                a.y[0], a.info.stick_time, a.info.omega_l_min
+        let (b_back, how) = match partner {
+            Some(j) => {
+                paired[j] = true;
+                (
+                    Some(ends[j].1),
+                    format!(
+                        "(two branches end here: continuation steps collapsed at u = {} and {})",
+                        a.y[0], ends[j].0.y[0]
+                    ),
+                )
+            }
+            None => (
+                None,
+                format!(
+                    "(a branch ends here: continuation step collapsed at u = {}, stick time {:e} \
+                     s, min omega_l {:e})",
+                    a.y[0], a.info.stick_time, a.info.omega_l_min
+                ),
             ),
-        ));
-        if let Some(j) = partner {
-            paired[j] = true;
-            let (b, _) = ends[j];
-            out.push(discontinuous_fold(&ga, a, b, a_back.y[0]));
+        };
+        match (grazing::classify(model, ga.u, ga.w, point_tol), b_back) {
+            (Ok(f), Some(b_back)) => {
+                let sides = [a_back.y[0], b_back.y[0]].map(|u| resolved(u, ga.u).then_some(u));
+                out.extend(classified(&ga, &f, sides, &how));
+            }
+            (Ok(f), None) => {
+                let mut p = grazing_point(&ga, format!("{how}; {}", counts(&f)));
+                set_feigin(&mut p, &f);
+                out.push(p);
+            }
+            (Err(e), _) => out.push(grazing_point(&ga, format!("{how}; not classified: {e}"))),
         }
     }
     out

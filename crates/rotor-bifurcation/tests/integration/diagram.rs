@@ -348,3 +348,35 @@ fn hysteresis_of_a_brute_force_sweep_matches_the_bistable_window() {
         "down jump at {down}, Hopf at {hopf}"
     );
 }
+
+/// Grazing of the upper disc (issue 33, item 2). On the Stribeck set the upper disc has static
+/// friction (T_su = 0.38 N m), so a cycle reaching ω_u = 0 would be a special point of its own.
+/// No cycle of the diagram comes near it: the smallest ω_u over every periodic branch point is
+/// 0.0577 rad/s, on the slipping cycles next to D (0.18378 V, where the cycles' mean ω_u is
+/// smallest), against an integration error of ~1e-9 rad/s. Table 1 (T_su = 0: a purely
+/// viscous upper disc, whose ω_u = 0 is no sliding surface) stays above 0.59 rad/s.
+#[test]
+fn no_cycle_of_the_diagrams_touches_omega_u_zero() {
+    for (name, d, floor) in [
+        // Floors: the measured minima (0.0577, 0.5954 rad/s) rounded down to one digit.
+        ("stribeck", st_diagram(), 0.05),
+        ("table1", t1_diagram(), 0.5),
+    ] {
+        let low = d
+            .periodic
+            .iter()
+            .min_by(|a, b| a.omega_u_min.total_cmp(&b.omega_u_min))
+            .unwrap();
+        assert!(
+            low.omega_u_min > floor,
+            "{name}: min omega_u {} at u = {}",
+            low.omega_u_min,
+            low.u
+        );
+        // The minimum is the velocity's minimum over the cycle, not a sample: never above the
+        // upper disc's velocity at the cycle's section point.
+        for r in &d.periodic {
+            assert!(r.omega_u_min <= r.section_state[1] + 1e-9, "{name} {r:?}");
+        }
+    }
+}

@@ -45,6 +45,7 @@ fn json_follows_the_cli_contract() {
                 same(num(p, k), x, k);
             }
             assert_eq!(p["stable"].as_bool(), Some(row.stable));
+            same(num(p, "omega_u_min"), row.omega_u_min, "omega_u_min");
             let m = p["multipliers"].as_array().unwrap();
             assert_eq!(m.len(), 3);
             for (x, want) in m.iter().zip(&row.multipliers) {
@@ -75,6 +76,23 @@ fn json_follows_the_cli_contract() {
             same(num(p, "u"), row.u, "u");
             // Folds say whether they are discontinuous; nothing else carries the field.
             assert_eq!(p["discontinuous"].is_boolean(), kind == "fold", "{p}");
+            // Hopf points carry their first Lyapunov coefficient; grazing points and
+            // discontinuous folds their Feigin type, counts and both sides' multipliers.
+            assert_eq!(p["l1"].is_f64(), kind == "hopf", "{p}");
+            let at_grazing = kind == "grazing" || p["discontinuous"] == true;
+            let t = p["grazing_type"].as_str();
+            assert_eq!(t.is_some(), at_grazing, "{p}");
+            if at_grazing {
+                assert!(matches!(t, Some("persistence" | "nonsmooth_fold")), "{p}");
+                assert!(p["period_doubling"].is_boolean(), "{p}");
+                for k in ["sigma_plus", "sigma_minus"] {
+                    assert_eq!(p[k].as_array().map(|a| a.len()), Some(2), "{p}");
+                }
+                for k in ["slipping_multipliers", "stick_slip_multipliers"] {
+                    let m = p[k].as_array().unwrap();
+                    assert!(m.len() == 2 && m.iter().all(|z| z.as_array().unwrap().len() == 2));
+                }
+            }
         }
     }
     // The Stribeck set's E: a discontinuous fold.

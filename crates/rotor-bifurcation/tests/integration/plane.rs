@@ -3,6 +3,7 @@
 //! points of the Stribeck set over its lower static level.
 
 use rotor_bifurcation::PointKind;
+use rotor_bifurcation::feigin::GrazingType;
 use rotor_bifurcation::plane::{
     Codim2Kind, Curve, CurveKind, PlaneOptions, first_lyapunov, plane, solve_u,
 };
@@ -53,24 +54,40 @@ fn curves_started_elsewhere_pass_through_the_one_parameter_points() {
     }
 }
 
-/// The first Lyapunov coefficient agrees with the direction of the small cycles the
-/// one-parameter diagram finds by shooting: Table 1's H1 supercritical (l1 < 0), H2 and both
-/// Hopf points of the Stribeck set subcritical (l1 > 0).
+/// The u-diagram's Hopf points carry their first Lyapunov coefficient, and its sign (their
+/// criticality) agrees with the direction of the small cycles the diagram finds by shooting:
+/// Table 1's H1 supercritical (l1 < 0), H2 and both Hopf points of the Stribeck set
+/// subcritical (l1 > 0). Table 1's H2 has l1 ≈ 1.7e-3 (issue 33, from independent code).
 #[test]
 fn the_lyapunov_coefficient_agrees_with_the_cycles_direction() {
     for (name, d) in [("table1", t1_diagram()), ("stribeck", st_diagram())] {
         let m = model(name);
         for sp in d.points.iter().filter(|p| p.kind == PointKind::Hopf) {
             let l1 = first_lyapunov(&m, sp.omega.unwrap()).unwrap();
+            assert_eq!(sp.l1, Some(l1), "{name} {sp:?}");
             let sup = sp.detail.starts_with("supercritical");
             assert!(
-                sup == (l1 < 0.0) && sp.detail.contains("critical"),
+                sup == (l1 < 0.0)
+                    && sp
+                        .detail
+                        .starts_with(if sup { "super" } else { "subcritical" }),
                 "{name} at {}: l1 = {l1}, {}",
                 sp.u,
                 sp.detail
             );
+            // The witness from shooting, in the same detail: stable small cycles ⇔ l1 < 0.
+            let stable = sp.detail.contains("are stable)");
+            assert!(
+                stable || sp.detail.contains("are unstable)"),
+                "{}",
+                sp.detail
+            );
+            assert_eq!(stable, l1 < 0.0, "{name} at {}: {}", sp.u, sp.detail);
         }
     }
+    let h2 = crate::common::points(t1_diagram(), "hopf")[1].l1.unwrap();
+    // Two significant digits, as the issue quotes it.
+    assert!((h2 - 1.7e-3).abs() < 0.05e-3, "{h2}");
 }
 
 /// Over the Stribeck set's lower static level T_sl ∈ [0.1, 0.45] the curves meet in a
@@ -142,6 +159,46 @@ fn the_stribeck_set_has_its_codimension_two_points_where_the_curves_say() {
     };
     assert_eq!(at_file("G1"), CurveKind::DiscontinuousFold);
     assert_eq!(at_file("G2"), CurveKind::DiscontinuousFold);
+    // The pieces of a grazing curve meet exactly at their grazing_fold point, and every typed
+    // point of a piece has the piece's type: the plane draws the classifier's type at every p.
+    for w in pl.curves.windows(2) {
+        let (a, b) = (&w[0], &w[1]);
+        if a.label == b.label && a.kind != b.kind {
+            let (end, start) = (a.points.last().unwrap(), b.points.first().unwrap());
+            assert_eq!((end.p, end.u), (start.p, start.u));
+            assert!(
+                pl.points
+                    .iter()
+                    .any(|q| q.kind == Codim2Kind::GrazingFold && q.p == end.p && q.u == end.u),
+                "{:?}",
+                pl.points
+            );
+        }
+    }
+    for c in pl.curves.iter().filter(|c| c.label.starts_with('G')) {
+        let want = if c.kind == CurveKind::DiscontinuousFold {
+            GrazingType::NonsmoothFold
+        } else {
+            GrazingType::Persistence
+        };
+        for q in c.points.iter().filter(|q| q.grazing_type.is_some()) {
+            assert_eq!(q.grazing_type, Some(want), "{} {q:?}", c.label);
+        }
+    }
+    // At T_sl = 0.128 the upper grazing curve is persistence, as the u-diagram says there
+    // (points.rs: a_persistence_through_grazing_is_not_a_fold).
+    let g2_at = |p: f64| {
+        pl.curves
+            .iter()
+            .filter(|c| c.label == "G2")
+            .find(|c| {
+                let (lo, hi) = (c.points.first().unwrap().p, c.points.last().unwrap().p);
+                lo.min(hi) <= p && p <= lo.max(hi)
+            })
+            .unwrap()
+            .kind
+    };
+    assert_eq!(g2_at(0.128), CurveKind::Grazing);
 }
 
 fn model_at(base: &rotor_model::Params, p: f64) -> rotor_model::Model {
