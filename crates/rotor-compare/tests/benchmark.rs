@@ -146,12 +146,12 @@ fn every_solver_passes_check_at_its_level() {
             let rep = check(sc, &r, &own.unwrap(), Some(&ev), Level::Strict).unwrap();
             // The orbit is the reference solver's own, recomputed densely: it differs from
             // the stored trace by the stored trace's error and the polyline's chord error
-            // (below 1e-9 of the scale: `rotor_compare::orbit`), not by 0.
+            // (about 3e-9 of the scale at most: `rotor_compare::orbit`), not by 0.
             let orbit_err = r.error("omega_l") / r.samples.iter().map(|s| s.x[2].abs()).fold(1e-3, f64::max);
             if !rep
                 .quantities
                 .iter()
-                .all(|q| q.difference == 0.0 || (q.name == "orbit" && q.difference <= 10.0 * orbit_err + 1e-9))
+                .all(|q| q.difference == 0.0 || (q.name == "orbit" && q.difference <= 10.0 * orbit_err + 3e-9))
             {
                 out.push(format!("{} reference:\n{}", sc.name, rep.table()));
             }
