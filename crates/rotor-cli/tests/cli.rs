@@ -736,6 +736,10 @@ fn bench_shards_merge_to_one_run_timings_aside() {
         "st-u1.5-rest",
         "--scenario",
         "t1-u0.5-rest",
+        // A client that fails every run (`false JOB.json` exits 1): its scenes are joined
+        // and its status and reason recomputed from them.
+        "--external",
+        "broken=false",
     ];
     let run = |extra: &[&str]| {
         let o = rotor(&[&suite[..], extra].concat());
@@ -763,6 +767,10 @@ fn bench_shards_merge_to_one_run_timings_aside() {
     assert_eq!(b2["scenes"].as_array().unwrap().len(), 1);
     assert!(merged.get("shard").is_none());
     assert_eq!(merged["scenes"].as_array().unwrap().len(), 3);
+    let broken = &merged["clients"].as_array().unwrap().last().unwrap();
+    assert_eq!(broken["name"], "broken");
+    assert_eq!(broken["status"], "failed");
+    assert_eq!(broken["scenes"].as_array().unwrap().len(), 3);
     assert_eq!(
         without_timings(&merged, false),
         without_timings(&one, false)
