@@ -9,7 +9,7 @@ use rotor_compare::check::{Level, check};
 use rotor_compare::gridmetrics::{StickExit, grid_metrics};
 use rotor_compare::trace::{read_events, read_trace};
 use rotor_model::SteadyState;
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 use crate::ladder::{LadderPoint, Loaded};
 use crate::measure::{Errors, Timing, run_point, scene_at, time_at_error};
@@ -17,7 +17,7 @@ use crate::options::{BenchOptions, SolverKind};
 use crate::protocol::{ClientSays, ClientSpec, Ended, Job, RunOutput, run_client, tail};
 
 /// Why a run gave no usable point.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum FailureKind {
     /// The command could not be started.
@@ -37,14 +37,14 @@ pub enum FailureKind {
 }
 
 /// A run's failure with its reason.
-#[derive(Debug, Clone, PartialEq, Serialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Failure {
     pub kind: FailureKind,
     pub detail: String,
 }
 
 /// One setting of a client on one scene.
-#[derive(Debug, Clone, PartialEq, Serialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct ClientPoint {
     pub setting: f64,
     /// Wall time of the whole process (from the spawn to the exit).
@@ -77,13 +77,15 @@ impl ClientPoint {
 }
 
 /// Client time / Rust time at the client's error.
-#[derive(Debug, Clone, Serialize)]
+#[derive(Debug, Clone, Serialize, Deserialize)]
 pub struct Ratio {
     pub against: SolverKind,
     /// `"steady_rel"` or `"transient_max"`.
-    pub error_kind: &'static str,
+    #[serde(deserialize_with = "crate::merge::static_str")]
+    pub error_kind: crate::merge::Word,
     /// `"in_process"` (the client's `solve_seconds`) or `"whole_process"` (its wall time).
-    pub time: &'static str,
+    #[serde(deserialize_with = "crate::merge::static_str")]
+    pub time: crate::merge::Word,
     pub setting: f64,
     pub error: f64,
     pub client_seconds: f64,
@@ -99,7 +101,7 @@ pub struct Ratio {
 }
 
 /// Time per step of a fixed-step client vs rotor-moreau at one h.
-#[derive(Debug, Clone, Serialize)]
+#[derive(Debug, Clone, Serialize, Deserialize)]
 pub struct PerStep {
     pub h: f64,
     pub client_s_per_step: f64,
@@ -113,7 +115,7 @@ pub struct PerStep {
 }
 
 /// A client on one scene.
-#[derive(Debug, Clone, Serialize)]
+#[derive(Debug, Clone, Serialize, Deserialize)]
 pub struct ClientScene {
     pub scene: String,
     pub points: Vec<ClientPoint>,
@@ -122,7 +124,7 @@ pub struct ClientScene {
 }
 
 /// Whether a client ran.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum ClientStatus {
     /// At least one point was placed.
@@ -144,7 +146,7 @@ impl ClientStatus {
 }
 
 /// The protocol's overhead for one client, medians over its runs [s].
-#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct Overhead {
     /// Writing the job file, reading and grading the trace.
     pub protocol_s: f64,
@@ -154,14 +156,15 @@ pub struct Overhead {
 }
 
 /// One client over every scene.
-#[derive(Debug, Clone, Serialize)]
+#[derive(Debug, Clone, Serialize, Deserialize)]
 pub struct ClientReport {
     pub name: String,
     pub command: String,
     pub peer: bool,
     pub fixed_step: bool,
     /// `"tol"` or `"h"`.
-    pub setting_name: &'static str,
+    #[serde(deserialize_with = "crate::merge::static_str")]
+    pub setting_name: crate::merge::Word,
     pub status: ClientStatus,
     /// Why it was skipped or failed.
     pub reason: Option<String>,
@@ -552,6 +555,25 @@ pub(crate) fn run(
             per_step,
         });
     }
+    let (status, reason, overhead) = summary(&out);
+    ClientReport {
+        name: spec.name.clone(),
+        command: spec.command_line(),
+        peer: spec.peer,
+        fixed_step: spec.fixed_step,
+        setting_name: if spec.fixed_step { "h" } else { "tol" },
+        status,
+        reason,
+        version: says.version,
+        method: says.method,
+        scenes: out,
+        overhead,
+    }
+}
+
+/// A client's status, the reason it placed no point (if so) and the protocol's overhead, from
+/// its points over every scene (for one run, and for shards joined by [`crate::merge`]).
+pub(crate) fn summary(out: &[ClientScene]) -> (ClientStatus, Option<String>, Option<Overhead>) {
     let all: Vec<&ClientPoint> = out.iter().flat_map(|s| &s.points).collect();
     let placed = all.iter().any(|p| p.wall.is_some());
     let median = |mut v: Vec<f64>| -> Option<f64> {
@@ -575,23 +597,12 @@ pub(crate) fn run(
             .find_map(|p| p.failure.as_ref().map(|f| f.detail.clone()))
             .unwrap_or_else(|| "no setting".into())
     });
-    ClientReport {
-        name: spec.name.clone(),
-        command: spec.command_line(),
-        peer: spec.peer,
-        fixed_step: spec.fixed_step,
-        setting_name: if spec.fixed_step { "h" } else { "tol" },
-        status: if placed {
-            ClientStatus::Ran
-        } else {
-            ClientStatus::Failed
-        },
-        reason,
-        version: says.version,
-        method: says.method,
-        scenes: out,
-        overhead,
-    }
+    let status = if placed {
+        ClientStatus::Ran
+    } else {
+        ClientStatus::Failed
+    };
+    (status, reason, overhead)
 }
 
 fn skipped_point(setting: f64) -> ClientPoint {

@@ -5,7 +5,7 @@ use rotor_compare::check::{Level, check};
 use rotor_compare::gridmetrics::{StickExit, grid_metrics};
 use rotor_compare::reference::Reference;
 use rotor_model::{Output, Scenario, Scene, Stats, SteadyState};
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 use crate::BenchError;
 use crate::measure::{
@@ -14,7 +14,7 @@ use crate::measure::{
 use crate::options::{BenchOptions, SceneSpec, SolverKind};
 
 /// One scene: its reference and every ladder point.
-#[derive(Debug, Clone, Serialize)]
+#[derive(Debug, Clone, Serialize, Deserialize)]
 pub struct SceneReport {
     pub name: String,
     pub description: String,
@@ -29,7 +29,7 @@ pub struct SceneReport {
 }
 
 /// The reference run and the estimate of its own error.
-#[derive(Debug, Clone, Serialize)]
+#[derive(Debug, Clone, Serialize, Deserialize)]
 pub struct ReferenceReport {
     pub solver: SolverKind,
     pub tol: f64,
@@ -50,11 +50,12 @@ pub struct ReferenceReport {
 }
 
 /// One solver at one accuracy setting.
-#[derive(Debug, Clone, Serialize)]
+#[derive(Debug, Clone, Serialize, Deserialize)]
 pub struct LadderPoint {
     pub solver: SolverKind,
     /// `tol` or `h`.
-    pub setting_name: &'static str,
+    #[serde(deserialize_with = "crate::merge::static_str")]
+    pub setting_name: crate::merge::Word,
     pub setting: f64,
     /// `None` if the run failed.
     pub timing: Option<Timing>,

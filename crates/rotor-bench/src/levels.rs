@@ -2,7 +2,7 @@
 //! scene, timed side by side.
 
 use rotor_model::{Output, SolveError};
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 use crate::BenchError;
 use crate::ladder::Loaded;
@@ -10,10 +10,11 @@ use crate::measure::{Timing, scene_at, solver};
 use crate::options::{BenchOptions, SolverKind};
 
 /// Metrics-only vs final-state-only vs full-trace run of one solver (all with metrics).
-#[derive(Debug, Clone, Serialize)]
+#[derive(Debug, Clone, Serialize, Deserialize)]
 pub struct OutputLevel {
     pub solver: SolverKind,
-    pub setting_name: &'static str,
+    #[serde(deserialize_with = "crate::merge::static_str")]
+    pub setting_name: crate::merge::Word,
     pub setting: f64,
     /// `Output::Metrics`: skips whole periods once the cycle has converged.
     pub metrics_only: Timing,

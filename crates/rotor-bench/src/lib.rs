@@ -33,6 +33,7 @@ mod clients;
 mod ladder;
 mod levels;
 mod measure;
+pub mod merge;
 mod options;
 mod peers;
 pub mod profile;
@@ -40,7 +41,7 @@ pub mod protocol;
 mod report;
 
 use rotor_model::{Model, Output, ScenarioError, Scene, SolveError};
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 use thiserror::Error;
 
 pub use clients::{
@@ -50,6 +51,7 @@ pub use clients::{
 pub use ladder::{LadderPoint, ReferenceReport, SceneReport};
 pub use levels::OutputLevel;
 pub use measure::{Errors, RefData, Timing, solver, time_at_error, timed};
+pub use merge::{ShardInfo, merge};
 pub use options::{BenchOptions, PeerOptions, SceneSpec, SolverKind, workspace_root};
 pub use peers::available as peer_available;
 pub use profile::Profile;
@@ -97,13 +99,16 @@ pub enum BenchError {
     /// The report holds a non-finite number (a bug): nothing is written.
     #[error("the benchmark report holds {path} = {value}: not written (JSON has no NaN)")]
     NonFinite { path: String, value: f64 },
+    /// Shard reports that do not fit together (`rotor bench --merge`).
+    #[error("{0}")]
+    Merge(String),
     /// The report could not be serialised (a bug).
     #[error("the benchmark report cannot be serialised: {0}")]
     Serialise(String),
 }
 
 /// The whole benchmark's result.
-#[derive(Debug, Clone, Serialize)]
+#[derive(Debug, Clone, Serialize, Deserialize)]
 pub struct BenchReport {
     /// Per scene: reference and ladders.
     pub scenes: Vec<SceneReport>,
@@ -115,10 +120,14 @@ pub struct BenchReport {
     pub profile: Profile,
     /// Where and how it was measured.
     pub environment: Environment,
+    /// Which part of the suite this report holds (`rotor bench --shard I/N`); absent from a
+    /// whole run's report and from shards joined by [`merge()`].
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub shard: Option<ShardInfo>,
 }
 
 /// Conditions of the measurement.
-#[derive(Debug, Clone, Serialize)]
+#[derive(Debug, Clone, Serialize, Deserialize)]
 pub struct Environment {
     /// Cores the process may use.
     pub cores: usize,
@@ -146,6 +155,16 @@ fn validate(opts: &BenchOptions) -> Result<(), BenchError> {
     let bad = |m: String| Err(BenchError::Options(m));
     if opts.scenes.is_empty() {
         return bad("no scene".into());
+    }
+    if let Some(s) = opts.shard
+        && s.n > opts.scenes.len()
+    {
+        return bad(format!(
+            "--shard {}/{}: the suite has {n} scene(s), so N can be at most {n}",
+            s.i,
+            s.n,
+            n = opts.scenes.len()
+        ));
     }
     for s in &opts.scenes {
         let [a, b] = s.transient;
@@ -207,10 +226,19 @@ fn validate(opts: &BenchOptions) -> Result<(), BenchError> {
 /// step, for a CLI's stderr).
 pub fn run(opts: &BenchOptions, mut progress: impl FnMut(&str)) -> Result<BenchReport, BenchError> {
     validate(opts)?;
+    let shard = opts.shard.unwrap_or(rotor_compare::sweep::Shard::ALL);
+    let shard_info = opts.shard.map(|s| merge::shard_info(opts, s));
+    // The first scene of the suite is shard 1's: the output levels, measured on it, are
+    // that shard's alone, so that the joined report holds them once.
+    let mut opts = std::borrow::Cow::Borrowed(opts);
+    if shard.i != 1 {
+        opts.to_mut().output_levels = false;
+    }
+    let opts = &*opts;
     let load_start = load_average();
     let mut scenes = Vec::new();
     let mut loaded: Vec<(Loaded, Vec<LadderPoint>)> = Vec::new();
-    for spec in &opts.scenes {
+    for spec in shard.indices(opts.scenes.len()).map(|k| &opts.scenes[k]) {
         let (l, reference) = load(opts, spec, &mut progress)?;
         let points = ladders(opts, &l, &mut progress);
         scenes.push(SceneReport {
@@ -278,6 +306,7 @@ pub fn run(opts: &BenchOptions, mut progress: impl FnMut(&str)) -> Result<BenchR
             load_start,
             load_end: load_average(),
         },
+        shard: shard_info,
     })
 }
 

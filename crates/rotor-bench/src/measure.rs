@@ -3,12 +3,12 @@
 use std::time::Instant;
 
 use rotor_model::{OMEGA_L, Output, Scene, SolveError, Solver, SteadyState, Trajectory};
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 use crate::options::SolverKind;
 
 /// Run time of one setting: the median of `repeats` timed runs.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct Timing {
     /// Median wall-clock time of one run (s).
     pub median_s: f64,
@@ -182,7 +182,7 @@ fn grid_index(t: f64, dt: f64) -> Option<i64> {
 
 /// Errors of one run against the reference (absent where the run gives no cycle or its
 /// samples do not match the grid).
-#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize)]
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
 pub struct Errors {
     /// |T − T_ref| (s).
     pub period: Option<f64>,

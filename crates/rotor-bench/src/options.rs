@@ -115,6 +115,9 @@ pub struct BenchOptions {
     pub client_tols: Vec<f64>,
     /// The ladder of an external client with a step h (1e-2 … 1e-4).
     pub client_hs: Vec<f64>,
+    /// Run only every N-th scene from the I-th (`rotor bench --shard I/N`, for job arrays);
+    /// [`crate::merge`] joins the shards' reports.
+    pub shard: Option<rotor_compare::sweep::Shard>,
 }
 
 /// The workspace root: the current directory if it holds `fixtures/`, else the checkout
@@ -167,6 +170,7 @@ impl Default for BenchOptions {
             timeout: 60.0,
             client_tols: decades(3, 12),
             client_hs: vec![1e-2, 3e-3, 1e-3, 3e-4, 1e-4],
+            shard: None,
         }
     }
 }

@@ -8,13 +8,13 @@
 //! `solve_seconds`, or its wall time when it reports none).
 
 use rotor_plot::{Panel, Series, render};
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 use crate::clients::ClientReport;
 use crate::ladder::SceneReport;
 
 /// One solver or client in the profile.
-#[derive(Debug, Clone, PartialEq, Serialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct ProfileEntry {
     pub name: String,
     /// Its time per scene [s] (`None`: not solved).
@@ -24,9 +24,10 @@ pub struct ProfileEntry {
 }
 
 /// The performance profile.
-#[derive(Debug, Clone, PartialEq, Serialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Profile {
-    pub criterion: &'static str,
+    #[serde(deserialize_with = "crate::merge::static_str")]
+    pub criterion: crate::merge::Word,
     pub scenes: Vec<String>,
     pub entries: Vec<ProfileEntry>,
 }
@@ -89,6 +90,12 @@ impl Profile {
 }
 
 /// The profile of the Rust solvers and every client that ran.
+/// What "solved" and "time" mean in the profile.
+pub const CRITERION: &str = "fastest point whose trace passes the scene's loose gate \
+                             (event-moreau tolerances, as rotor check); in-process time \
+                             (solve_seconds, else wall)";
+
+/// The profile of the solvers and clients over the scenes.
 pub fn profile(scenes: &[SceneReport], clients: &[ClientReport]) -> Profile {
     let fastest = |times: Vec<f64>| times.into_iter().reduce(f64::min);
     let mut entries: Vec<(String, Vec<Option<f64>>)> = Vec::new();
@@ -127,8 +134,7 @@ pub fn profile(scenes: &[SceneReport], clients: &[ClientReport]) -> Profile {
         .map(|k| entries.iter().filter_map(|(_, t)| t[k]).reduce(f64::min))
         .collect();
     Profile {
-        criterion: "fastest point whose trace passes the scene's loose gate (event-moreau \
-                    tolerances, as rotor check); in-process time (solve_seconds, else wall)",
+        criterion: CRITERION,
         scenes: scenes.iter().map(|s| s.name.clone()).collect(),
         entries: entries
             .into_iter()

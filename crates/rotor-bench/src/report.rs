@@ -293,6 +293,16 @@ impl BenchReport {
             load(env.load_start),
             load(env.load_end)
         );
+        if let Some(sh) = &self.shard {
+            let _ = writeln!(
+                s,
+                "shard {}/{} of a suite of {} scene(s): rotor bench --merge joins the shards' \
+                 --json reports",
+                sh.index,
+                sh.count,
+                sh.suite["scenes"].as_array().map_or(0, Vec::len)
+            );
+        }
         s
     }
 

@@ -17,6 +17,11 @@ use rotor_model::{Model, Params, State, SteadyState};
 struct Cli {
     #[command(subcommand)]
     command: Option<Command>,
+    /// Threads of the main job (no subcommand; default: SLURM_CPUS_PER_TASK when set, else
+    /// the cores available to the process). The subcommands that run in parallel take their
+    /// own `--threads`.
+    #[arg(long, value_name = "N", value_parser = threads_arg)]
+    threads: Option<usize>,
 }
 
 #[derive(Subcommand, Debug)]
@@ -119,6 +124,10 @@ enum Command {
         /// Keep the rows already in the output and run only the rest.
         #[arg(long)]
         resume: bool,
+        /// Threads to run on (default: SLURM_CPUS_PER_TASK when set, else the cores
+        /// available to the process).
+        #[arg(long, value_name = "N", value_parser = threads_arg)]
+        threads: Option<usize>,
         /// Horizon of each run [s] (metrics over its second half).
         #[arg(long, default_value_t = 600.0, allow_hyphen_values = true)]
         t_end: f64,
@@ -168,6 +177,19 @@ enum Command {
         /// windows and grid) instead of the default scenes. Repeatable.
         #[arg(long = "scenario", value_name = "SCENARIO.toml")]
         scenario: Vec<PathBuf>,
+        /// Run only every N-th scene from the I-th (I from 1), for job arrays; the report
+        /// records the shard, and `--merge` joins the shards' reports.
+        #[arg(long, value_name = "I/N")]
+        shard: Option<String>,
+        /// Run nothing: join the reports of `--shard` runs (any order) into the report one
+        /// run writes, timings aside (BENCHMARK.md), written with --json, --svg, --csv.
+        #[arg(
+            long,
+            value_name = "SHARD.json",
+            num_args = 1..,
+            conflicts_with_all = ["shard", "quick", "no_peers", "external", "fixed_step", "scenario"]
+        )]
+        merge: Vec<PathBuf>,
     },
     /// Write the benchmark's reference data for every scenario: trace, events and steady
     /// state of the event-driven solver, with their stated errors.
@@ -175,6 +197,10 @@ enum Command {
         /// Output directory (default: fixtures/reference).
         #[arg(long)]
         out: Option<PathBuf>,
+        /// Threads to run on (default: SLURM_CPUS_PER_TASK when set, else the cores
+        /// available to the process).
+        #[arg(long, value_name = "N", value_parser = threads_arg)]
+        threads: Option<usize>,
     },
     /// Grade one trace (CSV t,alpha,omega_u,omega_l on the scenario's grid) against the
     /// reference with the scenario's own gates. Exit 0: every gate passes; 1: a gate fails;
@@ -208,6 +234,10 @@ enum Command {
         /// Report directory.
         #[arg(long, default_value = "reports")]
         report: PathBuf,
+        /// Threads to run on (default: SLURM_CPUS_PER_TASK when set, else the cores
+        /// available to the process).
+        #[arg(long, value_name = "N", value_parser = threads_arg)]
+        threads: Option<usize>,
     },
 }
 
@@ -300,6 +330,32 @@ fn warn_inexact(stats: &rotor_model::Stats) {
     if let Some(w) = rotor_compare::request::inexact_warning(stats, "--h") {
         eprintln!("warning: {w}");
     }
+}
+
+/// `--threads N`: a whole number from 1 (clap's error names the flag and the value).
+fn threads_arg(s: &str) -> Result<usize, String> {
+    rotor_compare::threads::parse_count(s)
+}
+
+/// Starts the thread pool of a command that runs in parallel: `--threads`, else
+/// `SLURM_CPUS_PER_TASK`, else the cores available ([`rotor_compare::threads`]). Returns the
+/// count in words ("1 thread", "8 threads, from SLURM_CPUS_PER_TASK") for the run's summary.
+fn thread_pool(explicit: Option<usize>) -> Result<String> {
+    use rotor_compare::threads::Source;
+    let (n, src) = rotor_compare::threads::resolve(explicit).map_err(|e| anyhow!(e))?;
+    rayon::ThreadPoolBuilder::new()
+        .num_threads(n)
+        .build_global()
+        .map_err(|e| anyhow!("--threads {n}: cannot start the thread pool: {e}"))?;
+    let count = if n == 1 {
+        "1 thread".to_owned()
+    } else {
+        format!("{n} threads")
+    };
+    Ok(match src {
+        Source::Explicit => count,
+        other => format!("{count}, {}", other.describe()),
+    })
 }
 
 /// Checks a numeric option: finite and in range, naming the flag and the value.
@@ -480,7 +536,7 @@ fn sweep(
     x0: Option<&str>,
     solver: &str,
     shard: Option<&str>,
-    (resume, t_end): (bool, f64),
+    (resume, t_end, threads): (bool, f64, Option<usize>),
     csv: &Path,
 ) -> Result<()> {
     use rayon::prelude::*;
@@ -507,6 +563,7 @@ fn sweep(
     if resume && csv.as_os_str() == "-" {
         bail!("--resume needs an output file, not standard output");
     }
+    let threads = thread_pool(threads)?;
     let total = shard.count(s.len());
     let bar = progress_bar(total as u64, "points");
     let t0 = std::time::Instant::now();
@@ -527,9 +584,8 @@ fn sweep(
     bar.finish_and_clear();
     let secs = t0.elapsed().as_secs_f64();
     eprintln!(
-        "{ran} points in {secs:.2} s ({:.3} ms per point on {} threads){}",
+        "{ran} points in {secs:.2} s ({:.3} ms per point on {threads}){}",
         1e3 * secs / ran.max(1) as f64,
-        rayon::current_num_threads(),
         if ran < total {
             format!("; {} already in {}", total - ran, csv.display())
         } else {
@@ -555,6 +611,7 @@ struct BenchClients<'a> {
     fixed_step: &'a [String],
     timeout: f64,
     scenarios: &'a [PathBuf],
+    shard: Option<&'a str>,
 }
 
 fn bench(
@@ -563,7 +620,6 @@ fn bench(
     no_peers: bool,
     clients: BenchClients,
 ) -> Result<()> {
-    use rotor_compare::report::write_output;
     let mut opts = if quick {
         rotor_bench::BenchOptions::quick()
     } else {
@@ -599,7 +655,40 @@ fn bench(
             })
             .collect::<Result<_>>()?;
     }
+    opts.shard = clients
+        .shard
+        .map(rotor_compare::sweep::Shard::parse)
+        .transpose()?;
     let report = rotor_bench::run(&opts, |m| eprintln!("{m}"))?;
+    write_bench(&report, [json, svg, csv])
+}
+
+/// `rotor bench --merge`: the shards' reports joined into one.
+fn bench_merge(shards: &[PathBuf], outputs: [Option<&Path>; 3]) -> Result<()> {
+    let reports = shards
+        .iter()
+        .map(|p| {
+            let text = std::fs::read_to_string(p)
+                .with_context(|| format!("--merge {}: cannot read", p.display()))?;
+            let r: rotor_bench::BenchReport = serde_json::from_str(&text).with_context(|| {
+                format!(
+                    "--merge {}: not a report of rotor bench --json",
+                    p.display()
+                )
+            })?;
+            Ok((p.display().to_string(), r))
+        })
+        .collect::<Result<Vec<_>>>()?;
+    let report = rotor_bench::merge(&reports)?;
+    write_bench(&report, outputs)
+}
+
+/// Prints a benchmark report's table and writes its files.
+fn write_bench(
+    report: &rotor_bench::BenchReport,
+    [json, svg, csv]: [Option<&Path>; 3],
+) -> Result<()> {
+    use rotor_compare::report::write_output;
     say(&report.table(), [json, svg, csv])?;
     for (path, text) in [
         (json, report.to_json()?),
@@ -893,7 +982,7 @@ fn stress_section() -> rotor_compare::report::Section {
 }
 
 /// `rotor compare`; with `main_job`, the report also gets the bifurcation diagrams.
-fn compare(files: &[PathBuf], report: &Path, main_job: bool) -> Result<()> {
+fn compare(files: &[PathBuf], report: &Path, main_job: bool, threads: Option<usize>) -> Result<()> {
     use rayon::prelude::*;
     let files = if files.is_empty() {
         let dir = fixtures_dir().join("scenarios");
@@ -921,6 +1010,8 @@ fn compare(files: &[PathBuf], report: &Path, main_job: bool) -> Result<()> {
         }
     }
     let stribeck = Params::from_file(&fixtures_dir().join("params/stribeck.toml"))?;
+    let threads = thread_pool(threads)?;
+    eprintln!("{} scenarios on {threads}", scenarios.len());
     let t0 = std::time::Instant::now();
     let bar = progress_bar(scenarios.len() as u64, "scenarios");
     let sets = [
@@ -1039,6 +1130,29 @@ fn steady_json(st: &rotor_compare::SteadyAnswer) -> String {
 }
 
 impl Command {
+    /// The subcommand's name on the command line.
+    fn name(&self) -> &'static str {
+        use Command::*;
+        match self {
+            Simulate { .. } => "simulate",
+            Steady { .. } => "steady",
+            Bifurcation { .. } => "bifurcation",
+            Bifurcation2 { .. } => "bifurcation2",
+            Sweep { .. } => "sweep",
+            Merge { .. } => "merge",
+            Bench { .. } => "bench",
+            Reference { .. } => "reference",
+            Check { .. } => "check",
+            Compare { .. } => "compare",
+        }
+    }
+
+    /// Whether it runs in parallel (and takes `--threads`).
+    fn parallel(&self) -> bool {
+        use Command::*;
+        matches!(self, Sweep { .. } | Reference { .. } | Compare { .. })
+    }
+
     /// The output files the command writes, with their flags (directories it creates, as
     /// `compare --report` and `reference --out`, are not listed).
     fn outputs(&self) -> Vec<(&'static str, &Path)> {
@@ -1060,6 +1174,22 @@ impl Command {
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
+    // `rotor --threads N` is the main job's; a subcommand takes its own after its name.
+    if cli.threads.is_some()
+        && let Some(cmd) = &cli.command
+    {
+        eprintln!(
+            "error: --threads before the subcommand sets the main job's threads; give it after \
+             the subcommand's name (rotor {} ... --threads N){}",
+            cmd.name(),
+            if cmd.parallel() {
+                ""
+            } else {
+                ", which runs on one thread and takes no --threads"
+            }
+        );
+        return ExitCode::from(2);
+    }
     // Outputs that cannot be written are refused before any work; for `check` that is
     // unusable input (exit 2).
     if let Some(cmd) = &cli.command
@@ -1105,7 +1235,9 @@ fn main() -> ExitCode {
             fixed_step,
             timeout,
             scenario,
-        }) => bench(
+            shard,
+            merge,
+        }) if merge.is_empty() => bench(
             [json.as_deref(), svg.as_deref(), csv.as_deref()],
             *quick,
             *no_peers,
@@ -1114,9 +1246,21 @@ fn main() -> ExitCode {
                 fixed_step,
                 timeout: *timeout,
                 scenarios: scenario,
+                shard: shard.as_deref(),
             },
         ),
-        Some(Command::Compare { scenarios, report }) => compare(scenarios, report, false),
+        Some(Command::Bench {
+            json,
+            svg,
+            csv,
+            merge,
+            ..
+        }) => bench_merge(merge, [json.as_deref(), svg.as_deref(), csv.as_deref()]),
+        Some(Command::Compare {
+            scenarios,
+            report,
+            threads,
+        }) => compare(scenarios, report, false, *threads),
         Some(Command::Sweep {
             u,
             param,
@@ -1125,6 +1269,7 @@ fn main() -> ExitCode {
             solver,
             shard,
             resume,
+            threads,
             t_end,
             csv,
         }) => sweep(
@@ -1134,7 +1279,7 @@ fn main() -> ExitCode {
             x0.as_deref(),
             solver,
             shard.as_deref(),
-            (*resume, *t_end),
+            (*resume, *t_end, *threads),
             csv,
         ),
         Some(Command::Merge { shards, csv }) => merge(shards, csv),
@@ -1154,7 +1299,15 @@ fn main() -> ExitCode {
             json,
             svg.as_deref(),
         ),
-        Some(Command::Reference { out }) => {
+        Some(Command::Reference { out, threads }) => {
+            let threads = match thread_pool(*threads) {
+                Ok(t) => t,
+                Err(e) => {
+                    eprintln!("error: {e:#}");
+                    return ExitCode::FAILURE;
+                }
+            };
+            eprintln!("reference data on {threads}");
             let fixtures = fixtures_dir();
             let out = out.clone().unwrap_or_else(|| open::default_out(&fixtures));
             open::write_reference(&fixtures.join("scenarios"), &out)
@@ -1176,7 +1329,7 @@ fn main() -> ExitCode {
                 json.as_deref(),
             );
         }
-        None => compare(&[], Path::new("reports"), true),
+        None => compare(&[], Path::new("reports"), true, cli.threads),
     };
     match res {
         Ok(()) => ExitCode::SUCCESS,

@@ -636,3 +636,238 @@ fn a_closed_standard_output_ends_quietly() {
     }
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// The thread count of a parallel run: `--threads N`, else `SLURM_CPUS_PER_TASK`, else the
+/// cores available; the run says which. Bad values are refused, naming the flag or the
+/// variable and the value.
+#[test]
+fn threads_follow_the_flag_then_slurm_then_the_cores() {
+    let sweep = |threads: Option<&str>, slurm: Option<&str>| {
+        let mut c = Command::new(env!("CARGO_BIN_EXE_rotor"));
+        c.args([
+            "sweep",
+            "--u",
+            "0.5:1.5:3",
+            "--param",
+            "k_theta=0.06:0.08:2",
+            "--t-end",
+            "20",
+            "--csv",
+            "-",
+        ]);
+        if let Some(t) = threads {
+            c.args(["--threads", t]);
+        }
+        c.env_remove("SLURM_CPUS_PER_TASK");
+        if let Some(s) = slurm {
+            c.env("SLURM_CPUS_PER_TASK", s);
+        }
+        let o = c.output().unwrap();
+        (
+            o.status.success(),
+            String::from_utf8_lossy(&o.stderr).into_owned(),
+        )
+    };
+    let (ok, err) = sweep(Some("1"), None);
+    assert!(ok && err.contains("per point on 1 thread)"), "{err}");
+    let (ok, err) = sweep(Some("3"), Some("5"));
+    assert!(ok && err.contains("per point on 3 threads)"), "{err}");
+    let (ok, err) = sweep(None, Some("5"));
+    assert!(
+        ok && err.contains("per point on 5 threads, from SLURM_CPUS_PER_TASK)"),
+        "{err}"
+    );
+    let (ok, err) = sweep(None, None);
+    let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
+    let words = if cores == 1 {
+        "on 1 thread, the cores available".to_owned()
+    } else {
+        format!("on {cores} threads, the cores available")
+    };
+    assert!(ok && err.contains(&words), "{err}");
+    for (threads, slurm, needle) in [
+        (Some("0"), None, "'0' for '--threads <N>'"),
+        (Some("two"), None, "'two' for '--threads <N>'"),
+        (None, Some("0"), "SLURM_CPUS_PER_TASK=\"0\""),
+        (None, Some("lots"), "SLURM_CPUS_PER_TASK=\"lots\""),
+    ] {
+        let (ok, err) = sweep(threads, slurm);
+        assert!(!ok && err.contains(needle), "{err}");
+        assert!(!err.contains("panicked"), "{err}");
+    }
+    // The other parallel commands take it too; a serial one refuses it by name.
+    for args in [
+        &["compare", "--threads", "0"][..],
+        &["reference", "--threads", "x"],
+        &["--threads", "0"],
+    ] {
+        let o = rotor(args);
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert!(!o.status.success() && err.contains("--threads"), "{err}");
+    }
+    let o = rotor(&[
+        "simulate",
+        "--solver",
+        "event",
+        "--u",
+        "1",
+        "--threads",
+        "2",
+    ]);
+    assert!(!o.status.success());
+    let o = rotor(&[
+        "--threads",
+        "2",
+        "simulate",
+        "--solver",
+        "event",
+        "--u",
+        "1",
+        "--csv",
+        "-",
+    ]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        !o.status.success() && err.contains("takes no --threads"),
+        "{err}"
+    );
+}
+
+/// `rotor bench --shard I/N` in two processes, joined by `rotor bench --merge` in the other
+/// order, is one run's report with the timings aside; shards that do not fit are refused,
+/// naming the file.
+#[test]
+fn bench_shards_merge_to_one_run_timings_aside() {
+    let dir = std::env::temp_dir().join(format!("rotor-cli-bench-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let p = |f: &str| dir.join(f).to_str().unwrap().to_owned();
+    let suite = [
+        "bench",
+        "--quick",
+        "--no-peers",
+        "--scenario",
+        "t1-u1.5-rest",
+        "--scenario",
+        "st-u1.5-rest",
+        "--scenario",
+        "t1-u0.5-rest",
+        // A client that fails every run (`false JOB.json` exits 1): its scenes are joined
+        // and its status and reason recomputed from them.
+        "--external",
+        "broken=false",
+    ];
+    let run = |extra: &[&str]| {
+        let o = rotor(&[&suite[..], extra].concat());
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    };
+    run(&["--json", &p("one.json")]);
+    run(&["--shard", "1/2", "--json", &p("b1.json")]);
+    run(&["--shard", "2/2", "--json", &p("b2.json")]);
+    let o = rotor(&[
+        "bench",
+        "--merge",
+        &p("b2.json"),
+        &p("b1.json"),
+        "--json",
+        &p("m.json"),
+        "--svg",
+        &p("m.svg"),
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let read = |f: &str| -> serde_json::Value {
+        serde_json::from_str(&std::fs::read_to_string(dir.join(f)).unwrap()).unwrap()
+    };
+    let (one, merged, b2) = (read("one.json"), read("m.json"), read("b2.json"));
+    assert_eq!(b2["shard"]["index"], 2);
+    assert_eq!(b2["scenes"].as_array().unwrap().len(), 1);
+    assert!(merged.get("shard").is_none());
+    assert_eq!(merged["scenes"].as_array().unwrap().len(), 3);
+    let broken = &merged["clients"].as_array().unwrap().last().unwrap();
+    assert_eq!(broken["name"], "broken");
+    assert_eq!(broken["status"], "failed");
+    assert_eq!(broken["scenes"].as_array().unwrap().len(), 3);
+    assert_eq!(
+        without_timings(&merged, false),
+        without_timings(&one, false)
+    );
+    assert!(
+        std::fs::read_to_string(dir.join("m.svg"))
+            .unwrap()
+            .contains("<svg")
+    );
+    // Refused, naming the file: a missing shard, one given twice, a whole run's report, a
+    // shard of another suite.
+    run(&[
+        "--scenario",
+        "st-u2.5-rest",
+        "--shard",
+        "2/2",
+        "--json",
+        &p("x2.json"),
+    ]);
+    for (files, needle) in [
+        (vec![p("b1.json")], "shard(s) 2/2 missing".to_owned()),
+        (
+            vec![p("b1.json"), p("b1.json")],
+            "are both shard 1/2".to_owned(),
+        ),
+        (
+            vec![p("one.json"), p("b1.json")],
+            format!("{}: not a shard", p("one.json")),
+        ),
+        (
+            vec![p("b1.json"), p("x2.json")],
+            format!("{}: a shard of a different suite", p("x2.json")),
+        ),
+    ] {
+        let mut args = vec!["bench", "--merge"];
+        args.extend(files.iter().map(String::as_str));
+        args.extend(["--json", "-"]);
+        let o = rotor(&args);
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert!(!o.status.success() && err.contains(&needle), "{err}");
+        assert!(o.stdout.is_empty());
+    }
+    let o = rotor(&["bench", "--quick", "--shard", "2/2", "--json", "-"]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(!o.status.success() && err.contains("--shard 2/2"), "{err}");
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+/// A bench report with every number and flag under a timing key replaced by a mark (a
+/// missing value stays missing: whether a point was solved is not a timing).
+fn without_timings(v: &serde_json::Value, timing: bool) -> serde_json::Value {
+    const TIMING: [&str; 15] = [
+        "median_s",
+        "min_s",
+        "repeats",
+        "seconds",
+        "ratio",
+        "final_ratio",
+        "ratio_of_minima",
+        "times",
+        "ratios",
+        "client_seconds",
+        "rust_seconds",
+        "rust_is_bound",
+        "protocol_s",
+        "process_s",
+        "environment",
+    ];
+    use serde_json::Value;
+    match v {
+        Value::Object(m) => Value::Object(
+            m.iter()
+                .map(|(k, x)| {
+                    (
+                        k.clone(),
+                        without_timings(x, timing || TIMING.contains(&k.as_str())),
+                    )
+                })
+                .collect(),
+        ),
+        Value::Array(a) => Value::Array(a.iter().map(|x| without_timings(x, timing)).collect()),
+        Value::Number(_) | Value::Bool(_) if timing => Value::String("timing".into()),
+        other => other.clone(),
+    }
+}

@@ -18,6 +18,7 @@ pub mod solvers;
 pub mod steady;
 pub mod stress;
 pub mod sweep;
+pub mod threads;
 pub mod trace;
 
 pub use gate::{Failure, GateResult, Measured, check_pair};

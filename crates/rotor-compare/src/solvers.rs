@@ -191,6 +191,16 @@ impl Serialize for SolverKind {
     }
 }
 
+/// A solver by its name, as it is serialised (a report read back: `rotor bench --merge`).
+impl<'de> serde::Deserialize<'de> for SolverKind {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<SolverKind, D::Error> {
+        let name = String::deserialize(d)?;
+        SolverKind::by_name(&name).ok_or_else(|| {
+            serde::de::Error::custom(format!("{name:?} is not a solver of this build"))
+        })
+    }
+}
+
 /// The gated pairs of a solver set: its first solver (the reference) against each other one.
 pub fn pairs(solvers: &[SolverKind]) -> Vec<(SolverKind, SolverKind)> {
     match solvers.split_first() {

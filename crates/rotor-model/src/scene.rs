@@ -279,7 +279,7 @@ pub struct Event {
 }
 
 /// Work counters, for benchmarks and snapshots.
-#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize)]
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, serde::Deserialize)]
 pub struct Stats {
     /// Accepted steps.
     pub steps: u64,

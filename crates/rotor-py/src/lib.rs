@@ -411,16 +411,19 @@ fn steady<'py>(
     to_py(py, &answer)
 }
 
-/// ``steady`` at every value of ``u`` (a sequence or 1-d array), on all cores.
+/// ``steady`` at every value of ``u`` (a sequence or 1-d array), in parallel.
 ///
 /// Returns a list of dicts, one per u in order, each as ``steady`` returns it. A u at which
 /// no steady state is found raises ``rotorbench.SolveError`` naming that u (its attribute
-/// ``u``). Other arguments as for ``steady``.
+/// ``u``). ``threads``: how many threads (default: ``SLURM_CPUS_PER_TASK`` when set, else the
+/// cores available to the process, as ``rotor sweep --threads``). Other arguments as for
+/// ``steady``.
 #[pyfunction]
 #[pyo3(
-    signature = (u, solver="event", params=None, x0=[0.0; 3], tol=None, h=None),
-    text_signature = "(u, solver='event', params=None, x0=(0.0, 0.0, 0.0), tol=None, h=None)"
+    signature = (u, solver="event", params=None, x0=[0.0; 3], tol=None, h=None, threads=None),
+    text_signature = "(u, solver='event', params=None, x0=(0.0, 0.0, 0.0), tol=None, h=None, threads=None)"
 )]
+#[allow(clippy::too_many_arguments)]
 fn sweep<'py>(
     py: Python<'py>,
     u: PyArrayLike1<'py, f64, AllowTypeChange>,
@@ -429,7 +432,21 @@ fn sweep<'py>(
     x0: [f64; 3],
     tol: Option<f64>,
     h: Option<f64>,
+    threads: Option<i64>,
 ) -> PyResult<Bound<'py, PyList>> {
+    let explicit = threads
+        .map(|n| {
+            usize::try_from(n)
+                .map_err(|_| "expected at least 1 thread".to_owned())
+                .and_then(rotor_compare::threads::check_count)
+                .map_err(|why| PyValueError::new_err(format!("threads = {n}: {why}")))
+        })
+        .transpose()?;
+    let (n, _) = rotor_compare::threads::resolve(explicit).map_err(PyValueError::new_err)?;
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(n)
+        .build()
+        .map_err(|e| PyValueError::new_err(format!("threads = {n}: cannot start them: {e}")))?;
     let us = u.as_array().to_vec();
     let mut jobs = Vec::with_capacity(us.len());
     for (i, &u) in us.iter().enumerate() {
@@ -450,9 +467,11 @@ fn sweep<'py>(
     }
     let model = Model::new(params_of(params)?);
     let answers: Vec<Result<SteadyAnswer, SteadyError>> = detached(py, move || {
-        jobs.par_iter()
-            .map(|(kind, scene, opts)| rotor_compare::steady(*kind, &model, scene, opts))
-            .collect()
+        pool.install(|| {
+            jobs.par_iter()
+                .map(|(kind, scene, opts)| rotor_compare::steady(*kind, &model, scene, opts))
+                .collect()
+        })
     })?;
     let out = PyList::empty(py);
     let mut stats = Stats::default();

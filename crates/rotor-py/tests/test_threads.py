@@ -42,3 +42,25 @@ def test_a_thread_pool_gives_the_sequential_answers():
     with ThreadPoolExecutor(max_workers=3) as pool:
         steadies = list(pool.map(lambda u: rotorbench.steady(u=u), us))
     assert steadies == rotorbench.sweep(us)
+
+
+def test_sweep_threads_follow_the_argument_then_slurm(monkeypatch):
+    """``sweep(threads=N)``, else ``SLURM_CPUS_PER_TASK``, else the cores: the same answers
+    on any count; a bad count or variable is a ValueError naming it and its value."""
+    import pytest
+
+    us = [0.5, 1.5, 2.5]
+    monkeypatch.delenv("SLURM_CPUS_PER_TASK", raising=False)
+    whole = rotorbench.sweep(us)
+    assert rotorbench.sweep(us, threads=1) == whole
+    assert rotorbench.sweep(us, threads=3) == whole
+    for bad in [0, -2, 100000]:
+        with pytest.raises(ValueError, match=f"threads = {bad}: "):
+            rotorbench.sweep(us, threads=bad)
+    monkeypatch.setenv("SLURM_CPUS_PER_TASK", "2")
+    assert rotorbench.sweep(us) == whole
+    monkeypatch.setenv("SLURM_CPUS_PER_TASK", "lots")
+    with pytest.raises(ValueError, match='SLURM_CPUS_PER_TASK="lots"'):
+        rotorbench.sweep(us)
+    # An explicit count does not read the variable.
+    assert rotorbench.sweep(us, threads=2) == whole

@@ -82,8 +82,12 @@ def sweep(
     x0: Sequence[float] = (0.0, 0.0, 0.0),
     tol: Optional[float] = None,
     h: Optional[float] = None,
+    threads: Optional[int] = None,
 ) -> List[Dict[str, Any]]:
-    """``steady`` at every u, on all cores; one dict per u, in order."""
+    """``steady`` at every u, in parallel; one dict per u, in order.
+
+    ``threads``: default ``SLURM_CPUS_PER_TASK`` when set, else the cores available.
+    """
 
 def bifurcation(
     params: ParamsLike = None, u_min: float = 0.0, u_max: float = 7.0
