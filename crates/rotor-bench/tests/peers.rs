@@ -223,8 +223,8 @@ fn the_first_order_client_converges_and_passes_loose_at_h_1e_5() {
         eprintln!("first-order client not tested: no C compiler");
         return;
     }
-    let sc = rotor_compare::load_scenario(&root.join("fixtures/scenarios/t1-u1.5-rest.toml"))
-        .unwrap();
+    let sc =
+        rotor_compare::load_scenario(&root.join("fixtures/scenarios/t1-u1.5-rest.toml")).unwrap();
     let r = rotor_compare::reference::read(&root.join("fixtures/reference"), &sc.name).unwrap();
     let digits: Vec<(f64, bool)> = [1e-3, 1e-4, 1e-5]
         .into_iter()
@@ -243,7 +243,10 @@ fn the_first_order_client_converges_and_passes_loose_at_h_1e_5() {
             };
             let path = dir.join(format!("job-{h:e}.json"));
             std::fs::write(&path, serde_json::to_string(&job).unwrap()).unwrap();
-            let st = std::process::Command::new(&exe).arg(&path).status().unwrap();
+            let st = std::process::Command::new(&exe)
+                .arg(&path)
+                .status()
+                .unwrap();
             assert!(st.success());
             let t = rotor_compare::trace::read_trace(&job.trace, usize::MAX).unwrap();
             let e = rotor_compare::trace::read_events(&job.events).unwrap();

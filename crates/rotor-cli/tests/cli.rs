@@ -326,11 +326,21 @@ fn check_grades_with_exit_codes_0_1_2() {
     assert_eq!(v["scenario"], "t1-u0.02-rest");
     assert_eq!(v["passed"], true);
     assert_eq!(v["gate"], "strict");
-    for key in ["name", "difference", "scale", "tolerance", "passed", "digits"] {
+    for key in [
+        "name",
+        "difference",
+        "scale",
+        "tolerance",
+        "passed",
+        "digits",
+    ] {
         assert!(v["quantities"][0].get(key).is_some(), "{key}: {v}");
     }
     assert!(v["digits"].as_f64().unwrap() >= 7.0, "{v}");
-    assert!(v["benchmark"].as_str().unwrap().starts_with("rotorbench-"), "{v}");
+    assert!(
+        v["benchmark"].as_str().unwrap().starts_with("rotorbench-"),
+        "{v}"
+    );
     // Without an events file the verdict says what it did not grade.
     assert_eq!(v["not_graded"][0], "events", "{v}");
     assert!(String::from_utf8_lossy(&o.stderr).contains("events not graded"));

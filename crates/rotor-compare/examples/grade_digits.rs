@@ -31,9 +31,7 @@ fn main() {
             .unwrap_or_else(|e| panic!("{e}"));
         println!("== {}", sc.name);
         for &(kind, setting) in &runs {
-            let mut scene = sc.scene(Output::Grid {
-                dt: sc.compare.dt,
-            });
+            let mut scene = sc.scene(Output::Grid { dt: sc.compare.dt });
             if kind.is_fixed_step() {
                 scene.h = setting;
             } else {
@@ -63,7 +61,9 @@ fn main() {
                     let cols: Vec<String> = rep
                         .quantities
                         .iter()
-                        .map(|q| format!("{}={:.1}", q.name.trim_start_matches("steady_"), q.digits))
+                        .map(|q| {
+                            format!("{}={:.1}", q.name.trim_start_matches("steady_"), q.digits)
+                        })
                         .collect();
                     println!(
                         "{:>8} {setting:e}: digits {:.1}  {}{}",
@@ -103,7 +103,10 @@ fn main() {
                 .collect();
             println!("  reference verified: {}", cols.join(" "));
             let orbit = rep.quantities.iter().find(|q| q.name == "orbit");
-            println!("  reference's own orbit distance: {:?}", orbit.map(|q| q.difference));
+            println!(
+                "  reference's own orbit distance: {:?}",
+                orbit.map(|q| q.difference)
+            );
         }
     }
 }

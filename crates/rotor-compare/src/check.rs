@@ -457,7 +457,7 @@ fn sample_differences(trace: &[Sample], reference: &[Sample]) -> [(f64, f64); 3]
     for (a, r) in trace.iter().zip(reference) {
         for (i, di) in d.iter_mut().enumerate() {
             let e = (a.x[i] - r.x[i]).abs();
-            if !(e <= di.0) {
+            if e.is_nan() || e > di.0 {
                 *di = (e, r.t);
             }
         }
@@ -760,7 +760,9 @@ fn grade_steady(
     };
     let window = &trace[trace.partition_point(|s| s.t < from - TIME_TOL)..];
     let rs = &reference.samples;
-    let start = &rs[rs.partition_point(|s| s.t < from - TIME_TOL).min(rs.len() - 1)];
+    let start = &rs[rs
+        .partition_point(|s| s.t < from - TIME_TOL)
+        .min(rs.len() - 1)];
     let mut g = match Orbit::cycle(sc, start.x, period, reference.json.tol, scale) {
         Ok(o) => {
             let (d, at) = o.largest_distance(window);
@@ -821,7 +823,14 @@ pub fn check(
         q.extend(grade_stick(disc, &trace.samples, reference, t_scale, level));
     }
     if let Some(from) = sc.compare.steady_from {
-        q.extend(grade_steady(sc, reference, &trace.samples, from, scale, level));
+        q.extend(grade_steady(
+            sc,
+            reference,
+            &trace.samples,
+            from,
+            scale,
+            level,
+        ));
     }
     within_reference(sc, reference, &q, level)?;
     Ok(CheckReport {

@@ -121,7 +121,7 @@ impl Orbit {
             };
             guess = Some(self.times[k]);
             prev_t = s.t;
-            if !(d <= worst.0) {
+            if d.is_nan() || d > worst.0 {
                 worst = (d, s.t);
             }
         }

@@ -131,8 +131,16 @@ fn every_solver_passes_check_at_its_level() {
             };
             for (kind, scene, level) in [
                 (SolverKind::EVENT, tight, Level::Strict),
-                (SolverKind::SWITCH, scene_for(SolverKind::SWITCH, sc), Level::Loose),
-                (SolverKind::MOREAU, scene_for(SolverKind::MOREAU, sc), Level::Loose),
+                (
+                    SolverKind::SWITCH,
+                    scene_for(SolverKind::SWITCH, sc),
+                    Level::Loose,
+                ),
+                (
+                    SolverKind::MOREAU,
+                    scene_for(SolverKind::MOREAU, sc),
+                    Level::Loose,
+                ),
             ] {
                 let tr = kind.solver().simulate(&sc.model, &scene).unwrap();
                 let (t, e) = as_files(sc, &tr);
@@ -147,12 +155,12 @@ fn every_solver_passes_check_at_its_level() {
             // The orbit is the reference solver's own, recomputed densely: it differs from
             // the stored trace by the stored trace's error and the polyline's chord error
             // (about 3e-9 of the scale at most: `rotor_compare::orbit`), not by 0.
-            let orbit_err = r.error("omega_l") / r.samples.iter().map(|s| s.x[2].abs()).fold(1e-3, f64::max);
-            if !rep
-                .quantities
-                .iter()
-                .all(|q| q.difference == 0.0 || (q.name == "orbit" && q.difference <= 10.0 * orbit_err + 3e-9))
-            {
+            let orbit_err =
+                r.error("omega_l") / r.samples.iter().map(|s| s.x[2].abs()).fold(1e-3, f64::max);
+            if !rep.quantities.iter().all(|q| {
+                q.difference == 0.0
+                    || (q.name == "orbit" && q.difference <= 10.0 * orbit_err + 3e-9)
+            }) {
                 out.push(format!("{} reference:\n{}", sc.name, rep.table()));
             }
             out

@@ -147,7 +147,11 @@ fn wrong_traces_fail() {
             let rep = grade(&sc, &r, t, Some(e), level);
             let must_fail = level == Level::Strict || *gross;
             if must_fail && rep.passed {
-                wrong.push(format!("{name} passed at {}:\n{}", level.name(), rep.table()));
+                wrong.push(format!(
+                    "{name} passed at {}:\n{}",
+                    level.name(),
+                    rep.table()
+                ));
             }
         }
     }
@@ -169,7 +173,10 @@ fn a_trace_without_events_says_events_not_graded() {
     assert!(rep.passed);
     assert_eq!(rep.not_graded, ["events"]);
     let v = rep.verdict();
-    assert!(v.contains("PASSED") && v.contains("events not graded"), "{v}");
+    assert!(
+        v.contains("PASSED") && v.contains("events not graded"),
+        "{v}"
+    );
     assert!(!rep.quantities.iter().any(|q| q.name == "events"));
     // The stick intervals are graded all the same.
     assert!(rep.quantities.iter().any(|q| q.name == "stick_lower"));
@@ -209,7 +216,12 @@ fn each_quantity_alone_fails_at_twice_its_tolerance_and_passes_at_half() {
                 } else {
                     vec![]
                 };
-                assert_eq!(failing(&rep), expect, "{name} ×{factor} at {}", level.name());
+                assert_eq!(
+                    failing(&rep),
+                    expect,
+                    "{name} ×{factor} at {}",
+                    level.name()
+                );
                 // Alone: every other quantity is exactly as for the reference.
                 for (q, q0) in rep.quantities.iter().zip(&reference.quantities) {
                     if q.name != name {
@@ -228,7 +240,12 @@ fn each_quantity_alone_fails_at_twice_its_tolerance_and_passes_at_half() {
             } else {
                 vec![]
             };
-            assert_eq!(failing(&rep), expect, "events ×{factor} at {}", level.name());
+            assert_eq!(
+                failing(&rep),
+                expect,
+                "events ×{factor} at {}",
+                level.name()
+            );
             // A steady sample moved off the orbit, normally to it (a move along the orbit is
             // a phase, which the orbit's shape does not see): `orbit` fails at 2×, and
             // nothing at 0.5×.
@@ -249,7 +266,9 @@ fn each_quantity_alone_fails_at_twice_its_tolerance_and_passes_at_half() {
             let tn = tangent.iter().map(|x| x * x).sum::<f64>().sqrt();
             let tau: Vec<f64> = tangent.iter().map(|x| x / tn).collect();
             // e_α minus its tangential part, normalised.
-            let mut n: Vec<f64> = (0..3).map(|i| f64::from(i == 0) - tau[0] * tau[i]).collect();
+            let mut n: Vec<f64> = (0..3)
+                .map(|i| f64::from(i == 0) - tau[0] * tau[i])
+                .collect();
             let nn = n.iter().map(|x| x * x).sum::<f64>().sqrt();
             n.iter_mut().for_each(|x| *x /= nn);
             let mut t = base.clone();
@@ -291,8 +310,16 @@ fn stick_intervals_are_graded_from_the_grid() {
             // The trace now shows its onset in (t[a-2], t[a-1]]: `on` lies past it by:
             let outside = on - r.samples[a - 1].t;
             let rep = grade(&sc, &r, &t, Some(&ev), level);
-            let q = rep.quantities.iter().find(|q| q.name == "stick_lower").unwrap();
-            assert!((q.difference - outside).abs() < 1e-12, "{} vs {outside}", q.difference);
+            let q = rep
+                .quantities
+                .iter()
+                .find(|q| q.name == "stick_lower")
+                .unwrap();
+            assert!(
+                (q.difference - outside).abs() < 1e-12,
+                "{} vs {outside}",
+                q.difference
+            );
             assert_eq!(q.passed, outside <= q.tolerance);
         }
         // A stuck sample that slips in mid-stick: two intervals where the reference has one.
@@ -300,7 +327,11 @@ fn stick_intervals_are_graded_from_the_grid() {
         let mut t = base.clone();
         t.samples[mid].x[2] = 1e-6;
         let rep = grade(&sc, &r, &t, Some(&ev), level);
-        let q = rep.quantities.iter().find(|q| q.name == "stick_lower").unwrap();
+        let q = rep
+            .quantities
+            .iter()
+            .find(|q| q.name == "stick_lower")
+            .unwrap();
         assert!(!q.passed && q.note.as_ref().unwrap().contains("not in the reference"));
     }
 }
@@ -313,19 +344,29 @@ fn unsorted_out_of_range_and_unmatched_events() {
     let (t, ev) = own(&r);
     let mut e = ev.clone();
     e.events.swap(3, 4);
-    let m = check(&sc, &r, &t, Some(&e), Level::Loose).unwrap_err().to_string();
-    assert!(m.contains("line 6") && m.contains("before the previous event"), "{m}");
+    let m = check(&sc, &r, &t, Some(&e), Level::Loose)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        m.contains("line 6") && m.contains("before the previous event"),
+        "{m}"
+    );
     let mut e = ev.clone();
     let last = e.events.len() - 1;
     e.events[last].t = sc.t_end + 1.0;
-    let m = check(&sc, &r, &t, Some(&e), Level::Loose).unwrap_err().to_string();
+    let m = check(&sc, &r, &t, Some(&e), Level::Loose)
+        .unwrap_err()
+        .to_string();
     assert!(m.contains("outside [0, 200]"), "{m}");
     let mut e = ev.clone();
     e.events[7].kind = rotor_model::EventKind::Reversal(rotor_model::Disc::Lower);
     let rep = grade(&sc, &r, &t, Some(&e), Level::Loose);
     let q = rep.quantities.iter().find(|q| q.name == "events").unwrap();
     let note = q.note.as_deref().unwrap();
-    assert!(!q.passed && note.contains("1 missing") && note.contains("lower reversal"), "{note}");
+    assert!(
+        !q.passed && note.contains("1 missing") && note.contains("lower reversal"),
+        "{note}"
+    );
 }
 
 /// The file's precision is not the solver's error: a correct trace written with printf's
@@ -342,7 +383,13 @@ fn a_six_digit_trace_is_graded_where_six_digits_suffice_and_refused_where_not() 
     };
     let mut text = String::from("t,alpha,omega_u,omega_l\n");
     for s in &r.samples {
-        text.push_str(&format!("{},{},{},{}\n", g(s.t), g(s.x[0]), g(s.x[1]), g(s.x[2])));
+        text.push_str(&format!(
+            "{},{},{},{}\n",
+            g(s.t),
+            g(s.x[0]),
+            g(s.x[1]),
+            g(s.x[2])
+        ));
     }
     let t = parse_trace(text.as_bytes(), Path::new("g.csv")).unwrap();
     assert_eq!(t.digits, 6);
@@ -350,9 +397,22 @@ fn a_six_digit_trace_is_graded_where_six_digits_suffice_and_refused_where_not() 
     let rep = grade(&sc, &r, &t, Some(&ev), Level::Loose);
     assert!(rep.passed, "{}", rep.table());
     let e = check(&sc, &r, &t, Some(&ev), Level::Strict).unwrap_err();
-    assert!(matches!(e, CheckError::Precision { digits: 6, needed: 8, .. }), "{e}");
+    assert!(
+        matches!(
+            e,
+            CheckError::Precision {
+                digits: 6,
+                needed: 8,
+                ..
+            }
+        ),
+        "{e}"
+    );
     let m = e.to_string();
-    assert!(m.contains("g.csv") && m.contains("6 significant digits") && m.contains("%.17g"), "{m}");
+    assert!(
+        m.contains("g.csv") && m.contains("6 significant digits") && m.contains("%.17g"),
+        "{m}"
+    );
     // --digits 5 needs 6: graded.
     assert!(check(&sc, &r, &t, Some(&ev), Level::Digits(5)).is_ok());
 }
@@ -383,7 +443,10 @@ fn no_level_is_tighter_than_ten_times_the_reference_error() {
     let (sc, r) = scenario("t1-u2.5-eq-pert");
     let (t, ev) = own(&r);
     let e = check(&sc, &r, &t, Some(&ev), Level::Digits(9)).unwrap_err();
-    assert!(matches!(e, CheckError::BeyondReference { asked: 9, .. }), "{e}");
+    assert!(
+        matches!(e, CheckError::BeyondReference { asked: 9, .. }),
+        "{e}"
+    );
 }
 
 /// Honest solvers of other kinds pass, and a converging method's digits rise with its
@@ -409,10 +472,19 @@ fn digits_rise_as_a_method_converges() {
         let e = parse_events(&write_events(&tr.events), Path::new("e.csv")).unwrap();
         grade(&sc, &r, &t, Some(&e), Level::Loose).digits
     };
-    let (m3, m4) = (digits(SolverKind::MOREAU, 1e-3), digits(SolverKind::MOREAU, 1e-4));
-    let (e8, e11) = (digits(SolverKind::EVENT, 1e-8), digits(SolverKind::EVENT, 1e-11));
+    let (m3, m4) = (
+        digits(SolverKind::MOREAU, 1e-3),
+        digits(SolverKind::MOREAU, 1e-4),
+    );
+    let (e8, e11) = (
+        digits(SolverKind::EVENT, 1e-8),
+        digits(SolverKind::EVENT, 1e-11),
+    );
     // Second order: 10× smaller h gains about 2 digits (measured 4.1 -> 6.5); at least 1.5.
     assert!(m4 - m3 >= 1.5 && m3 >= f64::from(LOOSE_DIGITS), "{m3} {m4}");
     // Tolerance proportionality: 1000× tighter gains about 3 (measured 5.9 -> 8.7); at least 2.
-    assert!(e11 - e8 >= 2.0 && e11 >= f64::from(STRICT_DIGITS), "{e8} {e11}");
+    assert!(
+        e11 - e8 >= 2.0 && e11 >= f64::from(STRICT_DIGITS),
+        "{e8} {e11}"
+    );
 }
