@@ -488,3 +488,45 @@ fn digits_rise_as_a_method_converges() {
         "{e8} {e11}"
     );
 }
+
+/// The steady extrema are read off the grid by integrating from the sample before each
+/// extremum, so they cannot be moved without moving that sample: a move of the samples
+/// around the last cycle's ω_l and ω_u maxima by 2× the tolerance fails the extremum (with
+/// the sample it moved), by 0.5× passes everything, at both levels.
+#[test]
+fn the_steady_extrema_fail_at_twice_their_tolerance_and_pass_at_half() {
+    let (sc, r) = scenario("t1-u1.5-rest");
+    let (base, ev) = own(&r);
+    // The last cycle's largest samples of each velocity (within the last period).
+    let last = |i: usize| {
+        let from = r.samples.len() - 1 - (4.6 / sc.compare.dt) as usize;
+        (from..r.samples.len())
+            .max_by(|&a, &b| r.samples[a].x[i].total_cmp(&r.samples[b].x[i]))
+            .unwrap()
+    };
+    for level in LEVELS {
+        let reference = grade(&sc, &r, &base, Some(&ev), level);
+        for (i, metric) in [(2, "steady_omega_l_max"), (1, "steady_omega_u_max")] {
+            let tol = reference
+                .quantities
+                .iter()
+                .find(|q| q.name == metric)
+                .unwrap()
+                .tolerance;
+            let k = last(i);
+            for factor in [2.0, 0.5] {
+                let mut t = base.clone();
+                for j in k - 2..=k + 2 {
+                    t.samples[j].x[i] += factor * tol;
+                }
+                let rep = grade(&sc, &r, &t, Some(&ev), level);
+                let f = failing(&rep);
+                if factor > 1.0 {
+                    assert!(f.contains(&metric.to_string()), "{metric} ×2: {f:?}");
+                } else {
+                    assert!(f.is_empty(), "{metric} ×0.5 at {}: {f:?}", level.name());
+                }
+            }
+        }
+    }
+}
