@@ -244,16 +244,7 @@ pub(crate) fn ladders(
 /// grades an external trace.
 fn passes_loose(l: &Loaded, tr: &rotor_model::Trajectory) -> bool {
     let (sc, r) = &l.view;
-    let trace = rotor_compare::trace::Trace {
-        path: "run".into(),
-        samples: tr.samples.clone(),
-        lines: (2..tr.samples.len() as u64 + 2).collect(),
-        digits: rotor_compare::trace::FULL_DIGITS,
-    };
-    let events = rotor_compare::trace::EventsFile {
-        path: "run".into(),
-        events: tr.events.clone(),
-        lines: (2..tr.events.len() as u64 + 2).collect(),
-    };
+    let trace = rotor_compare::trace::Trace::of_run("run", tr.samples.clone());
+    let events = rotor_compare::trace::EventsFile::of_run("run", &tr.events);
     check(sc, r, &trace, Some(&events), Level::Loose).is_ok_and(|c| c.passed)
 }

@@ -11,7 +11,7 @@ use std::path::Path;
 
 use rotor_compare::check::{Level, check, reference_error};
 use rotor_compare::solvers::SolverKind;
-use rotor_compare::trace::{EventsFile, FULL_DIGITS, Trace};
+use rotor_compare::trace::{EventsFile, Trace};
 use rotor_model::{Output, Scenario, Scene};
 
 fn main() {
@@ -45,17 +45,8 @@ fn main() {
                     continue;
                 }
             };
-            let trace = Trace {
-                path: "run".into(),
-                lines: (2..tr.samples.len() as u64 + 2).collect(),
-                samples: tr.samples,
-                digits: FULL_DIGITS,
-            };
-            let events = EventsFile {
-                path: "run".into(),
-                lines: (2..tr.events.len() as u64 + 2).collect(),
-                events: tr.events,
-            };
+            let trace = Trace::of_run("run", tr.samples);
+            let events = EventsFile::of_run("run", &tr.events);
             match check(&sc, &r, &trace, Some(&events), Level::Digits(1)) {
                 Ok(rep) => {
                     let cols: Vec<String> = rep
@@ -84,12 +75,7 @@ fn main() {
         if let Ok(rep) = check(
             &sc,
             &r,
-            &Trace {
-                path: "ref".into(),
-                lines: (2..r.samples.len() as u64 + 2).collect(),
-                samples: r.samples.clone(),
-                digits: FULL_DIGITS,
-            },
+            &Trace::of_run("ref", r.samples.clone()),
             None,
             Level::Digits(1),
         ) {

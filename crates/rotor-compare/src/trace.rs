@@ -186,6 +186,17 @@ pub struct Trace {
 }
 
 impl Trace {
+    /// A run's grid samples as a trace (rows numbered as in a file written from them, at full
+    /// precision): how this project's own runs are graded as external traces are.
+    pub fn of_run(path: &str, samples: Vec<Sample>) -> Trace {
+        Trace {
+            path: path.into(),
+            lines: (2..samples.len() as u64 + 2).collect(),
+            samples,
+            digits: FULL_DIGITS,
+        }
+    }
+
     /// A trace from its four columns (the Python package's arrays): of equal, nonzero
     /// lengths, every value finite. Its rows are named by index ([`ARRAYS`]).
     pub fn from_columns(columns: [&[f64]; 4]) -> Result<Trace, TraceError> {
@@ -253,6 +264,20 @@ fn file_digits(most: u32) -> u32 {
 }
 
 impl EventsFile {
+    /// A run's events as an events file (its mode switches; extrema are no rows of one).
+    pub fn of_run(path: &str, events: &[Event]) -> EventsFile {
+        let events: Vec<Event> = events
+            .iter()
+            .filter(|e| event_row(e.kind).is_some())
+            .copied()
+            .collect();
+        EventsFile {
+            path: path.into(),
+            lines: (2..events.len() as u64 + 2).collect(),
+            events,
+        }
+    }
+
     /// Events given as a list (the Python package's `check`): each `(t, disc, kind)` with disc
     /// `upper|lower` and kind `stick_start|stick_end|reversal`, as in an events file. Named by
     /// index ([`ARRAYS`]); the times are checked by [`crate::check::check_events`].

@@ -8,7 +8,7 @@ use rotor_compare::check::{
     CheckError, CheckReport, LOOSE_DIGITS, Level, STRICT_DIGITS, check, reference_error,
 };
 use rotor_compare::reference::{self, Reference};
-use rotor_compare::trace::{EventsFile, Trace, parse_events, parse_trace, write_events};
+use rotor_compare::trace::{EventsFile, Trace, parse_trace};
 use rotor_compare::{SolverKind, load_scenario, run::scene_for};
 use rotor_model::{Event, Scenario, Scene};
 
@@ -36,14 +36,10 @@ fn all_scenarios() -> Vec<(Scenario, Reference)> {
 
 /// The reference's own files as a client would hand them in.
 fn own(r: &Reference) -> (Trace, EventsFile) {
-    let t = Trace {
-        path: "ref.csv".into(),
-        lines: (2..r.samples.len() as u64 + 2).collect(),
-        samples: r.samples.clone(),
-        digits: 17,
-    };
-    let e = parse_events(&write_events(&r.events), Path::new("ref.events.csv")).unwrap();
-    (t, e)
+    (
+        Trace::of_run("ref.csv", r.samples.clone()),
+        EventsFile::of_run("ref.events.csv", &r.events),
+    )
 }
 
 fn grade(sc: &Scenario, r: &Reference, t: &Trace, e: Option<&EventsFile>, l: Level) -> CheckReport {
@@ -132,13 +128,8 @@ fn wrong_traces_fail() {
         .solver()
         .simulate(&sc.model, &scene_for(SolverKind::EVENT, &wrong_u))
         .unwrap();
-    let t = Trace {
-        path: "u1.52.csv".into(),
-        lines: (2..tr.samples.len() as u64 + 2).collect(),
-        samples: tr.samples.clone(),
-        digits: 17,
-    };
-    let e = parse_events(&write_events(&tr.events), Path::new("e.csv")).unwrap();
+    let t = Trace::of_run("u1.52.csv", tr.samples);
+    let e = EventsFile::of_run("u1.52.events.csv", &tr.events);
     cases.push(("the run at u = 1.52 V", t, e, true));
 
     let mut wrong = Vec::new();
@@ -463,13 +454,8 @@ fn digits_rise_as_a_method_converges() {
             scene.tol = setting;
         }
         let tr = kind.solver().simulate(&sc.model, &scene).unwrap();
-        let t = Trace {
-            path: "run".into(),
-            lines: (2..tr.samples.len() as u64 + 2).collect(),
-            samples: tr.samples,
-            digits: 17,
-        };
-        let e = parse_events(&write_events(&tr.events), Path::new("e.csv")).unwrap();
+        let t = Trace::of_run("run", tr.samples);
+        let e = EventsFile::of_run("run.events", &tr.events);
         grade(&sc, &r, &t, Some(&e), Level::Loose).digits
     };
     let (m3, m4) = (
