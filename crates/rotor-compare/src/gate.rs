@@ -342,7 +342,7 @@ mod tests {
         let tol = PairTolerance {
             period_rel: Some(1e-10),
             omega_l_max_rel: Some(1e-9),
-            omega_l_min_rel: Some(3e-9),
+            omega_l_min: Some(3e-9),
             omega_u_max_rel: Some(1e-11),
             omega_u_min_rel: Some(3e-11),
             stick_time: Some(1e-8),
@@ -375,10 +375,10 @@ mod tests {
                 "omega_l_min",
                 |m, f| {
                     if let SteadyState::LimitCycle { omega_l_min, .. } = m {
-                        *omega_l_min += f * 1e-3
+                        *omega_l_min += f
                     }
                 },
-                1e-9,
+                3e-9,
             ),
             (
                 "omega_u_max",
@@ -414,8 +414,8 @@ mod tests {
                 let mut b = a.clone();
                 shift(b.metrics.as_mut().unwrap(), factor * gate);
                 let f = check_pair("p", &a, &b, None, &tol).failures("s");
-                // ω_l's minimum is 0: the floor 1e-12 gates it absolutely (not its own
-                // 3e-9), so a shift of 2e-12 fails and 5e-13 passes.
+                // ω_l's minimum is gated absolutely (rad/s) by its own 3e-9, not through
+                // the relative gates' floor: 6e-9 fails and 1.5e-9 passes.
                 assert_eq!(!f.is_empty(), fails, "{name} x{factor}: {f:?}");
                 if fails {
                     assert!(

@@ -519,14 +519,18 @@ mod tests {
 
     /// On the 1.5 V stick-slip cycle the settled metrics agree with the event-driven
     /// solver's refined fixed point within the fixtures' gates (switch 2e-6, Moreau–Jean
-    /// 3e-6 relative; their origins are in fixtures/scenarios/t1-u1.5-rest.toml).
+    /// 3e-6 relative; their origins are in fixtures/scenarios/t1-u1.5-rest.toml). ω_l's
+    /// minimum is 0 in the reference and the stuck velocity η = 1e-10 rad/s in the switch
+    /// model (measured Δ 1.0e-10 rad/s): it is compared absolutely, with the floor 1e-4 rad/s
+    /// (below every other metric of this cycle, all > 0.8), so the gate 2e-6 reads as
+    /// 2e-10 rad/s = 2η there.
     #[test]
     fn a_settled_cycle_agrees_with_the_refined_one() {
         let m = Model::table1();
         let reference = event_steady(&m, 1.5);
         for (kind, gate) in [(SolverKind::SWITCH, 2e-6), (SolverKind::MOREAU, 3e-6)] {
             let s = settle(kind, &m, &base(1.5), &SettleOptions::default()).unwrap();
-            let (what, c) = change(&reference, &s.state, 1e-8);
+            let (what, c) = change(&reference, &s.state, 1e-4);
             assert!(c <= gate, "{kind:?}: {what} differs by {c:e}");
         }
     }

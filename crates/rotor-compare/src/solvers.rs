@@ -78,7 +78,7 @@ pub static EVENT: SolverInfo = SolverInfo {
     make: || Box::new(rotor_event::EventSolver::default()),
 };
 
-/// Leine's switch model (DOPRI5, band η = 1e-7).
+/// Leine's switch model as published (DOPRI5, band η = 1e-10).
 pub static SWITCH: SolverInfo = SolverInfo {
     name: "switch",
     label: "switch model",

@@ -897,14 +897,26 @@ fn stress_an_extremum_of_one_disc_keeps_the_other_discs_stick() {
                 "{}: a stick-slip cycle ({stick_time} s stuck)",
                 kind.name()
             );
-            assert_eq!(omega_l_min, 0.0, "{}", kind.name());
-            // No event state has the lower disc moving backwards.
+            // 0 exactly, or the switch model's stuck velocity: the one it entered the band
+            // with, within η of 0.
+            let stuck = if kind == SolverKind::SWITCH {
+                rotor_switch::SwitchOptions::default().eta
+            } else {
+                0.0
+            };
+            assert!(
+                omega_l_min.abs() <= stuck,
+                "{}: {omega_l_min:e}",
+                kind.name()
+            );
+            // No event state has the lower disc moving backwards (beyond the switch model's
+            // stuck velocity).
             let worst = tr
                 .events
                 .iter()
                 .map(|e| e.x[rotor_model::OMEGA_L])
                 .fold(0.0, f64::min);
-            assert_eq!(worst, 0.0, "{}", kind.name());
+            assert!(worst >= -stuck, "{}: {worst:e}", kind.name());
         }
     }
 }

@@ -11,8 +11,8 @@
 //! steady_from = 100.0                # s, steady-state metrics over [steady_from, t_end]
 //! [tolerance.event-switch]           # per solver pair and quantity, each with its origin
 //! transient_max = 3e-8               # rad/s; also transient_rms, event_time (s)
-//! period_rel = 2e-10                 # relative; also omega_l_max_rel, omega_l_min_rel,
-//!                                    # omega_u_max_rel, omega_u_min_rel
+//! period_rel = 2e-10                 # relative; also omega_l_max_rel, omega_u_max_rel,
+//!                                    # omega_u_min_rel; omega_l_min is in rad/s
 //! stick_time = 1e-7                  # s
 //! steady_abs = 1e-12                 # absolute floor of the relative ones
 //! ```
@@ -99,8 +99,10 @@ pub struct PairTolerance {
     pub period_rel: Option<f64>,
     /// Max of ω_l over a cycle, relative.
     pub omega_l_max_rel: Option<f64>,
-    /// Min of ω_l over a cycle, relative.
-    pub omega_l_min_rel: Option<f64>,
+    /// Min of ω_l over a cycle [rad/s], absolute: it is 0 (or the switch model's stuck
+    /// velocity, ≤ its band η) on every cycle on which the lower disc sticks, where a relative
+    /// difference is 0 or 1 and says nothing.
+    pub omega_l_min: Option<f64>,
     /// Max of ω_u over a cycle, relative.
     pub omega_u_max_rel: Option<f64>,
     /// Min of ω_u over a cycle, relative.
@@ -120,8 +122,9 @@ pub struct PairTolerance {
 
 /// Keys of `[tolerance.<pair>]` tables that one quantity's key each replaced: a file that
 /// still states one is refused with the keys to use instead (never read as one of them).
-pub const RETIRED_KEYS: [(&str, &str); 3] = [
-    ("omega_l_rel", "omega_l_max_rel and omega_l_min_rel"),
+pub const RETIRED_KEYS: [(&str, &str); 4] = [
+    ("omega_l_rel", "omega_l_max_rel and omega_l_min"),
+    ("omega_l_min_rel", "omega_l_min (absolute, rad/s)"),
     ("omega_u_rel", "omega_u_max_rel and omega_u_min_rel"),
     (
         "equilibrium_rel",
@@ -139,7 +142,7 @@ struct RawPairTolerance {
     event_time: Option<f64>,
     period_rel: Option<f64>,
     omega_l_max_rel: Option<f64>,
-    omega_l_min_rel: Option<f64>,
+    omega_l_min: Option<f64>,
     omega_u_max_rel: Option<f64>,
     omega_u_min_rel: Option<f64>,
     stick_time: Option<f64>,
@@ -148,6 +151,7 @@ struct RawPairTolerance {
     equilibrium_alpha_rel: Option<f64>,
     steady_abs: Option<f64>,
     omega_l_rel: Option<f64>,
+    omega_l_min_rel: Option<f64>,
     omega_u_rel: Option<f64>,
     equilibrium_rel: Option<f64>,
 }
@@ -155,7 +159,12 @@ struct RawPairTolerance {
 impl RawPairTolerance {
     /// The tolerances, or the first retired key stated with its value.
     fn current(&self) -> Result<PairTolerance, (&'static str, f64)> {
-        let retired = [self.omega_l_rel, self.omega_u_rel, self.equilibrium_rel];
+        let retired = [
+            self.omega_l_rel,
+            self.omega_l_min_rel,
+            self.omega_u_rel,
+            self.equilibrium_rel,
+        ];
         if let Some((i, v)) = retired
             .iter()
             .enumerate()
@@ -169,7 +178,7 @@ impl RawPairTolerance {
             event_time: self.event_time,
             period_rel: self.period_rel,
             omega_l_max_rel: self.omega_l_max_rel,
-            omega_l_min_rel: self.omega_l_min_rel,
+            omega_l_min: self.omega_l_min,
             omega_u_max_rel: self.omega_u_max_rel,
             omega_u_min_rel: self.omega_u_min_rel,
             stick_time: self.stick_time,
@@ -188,7 +197,7 @@ pub const TOLERANCE_KEYS: [&str; 13] = [
     "event_time",
     "period_rel",
     "omega_l_max_rel",
-    "omega_l_min_rel",
+    "omega_l_min",
     "omega_u_max_rel",
     "omega_u_min_rel",
     "stick_time",
@@ -202,7 +211,7 @@ pub const TOLERANCE_KEYS: [&str; 13] = [
 pub const CYCLE_KEYS: [&str; 6] = [
     "period_rel",
     "omega_l_max_rel",
-    "omega_l_min_rel",
+    "omega_l_min",
     "omega_u_max_rel",
     "omega_u_min_rel",
     "stick_time",
@@ -221,7 +230,11 @@ pub const EQUILIBRIUM_KEYS: [&str; 3] = [
 pub const STEADY_QUANTITIES: [SteadyQuantity; 9] = [
     SteadyQuantity::relative("period_rel", "period"),
     SteadyQuantity::relative("omega_l_max_rel", "omega_l_max"),
-    SteadyQuantity::relative("omega_l_min_rel", "omega_l_min"),
+    SteadyQuantity {
+        key: "omega_l_min",
+        metric: "omega_l_min",
+        relative: false,
+    },
     SteadyQuantity::relative("omega_u_max_rel", "omega_u_max"),
     SteadyQuantity::relative("omega_u_min_rel", "omega_u_min"),
     SteadyQuantity {
@@ -261,7 +274,7 @@ impl PairTolerance {
             "event_time" => self.event_time,
             "period_rel" => self.period_rel,
             "omega_l_max_rel" => self.omega_l_max_rel,
-            "omega_l_min_rel" => self.omega_l_min_rel,
+            "omega_l_min" => self.omega_l_min,
             "omega_u_max_rel" => self.omega_u_max_rel,
             "omega_u_min_rel" => self.omega_u_min_rel,
             "stick_time" => self.stick_time,
@@ -282,7 +295,7 @@ impl PairTolerance {
             "event_time" => &mut self.event_time,
             "period_rel" => &mut self.period_rel,
             "omega_l_max_rel" => &mut self.omega_l_max_rel,
-            "omega_l_min_rel" => &mut self.omega_l_min_rel,
+            "omega_l_min" => &mut self.omega_l_min,
             "omega_u_max_rel" => &mut self.omega_u_max_rel,
             "omega_u_min_rel" => &mut self.omega_u_min_rel,
             "stick_time" => &mut self.stick_time,
@@ -773,10 +786,10 @@ mod tests {
             e.contains("unknown field") && e.contains("omega_u_mni_rel"),
             "{e}"
         );
-        let e = err(&ok.replacen("omega_l_min_rel", "# omega_l_min_rel", 1));
+        let e = err(&ok.replacen("omega_l_min", "# omega_l_min", 1));
         assert!(
-            e.contains("tolerance.event-moreau.omega_l_min_rel = (missing)")
-                || e.contains("tolerance.event-switch.omega_l_min_rel = (missing)"),
+            e.contains("tolerance.event-moreau.omega_l_min = (missing)")
+                || e.contains("tolerance.event-switch.omega_l_min = (missing)"),
             "{e}"
         );
         // An equilibrium's gates come as a set of three, too.

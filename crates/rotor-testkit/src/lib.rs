@@ -121,7 +121,7 @@ pub fn bad_pair_cases() -> Vec<BadFile> {
 const STEADY_KEYS: [&str; 13] = [
     "period_rel",
     "omega_l_max_rel",
-    "omega_l_min_rel",
+    "omega_l_min",
     "omega_u_max_rel",
     "omega_u_min_rel",
     "stick_time",
