@@ -200,19 +200,15 @@ fn run_dir(work: &Path, client: &str, scene: &str, k: usize) -> PathBuf {
 
 /// The job of one run.
 fn job_for(l: &Loaded, spec: &ClientSpec, setting: f64, dir: &Path) -> Job {
-    let sc = &l.scenario;
-    Job {
-        scenario: sc.name.clone(),
-        params: serde_json::to_value(sc.model.params).expect("plain numbers and strings"),
-        u: sc.u,
-        x0: [sc.x0[0], sc.x0[1], sc.x0[2]],
-        t_end: l.spec.t_end,
-        dt: l.spec.dt,
-        tol: (!spec.fixed_step).then_some(setting),
-        h: spec.fixed_step.then_some(setting),
-        trace: dir.join("trace.csv"),
-        events: dir.join("events.csv"),
-    }
+    Job::new(
+        &l.scenario,
+        l.spec.t_end,
+        l.spec.dt,
+        spec.fixed_step,
+        setting,
+        dir.join("trace.csv"),
+        dir.join("events.csv"),
+    )
 }
 
 /// Runs once: writes the job, starts the client. `Err` is the failure of the run.
@@ -230,8 +226,7 @@ fn run_once(
         let _ = std::fs::remove_file(p);
     }
     let path = dir.join("job.json");
-    let text = serde_json::to_string_pretty(job).expect("plain numbers and strings");
-    std::fs::write(&path, text)
+    std::fs::write(&path, job.to_json())
         .map_err(|e| fail(FailureKind::Spawn, format!("{}: {e}", path.display())))?;
     let write_s = t0.elapsed().as_secs_f64();
     let out = run_client(&spec.argv, &path, timeout).map_err(|e| fail(FailureKind::Spawn, e))?;

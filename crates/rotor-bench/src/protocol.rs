@@ -146,6 +146,8 @@ pub fn split_words(s: &str) -> Result<Vec<String>, String> {
 /// The job file of one run (BENCHMARK.md).
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Job {
+    /// The suite's version ([`rotor_compare::check::BENCHMARK`]).
+    pub benchmark: &'static str,
     pub scenario: String,
     /// Every field of the parameter file, friction family names included.
     pub params: serde_json::Value,
@@ -157,6 +159,56 @@ pub struct Job {
     pub h: Option<f64>,
     pub trace: PathBuf,
     pub events: PathBuf,
+}
+
+impl Job {
+    /// The job of a scene: the scenario's parameters, u and x0 (absolute), the scene's
+    /// horizon and grid, and the client's knob: `tol` set and `h` null, or the reverse.
+    pub fn new(
+        sc: &rotor_model::Scenario,
+        t_end: f64,
+        dt: f64,
+        fixed_step: bool,
+        setting: f64,
+        trace: PathBuf,
+        events: PathBuf,
+    ) -> Job {
+        Job {
+            benchmark: rotor_compare::check::BENCHMARK,
+            scenario: sc.name.clone(),
+            params: serde_json::to_value(sc.model.params).expect("plain numbers and strings"),
+            u: sc.u,
+            x0: [sc.x0[0], sc.x0[1], sc.x0[2]],
+            t_end,
+            dt,
+            tol: (!fixed_step).then_some(setting),
+            h: fixed_step.then_some(setting),
+            trace,
+            events,
+        }
+    }
+
+    /// The job `rotor bench --scenario PATH` hands a client of that knob on that scene (the
+    /// scenario's own horizon and grid): what `rotor job` prints.
+    pub fn for_scenario(
+        path: &Path,
+        fixed_step: bool,
+        setting: f64,
+        trace: PathBuf,
+        events: PathBuf,
+    ) -> Result<Job, crate::BenchError> {
+        let spec = crate::SceneSpec::from_scenario(path)?;
+        let sc = rotor_compare::load_scenario(path)?;
+        Ok(Job::new(
+            &sc, spec.t_end, spec.dt, fixed_step, setting, trace, events,
+        ))
+    }
+
+    /// The job file's text (numbers as the shortest decimal that reads back to the same
+    /// double: x0 at full precision).
+    pub fn to_json(&self) -> String {
+        serde_json::to_string_pretty(self).expect("plain numbers and strings")
+    }
 }
 
 /// How a client's process ended.

@@ -229,18 +229,15 @@ fn the_first_order_client_converges_and_passes_loose_at_h_1e_5() {
     let digits: Vec<(f64, bool)> = [1e-3, 1e-4, 1e-5]
         .into_iter()
         .map(|h| {
-            let job = rotor_bench::protocol::Job {
-                scenario: sc.name.clone(),
-                params: serde_json::to_value(sc.model.params).unwrap(),
-                u: sc.u,
-                x0: [sc.x0[0], sc.x0[1], sc.x0[2]],
-                t_end: sc.t_end,
-                dt: sc.compare.dt,
-                tol: None,
-                h: Some(h),
-                trace: dir.join(format!("trace-{h:e}.csv")),
-                events: dir.join(format!("events-{h:e}.csv")),
-            };
+            let job = rotor_bench::protocol::Job::new(
+                &sc,
+                sc.t_end,
+                sc.compare.dt,
+                true,
+                h,
+                dir.join(format!("trace-{h:e}.csv")),
+                dir.join(format!("events-{h:e}.csv")),
+            );
             let path = dir.join(format!("job-{h:e}.json"));
             std::fs::write(&path, serde_json::to_string(&job).unwrap()).unwrap();
             let st = std::process::Command::new(&exe)

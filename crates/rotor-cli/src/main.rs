@@ -191,6 +191,30 @@ enum Command {
         )]
         merge: Vec<PathBuf>,
     },
+    /// Print the job file `rotor bench` hands an external client for a scenario (its own
+    /// horizon and grid, as with `bench --scenario`), x0 at full precision (BENCHMARK.md).
+    /// One of --tol and --h is required: it says which knob the client has.
+    Job {
+        /// Scenario file, or a name in fixtures/scenarios (`t1-u1.5-rest`).
+        scenario: PathBuf,
+        /// The tolerance of a client with a tolerance (the job's `h` is null).
+        #[arg(
+            long,
+            value_name = "T",
+            allow_hyphen_values = true,
+            conflicts_with = "h"
+        )]
+        tol: Option<f64>,
+        /// The step of a fixed-step client [s] (the job's `tol` is null).
+        #[arg(long, value_name = "H", allow_hyphen_values = true)]
+        h: Option<f64>,
+        /// The path the client writes its trace to.
+        #[arg(long, value_name = "P", default_value = "trace.csv")]
+        trace: PathBuf,
+        /// The path the client writes its events to.
+        #[arg(long, value_name = "P", default_value = "events.csv")]
+        events: PathBuf,
+    },
     /// Write the benchmark's reference data for every scenario: trace, events and steady
     /// state of the event-driven solver, with their stated errors.
     Reference {
@@ -661,6 +685,46 @@ fn bench(
         .transpose()?;
     let report = rotor_bench::run(&opts, |m| eprintln!("{m}"))?;
     write_bench(&report, [json, svg, csv])
+}
+
+/// `rotor job`: the job file of a scenario, printed.
+fn job(
+    scenario: &Path,
+    tol: Option<f64>,
+    h: Option<f64>,
+    trace: &Path,
+    events: &Path,
+) -> Result<()> {
+    let (fixed_step, setting) = match (tol, h) {
+        (Some(t), None) => {
+            check("tol", t, t > 0.0, "must be a positive number")?;
+            (false, t)
+        }
+        (None, Some(h)) => {
+            check("h", h, h > 0.0, "must be a positive number of seconds")?;
+            (true, h)
+        }
+        _ => bail!(
+            "rotor job {}: give --tol T (a client with a tolerance) or --h H (a fixed-step \
+             client), one of them",
+            scenario.display()
+        ),
+    };
+    for (flag, p) in [("--trace", trace), ("--events", events)] {
+        if p.as_os_str().is_empty() {
+            bail!("{flag} \"\": an empty path");
+        }
+    }
+    let path = fixture_path("scenario", scenario, "scenarios")?;
+    let job = rotor_bench::protocol::Job::for_scenario(
+        &path,
+        fixed_step,
+        setting,
+        trace.to_owned(),
+        events.to_owned(),
+    )?;
+    out::print(&(job.to_json() + "\n"))?;
+    Ok(())
 }
 
 /// `rotor bench --merge`: the shards' reports joined into one.
@@ -1141,6 +1205,7 @@ impl Command {
             Sweep { .. } => "sweep",
             Merge { .. } => "merge",
             Bench { .. } => "bench",
+            Job { .. } => "job",
             Reference { .. } => "reference",
             Check { .. } => "check",
             Compare { .. } => "compare",
@@ -1163,7 +1228,7 @@ impl Command {
             Bifurcation2 { json, svg, .. } => (None, Some(json), svg.as_ref()),
             Bench { json, svg, csv, .. } => (csv.as_ref(), json.as_ref(), svg.as_ref()),
             Check { json, .. } => (None, json.as_ref(), None),
-            Steady { .. } | Compare { .. } | Reference { .. } => (None, None, None),
+            Steady { .. } | Compare { .. } | Reference { .. } | Job { .. } => (None, None, None),
         };
         [("--csv", csv), ("--json", json), ("--svg", svg)]
             .into_iter()
@@ -1256,6 +1321,13 @@ fn main() -> ExitCode {
             merge,
             ..
         }) => bench_merge(merge, [json.as_deref(), svg.as_deref(), csv.as_deref()]),
+        Some(Command::Job {
+            scenario,
+            tol,
+            h,
+            trace,
+            events,
+        }) => job(scenario, *tol, *h, trace, events),
         Some(Command::Compare {
             scenarios,
             report,

@@ -881,3 +881,75 @@ fn without_timings(v: &serde_json::Value, timing: bool) -> serde_json::Value {
         other => other.clone(),
     }
 }
+
+/// `rotor job` prints the job file of a scenario, by name or file: the suite's version, the
+/// scenario's own horizon and grid, the knob given (the other null), the paths given (or
+/// trace.csv and events.csv), and x0 bit for bit the scenario's (the eq-pert start is the
+/// perturbed equilibrium, which the reference CSV shows to 12 digits only). Bad input is an
+/// error naming the flag and the value.
+#[test]
+fn job_prints_the_job_file_with_x0_at_full_precision() {
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
+    let path = root.join("fixtures/scenarios/t1-u2.5-eq-pert.toml");
+    let sc = rotor_compare::load_scenario(&path).unwrap();
+    let json = |o: std::process::Output| -> serde_json::Value {
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        serde_json::from_slice(&o.stdout).unwrap()
+    };
+    let by_name = json(rotor(&["job", "t1-u2.5-eq-pert", "--h", "1e-3"]));
+    assert_eq!(by_name["benchmark"], rotor_compare::check::BENCHMARK);
+    assert_eq!(by_name["scenario"], "t1-u2.5-eq-pert");
+    assert_eq!(by_name["h"], 1e-3);
+    assert!(by_name["tol"].is_null());
+    assert_eq!(by_name["trace"], "trace.csv");
+    assert_eq!(by_name["events"], "events.csv");
+    assert_eq!(by_name["t_end"], sc.t_end);
+    assert_eq!(by_name["dt"], sc.compare.dt);
+    assert_eq!(by_name["u"], sc.u);
+    assert_eq!(
+        by_name["params"],
+        serde_json::to_value(sc.model.params).unwrap()
+    );
+    let x0: Vec<f64> = by_name["x0"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|v| v.as_f64().unwrap())
+        .collect();
+    assert_eq!(x0, [sc.x0[0], sc.x0[1], sc.x0[2]]);
+    assert!(x0[2] != 0.0, "the eq-pert start is not rest");
+    let by_file = json(rotor(&[
+        "job",
+        path.to_str().unwrap(),
+        "--tol",
+        "1e-8",
+        "--trace",
+        "out/t.csv",
+        "--events",
+        "out/e.csv",
+    ]));
+    assert_eq!(by_file["tol"], 1e-8);
+    assert!(by_file["h"].is_null());
+    assert_eq!(by_file["trace"], "out/t.csv");
+    assert_eq!(by_file["events"], "out/e.csv");
+    assert_eq!(by_file["x0"], by_name["x0"]);
+    for (args, needle) in [
+        (&["job", "t1-u1.5-rest"][..], "give --tol T"),
+        (&["job", "t1-u1.5-rest", "--tol", "-1"], "--tol -1"),
+        (&["job", "t1-u1.5-rest", "--h", "0"], "--h 0"),
+        (&["job", "t1-u1.5-rest", "--h", "inf"], "--h inf"),
+        (&["job", "t1-u1.5-rest", "--tol", "abc"], "'abc' for '--tol"),
+        (
+            &["job", "t1-u1.5-rest", "--tol", "1e-8", "--h", "1e-3"],
+            "cannot be used with",
+        ),
+        (&["job", "no-such-scene", "--tol", "1e-8"], "no-such-scene"),
+    ] {
+        let o = rotor(args);
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert!(!o.status.success(), "{args:?}");
+        assert!(err.contains(needle), "{args:?}: {err}");
+        assert!(!err.contains("panicked"), "{args:?}: {err}");
+        assert!(o.stdout.is_empty(), "{args:?}");
+    }
+}
