@@ -230,6 +230,8 @@ fn run_once(
         .map_err(|e| fail(FailureKind::Spawn, format!("{}: {e}", path.display())))?;
     let write_s = t0.elapsed().as_secs_f64();
     let out = run_client(&spec.argv, &path, timeout).map_err(|e| fail(FailureKind::Spawn, e))?;
+    // Kept with the run's other files (`--keep`): what the client said about a failure.
+    let _ = std::fs::write(dir.join("stderr.txt"), &out.stderr);
     match &out.ended {
         Ended::TimedOut => Err(fail(
             FailureKind::Timeout,
@@ -512,6 +514,24 @@ fn per_step(
     out
 }
 
+/// Why the rest of a tolerance ladder is not run when the client's answer does not move.
+pub const KNOB_IGNORED: &str = "not run: the same answer at four tolerances in a row: the \
+     client ignores tol (a fixed-step client? declare it as NAME:h=COMMAND or --fixed-step NAME)";
+
+/// Whether the last four points of a tolerance ladder are one answer: each placed, with equal
+/// errors and digits. A client that ignores `tol` (a fixed-step one run the naive way, at its
+/// own default step) gives that; an adaptive one moves within four decades (this project's
+/// switch model repeats itself at two: tol 1e-3 and 1e-4, where h_max binds).
+pub(crate) fn ignores_its_knob(points: &[ClientPoint]) -> bool {
+    let Some(last) = points.len().checked_sub(4).map(|i| &points[i..]) else {
+        return false;
+    };
+    last.iter().all(|p| p.wall.is_some())
+        && last
+            .windows(2)
+            .all(|w| w[0].errors == w[1].errors && w[0].digits == w[1].digits)
+}
+
 /// Runs one client over its ladder on every scene.
 pub(crate) fn run(
     spec: &ClientSpec,
@@ -562,6 +582,9 @@ pub(crate) fn run(
                 stop = Some("not run: the same failure at the two settings before");
             }
             points.push(p);
+            if stop.is_none() && !spec.fixed_step && ignores_its_knob(&points) {
+                stop = Some(KNOB_IGNORED);
+            }
         }
         let ratios = ratios(&points, rust, spec.fixed_step);
         let per_step = if spec.fixed_step {
@@ -640,5 +663,52 @@ fn skipped_point(setting: f64) -> ClientPoint {
         failing: Vec::new(),
         failure: None,
         protocol_s: None,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn placed(steady: f64, digits: f64) -> ClientPoint {
+        ClientPoint {
+            wall: Some(Timing {
+                median_s: 0.1,
+                min_s: 0.1,
+                repeats: 1,
+            }),
+            errors: Errors {
+                steady_rel: Some(steady),
+                ..Errors::default()
+            },
+            digits: Some(digits),
+            ..skipped_point(1e-3)
+        }
+    }
+
+    /// Four identical answers in a row stop a tolerance ladder; three do not (this project's
+    /// switch model repeats one at two tolerances), nor four with one that moved or one
+    /// that failed.
+    #[test]
+    fn four_identical_answers_mean_an_ignored_knob() {
+        let same = placed(1e-4, 3.2);
+        assert!(ignores_its_knob(&vec![same.clone(); 4]));
+        assert!(ignores_its_knob(&[
+            placed(1e-2, 1.0),
+            same.clone(),
+            same.clone(),
+            same.clone(),
+            same.clone()
+        ]));
+        assert!(!ignores_its_knob(&vec![same.clone(); 3]));
+        let mut moved = vec![same.clone(); 4];
+        moved[3] = placed(9e-5, 3.2);
+        assert!(!ignores_its_knob(&moved));
+        let mut digits = vec![same.clone(); 4];
+        digits[2] = placed(1e-4, 3.3);
+        assert!(!ignores_its_knob(&digits));
+        let mut failed = vec![same.clone(); 4];
+        failed[0] = skipped_point(1e-3);
+        assert!(!ignores_its_knob(&failed));
     }
 }

@@ -266,7 +266,9 @@ pub fn run(opts: &BenchOptions, mut progress: impl FnMut(&str)) -> Result<BenchR
     // One directory per run (runs may share a process: tests run in parallel).
     static RUNS: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
     let n = RUNS.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
-    let work = std::env::temp_dir().join(format!("rotor-bench-{}-{n}", std::process::id()));
+    let work = opts.keep.clone().unwrap_or_else(|| {
+        std::env::temp_dir().join(format!("rotor-bench-{}-{n}", std::process::id()))
+    });
     std::fs::create_dir_all(&work)
         .map_err(|e| BenchError::Work(format!("{}: cannot create: {e}", work.display())))?;
     let mut clients = Vec::new();
@@ -291,7 +293,9 @@ pub fn run(opts: &BenchOptions, mut progress: impl FnMut(&str)) -> Result<BenchR
             &mut progress,
         ));
     }
-    let _ = std::fs::remove_dir_all(&work);
+    if opts.keep.is_none() {
+        let _ = std::fs::remove_dir_all(&work);
+    }
     let profile = profile::profile(&scenes, &clients);
     Ok(BenchReport {
         scenes,

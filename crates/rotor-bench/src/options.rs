@@ -118,6 +118,9 @@ pub struct BenchOptions {
     /// Run only every N-th scene from the I-th (`rotor bench --shard I/N`, for job arrays);
     /// [`crate::merge`] joins the shards' reports.
     pub shard: Option<rotor_compare::sweep::Shard>,
+    /// Where to keep every external run's files (`DIR/CLIENT/SCENE/runK`: job.json,
+    /// trace.csv, events.csv, stderr.txt); `None`: a temporary directory, deleted after.
+    pub keep: Option<std::path::PathBuf>,
 }
 
 /// The workspace root: the current directory if it holds `fixtures/`, else the checkout
@@ -169,8 +172,11 @@ impl Default for BenchOptions {
             clients: Vec::new(),
             timeout: 60.0,
             client_tols: decades(3, 12),
-            client_hs: vec![1e-2, 3e-3, 1e-3, 3e-4, 1e-4],
+            // Steps that divide the 0.01 s output grid (every sample falls on a step end), in
+            // the 1-2-5 sequence.
+            client_hs: vec![1e-2, 5e-3, 2e-3, 1e-3, 5e-4, 2e-4, 1e-4],
             shard: None,
+            keep: None,
         }
     }
 }

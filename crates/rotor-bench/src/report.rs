@@ -574,9 +574,9 @@ fn client_table(s: &mut String, p: &ClientReport) {
                     format!("{:.1e}", r.error),
                     ms(r.client_seconds),
                     ms(r.rust_seconds),
-                    format!("{ge}{:.0}", r.ratio),
+                    format!("{ge}{}", ratio3(r.ratio)),
                     r.ratio_of_minima
-                        .map_or("-".into(), |m| format!("{ge}{m:.0}"))
+                        .map_or("-".into(), |m| format!("{ge}{}", ratio3(m)))
                 );
             }
         }
@@ -596,12 +596,12 @@ fn client_table(s: &mut String, p: &ClientReport) {
             for q in &sc.per_step {
                 let _ = writeln!(
                     s,
-                    "{:>9} {:>15.3} {:>15.4} {:>8.0} {:>10.0} {:>13} {:>14}",
+                    "{:>9} {:>15.3} {:>15.4} {:>8} {:>10} {:>13} {:>14}",
                     format!("{:.0e}", q.h),
                     1e6 * q.client_s_per_step,
                     1e6 * q.moreau_s_per_step,
-                    q.ratio,
-                    q.ratio_of_minima,
+                    ratio3(q.ratio),
+                    ratio3(q.ratio_of_minima),
                     e(q.client_errors.steady_rel),
                     e(q.moreau_errors.steady_rel)
                 );
@@ -611,7 +611,46 @@ fn client_table(s: &mut String, p: &ClientReport) {
     let _ = writeln!(s);
 }
 
+/// A time ratio to 3 significant digits (`0.482`, `1.23`, `12.3`, `148`; whole numbers from
+/// 100 up): timings on a shared machine vary by more than that, and a whole number alone
+/// hides a ratio near 1.
+pub fn ratio3(x: f64) -> String {
+    if !x.is_finite() || x <= 0.0 {
+        return format!("{x}");
+    }
+    let decimals = (2 - x.log10().floor() as i32).max(0) as usize;
+    let s = format!("{x:.decimals$}");
+    // 9.996 rounds to "10.00": one digit too many.
+    match s.split_once('.') {
+        Some((whole, frac)) if whole.trim_start_matches('0').len() + frac.len() > 3 => {
+            format!("{x:.*}", decimals.saturating_sub(1))
+        }
+        _ => s,
+    }
+}
+
 /// Whether a point is placed on the plots: it ran and gave a usable trace.
 fn placed(f: Option<&crate::clients::Failure>) -> bool {
     f.is_none_or(|f| f.kind == FailureKind::FailsGate)
+}
+
+#[cfg(test)]
+mod ratio_tests {
+    use super::ratio3;
+
+    #[test]
+    fn ratios_have_three_significant_digits() {
+        for (x, want) in [
+            (0.48249, "0.482"),
+            (1.234, "1.23"),
+            (1.0, "1.00"),
+            (9.996, "10.0"),
+            (12.34, "12.3"),
+            (99.96, "100"),
+            (148.4, "148"),
+            (3483.2, "3483"),
+        ] {
+            assert_eq!(ratio3(x), want, "{x}");
+        }
+    }
 }

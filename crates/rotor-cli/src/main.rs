@@ -181,13 +181,17 @@ enum Command {
         /// records the shard, and `--merge` joins the shards' reports.
         #[arg(long, value_name = "I/N")]
         shard: Option<String>,
+        /// Keep every external run's files (job.json, trace.csv, events.csv, stderr.txt) in
+        /// DIR/CLIENT/SCENE/runK instead of deleting them.
+        #[arg(long, value_name = "DIR")]
+        keep: Option<PathBuf>,
         /// Run nothing: join the reports of `--shard` runs (any order) into the report one
         /// run writes, timings aside (BENCHMARK.md), written with --json, --svg, --csv.
         #[arg(
             long,
             value_name = "SHARD.json",
             num_args = 1..,
-            conflicts_with_all = ["shard", "quick", "no_peers", "external", "fixed_step", "scenario"]
+            conflicts_with_all = ["shard", "quick", "no_peers", "external", "fixed_step", "scenario", "keep"]
         )]
         merge: Vec<PathBuf>,
     },
@@ -636,6 +640,7 @@ struct BenchClients<'a> {
     timeout: f64,
     scenarios: &'a [PathBuf],
     shard: Option<&'a str>,
+    keep: Option<&'a Path>,
 }
 
 fn bench(
@@ -683,8 +688,34 @@ fn bench(
         .shard
         .map(rotor_compare::sweep::Shard::parse)
         .transpose()?;
+    opts.keep = clients.keep.map(Path::to_path_buf);
     let report = rotor_bench::run(&opts, |m| eprintln!("{m}"))?;
-    write_bench(&report, [json, svg, csv])
+    write_bench(&report, [json, svg, csv])?;
+    // The report is written first (nothing is lost); then a named client that placed no
+    // point on any scene fails the command, by name (a peer that is not installed does not).
+    let unsolved: Vec<String> = report
+        .clients
+        .iter()
+        .filter(|c| !c.peer && c.status != rotor_bench::ClientStatus::Ran)
+        .map(|c| {
+            format!(
+                "{} ({})",
+                c.name,
+                c.reason.as_deref().unwrap_or("no usable trace")
+            )
+        })
+        .collect();
+    if !unsolved.is_empty() {
+        bail!(
+            "--external: solved no scene: {}{}",
+            unsolved.join("; "),
+            clients.keep.map_or(String::new(), |d| format!(
+                " (runs kept in {})",
+                d.display()
+            ))
+        );
+    }
+    Ok(())
 }
 
 /// `rotor job`: the job file of a scenario, printed.
@@ -1301,6 +1332,7 @@ fn main() -> ExitCode {
             timeout,
             scenario,
             shard,
+            keep,
             merge,
         }) if merge.is_empty() => bench(
             [json.as_deref(), svg.as_deref(), csv.as_deref()],
@@ -1312,6 +1344,7 @@ fn main() -> ExitCode {
                 timeout: *timeout,
                 scenarios: scenario,
                 shard: shard.as_deref(),
+                keep: keep.as_deref(),
             },
         ),
         Some(Command::Bench {

@@ -766,9 +766,16 @@ fn bench_shards_merge_to_one_run_timings_aside() {
         "--external",
         "broken=false",
     ];
+    // The broken client solves no scene, so each run exits 1, naming it, after writing its
+    // report.
     let run = |extra: &[&str]| {
         let o = rotor(&[&suite[..], extra].concat());
-        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(1), "{err}");
+        assert!(
+            err.contains("solved no scene: broken (exit status 1"),
+            "{err}"
+        );
     };
     run(&["--json", &p("one.json")]);
     run(&["--shard", "1/2", "--json", &p("b1.json")]);
@@ -952,4 +959,44 @@ fn job_prints_the_job_file_with_x0_at_full_precision() {
         assert!(!err.contains("panicked"), "{args:?}: {err}");
         assert!(o.stdout.is_empty(), "{args:?}");
     }
+}
+
+/// `--keep DIR` keeps every run's job, trace and standard error; a named client that solves
+/// no scene makes `bench` exit 1, naming it, with its report still written.
+#[test]
+fn bench_keeps_runs_and_names_an_unsolved_client() {
+    let dir = std::env::temp_dir().join(format!("rotor-cli-keep-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    let keep = dir.join("runs");
+    let json = dir.join("b.json");
+    // A client that writes one line on standard error and exits 2.
+    let o = rotor(&[
+        "bench",
+        "--quick",
+        "--no-peers",
+        "--external",
+        "noisy=sh -c 'echo cannot read the job >&2; exit 2' --",
+        "--keep",
+        keep.to_str().unwrap(),
+        "--json",
+        json.to_str().unwrap(),
+    ]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "{err}");
+    assert!(
+        err.contains("solved no scene: noisy (exit status 2"),
+        "{err}"
+    );
+    assert!(
+        err.contains(&format!("runs kept in {}", keep.display())),
+        "{err}"
+    );
+    assert!(json.exists(), "the report is written before the failure");
+    let run0 = keep.join("noisy/t1-u1.5-rest/run0");
+    assert!(run0.join("job.json").exists());
+    assert_eq!(
+        std::fs::read_to_string(run0.join("stderr.txt")).unwrap(),
+        "cannot read the job\n"
+    );
 }
