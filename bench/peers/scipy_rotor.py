@@ -8,29 +8,33 @@ What a careful scipy user would write for the two-disc rotor with set-valued fri
     J_u omega_u'   = k_m u - k_theta alpha - T_fu(omega_u)
     J_l omega_l'   =         k_theta alpha - T_fl(omega_l)
 
-integrated with `scipy.integrate.solve_ivp` (DOP853 by default) piece by piece between
-events, switching vector fields at the events (Filippov's solution for this one switching
-surface):
+integrated with `scipy.integrate.solve_ivp` (DOP853 by default; `--method Radau|BDF|LSODA|
+RK45|RK23` for another) piece by piece between events, switching vector fields at the events
+(Filippov's solution; each disc has its own switching surface omega = 0):
 
-* slip on branch s = +1 / -1 (sign of omega_l): the friction law of the branch,
-  T_fl = b_l omega + s N(s omega), with N the friction level of docs/model.md continued
-  smoothly past omega = 0 so that the event function is smooth across its root;
-  terminal event omega_l = 0 (direction -s);
-* at omega_l = 0: stick if |k_theta alpha| <= N(0) = T_sl (the spring torque is inside the
-  stick interval), else the disc reverses and slips on the other branch;
-* stick: omega_l = 0 and omega_l' = 0 (the friction takes the spring torque: the equivalent
-  control); terminal events k_theta alpha = +T_sl (exit to s = +1) and -T_sl (exit to s = -1);
-* non-terminal event omega_l' = 0 from above (a maximum of omega_l) while slipping, for the
-  steady-state metrics.
+* each disc is in a mode: slip on branch s = +1 / -1 (the sign of its omega), or stick;
+* slip on branch s: the disc's friction law on that branch, T_f = a(omega) + b omega +
+  s N(s omega), with N the friction level of docs/model.md continued smoothly past omega = 0
+  so that the event function is smooth across its root; terminal event omega = 0
+  (direction -s);
+* at omega = 0: stick if the applied torque T_ex (k_theta alpha on the lower disc,
+  k_m u - k_theta alpha on the upper) lies in the disc's stick interval [lo, hi] =
+  a(0) + N(0) [-1, 1], else slip the way it pushes (a reversal, or passing a kink);
+* stick: omega = 0 and omega' = 0 (the friction takes the applied torque: the equivalent
+  control); terminal events T_ex = hi (exit to s = +1) and T_ex = lo (exit to s = -1). The
+  discs couple only through alpha, so a stuck disc's friction never enters the other's
+  equation, and each disc's mode is decided alone;
+* non-terminal event omega_l' = 0 from above (a maximum of omega_l) while slipping.
 
-The upper disc must be smooth (Table 1: T_su = dT_su = db_u = 0, so T_fu = b_u omega_u);
-a parameter file with upper static friction is refused (it needs a second switching surface).
-The lower disc may use either family of docs/model.md (exponential: Table 1; stribeck).
+A smooth upper disc (Table 1: T_su = dT_su = db_u = 0, so T_fu = b_u omega_u) has no
+switching surface and is integrated straight through omega_u = 0. The lower disc may use
+either family of docs/model.md (exponential: Table 1; stribeck); the upper disc's law is
+T_fu = dT_su + s db_u omega + b_u omega + s T_su on branch s.
 
-A client of the benchmark's job-file protocol: `python3 scipy_rotor.py JOB.json` integrates
-the job's scene at rtol = atol = the job's tol, writes the trace (alpha, omega_u, omega_l on
-the grid) and the events it locates (stick onsets and exits, reversals of the lower disc),
-and prints {"solve_seconds": S, ...}: time.perf_counter() around the simulation alone
+A client of the benchmark's job-file protocol: `python3 scipy_rotor.py [--method M] JOB.json`
+integrates the job's scene at rtol = atol = the job's tol, writes the trace (alpha, omega_u,
+omega_l on the grid) and the events it locates (stick onsets and exits, reversals of either
+disc), and prints {"solve_seconds": S, ...}: time.perf_counter() around the simulation alone
 (interpreter start-up, imports, reading the job and writing the files excluded).
 """
 
@@ -46,6 +50,11 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import peer_common as common  # noqa: E402  (shared set-up, next to this script)
 
 
+UPPER, LOWER = 0, 1
+DISC_NAMES = ("upper", "lower")
+METHODS = ("DOP853", "RK45", "RK23", "Radau", "BDF", "LSODA")
+
+
 class Rotor:
     """Parameters and the vector fields of each mode."""
 
@@ -55,14 +64,14 @@ class Rotor:
         self.k_m = params["k_m"]
         self.k_theta = params["k_theta"]
         up = params["upper"]
-        for key in ("t_s", "dt_s", "db"):
-            if up.get(key, 0.0) != 0.0:
-                raise ValueError(
-                    f"upper.{key} = {up[key]}: this peer implements a smooth upper disc "
-                    "(T_su = dT_su = db_u = 0, as Table 1); upper static friction needs a "
-                    "second switching surface"
-                )
         self.b_u = up["b"]
+        self.t_su = up.get("t_s", 0.0)
+        self.dt_su = up.get("dt_s", 0.0)
+        self.db_u = up.get("db", 0.0)
+        if self.t_su < 0.0:
+            raise ValueError(f"upper.t_s = {self.t_su}: must not be negative")
+        # A smooth upper disc has no switching surface (Table 1).
+        self.upper_smooth = self.t_su == 0.0 and self.dt_su == 0.0 and self.db_u == 0.0
         lo = params["lower"]
         self.family = lo["family"]
         self.b_l = lo["b"]
@@ -79,13 +88,18 @@ class Rotor:
         if self.t_sl <= 0.0:
             raise ValueError(f"lower.t_s = {self.t_sl}: the lower disc must have static friction")
         self.drive = self.k_m * u
+        # Stick intervals [lo, hi] of each disc.
+        self.interval = (
+            (self.dt_su - self.t_su, self.dt_su + self.t_su),
+            (-self.t_sl, self.t_sl),
+        )
 
     def level(self, x):
         """Friction level N(x) of the lower disc, x = s*omega (x >= 0 on the branch).
 
-        Exponential (docs/model.md): T_sl + T_1 (1 - 2/(1 + e^{w_1 x})) + T_2 (1 - 2/(1 + e^{w_2 x})),
-        written with 1 - 2/(1 + e^y) = tanh(y/2), which is odd in x: a smooth continuation.
-        Stribeck: T_cl + (T_sl - T_cl) exp(-|x/omega_s|^delta) (even in x).
+        Exponential (docs/model.md): T_sl + T_1 tanh(w_1 x / 2) + T_2 tanh(w_2 x / 2), which
+        is odd in x: a smooth continuation. Stribeck: T_cl + (T_sl - T_cl)
+        exp(-|x/omega_s|^delta) (even in x).
         """
         if self.family == "exponential":
             return (
@@ -95,75 +109,101 @@ class Rotor:
             )
         return self.t_cl + (self.t_sl - self.t_cl) * math.exp(-abs(x / self.omega_s) ** self.delta)
 
-    def upper_accel(self, alpha, w_u):
-        return (self.drive - self.k_theta * alpha - self.b_u * w_u) / self.j_u
+    def applied(self, disc, alpha):
+        """T_ex of a disc: what its friction must take for it to stay stuck."""
+        spring = self.k_theta * alpha
+        return self.drive - spring if disc == UPPER else spring
 
-    def lower_accel(self, alpha, w_l, s):
-        friction = self.b_l * w_l + s * self.level(s * w_l)
-        return (self.k_theta * alpha - friction) / self.j_l
+    def friction(self, disc, w, s):
+        """The friction torque on branch s (s = 0: the smooth upper law)."""
+        if disc == UPPER:
+            if s == 0.0:
+                return self.b_u * w
+            return self.dt_su + s * self.db_u * w + self.b_u * w + s * self.t_su
+        return self.b_l * w + s * self.level(s * w)
 
-    def slip(self, s):
+    def accel(self, disc, x, s):
+        """omega' of a disc in mode s (0 for a stuck set-valued disc)."""
+        if s is None:
+            return 0.0
+        j = self.j_u if disc == UPPER else self.j_l
+        w = x[1 + disc]
+        return (self.applied(disc, x[0]) - self.friction(disc, w, s)) / j
+
+    def field(self, modes):
+        """The vector field of a mode pair; a mode is +1/-1 (slip), None (stuck), or 0 for
+        the smooth upper disc (no switching surface)."""
+
         def f(t, x):
-            alpha, w_u, w_l = x
-            return [w_u - w_l, self.upper_accel(alpha, w_u), self.lower_accel(alpha, w_l, s)]
+            return [x[1] - x[2], self.accel(UPPER, x, modes[0]), self.accel(LOWER, x, modes[1])]
 
         return f
 
-    def stick(self, t, x):
-        alpha, w_u, _ = x
-        return [w_u, self.upper_accel(alpha, w_u), 0.0]
+    def mode_at(self, disc, x):
+        """As rotor-model's Model::mode_at: slip by the sign of omega, else stick if the
+        applied torque is inside the stick interval, else slip the way it pushes."""
+        w = x[1 + disc]
+        if w > 0.0:
+            return 1.0
+        if w < 0.0:
+            return -1.0
+        return self.at_rest(disc, x)
+
+    def at_rest(self, disc, x):
+        """The mode of a disc at omega = 0: stuck (None) or the branch it slips on."""
+        torque = self.applied(disc, x[0])
+        lo, hi = self.interval[disc]
+        if lo <= torque <= hi:
+            return None
+        return 1.0 if torque > hi else -1.0
 
 
-def slip_events(rotor, s):
-    """Terminal omega_l = 0 (leaving branch s), and omega_l maxima (non-terminal)."""
+def events_of(rotor, modes):
+    """The event functions of a mode pair, each tagged (disc, what): terminal omega = 0 for a
+    slipping disc with a switching surface, terminal stick exits for a stuck disc, and the
+    non-terminal maxima of omega_l while it slips."""
+    evs, tags = [], []
+    for disc in (UPPER, LOWER):
+        s = modes[disc]
+        if s == 0.0:
+            continue
+        if s is None:
+            lo, hi = rotor.interval[disc]
+            for bound, side in ((hi, 1.0), (lo, -1.0)):
 
-    def zero(t, x):
-        return x[2]
+                def leave(t, x, d=disc, b=bound):
+                    return rotor.applied(d, x[0]) - b
 
-    zero.terminal = True
-    zero.direction = -s
+                leave.terminal = True
+                leave.direction = side
+                evs.append(leave)
+                tags.append((disc, "exit", side))
+        else:
 
-    def peak(t, x):
-        return rotor.lower_accel(x[0], x[2], s)
+            def zero(t, x, d=disc):
+                return x[1 + d]
 
-    peak.terminal = False
-    peak.direction = -1.0
-    return [zero, peak]
+            zero.terminal = True
+            zero.direction = -s
+            evs.append(zero)
+            tags.append((disc, "zero", s))
+    if modes[LOWER] not in (None, 0.0):
 
+        def peak(t, x, s=modes[LOWER]):
+            return rotor.accel(LOWER, x, s)
 
-def stick_events(rotor):
-    """Terminal: the spring torque k_theta alpha reaches +T_sl or -T_sl."""
-
-    def exit_hi(t, x):
-        return rotor.k_theta * x[0] - rotor.t_sl
-
-    exit_hi.terminal = True
-    exit_hi.direction = 1.0
-
-    def exit_lo(t, x):
-        return rotor.k_theta * x[0] + rotor.t_sl
-
-    exit_lo.terminal = True
-    exit_lo.direction = -1.0
-    return [exit_hi, exit_lo]
-
-
-def initial_mode(rotor, x):
-    """As rotor-model's Model::mode_at: slip by the sign of omega_l, else stick if the spring
-    torque is inside the stick interval, else slip the way it pushes."""
-    if x[2] > 0.0:
-        return 1.0
-    if x[2] < 0.0:
-        return -1.0
-    torque = rotor.k_theta * x[0]
-    return 0.0 if abs(torque) <= rotor.t_sl else math.copysign(1.0, torque)
+        peak.terminal = False
+        peak.direction = -1.0
+        evs.append(peak)
+        tags.append((LOWER, "peak", 0.0))
+    return evs, tags
 
 
 def simulate(rotor, x0, t_end, grid, tol, method):
     """One run: returns (the 3 x len(grid) solution on the grid, events, rhs evaluations)."""
     t = 0.0
     x = list(x0)
-    mode = initial_mode(rotor, x)
+    modes = [0.0 if rotor.upper_smooth else rotor.mode_at(UPPER, x), rotor.mode_at(LOWER, x)]
     y = np.empty((3, len(grid)))
     i = 0  # next grid sample
     events = []  # (t, disc, kind)
@@ -173,12 +213,12 @@ def simulate(rotor, x0, t_end, grid, tol, method):
         segments += 1
         if segments > 100_000:
             raise RuntimeError(f"more than 100000 segments by t = {t}: Zeno-like switching")
-        if mode == 0.0:
-            fun, evs = rotor.stick, stick_events(rotor)
-        else:
-            fun, evs = rotor.slip(mode), slip_events(rotor, mode)
+        for disc in (UPPER, LOWER):
+            if modes[disc] is None:
+                x[1 + disc] = 0.0
+        evs, tags = events_of(rotor, modes)
         sol = solve_ivp(
-            fun,
+            rotor.field(modes),
             (t, t_end),
             x,
             method=method,
@@ -192,42 +232,65 @@ def simulate(rotor, x0, t_end, grid, tol, method):
         nfev += sol.nfev
         n = len(sol.t)
         y[:, i : i + n] = sol.y
-        if mode == 0.0:
-            y[2, i : i + n] = 0.0
+        for disc in (UPPER, LOWER):
+            if modes[disc] is None:
+                y[1 + disc, i : i + n] = 0.0
         i += n
         if sol.status == 0:  # reached t_end
             break
-        # A terminal event ended the segment.
-        hit = [k for k, te in enumerate(sol.t_events) if evs[k].terminal and len(te)]
-        k = hit[0]
-        t = float(sol.t_events[k][-1])
-        x = [float(v) for v in sol.y_events[k][-1]]
-        x[2] = 0.0
-        if mode == 0.0:
-            events.append((t, "lower", "stick_end"))
-            mode = 1.0 if k == 0 else -1.0
-        else:
-            torque = rotor.k_theta * x[0]
-            if abs(torque) <= rotor.t_sl:
-                events.append((t, "lower", "stick_start"))
-                mode = 0.0
+        # A terminal event ended the segment: the earliest (two at one instant: both).
+        hits = [
+            (float(sol.t_events[k][-1]), k)
+            for k, te in enumerate(sol.t_events)
+            if evs[k].terminal and len(te)
+        ]
+        t_hit = min(th for th, _ in hits)
+        k0 = min(hits)[1]
+        t = t_hit
+        x = [float(v) for v in sol.y_events[k0][-1]]
+        for th, k in sorted(hits):
+            if th != t_hit:
+                continue
+            disc, what, side = tags[k]
+            name = DISC_NAMES[disc]
+            x[1 + disc] = 0.0
+            if what == "exit":
+                events.append((t, name, "stick_end"))
+                modes[disc] = side
             else:
-                events.append((t, "lower", "reversal"))
-                mode = math.copysign(1.0, torque)
+                new = rotor.at_rest(disc, x)
+                if new is None:
+                    events.append((t, name, "stick_start"))
+                else:
+                    events.append((t, name, "reversal"))
+                modes[disc] = new
     if i < len(grid):
         raise RuntimeError(f"{len(grid) - i} grid samples missing at the end")
     return y, events, nfev
 
 
+def options(argv):
+    """`[--method M] JOB.json`: the method and the argv left for the job reader."""
+    args = argv[1:]
+    method = "DOP853"
+    if len(args) >= 2 and args[0] == "--method":
+        method = args[1]
+        args = args[2:]
+        if method not in METHODS:
+            print(f"--method {method}: expected one of {', '.join(METHODS)}", file=sys.stderr)
+            sys.exit(2)
+    return method, [argv[0], *args]
+
+
 def main():
-    job = common.read_job(sys.argv)
+    method, argv = options(sys.argv)
+    job = common.read_job(argv)
     tol = job.get("tol")
     if tol is None or not (math.isfinite(tol) and tol > 0.0):
         print(f"the job's tol = {tol} must be positive (this client has a tolerance)", file=sys.stderr)
         sys.exit(2)
     rotor = common.build_model(job, Rotor)
     grid = common.grid_times(job["dt"], job["t_end"])
-    method = "DOP853"
     try:
         (y, events, nfev), seconds = common.timed(
             lambda: simulate(rotor, job["x0"], job["t_end"], grid, tol, method)

@@ -261,3 +261,57 @@ fn the_first_order_client_converges_and_passes_loose_at_h_1e_5() {
     );
     assert!(!digits[0].1 && digits[2].1, "{digits:?}");
 }
+
+/// The scipy peer handles the upper disc's static friction (a second switching surface), so
+/// it runs the Stribeck set: on st-u1.5-rest it passes strict at tol 1e-10 (measured 8.8
+/// digits over the 200 s scenario), and with scipy's stiff and multistep methods (`--method
+/// Radau|BDF|LSODA`) it passes loose at tol 1e-8 (measured 7.5, 4.6 and 5.9 digits). Each is
+/// a client of the same protocol, run over the scenario's own horizon and grid.
+#[test]
+fn scipy_peer_solves_the_stribeck_set_with_every_method() {
+    let o = options();
+    if !peer_present(&o.peers.python, "scipy") {
+        return;
+    }
+    let root = rotor_bench::workspace_root();
+    let peer = root.join("bench/peers/scipy_rotor.py");
+    let scene =
+        rotor_bench::SceneSpec::from_scenario(&root.join("fixtures/scenarios/st-u1.5-rest.toml"))
+            .unwrap();
+    let spec = |name: &str, method: &str| {
+        ClientSpec::parse(
+            &format!("{name}=python3 {} --method {method}", peer.display()),
+            &[],
+        )
+        .unwrap()
+    };
+    let strict = BenchOptions {
+        scenes: vec![scene.clone()],
+        clients: vec![spec("dop853", "DOP853")],
+        client_tols: vec![1e-10],
+        timeout: 60.0,
+        ..options()
+    };
+    let r = run(&strict, |m| eprintln!("{m}")).unwrap();
+    let p = &client(&r, "dop853").scenes[0].points[0];
+    assert_eq!(p.passes_strict, Some(true), "{p:?}");
+    let methods = [("radau", "Radau"), ("bdf", "BDF"), ("lsoda", "LSODA")];
+    let loose = BenchOptions {
+        scenes: vec![scene],
+        clients: methods.iter().map(|(n, m)| spec(n, m)).collect(),
+        client_tols: vec![1e-8],
+        timeout: 60.0,
+        ..options()
+    };
+    let r = run(&loose, |m| eprintln!("{m}")).unwrap();
+    for (name, method) in methods {
+        let c = client(&r, name);
+        assert_eq!(c.status, ClientStatus::Ran, "{name}: {:?}", c.reason);
+        let p = &c.scenes[0].points[0];
+        assert_eq!(p.passes_loose, Some(true), "{name}: {p:?}");
+        assert_eq!(
+            c.method.as_deref(),
+            Some(format!("solve_ivp {method}").as_str())
+        );
+    }
+}
