@@ -5,6 +5,7 @@ use rotor_event::{StopAt, flow};
 use rotor_model::{Model, State};
 use serde::Serialize;
 
+use crate::branch::Branch;
 use crate::continuation::{self, ContOptions, Continuer, End, Node};
 use crate::periodic::Shooter;
 use crate::points::{HOPF_CONDITION, PointKind, SpecialPoint, special_points, stuck_end_points};
@@ -442,12 +443,6 @@ pub fn diagram(model: &Model, opts: &DiagramOptions) -> Result<Diagram, BifError
         periodic,
         points,
     })
-}
-
-/// A followed branch and why each of its ends ended.
-pub(crate) struct Branch {
-    pub(crate) nodes: Vec<Node>,
-    pub(crate) ends: [End; 2],
 }
 
 /// Orients every tangent along the branch order.

@@ -17,7 +17,7 @@
 
 use rotor_model::{STEADY_QUANTITIES, Scenario};
 
-use crate::report::gate_scenario;
+use crate::gate::gate_scenario;
 use crate::run::ScenarioResult;
 use crate::solvers::{SolverKind, pair_name, pairs};
 pub use crate::stress::MAX_LOOSENESS;

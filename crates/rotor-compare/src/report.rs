@@ -6,10 +6,10 @@ use std::path::Path;
 
 use rotor_model::{Disc, Friction, Model, Params, Scenario, SteadyState};
 
-use crate::gate::{Failure, GateResult, check_pair};
+use crate::gate::{Failure, GateResult, gate_scenario};
 use crate::run::{ScenarioResult, solver_settings};
 use crate::snapshot::round_sig;
-use crate::solvers::{SolverKind, pair_name, pairs};
+use crate::solvers::SolverKind;
 use rotor_plot::{Panel, Series, render};
 
 /// One row of the report's gate table. A quantity that could not be measured (steady
@@ -42,46 +42,6 @@ fn unmeasured<'a>(gates: &[GateResult], fails: &'a [Failure]) -> Vec<&'a Failure
             .any(|g| g.pair == f.pair && g.measured.iter().any(|m| m.quantity == f.quantity))
     };
     fails.iter().filter(|f| !measured(f)).collect()
-}
-
-/// Gates every pair of one scenario. A solver error, or a pair without a tolerance in the
-/// scenario file, is a failure too.
-pub fn gate_scenario(r: &ScenarioResult) -> (Vec<GateResult>, Vec<Failure>) {
-    let sc = &r.scenario;
-    let mut gates = Vec::new();
-    let mut fails = Vec::new();
-    for run in &r.runs {
-        if let Err(e) = &run.result {
-            fails.push(Failure {
-                scenario: sc.name.clone(),
-                pair: run.kind.name().into(),
-                quantity: format!("run failed: {e}"),
-                diff: f64::INFINITY,
-                tol: 0.0,
-            });
-        }
-    }
-    let kinds: Vec<SolverKind> = r.runs.iter().map(|run| run.kind).collect();
-    for (a, b) in pairs(&kinds) {
-        let pair = pair_name(a, b);
-        let Some(tol) = sc.tolerance.get(&pair) else {
-            fails.push(Failure {
-                scenario: sc.name.clone(),
-                pair: pair.clone(),
-                quantity: "no [tolerance] stated for this pair in the scenario file".into(),
-                diff: f64::INFINITY,
-                tol: 0.0,
-            });
-            continue;
-        };
-        let (Some(ta), Some(tb)) = (r.traj(a), r.traj(b)) else {
-            continue;
-        };
-        let g = check_pair(&pair, ta, tb, sc.compare.transient, tol);
-        fails.extend(g.failures(&sc.name));
-        gates.push(g);
-    }
-    (gates, fails)
 }
 
 /// Writes `bytes` to `path`, or to standard output if `path` is `-` (as Unix tools do);

@@ -5,8 +5,8 @@ use std::path::Path;
 
 use std::sync::OnceLock;
 
+use rotor_compare::gate::gate_scenario;
 use rotor_compare::margins::{MAX_LOOSENESS, floor_violations, margins};
-use rotor_compare::report::gate_scenario;
 use rotor_compare::snapshot::snapshot;
 use rotor_compare::{SOLVERS, ScenarioResult, SolverKind, pair_name, pairs, run_scenario};
 use rotor_model::{Disc, Event, EventKind, Scenario, State, SteadyState, Trajectory};

@@ -6,8 +6,9 @@
 //! The solver is explicit Euler on the switch model (band η): first order, deliberately
 //! crude, with a coarse gate measured on the scenario.
 
+use rotor_compare::gate::gate_scenario;
 use rotor_compare::margins::margins;
-use rotor_compare::report::{gate_scenario, scenario_csv, scenario_svg};
+use rotor_compare::report::{scenario_csv, scenario_svg};
 use rotor_compare::snapshot::snapshot;
 use rotor_compare::solvers::Style;
 use rotor_compare::{Knob, SolverInfo, SolverKind, load_scenario_for, run_scenario_with};
