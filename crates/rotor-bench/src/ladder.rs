@@ -88,7 +88,7 @@ pub(crate) fn load(
     spec: &SceneSpec,
     progress: &mut impl FnMut(&str),
 ) -> Result<(Loaded, ReferenceReport), BenchError> {
-    let scenario = rotor_compare::load_scenario(&spec.scenario)?;
+    let scenario = rotor_solvers::load_scenario(&spec.scenario)?;
     let base = Scene {
         u: scenario.u,
         x0: scenario.x0,

@@ -99,7 +99,7 @@ pub const CRITERION: &str = "fastest point whose trace passes the scene's loose 
 pub fn profile(scenes: &[SceneReport], clients: &[ClientReport]) -> Profile {
     let fastest = |times: Vec<f64>| times.into_iter().reduce(f64::min);
     let mut entries: Vec<(String, Vec<Option<f64>>)> = Vec::new();
-    for kind in rotor_compare::SOLVERS {
+    for kind in rotor_solvers::SOLVERS {
         let times = scenes
             .iter()
             .map(|sc| {

@@ -224,7 +224,7 @@ fn the_first_order_client_converges_and_passes_loose_at_h_1e_5() {
         return;
     }
     let sc =
-        rotor_compare::load_scenario(&root.join("fixtures/scenarios/t1-u1.5-rest.toml")).unwrap();
+        rotor_solvers::load_scenario(&root.join("fixtures/scenarios/t1-u1.5-rest.toml")).unwrap();
     let r = rotor_compare::reference::read(&root.join("fixtures/reference"), &sc.name).unwrap();
     let digits: Vec<(f64, bool)> = [1e-3, 1e-4, 1e-5]
         .into_iter()

@@ -110,7 +110,7 @@ fn main() {
     let check_whole = time(n, || {
         run(&["check", s, "--trace", t, "--events", e, "--gate", "strict"])
     });
-    let sc = rotor_compare::load_scenario(&sc_path).unwrap();
+    let sc = rotor_solvers::load_scenario(&sc_path).unwrap();
     let r = rotor_compare::reference::read(&root.join("fixtures/reference"), &sc.name).unwrap();
     let check_in = time(n, || {
         let tr = rotor_compare::trace::read_trace(&trace, usize::MAX).unwrap();

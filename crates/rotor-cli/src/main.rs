@@ -8,8 +8,8 @@ mod out;
 
 use anyhow::{Context, Result, anyhow, bail};
 use clap::{Parser, Subcommand};
-use rotor_compare::SolverKind;
 use rotor_model::{Model, Params, State, SteadyState};
+use rotor_solvers::SolverKind;
 
 /// Two-disc rotor with set-valued friction: three independent solvers, cross-validated.
 #[derive(Parser, Debug)]
@@ -290,16 +290,16 @@ fn load_model(params: Option<&Path>) -> Result<Model> {
 }
 
 /// The file a path argument names: a path, or the name of a file in `fixtures/KIND`
-/// ([`rotor_compare::fixtures::resolve`]). A name that is neither is an error naming `flag`
+/// ([`rotor_solvers::fixtures::resolve`]). A name that is neither is an error naming `flag`
 /// and listing the names there.
 pub(crate) fn fixture_path(flag: &str, p: &Path, kind: &str) -> Result<PathBuf> {
     let dir = fixtures_dir().join(kind);
-    rotor_compare::fixtures::resolve(p, Some(&dir)).ok_or_else(|| {
+    rotor_solvers::fixtures::resolve(p, Some(&dir)).ok_or_else(|| {
         anyhow!(
             "{flag} {}: no such file, nor a name in {} (names: {})",
             p.display(),
             dir.canonicalize().unwrap_or_else(|_| dir.clone()).display(),
-            rotor_compare::fixtures::names(&dir).join(", ")
+            rotor_solvers::fixtures::names(&dir).join(", ")
         )
     })
 }
@@ -924,8 +924,8 @@ fn probe_section(
              Each probe:\n\n{}",
             rows.len(),
             bad.len(),
-            probes::probe_summary_markdown(&rows, &rotor_compare::SOLVERS),
-            probes::probe_table_markdown(&rows, &rotor_compare::SOLVERS)
+            probes::probe_summary_markdown(&rows, &rotor_solvers::SOLVERS),
+            probes::probe_table_markdown(&rows, &rotor_solvers::SOLVERS)
         ),
         files: Vec::new(),
         timings: format!(
@@ -996,7 +996,7 @@ fn compare(files: &[PathBuf], report: &Path, main_job: bool, threads: Option<usi
     };
     let scenarios = files
         .iter()
-        .map(|f| rotor_compare::load_scenario(f))
+        .map(|f| rotor_solvers::load_scenario(f))
         .collect::<Result<Vec<_>, _>>()?;
     // Report files are named after the scenarios: two of one name would overwrite each other.
     for (i, a) in scenarios.iter().enumerate() {
@@ -1025,7 +1025,7 @@ fn compare(files: &[PathBuf], report: &Path, main_job: bool, threads: Option<usi
             scenarios
                 .par_iter()
                 .map(|sc| {
-                    let r = rotor_compare::run_scenario(sc);
+                    let r = rotor_solvers::run_scenario(sc);
                     bar.inc(1);
                     r
                 })
@@ -1087,7 +1087,7 @@ fn compare(files: &[PathBuf], report: &Path, main_job: bool, threads: Option<usi
     out::line(format_args!(
         "{} scenarios, {} solvers, {:.2} s wall; report in {}",
         results.len(),
-        rotor_compare::SOLVERS.len(),
+        rotor_solvers::SOLVERS.len(),
         wall,
         report.display()
     ))?;

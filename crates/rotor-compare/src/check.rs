@@ -865,7 +865,7 @@ pub fn grade(
     events: Option<&EventsFile>,
     level: Level,
 ) -> Result<CheckReport, GradeError> {
-    let sc = crate::load_scenario(scenario)?;
+    let sc = rotor_solvers::load_scenario(scenario)?;
     let r = crate::reference::read(&crate::reference::dir_for(scenario), &sc.name)?;
     Ok(check(&sc, &r, trace, events, level)?)
 }

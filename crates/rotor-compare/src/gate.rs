@@ -10,8 +10,8 @@
 
 use rotor_model::{Disc, EventKind, PairTolerance, SteadyState, Trajectory};
 
-use crate::run::ScenarioResult;
-use crate::solvers::{SolverKind, pair_name, pairs};
+use rotor_solvers::run::ScenarioResult;
+use rotor_solvers::solvers::{SolverKind, pair_name, pairs};
 
 /// A measured difference with its gate.
 #[derive(Debug, Clone, PartialEq, serde::Serialize)]

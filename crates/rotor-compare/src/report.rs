@@ -7,10 +7,10 @@ use std::path::Path;
 use rotor_model::{Disc, Friction, Model, Params, Scenario, SteadyState};
 
 use crate::gate::{Failure, GateResult, gate_scenario};
-use crate::run::{ScenarioResult, solver_settings};
 use crate::snapshot::round_sig;
-use crate::solvers::SolverKind;
 use rotor_plot::{Panel, Series, render};
+use rotor_solvers::run::{ScenarioResult, solver_settings};
+use rotor_solvers::solvers::SolverKind;
 
 /// One row of the report's gate table. A quantity that could not be measured (steady
 /// states of different kinds, or missing: `diff` not finite) has no numbers, only its FAIL.

@@ -27,7 +27,7 @@ use std::collections::BTreeMap;
 use rotor_model::{Stats, SteadyState};
 use serde::Serialize;
 
-use crate::run::ScenarioResult;
+use rotor_solvers::run::ScenarioResult;
 
 /// One solver's record.
 #[derive(Debug, Clone, PartialEq, Serialize)]

@@ -19,7 +19,7 @@ use std::sync::atomic::{AtomicBool, Ordering};
 
 use rotor_model::{Model, Output, Params, Scene, State, SteadyState};
 
-use crate::solvers::SolverKind;
+use rotor_solvers::solvers::SolverKind;
 
 /// The header of a sweep file.
 pub const HEADER: &str = "u,p,kind,period,omega_l_max,omega_l_min,stick_time";
@@ -821,7 +821,7 @@ mod tests {
             Params::from_file(std::path::Path::new(stribeck)).unwrap(),
         ] {
             let u = 0.5 * base.get("lower.t_s").unwrap() / base.get("k_m").unwrap();
-            for solver in crate::solvers::SOLVERS {
+            for solver in rotor_solvers::solvers::SOLVERS {
                 let sw = Sweep {
                     base,
                     u: Axis::parse("--u", &format!("{u}:{}:2", 0.5 * u)).unwrap(),

@@ -10,8 +10,8 @@ use rotor_compare::reference::{self, Reference};
 use rotor_compare::trace::{
     EventsFile, Trace, parse_events, parse_trace, write_events, write_trace,
 };
-use rotor_compare::{SolverKind, load_scenario, run::scene_for};
 use rotor_model::{Scenario, Trajectory};
+use rotor_solvers::{SolverKind, load_scenario, run::scene_for};
 
 fn fixtures() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../../fixtures")

@@ -19,8 +19,8 @@ use rotor_compare::stress::{
     Gate, MAX_LOOSENESS, Measure, Outcome, Setting, StressCase, StressRow, cases, full_from_env,
     linear_exact, run_case, stress_table_markdown,
 };
-use rotor_compare::{SOLVERS, SolverKind};
 use rotor_model::{Event, LowerFriction, Model, Output, Params, Scene, State, UpperFriction};
+use rotor_solvers::{SOLVERS, SolverKind};
 
 #[test]
 fn stress_cases_finish_and_agree_within_their_gates() {

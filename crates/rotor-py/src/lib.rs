@@ -146,7 +146,7 @@ fn fixtures() -> Option<PathBuf> {
 }
 
 /// A file argument: a path, or the name of a file of `fixtures/<kind>/` (without `.toml`;
-/// [`rotor_compare::fixtures::resolve`]), else a `ValueError` naming the argument and what
+/// [`rotor_solvers::fixtures::resolve`]), else a `ValueError` naming the argument and what
 /// was looked for.
 fn resolve(arg: &str, value: &Bound<'_, PyAny>, kind: &str) -> PyResult<PathBuf> {
     let path: PathBuf = value.extract().map_err(|_| {
@@ -156,13 +156,13 @@ fn resolve(arg: &str, value: &Bound<'_, PyAny>, kind: &str) -> PyResult<PathBuf>
         ))
     })?;
     let dir = fixtures().map(|f| f.join(kind));
-    if let Some(p) = rotor_compare::fixtures::resolve(&path, dir.as_deref()) {
+    if let Some(p) = rotor_solvers::fixtures::resolve(&path, dir.as_deref()) {
         return Ok(p);
     }
     let name = path.to_string_lossy().into_owned();
     let known = dir
         .as_deref()
-        .map(|d| rotor_compare::fixtures::names(d).join(", "));
+        .map(|d| rotor_solvers::fixtures::names(d).join(", "));
     Err(PyValueError::new_err(match known {
         Some(known) => format!(
             "{arg} = {name:?}: no such file, nor a name in {} (names: {known})",
@@ -615,7 +615,7 @@ fn params<'py>(py: Python<'py>, source: Option<&Bound<'py, PyAny>>) -> PyResult<
 #[pyfunction]
 fn scenario<'py>(py: Python<'py>, source: &Bound<'py, PyAny>) -> PyResult<Bound<'py, PyDict>> {
     let path = resolve("scenario", source, "scenarios")?;
-    let sc = rotor_compare::load_scenario(&path).map_err(value_error)?;
+    let sc = rotor_solvers::load_scenario(&path).map_err(value_error)?;
     let d = PyDict::new(py);
     d.set_item("name", &sc.name)?;
     d.set_item("description", &sc.description)?;
