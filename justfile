@@ -18,7 +18,7 @@ proptest-long:
     PROPTEST_CASES=3000 cargo test --release -p rotor-compare --test stress stress_random
     PROPTEST_CASES=50000 cargo test --release -p rotor-moreau --test integration properties
     PROPTEST_CASES=20000 cargo test --release -p rotor-model --test fuzz_files
-    PROPTEST_CASES=2000 cargo test --release -p rotor-compare --test benchmark mutated
+    PROPTEST_CASES=2000 cargo test --release -p rotor-grade --test benchmark mutated
 # Work-precision benchmark with peers (scipy, Siconos when installed), into reports/bench/.
 bench:
     cargo run --release -- bench --json reports/bench/bench.json --svg reports/bench/bench.svg --csv reports/bench/bench.csv > reports/bench/bench.txt

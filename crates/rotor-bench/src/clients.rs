@@ -5,9 +5,9 @@
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-use rotor_compare::check::{CheckError, Level, check};
-use rotor_compare::gridmetrics::{StickExit, grid_metrics};
-use rotor_compare::trace::{read_events, read_trace};
+use rotor_grade::check::{CheckError, Level, check};
+use rotor_grade::gridmetrics::{StickExit, grid_metrics};
+use rotor_grade::trace::{read_events, read_trace};
 use rotor_model::SteadyState;
 use serde::{Deserialize, Serialize};
 

@@ -394,7 +394,7 @@ fn simulate(common: &Common, t_end: f64, dt: f64, csv_path: &Path) -> Result<()>
         .with_context(|| format!("solver {}", solver.name()))?;
     warn_inexact(&traj.stats);
     rotor_compare::report::write_output_with(csv_path, |w| {
-        rotor_compare::trace::write_trace_to(w, &traj.samples, dt)
+        rotor_grade::trace::write_trace_to(w, &traj.samples, dt)
     })
     .with_context(|| format!("{}: cannot write", csv_path.display()))?;
     Ok(())

@@ -1,13 +1,9 @@
 //! Cross-validation: identical scenarios through the three independent solvers, agreement
 //! gates on θ̇_u and θ̇_l, and the report.
 
-pub mod check;
 pub mod gate;
-pub mod gridmetrics;
 pub mod margins;
-pub mod orbit;
 pub mod probes;
-pub mod reference;
 pub mod report;
 pub mod request;
 pub mod settle;
@@ -16,7 +12,6 @@ pub mod steady;
 pub mod stress;
 pub mod sweep;
 pub mod threads;
-pub mod trace;
 
 pub use gate::{Failure, GateResult, Measured, check_pair};
 pub use settle::{SettleError, SettleOptions, Settled, Unsettled, settle};

@@ -132,12 +132,12 @@ pub fn scenario_csv(r: &ScenarioResult) -> String {
         .map(|k| r.traj(*k).map_or(0, |t| t.samples.len()))
         .min()
         .unwrap_or(0);
-    let digits = crate::trace::time_digits(r.scenario.compare.dt);
+    let digits = rotor_grade::trace::time_digits(r.scenario.compare.dt);
     let mut row: Vec<f64> = Vec::with_capacity(1 + 2 * kinds.len());
     for i in 0..n {
         row.clear();
         let t = r.traj(kinds[0]).map_or(0.0, |tr| tr.samples[i].t);
-        row.push(crate::trace::round_to(t, digits));
+        row.push(rotor_grade::trace::round_to(t, digits));
         for k in &kinds {
             let x = r.traj(*k).map(|tr| tr.samples[i].x).unwrap_or_default();
             row.push(round_sig(x[1], 12, 0.0));

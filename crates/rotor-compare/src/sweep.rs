@@ -545,7 +545,7 @@ pub fn merge(paths: &[PathBuf]) -> Result<Merged, SweepError> {
         };
         let f = std::fs::File::open(path).map_err(io)?;
         // Lines are capped: a file without line ends fails at once instead of being read whole.
-        let f = crate::trace::LineCap::new(f, crate::trace::MAX_LINE);
+        let f = rotor_grade::trace::LineCap::new(f, rotor_grade::trace::MAX_LINE);
         let mut lines = std::io::BufReader::new(f).lines();
         match lines.next() {
             Some(Ok(h)) if h == HEADER => {}

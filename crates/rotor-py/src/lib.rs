@@ -3,7 +3,7 @@
 //! A thin layer. Every check, run and answer belongs to the Rust crates: the inputs go through
 //! [`rotor_compare::request`] (the checks and the words of the command line), the runs through
 //! the solvers, [`rotor_compare::steady`], [`rotor_bifurcation::diagram`] and
-//! [`rotor_compare::check::grade`]. This file converts arguments and results, releases the GIL
+//! [`rotor_grade::check::grade`]. This file converts arguments and results, releases the GIL
 //! around every run, and maps errors to exceptions:
 //!
 //! * bad input → `ValueError` (a wrong type → `TypeError`), naming the argument or field and
@@ -22,10 +22,10 @@ use pyo3::prelude::*;
 use pyo3::types::{PyBool, PyDict, PyList, PyString};
 use rayon::prelude::*;
 use rotor_bifurcation::{BifError, DiagramOptions};
-use rotor_compare::check::{GradeError, Level};
 use rotor_compare::request::{BadInput, Request};
-use rotor_compare::trace::{EventsFile, Trace, disc_name, event_row, round_to, time_digits};
 use rotor_compare::{SettleError, SteadyAnswer, SteadyError};
+use rotor_grade::check::{GradeError, Level};
+use rotor_grade::trace::{EventsFile, Trace, disc_name, event_row, round_to, time_digits};
 use rotor_model::{Model, Params, Stats};
 
 pyo3::create_exception!(
@@ -106,7 +106,7 @@ fn from_bif(py: Python<'_>, e: BifError) -> PyErr {
 }
 
 fn from_grade(e: GradeError) -> PyErr {
-    use rotor_compare::reference::ReferenceError;
+    use rotor_grade::reference::ReferenceError;
     match e {
         GradeError::Scenario(rotor_model::ScenarioError::Io { .. })
         | GradeError::Reference(ReferenceError::File { .. }) => PyOSError::new_err(e.to_string()),
@@ -594,7 +594,7 @@ fn check<'py>(
         Trace::from_columns([&cols[0], &cols[1], &cols[2], &cols[3]]).map_err(value_error)?;
     let events = events.filter(|e| !e.is_none()).map(events_of).transpose()?;
     let report = detached(py, move || {
-        rotor_compare::check::grade(&path, &trace, events.as_ref(), level)
+        rotor_grade::check::grade(&path, &trace, events.as_ref(), level)
     })?
     .map_err(from_grade)?;
     to_py(py, &report)

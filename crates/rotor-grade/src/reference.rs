@@ -371,6 +371,8 @@ pub fn compute(sc: &Scenario) -> Result<Reference, ReferenceError> {
         transient: sc.compare.transient,
         trace_digits,
         error,
+        // The path as the published reference files record it: the test moved to
+        // crates/rotor-grade/tests/reference_verified.rs (issue 29); the files stay as they are.
         error_method: format!(
             "{ERROR_MARGIN} x the largest difference from the event-driven solver at tol \
              {CHECK_TOL:e} (trace: over every sample of the run; event_time: over the matched \

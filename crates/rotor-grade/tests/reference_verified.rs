@@ -24,7 +24,7 @@ use std::path::{Path, PathBuf};
 
 use independent::{Ev, Problem, Run, Tableau};
 use rayon::prelude::*;
-use rotor_compare::reference;
+use rotor_grade::reference;
 use rotor_model::{Disc, EventKind, OMEGA_L, OMEGA_U, Scenario, State, SteadyState};
 
 fn fixtures() -> PathBuf {
@@ -259,7 +259,7 @@ fn verify(case: &Case, r: &reference::Reference) -> (Vec<Check>, Vec<String>) {
 
     // Events, one to one: disc, kind, time.
     let kind_of = |k: EventKind| -> (Disc, &'static str) {
-        rotor_compare::trace::event_row(k).expect("a switch")
+        rotor_grade::trace::event_row(k).expect("a switch")
     };
     let n_ref = r.events.len();
     let same_sequence = |run: &Run| {
