@@ -11,7 +11,7 @@ lint:
 # Numerical stress, full form (1e5 s horizon, whole tolerance and step ladders; ~25 s).
 # `cargo test` runs the fast form; .ci/run runs both.
 stress:
-    ROTOR_STRESS=full cargo test --release -p rotor-compare stress -- --nocapture
+    ROTOR_STRESS=full cargo test --release -p rotor-compare -p rotor-steady stress -- --nocapture
 # Every property test with thousands of fresh draws (CI draws a fixed seed; run this before a
 # change lands and keep what it finds in the *.proptest-regressions files). About 10 minutes.
 proptest-long:

@@ -405,7 +405,7 @@ fn steady(common: &Common) -> Result<()> {
         .steady()
         .map_err(|e| anyhow!(e.as_flag()))?;
     let model = load_model(common.params.as_deref())?;
-    let answer = rotor_compare::steady(kind, &model, &scene, &opts)
+    let answer = rotor_steady::steady(kind, &model, &scene, &opts)
         .with_context(|| format!("solver {}", kind.name()))?;
     warn_inexact(&answer.stats);
     out::line(format_args!("{}", steady_json(&answer)))?;
@@ -869,13 +869,13 @@ fn plane_section(sets: &[(&str, &str, Params)]) -> Result<rotor_compare::report:
 }
 
 /// The report section with the steady states probed next to every special point of both
-/// diagrams (`rotor_compare::probes`, all solvers, all offsets, both starts).
+/// diagrams (`rotor_steady::probes`, all solvers, all offsets, both starts).
 fn probe_section(
     sets: &[(&str, &str, Params)],
     diagrams: &[rotor_bifurcation::Diagram],
 ) -> rotor_compare::report::Section {
     use rayon::prelude::*;
-    use rotor_compare::probes;
+    use rotor_steady::probes;
     let mut rows = Vec::new();
     for ((_, slug, p), d) in sets.iter().zip(diagrams) {
         let m = Model::new(*p);
@@ -1125,7 +1125,7 @@ fn progress_bar(len: u64, what: &str) -> indicatif::ProgressBar {
     bar
 }
 
-fn steady_json(st: &rotor_compare::SteadyAnswer) -> String {
+fn steady_json(st: &rotor_steady::SteadyAnswer) -> String {
     serde_json::to_string(st).expect("plain floats and strings serialize")
 }
 

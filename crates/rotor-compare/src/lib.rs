@@ -3,16 +3,11 @@
 
 pub mod gate;
 pub mod margins;
-pub mod probes;
 pub mod report;
 pub mod request;
-pub mod settle;
 pub mod snapshot;
-pub mod steady;
 pub mod stress;
 pub mod sweep;
 pub mod threads;
 
 pub use gate::{Failure, GateResult, Measured, check_pair};
-pub use settle::{SettleError, SettleOptions, Settled, Unsettled, settle};
-pub use steady::{SteadyAnswer, SteadyError, SteadyMethod, SteadyOptions, steady};

@@ -9,9 +9,9 @@
 
 use rotor_model::{Num, Output, Scene, State, Stats};
 
-use crate::SteadyOptions;
 use rotor_solvers::SolverKind;
 pub use rotor_solvers::input::{BadInput, check_number, solver_kind};
+use rotor_steady::SteadyOptions;
 
 /// A setting the chosen solver has no use for (the adaptive solvers take no step size,
 /// Moreau–Jean no tolerance): said so, not silently dropped.
@@ -147,7 +147,7 @@ impl Request<'_> {
         Ok((kind, self.scene(t_end, Output::Grid { dt })?))
     }
 
-    /// A steady-state computation ([`crate::steady`]): the solver, the scene and the options
+    /// A steady-state computation ([`rotor_steady::steady`]): the solver, the scene and the options
     /// (the event-driven solver's refinement runs at `tol`).
     pub fn steady(&self) -> Result<(SolverKind, Scene, SteadyOptions), BadInput> {
         let mut opts = SteadyOptions::default();

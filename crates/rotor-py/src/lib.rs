@@ -2,7 +2,7 @@
 //!
 //! A thin layer. Every check, run and answer belongs to the Rust crates: the inputs go through
 //! [`rotor_compare::request`] (the checks and the words of the command line), the runs through
-//! the solvers, [`rotor_compare::steady`], [`rotor_bifurcation::diagram`] and
+//! the solvers, [`rotor_steady::steady`], [`rotor_bifurcation::diagram`] and
 //! [`rotor_grade::check::grade`]. This file converts arguments and results, releases the GIL
 //! around every run, and maps errors to exceptions:
 //!
@@ -23,10 +23,10 @@ use pyo3::types::{PyBool, PyDict, PyList, PyString};
 use rayon::prelude::*;
 use rotor_bifurcation::{BifError, DiagramOptions};
 use rotor_compare::request::{BadInput, Request};
-use rotor_compare::{SettleError, SteadyAnswer, SteadyError};
 use rotor_grade::check::{GradeError, Level};
 use rotor_grade::trace::{EventsFile, Trace, disc_name, event_row, round_to, time_digits};
 use rotor_model::{Model, Params, Stats};
+use rotor_steady::{SettleError, SteadyAnswer, SteadyError};
 
 pyo3::create_exception!(
     rotorbench,
@@ -404,7 +404,7 @@ fn steady<'py>(
     let model = Model::new(params_of(params)?);
     warn_ignored(py, &req)?;
     let answer = detached(py, move || {
-        rotor_compare::steady(kind, &model, &scene, &opts)
+        rotor_steady::steady(kind, &model, &scene, &opts)
     })?
     .map_err(|e| from_steady(py, e))?;
     warn_inexact(py, &answer.stats)?;
@@ -469,7 +469,7 @@ fn sweep<'py>(
     let answers: Vec<Result<SteadyAnswer, SteadyError>> = detached(py, move || {
         pool.install(|| {
             jobs.par_iter()
-                .map(|(kind, scene, opts)| rotor_compare::steady(*kind, &model, scene, opts))
+                .map(|(kind, scene, opts)| rotor_steady::steady(*kind, &model, scene, opts))
                 .collect()
         })
     })?;
