@@ -226,7 +226,7 @@ fn validate(opts: &BenchOptions) -> Result<(), BenchError> {
 /// step, for a CLI's stderr).
 pub fn run(opts: &BenchOptions, mut progress: impl FnMut(&str)) -> Result<BenchReport, BenchError> {
     validate(opts)?;
-    let shard = opts.shard.unwrap_or(rotor_compare::sweep::Shard::ALL);
+    let shard = opts.shard.unwrap_or(rotor_jobs::sweep::Shard::ALL);
     let shard_info = opts.shard.map(|s| merge::shard_info(opts, s));
     // The first scene of the suite is shard 1's: the output levels, measured on it, are
     // that shard's alone, so that the joined report holds them once.

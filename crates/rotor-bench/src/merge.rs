@@ -28,7 +28,7 @@ use serde::{Deserialize, Deserializer, Serialize};
 use crate::clients::{ClientReport, ClientStatus, summary};
 use crate::options::BenchOptions;
 use crate::{BenchError, BenchReport, Environment};
-use rotor_compare::sweep::Shard;
+use rotor_jobs::sweep::Shard;
 
 /// A shard's record in its report: which shard of which suite.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]

@@ -117,7 +117,7 @@ pub struct BenchOptions {
     pub client_hs: Vec<f64>,
     /// Run only every N-th scene from the I-th (`rotor bench --shard I/N`, for job arrays);
     /// [`crate::merge`] joins the shards' reports.
-    pub shard: Option<rotor_compare::sweep::Shard>,
+    pub shard: Option<rotor_jobs::sweep::Shard>,
 }
 
 /// The workspace root: the current directory if it holds `fixtures/`, else the checkout

@@ -265,7 +265,7 @@ struct Common {
 }
 
 fn kind_by_name(name: &str) -> Result<SolverKind> {
-    rotor_compare::request::solver_kind(name).map_err(|e| anyhow!(e.as_flag()))
+    rotor_jobs::request::solver_kind(name).map_err(|e| anyhow!(e.as_flag()))
 }
 
 /// Prints a command's summary: on standard output, unless one of its outputs goes there
@@ -327,7 +327,7 @@ fn parse_x0(s: Option<&str>) -> Result<State> {
 
 /// Moreau–Jean steps whose step problem did not converge are answers to distrust: say so.
 fn warn_inexact(stats: &rotor_model::Stats) {
-    if let Some(w) = rotor_compare::request::inexact_warning(stats, "--h") {
+    if let Some(w) = rotor_jobs::request::inexact_warning(stats, "--h") {
         eprintln!("warning: {w}");
     }
 }
@@ -368,9 +368,9 @@ fn check(flag: &str, v: f64, ok: bool, what: &str) -> Result<()> {
 
 /// The checked request of `simulate` and `steady` (the same checks and words as the Python
 /// package's), with a warning for a setting the solver ignores.
-fn request(common: &Common) -> Result<rotor_compare::request::Request<'_>> {
+fn request(common: &Common) -> Result<rotor_jobs::request::Request<'_>> {
     let x = parse_x0(common.x0.as_deref())?;
-    let req = rotor_compare::request::Request {
+    let req = rotor_jobs::request::Request {
         solver: &common.solver,
         u: common.u,
         x0: [x[0], x[1], x[2]],
@@ -540,7 +540,7 @@ fn sweep(
     csv: &Path,
 ) -> Result<()> {
     use rayon::prelude::*;
-    use rotor_compare::sweep::{Axis, Shard, Sweep, SweepStart, run};
+    use rotor_jobs::sweep::{Axis, Shard, Sweep, SweepStart, run};
     let base = load_model(params)?.params;
     let (name, range) = param
         .split_once('=')
@@ -599,7 +599,7 @@ fn merge(shards: &[PathBuf], csv: &Path) -> Result<()> {
     if shards.is_empty() {
         bail!("merge: no shard files given");
     }
-    let merged = rotor_compare::sweep::merge(shards)?;
+    let merged = rotor_jobs::sweep::merge(shards)?;
     rotor_compare::report::write_output_with(csv, |w| merged.write_to(w))
         .with_context(|| format!("{}: cannot write", csv.display()))?;
     Ok(())
@@ -657,7 +657,7 @@ fn bench(
     }
     opts.shard = clients
         .shard
-        .map(rotor_compare::sweep::Shard::parse)
+        .map(rotor_jobs::sweep::Shard::parse)
         .transpose()?;
     let report = rotor_bench::run(&opts, |m| eprintln!("{m}"))?;
     write_bench(&report, [json, svg, csv])

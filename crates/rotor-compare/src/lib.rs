@@ -4,10 +4,8 @@
 pub mod gate;
 pub mod margins;
 pub mod report;
-pub mod request;
 pub mod snapshot;
 pub mod stress;
-pub mod sweep;
 pub mod threads;
 
 pub use gate::{Failure, GateResult, Measured, check_pair};

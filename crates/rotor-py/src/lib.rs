@@ -1,7 +1,7 @@
 //! `rotorbench._rotorbench`: the native module of the Python package (docs/python.md).
 //!
 //! A thin layer. Every check, run and answer belongs to the Rust crates: the inputs go through
-//! [`rotor_compare::request`] (the checks and the words of the command line), the runs through
+//! [`rotor_jobs::request`] (the checks and the words of the command line), the runs through
 //! the solvers, [`rotor_steady::steady`], [`rotor_bifurcation::diagram`] and
 //! [`rotor_grade::check::grade`]. This file converts arguments and results, releases the GIL
 //! around every run, and maps errors to exceptions:
@@ -22,9 +22,9 @@ use pyo3::prelude::*;
 use pyo3::types::{PyBool, PyDict, PyList, PyString};
 use rayon::prelude::*;
 use rotor_bifurcation::{BifError, DiagramOptions};
-use rotor_compare::request::{BadInput, Request};
 use rotor_grade::check::{GradeError, Level};
 use rotor_grade::trace::{EventsFile, Trace, disc_name, event_row, round_to, time_digits};
+use rotor_jobs::request::{BadInput, Request};
 use rotor_model::{Model, Params, Stats};
 use rotor_steady::{SettleError, SteadyAnswer, SteadyError};
 
@@ -127,7 +127,7 @@ fn warn_ignored(py: Python<'_>, req: &Request<'_>) -> PyResult<()> {
 }
 
 fn warn_inexact(py: Python<'_>, stats: &Stats) -> PyResult<()> {
-    match rotor_compare::request::inexact_warning(stats, "h") {
+    match rotor_jobs::request::inexact_warning(stats, "h") {
         Some(w) => warn(py, &w),
         None => Ok(()),
     }

@@ -4,7 +4,7 @@
 
 use rayon::prelude::*;
 use rotor_bifurcation::plane::{CurveKind, PlaneOptions, plane, solve_u};
-use rotor_compare::sweep::{Axis, Sweep, SweepStart};
+use rotor_jobs::sweep::{Axis, Sweep, SweepStart};
 use rotor_model::{Params, State};
 use rotor_solvers::SolverKind;
 

@@ -374,7 +374,7 @@ pub fn run(
     }
     if !stdout {
         let text = serde_json::to_string_pretty(&sweep.info(shard)).expect("plain fields");
-        crate::report::write_atomic(&info_path(out), text.as_bytes()).map_err(|e| {
+        rotor_compare::report::write_atomic(&info_path(out), text.as_bytes()).map_err(|e| {
             SweepError::File {
                 path: info_path(out),
                 message: e.to_string(),
