@@ -3,14 +3,14 @@
 //! `rotor simulate`/`rotor steady` and the Python package's `simulate`/`steady`/`sweep` take
 //! the same inputs (a solver name, u, x0, a horizon, tol or h). A [`Request`] turns them into
 //! a solver and a validated [`Scene`], and refuses bad input with a [`BadInput`] that names
-//! the input and the value. The reason is worded once, here and in [`rotor_solvers::input`];
-//! each front end only spells the name its own way ([`BadInput::as_flag`] for the command
-//! line, `name = value` for Python).
+//! the input and the value. The reason is worded once, here and in [`rotor_solvers`]
+//! ([`check_number`], [`solver_kind`]); each front end only spells the name its own way
+//! ([`BadInput::as_flag`] for the command line, `name = value` for Python).
 
 use rotor_model::{Num, Output, Scene, State, Stats};
 
 use rotor_solvers::SolverKind;
-pub use rotor_solvers::input::{BadInput, check_number, solver_kind};
+pub use rotor_solvers::{BadInput, check_number, solver_kind};
 use rotor_steady::SteadyOptions;
 
 /// A setting the chosen solver has no use for (the adaptive solvers take no step size,

@@ -3,11 +3,11 @@
 //! any run.
 
 pub mod fixtures;
-pub mod input;
+mod input;
 pub mod run;
 pub mod solvers;
 
-pub use input::BadInput;
+pub use input::{BadInput, check_number, solver_kind};
 pub use run::{RunResult, ScenarioResult, run_scenario, run_scenario_with, solver_settings};
 pub use solvers::{
     Knob, SOLVERS, SolverInfo, SolverKind, load_scenario, load_scenario_for, pair_name, pairs,

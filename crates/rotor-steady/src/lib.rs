@@ -3,8 +3,8 @@
 //! bifurcation diagram's special points.
 
 pub mod probes;
-pub mod settle;
-pub mod steady;
+mod settle;
+mod steady;
 
 pub use settle::{SettleError, SettleOptions, Settled, Unsettled, settle};
 pub use steady::{SteadyAnswer, SteadyError, SteadyMethod, SteadyOptions, steady};
