@@ -1,4 +1,4 @@
-//! Gating a scenario's results and writing the report (CSV, SVG, README.md), atomically.
+//! Writing the report (CSV, SVG, README.md), atomically; the gates it shows are [`crate::gate`]'s.
 
 use std::fmt::Write as _;
 use std::io::Write as _;
