@@ -388,13 +388,13 @@ pub fn diagram(model: &Model, opts: &DiagramOptions) -> Result<Diagram, BifError
         points.extend(special_points(&cont, &b.nodes, opts.point_tol));
     }
     // Criticality of each Hopf point: the sign of its first Lyapunov coefficient (Kuznetsov's
-    // formula, `plane::first_lyapunov`). The stability of the computed cycles at the branch end
+    // formula, `equilibria::first_lyapunov`). The stability of the computed cycles at the branch end
     // next to it is reported beside it: at amplitudes of 0.02-0.08 rad/s it is a weaker witness
     // (Table 1's H2 has l1 = 1.7e-3), so it is shown, not used.
     for p in points.iter_mut().filter(|p| p.kind == PointKind::Hopf) {
         let l1 = p
             .omega
-            .and_then(|w| crate::plane::first_lyapunov(model, w))
+            .and_then(|w| crate::equilibria::first_lyapunov(model, w))
             .filter(|l| l.is_finite());
         p.l1 = l1;
         let cycles = hopfs
