@@ -81,11 +81,11 @@ impl ClientPoint {
 pub struct Ratio {
     pub against: SolverKind,
     /// `"steady_rel"` or `"transient_max"`.
-    #[serde(deserialize_with = "crate::merge::static_str")]
-    pub error_kind: crate::merge::Word,
+    #[serde(deserialize_with = "crate::word::static_str")]
+    pub error_kind: crate::word::Word,
     /// `"in_process"` (the client's `solve_seconds`) or `"whole_process"` (its wall time).
-    #[serde(deserialize_with = "crate::merge::static_str")]
-    pub time: crate::merge::Word,
+    #[serde(deserialize_with = "crate::word::static_str")]
+    pub time: crate::word::Word,
     pub setting: f64,
     pub error: f64,
     pub client_seconds: f64,
@@ -163,8 +163,8 @@ pub struct ClientReport {
     pub peer: bool,
     pub fixed_step: bool,
     /// `"tol"` or `"h"`.
-    #[serde(deserialize_with = "crate::merge::static_str")]
-    pub setting_name: crate::merge::Word,
+    #[serde(deserialize_with = "crate::word::static_str")]
+    pub setting_name: crate::word::Word,
     pub status: ClientStatus,
     /// Why it was skipped or failed.
     pub reason: Option<String>,

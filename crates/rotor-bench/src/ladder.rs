@@ -54,8 +54,8 @@ pub struct ReferenceReport {
 pub struct LadderPoint {
     pub solver: SolverKind,
     /// `tol` or `h`.
-    #[serde(deserialize_with = "crate::merge::static_str")]
-    pub setting_name: crate::merge::Word,
+    #[serde(deserialize_with = "crate::word::static_str")]
+    pub setting_name: crate::word::Word,
     pub setting: f64,
     /// `None` if the run failed.
     pub timing: Option<Timing>,

@@ -39,6 +39,7 @@ mod peers;
 pub mod profile;
 pub mod protocol;
 mod report;
+mod word;
 
 use rotor_model::{Model, Output, ScenarioError, Scene, SolveError};
 use serde::{Deserialize, Serialize};
