@@ -11,14 +11,14 @@ lint:
 # Numerical stress, full form (1e5 s horizon, whole tolerance and step ladders; ~25 s).
 # `cargo test` runs the fast form; .ci/run runs both.
 stress:
-    ROTOR_STRESS=full cargo test --release -p rotor-compare stress -- --nocapture
+    ROTOR_STRESS=full cargo test --release -p rotor-compare -p rotor-steady stress -- --nocapture
 # Every property test with thousands of fresh draws (CI draws a fixed seed; run this before a
 # change lands and keep what it finds in the *.proptest-regressions files). About 10 minutes.
 proptest-long:
     PROPTEST_CASES=3000 cargo test --release -p rotor-compare --test stress stress_random
     PROPTEST_CASES=50000 cargo test --release -p rotor-moreau --test integration properties
     PROPTEST_CASES=20000 cargo test --release -p rotor-model --test fuzz_files
-    PROPTEST_CASES=2000 cargo test --release -p rotor-compare --test benchmark mutated
+    PROPTEST_CASES=2000 cargo test --release -p rotor-grade --test benchmark mutated
 # Work-precision benchmark with peers (scipy, Siconos when installed), into reports/bench/.
 bench:
     cargo run --release -- bench --json reports/bench/bench.json --svg reports/bench/bench.svg --csv reports/bench/bench.csv > reports/bench/bench.txt

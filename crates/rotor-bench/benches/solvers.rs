@@ -6,7 +6,7 @@
 //! `cargo bench -p rotor-bench` (all), `cargo bench -p rotor-bench -- output` (one group).
 //! The work-precision ladders and the peers are in `rotor_bench::run`, not here.
 
-use rotor_compare::SOLVERS;
+use rotor_solvers::SOLVERS;
 use std::hint::black_box;
 use std::time::Duration;
 

@@ -5,9 +5,9 @@
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-use rotor_compare::check::{CheckError, Level, check};
-use rotor_compare::gridmetrics::{StickExit, grid_metrics};
-use rotor_compare::trace::{read_events, read_trace};
+use rotor_grade::check::{CheckError, Level, check};
+use rotor_grade::gridmetrics::{StickExit, grid_metrics};
+use rotor_grade::trace::{read_events, read_trace};
 use rotor_model::SteadyState;
 use serde::{Deserialize, Serialize};
 
@@ -81,11 +81,11 @@ impl ClientPoint {
 pub struct Ratio {
     pub against: SolverKind,
     /// `"steady_rel"` or `"transient_max"`.
-    #[serde(deserialize_with = "crate::merge::static_str")]
-    pub error_kind: crate::merge::Word,
+    #[serde(deserialize_with = "crate::word::static_str")]
+    pub error_kind: crate::word::Word,
     /// `"in_process"` (the client's `solve_seconds`) or `"whole_process"` (its wall time).
-    #[serde(deserialize_with = "crate::merge::static_str")]
-    pub time: crate::merge::Word,
+    #[serde(deserialize_with = "crate::word::static_str")]
+    pub time: crate::word::Word,
     pub setting: f64,
     pub error: f64,
     pub client_seconds: f64,
@@ -163,8 +163,8 @@ pub struct ClientReport {
     pub peer: bool,
     pub fixed_step: bool,
     /// `"tol"` or `"h"`.
-    #[serde(deserialize_with = "crate::merge::static_str")]
-    pub setting_name: crate::merge::Word,
+    #[serde(deserialize_with = "crate::word::static_str")]
+    pub setting_name: crate::word::Word,
     pub status: ClientStatus,
     /// Why it was skipped or failed.
     pub reason: Option<String>,

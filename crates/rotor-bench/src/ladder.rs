@@ -1,9 +1,9 @@
 //! The reference run of a scene and each solver's ladder of settings, every point timed and
 //! measured against the reference.
 
-use rotor_compare::check::{Level, check};
-use rotor_compare::gridmetrics::{StickExit, grid_metrics};
-use rotor_compare::reference::Reference;
+use rotor_grade::check::{Level, check};
+use rotor_grade::gridmetrics::{StickExit, grid_metrics};
+use rotor_grade::reference::Reference;
 use rotor_model::{Output, Scenario, Scene, Stats, SteadyState};
 use serde::{Deserialize, Serialize};
 
@@ -54,8 +54,8 @@ pub struct ReferenceReport {
 pub struct LadderPoint {
     pub solver: SolverKind,
     /// `tol` or `h`.
-    #[serde(deserialize_with = "crate::merge::static_str")]
-    pub setting_name: crate::merge::Word,
+    #[serde(deserialize_with = "crate::word::static_str")]
+    pub setting_name: crate::word::Word,
     pub setting: f64,
     /// `None` if the run failed.
     pub timing: Option<Timing>,
@@ -75,7 +75,7 @@ pub(crate) struct Loaded {
     pub(crate) base: Scene,
     pub(crate) refd: RefData,
     /// The reference's metrics read off its grid as a trace's are
-    /// ([`rotor_compare::gridmetrics`]): what a trace-only client's errors are measured
+    /// ([`rotor_grade::gridmetrics`]): what a trace-only client's errors are measured
     /// against, so that the reconstruction's own error cancels.
     pub(crate) grid_refd: RefData,
     /// The scene as a scenario (its horizon and windows) and the reference run as a
@@ -88,7 +88,7 @@ pub(crate) fn load(
     spec: &SceneSpec,
     progress: &mut impl FnMut(&str),
 ) -> Result<(Loaded, ReferenceReport), BenchError> {
-    let scenario = rotor_compare::load_scenario(&spec.scenario)?;
+    let scenario = rotor_solvers::load_scenario(&spec.scenario)?;
     let base = Scene {
         u: scenario.u,
         x0: scenario.x0,
@@ -244,7 +244,7 @@ pub(crate) fn ladders(
 /// grades an external trace.
 fn passes_loose(l: &Loaded, tr: &rotor_model::Trajectory) -> bool {
     let (sc, r) = &l.view;
-    let trace = rotor_compare::trace::Trace::of_run("run", tr.samples.clone());
-    let events = rotor_compare::trace::EventsFile::of_run("run", &tr.events);
+    let trace = rotor_grade::trace::Trace::of_run("run", tr.samples.clone());
+    let events = rotor_grade::trace::EventsFile::of_run("run", &tr.events);
     check(sc, r, &trace, Some(&events), Level::Loose).is_ok_and(|c| c.passed)
 }

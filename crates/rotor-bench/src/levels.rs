@@ -13,8 +13,8 @@ use crate::options::{BenchOptions, SolverKind};
 #[derive(Debug, Clone, Serialize, Deserialize)]
 pub struct OutputLevel {
     pub solver: SolverKind,
-    #[serde(deserialize_with = "crate::merge::static_str")]
-    pub setting_name: crate::merge::Word,
+    #[serde(deserialize_with = "crate::word::static_str")]
+    pub setting_name: crate::word::Word,
     pub setting: f64,
     /// `Output::Metrics`: skips whole periods once the cycle has converged.
     pub metrics_only: Timing,

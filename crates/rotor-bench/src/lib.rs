@@ -39,6 +39,7 @@ mod peers;
 pub mod profile;
 pub mod protocol;
 mod report;
+mod word;
 
 use rotor_model::{Model, Output, ScenarioError, Scene, SolveError};
 use serde::{Deserialize, Serialize};
@@ -214,7 +215,7 @@ fn validate(opts: &BenchOptions) -> Result<(), BenchError> {
     }
     let mut names: Vec<&str> = opts.clients.iter().map(|c| c.name.as_str()).collect();
     names.extend(["scipy", "siconos"]);
-    names.extend(rotor_compare::SOLVERS.map(SolverKind::name));
+    names.extend(rotor_solvers::SOLVERS.map(SolverKind::name));
     names.sort_unstable();
     if let Some(w) = names.windows(2).find(|w| w[0] == w[1]) {
         return bad(format!("two solvers or clients named {:?}", w[0]));
@@ -226,7 +227,7 @@ fn validate(opts: &BenchOptions) -> Result<(), BenchError> {
 /// step, for a CLI's stderr).
 pub fn run(opts: &BenchOptions, mut progress: impl FnMut(&str)) -> Result<BenchReport, BenchError> {
     validate(opts)?;
-    let shard = opts.shard.unwrap_or(rotor_compare::sweep::Shard::ALL);
+    let shard = opts.shard.unwrap_or(rotor_jobs::sweep::Shard::ALL);
     let shard_info = opts.shard.map(|s| merge::shard_info(opts, s));
     // The first scene of the suite is shard 1's: the output levels, measured on it, are
     // that shard's alone, so that the joined report holds them once.
@@ -317,7 +318,7 @@ pub fn run(opts: &BenchOptions, mut progress: impl FnMut(&str)) -> Result<BenchR
 /// The model and base scene of a scene spec (for benches and tests that drive the solvers
 /// directly): the spec's horizon, full trace on its grid, metrics on.
 pub fn scene_of(spec: &SceneSpec) -> Result<(Model, Scene), BenchError> {
-    let sc = rotor_compare::load_scenario(&spec.scenario)?;
+    let sc = rotor_solvers::load_scenario(&spec.scenario)?;
     Ok((
         sc.model,
         Scene {

@@ -23,12 +23,13 @@
 //! peers, clients) or of different counts N, a shard missing or given twice, a shard holding
 //! the wrong number of scenes.
 
-use serde::{Deserialize, Deserializer, Serialize};
+use serde::{Deserialize, Serialize};
 
 use crate::clients::{ClientReport, ClientStatus, summary};
 use crate::options::BenchOptions;
+pub use crate::word::Word;
 use crate::{BenchError, BenchReport, Environment};
-use rotor_compare::sweep::Shard;
+use rotor_jobs::sweep::Shard;
 
 /// A shard's record in its report: which shard of which suite.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -86,30 +87,6 @@ pub(crate) fn shard_info(opts: &BenchOptions, s: Shard) -> ShardInfo {
             "client_hs": opts.client_hs,
         }),
     }
-}
-
-/// A `&'static str` field of the report (a setting's name, a ratio's kind). Named, so that
-/// serde's derive reads it with [`static_str`] instead of borrowing it from the input.
-pub type Word = &'static str;
-
-/// Reads a `&'static str` field of a report back (a setting's name, a ratio's kind): the
-/// known words are shared; any other (a report of another version) is kept for the life of
-/// the process, which reads a handful of reports.
-pub(crate) fn static_str<'de, D: Deserializer<'de>>(d: D) -> Result<&'static str, D::Error> {
-    const KNOWN: [&str; 7] = [
-        "tol",
-        "h",
-        "steady_rel",
-        "transient_max",
-        "in_process",
-        "whole_process",
-        crate::profile::CRITERION,
-    ];
-    let s = String::deserialize(d)?;
-    Ok(KNOWN
-        .into_iter()
-        .find(|k| *k == s)
-        .unwrap_or_else(|| Box::leak(s.into_boxed_str())))
 }
 
 fn refuse(m: String) -> BenchError {

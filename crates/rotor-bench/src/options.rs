@@ -2,8 +2,8 @@
 
 use std::path::{Path, PathBuf};
 
-use rotor_compare::SOLVERS;
-pub use rotor_compare::SolverKind;
+use rotor_solvers::SOLVERS;
+pub use rotor_solvers::SolverKind;
 
 /// One benchmark scene: a scenario file, a horizon, and the windows the errors are read on.
 #[derive(Debug, Clone, PartialEq)]
@@ -37,7 +37,7 @@ impl SceneSpec {
     /// its grid. The error names the file when it compares no transient or no steady state
     /// (the benchmark measures both).
     pub fn from_scenario(path: &Path) -> Result<SceneSpec, crate::BenchError> {
-        let sc = rotor_compare::load_scenario(path)?;
+        let sc = rotor_solvers::load_scenario(path)?;
         let (Some(transient), Some(metrics_from)) = (sc.compare.transient, sc.compare.steady_from)
         else {
             return Err(crate::BenchError::Options(format!(
@@ -90,7 +90,7 @@ pub struct BenchOptions {
     /// Scenes; the first one is also used for the output-level ratios and the peers.
     pub scenes: Vec<SceneSpec>,
     /// Each solver with its ladder of settings (tolerances or steps), in report order;
-    /// default: every solver of `rotor_compare::SOLVERS` with its own ladder.
+    /// default: every solver of `rotor_solvers::SOLVERS` with its own ladder.
     pub ladders: Vec<(SolverKind, Vec<f64>)>,
     /// Tolerance of the reference run (event-driven solver).
     pub reference_tol: f64,
@@ -117,7 +117,7 @@ pub struct BenchOptions {
     pub client_hs: Vec<f64>,
     /// Run only every N-th scene from the I-th (`rotor bench --shard I/N`, for job arrays);
     /// [`crate::merge`] joins the shards' reports.
-    pub shard: Option<rotor_compare::sweep::Shard>,
+    pub shard: Option<rotor_jobs::sweep::Shard>,
     /// Where to keep every external run's files (`DIR/CLIENT/SCENE/runK`: job.json,
     /// trace.csv, events.csv, stderr.txt); `None`: a temporary directory, deleted after.
     pub keep: Option<std::path::PathBuf>,

@@ -12,6 +12,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::clients::ClientReport;
 use crate::ladder::SceneReport;
+pub use crate::word::CRITERION;
 
 /// One solver or client in the profile.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -26,8 +27,8 @@ pub struct ProfileEntry {
 /// The performance profile.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Profile {
-    #[serde(deserialize_with = "crate::merge::static_str")]
-    pub criterion: crate::merge::Word,
+    #[serde(deserialize_with = "crate::word::static_str")]
+    pub criterion: crate::word::Word,
     pub scenes: Vec<String>,
     pub entries: Vec<ProfileEntry>,
 }
@@ -89,17 +90,11 @@ impl Profile {
     }
 }
 
-/// The profile of the Rust solvers and every client that ran.
-/// What "solved" and "time" mean in the profile.
-pub const CRITERION: &str = "fastest point whose trace passes the scene's loose gate \
-                             (event-moreau tolerances, as rotor check); in-process time \
-                             (solve_seconds, else wall)";
-
 /// The profile of the solvers and clients over the scenes.
 pub fn profile(scenes: &[SceneReport], clients: &[ClientReport]) -> Profile {
     let fastest = |times: Vec<f64>| times.into_iter().reduce(f64::min);
     let mut entries: Vec<(String, Vec<Option<f64>>)> = Vec::new();
-    for kind in rotor_compare::SOLVERS {
+    for kind in rotor_solvers::SOLVERS {
         let times = scenes
             .iter()
             .map(|sc| {

@@ -146,7 +146,7 @@ pub fn split_words(s: &str) -> Result<Vec<String>, String> {
 /// The job file of one run (BENCHMARK.md).
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Job {
-    /// The suite's version ([`rotor_compare::check::BENCHMARK`]).
+    /// The suite's version ([`rotor_grade::check::BENCHMARK`]).
     pub benchmark: &'static str,
     pub scenario: String,
     /// Every field of the parameter file, friction family names included.
@@ -174,7 +174,7 @@ impl Job {
         events: PathBuf,
     ) -> Job {
         Job {
-            benchmark: rotor_compare::check::BENCHMARK,
+            benchmark: rotor_grade::check::BENCHMARK,
             scenario: sc.name.clone(),
             params: serde_json::to_value(sc.model.params).expect("plain numbers and strings"),
             u: sc.u,
@@ -198,7 +198,7 @@ impl Job {
         events: PathBuf,
     ) -> Result<Job, crate::BenchError> {
         let spec = crate::SceneSpec::from_scenario(path)?;
-        let sc = rotor_compare::load_scenario(path)?;
+        let sc = rotor_solvers::load_scenario(path)?;
         Ok(Job::new(
             &sc, spec.t_end, spec.dt, fixed_step, setting, trace, events,
         ))

@@ -1,6 +1,6 @@
 //! The report as a text table, JSON, CSV and a work-precision SVG.
 
-use rotor_compare::SOLVERS;
+use rotor_solvers::SOLVERS;
 use std::fmt::Write;
 
 use rotor_plot::{Panel, Series, render};

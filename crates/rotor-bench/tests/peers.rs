@@ -204,7 +204,7 @@ fn the_regularised_client_fails_the_gates_with_the_quantities_named() {
 /// the loose level at h = 1e-5 with its events graded.
 #[test]
 fn the_first_order_client_converges_and_passes_loose_at_h_1e_5() {
-    use rotor_compare::check::{Level, check};
+    use rotor_grade::check::{Level, check};
     let root = rotor_bench::workspace_root();
     let dir = std::env::temp_dir().join(format!("rotor-first-order-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
@@ -224,8 +224,8 @@ fn the_first_order_client_converges_and_passes_loose_at_h_1e_5() {
         return;
     }
     let sc =
-        rotor_compare::load_scenario(&root.join("fixtures/scenarios/t1-u1.5-rest.toml")).unwrap();
-    let r = rotor_compare::reference::read(&root.join("fixtures/reference"), &sc.name).unwrap();
+        rotor_solvers::load_scenario(&root.join("fixtures/scenarios/t1-u1.5-rest.toml")).unwrap();
+    let r = rotor_grade::reference::read(&root.join("fixtures/reference"), &sc.name).unwrap();
     let digits: Vec<(f64, bool)> = [1e-3, 1e-4, 1e-5]
         .into_iter()
         .map(|h| {
@@ -245,8 +245,8 @@ fn the_first_order_client_converges_and_passes_loose_at_h_1e_5() {
                 .status()
                 .unwrap();
             assert!(st.success());
-            let t = rotor_compare::trace::read_trace(&job.trace, usize::MAX).unwrap();
-            let e = rotor_compare::trace::read_events(&job.events).unwrap();
+            let t = rotor_grade::trace::read_trace(&job.trace, usize::MAX).unwrap();
+            let e = rotor_grade::trace::read_events(&job.events).unwrap();
             let rep = check(&sc, &r, &t, Some(&e), Level::Loose).unwrap();
             assert!(rep.not_graded.is_empty());
             (rep.digits, rep.passed)

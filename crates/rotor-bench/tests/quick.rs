@@ -3,7 +3,7 @@
 //! No assertion here is about speed.
 
 use rotor_bench::{BenchOptions, BenchReport, SolverKind, run};
-use rotor_compare::SOLVERS;
+use rotor_solvers::SOLVERS;
 
 fn quick() -> BenchReport {
     let mut lines = Vec::new();

@@ -5,6 +5,7 @@ use rotor_event::{StopAt, flow};
 use rotor_model::{Model, State};
 use serde::Serialize;
 
+use crate::branch::Branch;
 use crate::continuation::{self, ContOptions, Continuer, End, Node};
 use crate::periodic::Shooter;
 use crate::points::{HOPF_CONDITION, PointKind, SpecialPoint, special_points, stuck_end_points};
@@ -387,13 +388,13 @@ pub fn diagram(model: &Model, opts: &DiagramOptions) -> Result<Diagram, BifError
         points.extend(special_points(&cont, &b.nodes, opts.point_tol));
     }
     // Criticality of each Hopf point: the sign of its first Lyapunov coefficient (Kuznetsov's
-    // formula, `plane::first_lyapunov`). The stability of the computed cycles at the branch end
+    // formula, `equilibria::first_lyapunov`). The stability of the computed cycles at the branch end
     // next to it is reported beside it: at amplitudes of 0.02-0.08 rad/s it is a weaker witness
     // (Table 1's H2 has l1 = 1.7e-3), so it is shown, not used.
     for p in points.iter_mut().filter(|p| p.kind == PointKind::Hopf) {
         let l1 = p
             .omega
-            .and_then(|w| crate::plane::first_lyapunov(model, w))
+            .and_then(|w| crate::equilibria::first_lyapunov(model, w))
             .filter(|l| l.is_finite());
         p.l1 = l1;
         let cycles = hopfs
@@ -442,12 +443,6 @@ pub fn diagram(model: &Model, opts: &DiagramOptions) -> Result<Diagram, BifError
         periodic,
         points,
     })
-}
-
-/// A followed branch and why each of its ends ended.
-pub(crate) struct Branch {
-    pub(crate) nodes: Vec<Node>,
-    pub(crate) ends: [End; 2],
 }
 
 /// Orients every tangent along the branch order.

@@ -27,6 +27,7 @@
 //! the measurements are in `reports/measurements.md`.
 
 pub mod arc;
+mod branch;
 pub mod continuation;
 mod diagram;
 pub mod equilibria;

@@ -32,12 +32,13 @@
 //! nonsmooth point is not settled the point only records where the curves meet and what was
 //! seen; no normal form is claimed.
 
-use nalgebra::{Complex, Matrix3, Vector3};
-use rotor_model::{DiscMode, Mode, Model, Output, Params, Scene, Solver, State, SteadyState};
+use nalgebra::{Matrix3, Vector3};
+use rotor_model::{Model, Output, Params, Scene, Solver, State, SteadyState};
 use serde::Serialize;
 
 use crate::arc::{ArcEnd, ArcOptions, follow};
 use crate::continuation::{ContOptions, Continuer, Multipliers};
+pub use crate::equilibria::first_lyapunov;
 use crate::feigin::{Feigin, GrazingType};
 use crate::periodic::Shooter;
 use crate::{BifError, DiagramOptions, PointKind, diagram, grazing};
@@ -283,76 +284,6 @@ pub fn validate(base: &Params, opts: &PlaneOptions) -> Result<(), BifError> {
         })?;
     }
     Ok(())
-}
-
-/// The first Lyapunov coefficient of the Hopf point of the slipping equilibrium at velocity
-/// `omega` (Kuznetsov, *Elements of Applied Bifurcation Theory*, eq. (3.20)):
-///
-/// ```text
-/// l1 = Re[⟨p, C(q,q,q̄)⟩ − 2⟨p, B(q, A⁻¹B(q,q̄))⟩ + ⟨p, B(q̄, (2iβ − A)⁻¹B(q,q))⟩] / (2β),
-/// ```
-///
-/// with `Aq = iβq`, `Aᵀp = −iβp`, `⟨p, q⟩ = p̄ᵀq = 1`. In the slip field only the friction
-/// torques are nonlinear, each in its own disc's velocity, so B and C are diagonal:
-/// `B(x, y)_i = f_i'' x_i y_i`, `C(x, y, z)_i = f_i''' x_i y_i z_i` for the two velocity rows,
-/// with `f_i'' = −T_fi''(ω)/J_i` (central differences of the branch torque, steps 1e-3 and
-/// 2e-3 of 1 + |ω|: the torque is analytic on the branch). `None` if there is no complex pair.
-pub fn first_lyapunov(model: &Model, omega: f64) -> Option<f64> {
-    let e = model.slip_equilibrium_at(omega);
-    let mode = Mode {
-        upper: DiscMode::SlipPos,
-        lower: DiscMode::SlipPos,
-    };
-    let a = model.jacobian(&e.state(), e.u, mode);
-    let beta = crate::equilibria::complex_pair(model, omega)?.im;
-    let c = |v: f64| Complex::new(v, 0.0);
-    let ac: Matrix3<Complex<f64>> = a.map(c);
-    let ib = Complex::new(0.0, beta);
-    let null = |m: Matrix3<Complex<f64>>| -> Vector3<Complex<f64>> {
-        let r = |i: usize| Vector3::new(m[(i, 0)], m[(i, 1)], m[(i, 2)]);
-        [r(0).cross(&r(1)), r(0).cross(&r(2)), r(1).cross(&r(2))]
-            .into_iter()
-            .max_by(|x, y| x.norm().total_cmp(&y.norm()))
-            .expect("three candidates")
-    };
-    let id = Matrix3::<Complex<f64>>::identity();
-    let q = null(ac - id * ib);
-    let q = q / c(q.norm());
-    let p = null(ac.transpose() + id * ib);
-    let dot = |x: &Vector3<Complex<f64>>, y: &Vector3<Complex<f64>>| {
-        x.iter()
-            .zip(y.iter())
-            .map(|(a, b)| a.conj() * b)
-            .sum::<Complex<f64>>()
-    };
-    let pq = dot(&p, &q);
-    let p = p / pq.conj();
-    // Second and third derivatives of the two velocity rows of f = rhs(x) in ω_u, ω_l.
-    let d = |disc: rotor_model::Disc, j: f64| {
-        let fr = model.friction(disc);
-        let w = e.omega;
-        let t = |x: f64| fr.torque(x, 1.0);
-        let h2 = 1e-3 * (1.0 + w.abs());
-        let second = (t(w + h2) - 2.0 * t(w) + t(w - h2)) / (h2 * h2);
-        let h3 = 2e-3 * (1.0 + w.abs());
-        let third = (t(w + 2.0 * h3) - 2.0 * t(w + h3) + 2.0 * t(w - h3) - t(w - 2.0 * h3))
-            / (2.0 * h3 * h3 * h3);
-        (-second / j, -third / j)
-    };
-    let (bu, cu) = d(rotor_model::Disc::Upper, model.params.j_u);
-    let (bl, cl) = d(rotor_model::Disc::Lower, model.params.j_l);
-    let b = |x: &Vector3<Complex<f64>>, y: &Vector3<Complex<f64>>| {
-        Vector3::new(c(0.0), x[1] * y[1] * bu, x[2] * y[2] * bl)
-    };
-    let cc = |x: &Vector3<Complex<f64>>, y: &Vector3<Complex<f64>>, z: &Vector3<Complex<f64>>| {
-        Vector3::new(c(0.0), x[1] * y[1] * z[1] * cu, x[2] * y[2] * z[2] * cl)
-    };
-    let qb = q.map(|z| z.conj());
-    let inv_a = ac.try_inverse()?;
-    let inv_2 = (id * (ib * c(2.0)) - ac).try_inverse()?;
-    let term = dot(&p, &cc(&q, &q, &qb)) - dot(&p, &b(&q, &(inv_a * b(&q, &qb)))) * c(2.0)
-        + dot(&p, &b(&qb, &(inv_2 * b(&q, &q))));
-    Some(term.re / (2.0 * beta))
 }
 
 /// Hopf: `H(p, ω) = Re λ(ω; p)`.

@@ -6,8 +6,8 @@ use nalgebra::Complex;
 use rotor_model::Model;
 use serde::Serialize;
 
+use crate::branch::Branch;
 use crate::continuation::{Continuer, End, Node};
-use crate::diagram::Branch;
 use crate::feigin::{Feigin, GrazingType};
 use crate::{BifError, grazing};
 

@@ -60,12 +60,12 @@ fn main() {
     });
     let solve_format = time(n, || {
         let tr = solver.simulate_finite(&model, &scene).unwrap();
-        std::hint::black_box(rotor_compare::trace::write_trace(&tr.samples, 0.01));
+        std::hint::black_box(rotor_grade::trace::write_trace(&tr.samples, 0.01));
     });
     let solve_write = time(n, || {
         let tr = solver.simulate_finite(&model, &scene).unwrap();
         rotor_compare::report::write_output_with(&csv, |w| {
-            rotor_compare::trace::write_trace_to(w, &tr.samples, 0.01)
+            rotor_grade::trace::write_trace_to(w, &tr.samples, 0.01)
         })
         .unwrap();
     });
@@ -110,19 +110,14 @@ fn main() {
     let check_whole = time(n, || {
         run(&["check", s, "--trace", t, "--events", e, "--gate", "strict"])
     });
-    let sc = rotor_compare::load_scenario(&sc_path).unwrap();
-    let r = rotor_compare::reference::read(&root.join("fixtures/reference"), &sc.name).unwrap();
+    let sc = rotor_solvers::load_scenario(&sc_path).unwrap();
+    let r = rotor_grade::reference::read(&root.join("fixtures/reference"), &sc.name).unwrap();
     let check_in = time(n, || {
-        let tr = rotor_compare::trace::read_trace(&trace, usize::MAX).unwrap();
-        let ev = rotor_compare::trace::read_events(&events).unwrap();
-        let rep = rotor_compare::check::check(
-            &sc,
-            &r,
-            &tr,
-            Some(&ev),
-            rotor_compare::check::Level::Strict,
-        )
-        .unwrap();
+        let tr = rotor_grade::trace::read_trace(&trace, usize::MAX).unwrap();
+        let ev = rotor_grade::trace::read_events(&events).unwrap();
+        let rep =
+            rotor_grade::check::check(&sc, &r, &tr, Some(&ev), rotor_grade::check::Level::Strict)
+                .unwrap();
         assert!(rep.passed);
     });
     println!("rotor check t1-u1.5-rest --trace (200 s, 20 001 rows) --events --gate strict");

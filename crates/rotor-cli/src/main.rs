@@ -8,8 +8,8 @@ mod out;
 
 use anyhow::{Context, Result, anyhow, bail};
 use clap::{Parser, Subcommand};
-use rotor_compare::SolverKind;
 use rotor_model::{Model, Params, State, SteadyState};
+use rotor_solvers::SolverKind;
 
 /// Two-disc rotor with set-valued friction: three independent solvers, cross-validated.
 #[derive(Parser, Debug)]
@@ -293,7 +293,7 @@ struct Common {
 }
 
 fn kind_by_name(name: &str) -> Result<SolverKind> {
-    rotor_compare::request::solver_kind(name).map_err(|e| anyhow!(e.as_flag()))
+    rotor_jobs::request::solver_kind(name).map_err(|e| anyhow!(e.as_flag()))
 }
 
 /// Prints a command's summary: on standard output, unless one of its outputs goes there
@@ -318,16 +318,16 @@ fn load_model(params: Option<&Path>) -> Result<Model> {
 }
 
 /// The file a path argument names: a path, or the name of a file in `fixtures/KIND`
-/// ([`rotor_compare::fixtures::resolve`]). A name that is neither is an error naming `flag`
+/// ([`rotor_solvers::fixtures::resolve`]). A name that is neither is an error naming `flag`
 /// and listing the names there.
 pub(crate) fn fixture_path(flag: &str, p: &Path, kind: &str) -> Result<PathBuf> {
     let dir = fixtures_dir().join(kind);
-    rotor_compare::fixtures::resolve(p, Some(&dir)).ok_or_else(|| {
+    rotor_solvers::fixtures::resolve(p, Some(&dir)).ok_or_else(|| {
         anyhow!(
             "{flag} {}: no such file, nor a name in {} (names: {})",
             p.display(),
             dir.canonicalize().unwrap_or_else(|_| dir.clone()).display(),
-            rotor_compare::fixtures::names(&dir).join(", ")
+            rotor_solvers::fixtures::names(&dir).join(", ")
         )
     })
 }
@@ -355,7 +355,7 @@ fn parse_x0(s: Option<&str>) -> Result<State> {
 
 /// Moreau–Jean steps whose step problem did not converge are answers to distrust: say so.
 fn warn_inexact(stats: &rotor_model::Stats) {
-    if let Some(w) = rotor_compare::request::inexact_warning(stats, "--h") {
+    if let Some(w) = rotor_jobs::request::inexact_warning(stats, "--h") {
         eprintln!("warning: {w}");
     }
 }
@@ -396,9 +396,9 @@ fn check(flag: &str, v: f64, ok: bool, what: &str) -> Result<()> {
 
 /// The checked request of `simulate` and `steady` (the same checks and words as the Python
 /// package's), with a warning for a setting the solver ignores.
-fn request(common: &Common) -> Result<rotor_compare::request::Request<'_>> {
+fn request(common: &Common) -> Result<rotor_jobs::request::Request<'_>> {
     let x = parse_x0(common.x0.as_deref())?;
-    let req = rotor_compare::request::Request {
+    let req = rotor_jobs::request::Request {
         solver: &common.solver,
         u: common.u,
         x0: [x[0], x[1], x[2]],
@@ -422,7 +422,7 @@ fn simulate(common: &Common, t_end: f64, dt: f64, csv_path: &Path) -> Result<()>
         .with_context(|| format!("solver {}", solver.name()))?;
     warn_inexact(&traj.stats);
     rotor_compare::report::write_output_with(csv_path, |w| {
-        rotor_compare::trace::write_trace_to(w, &traj.samples, dt)
+        rotor_grade::trace::write_trace_to(w, &traj.samples, dt)
     })
     .with_context(|| format!("{}: cannot write", csv_path.display()))?;
     Ok(())
@@ -433,7 +433,7 @@ fn steady(common: &Common) -> Result<()> {
         .steady()
         .map_err(|e| anyhow!(e.as_flag()))?;
     let model = load_model(common.params.as_deref())?;
-    let answer = rotor_compare::steady(kind, &model, &scene, &opts)
+    let answer = rotor_steady::steady(kind, &model, &scene, &opts)
         .with_context(|| format!("solver {}", kind.name()))?;
     warn_inexact(&answer.stats);
     out::line(format_args!("{}", steady_json(&answer)))?;
@@ -568,7 +568,7 @@ fn sweep(
     csv: &Path,
 ) -> Result<()> {
     use rayon::prelude::*;
-    use rotor_compare::sweep::{Axis, Shard, Sweep, SweepStart, run};
+    use rotor_jobs::sweep::{Axis, Shard, Sweep, SweepStart, run};
     let base = load_model(params)?.params;
     let (name, range) = param
         .split_once('=')
@@ -627,7 +627,7 @@ fn merge(shards: &[PathBuf], csv: &Path) -> Result<()> {
     if shards.is_empty() {
         bail!("merge: no shard files given");
     }
-    let merged = rotor_compare::sweep::merge(shards)?;
+    let merged = rotor_jobs::sweep::merge(shards)?;
     rotor_compare::report::write_output_with(csv, |w| merged.write_to(w))
         .with_context(|| format!("{}: cannot write", csv.display()))?;
     Ok(())
@@ -686,7 +686,7 @@ fn bench(
     }
     opts.shard = clients
         .shard
-        .map(rotor_compare::sweep::Shard::parse)
+        .map(rotor_jobs::sweep::Shard::parse)
         .transpose()?;
     opts.keep = clients.keep.map(Path::to_path_buf);
     let report = rotor_bench::run(&opts, |m| eprintln!("{m}"))?;
@@ -964,13 +964,13 @@ fn plane_section(sets: &[(&str, &str, Params)]) -> Result<rotor_compare::report:
 }
 
 /// The report section with the steady states probed next to every special point of both
-/// diagrams (`rotor_compare::probes`, all solvers, all offsets, both starts).
+/// diagrams (`rotor_steady::probes`, all solvers, all offsets, both starts).
 fn probe_section(
     sets: &[(&str, &str, Params)],
     diagrams: &[rotor_bifurcation::Diagram],
 ) -> rotor_compare::report::Section {
     use rayon::prelude::*;
-    use rotor_compare::probes;
+    use rotor_steady::probes;
     let mut rows = Vec::new();
     for ((_, slug, p), d) in sets.iter().zip(diagrams) {
         let m = Model::new(*p);
@@ -1019,8 +1019,8 @@ fn probe_section(
              Each probe:\n\n{}",
             rows.len(),
             bad.len(),
-            probes::probe_summary_markdown(&rows, &rotor_compare::SOLVERS),
-            probes::probe_table_markdown(&rows, &rotor_compare::SOLVERS)
+            probes::probe_summary_markdown(&rows, &rotor_solvers::SOLVERS),
+            probes::probe_table_markdown(&rows, &rotor_solvers::SOLVERS)
         ),
         files: Vec::new(),
         timings: format!(
@@ -1091,7 +1091,7 @@ fn compare(files: &[PathBuf], report: &Path, main_job: bool, threads: Option<usi
     };
     let scenarios = files
         .iter()
-        .map(|f| rotor_compare::load_scenario(f))
+        .map(|f| rotor_solvers::load_scenario(f))
         .collect::<Result<Vec<_>, _>>()?;
     // Report files are named after the scenarios: two of one name would overwrite each other.
     for (i, a) in scenarios.iter().enumerate() {
@@ -1120,7 +1120,7 @@ fn compare(files: &[PathBuf], report: &Path, main_job: bool, threads: Option<usi
             scenarios
                 .par_iter()
                 .map(|sc| {
-                    let r = rotor_compare::run_scenario(sc);
+                    let r = rotor_solvers::run_scenario(sc);
                     bar.inc(1);
                     r
                 })
@@ -1182,7 +1182,7 @@ fn compare(files: &[PathBuf], report: &Path, main_job: bool, threads: Option<usi
     out::line(format_args!(
         "{} scenarios, {} solvers, {:.2} s wall; report in {}",
         results.len(),
-        rotor_compare::SOLVERS.len(),
+        rotor_solvers::SOLVERS.len(),
         wall,
         report.display()
     ))?;
@@ -1220,7 +1220,7 @@ fn progress_bar(len: u64, what: &str) -> indicatif::ProgressBar {
     bar
 }
 
-fn steady_json(st: &rotor_compare::SteadyAnswer) -> String {
+fn steady_json(st: &rotor_steady::SteadyAnswer) -> String {
     serde_json::to_string(st).expect("plain floats and strings serialize")
 }
 

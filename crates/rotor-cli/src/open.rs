@@ -5,8 +5,8 @@ use std::process::ExitCode;
 
 use anyhow::{Context, Result};
 use rayon::prelude::*;
-use rotor_compare::check::{CheckError, Level, check};
-use rotor_compare::reference;
+use rotor_grade::check::{CheckError, Level, check};
+use rotor_grade::reference;
 
 /// `rotor reference [--out DIR]`: the reference files of every scenario.
 pub fn write_reference(scenarios_dir: &Path, out: &Path) -> Result<()> {
@@ -14,7 +14,7 @@ pub fn write_reference(scenarios_dir: &Path, out: &Path) -> Result<()> {
         .with_context(|| format!("{}: cannot list scenarios", scenarios_dir.display()))?;
     let scenarios = files
         .iter()
-        .map(|f| rotor_compare::load_scenario(f))
+        .map(|f| rotor_solvers::load_scenario(f))
         .collect::<Result<Vec<_>, _>>()?;
     std::fs::create_dir_all(out).with_context(|| format!("{}: cannot create", out.display()))?;
     let refs = scenarios
@@ -84,12 +84,11 @@ fn verdict(
     .map_err(|e| anyhow::anyhow!(e.as_flag()))?;
     // The scenario and its reference first: the trace is read up to one row past their grid.
     let scenario = crate::fixture_path("scenario", scenario, "scenarios")?;
-    let sc = rotor_compare::load_scenario(&scenario)?;
+    let sc = rotor_solvers::load_scenario(&scenario)?;
     let r = reference::read(&reference::dir_for(&scenario), &sc.name)?;
-    let t =
-        rotor_compare::trace::read_trace(trace, r.samples.len() + 1).map_err(CheckError::from)?;
+    let t = rotor_grade::trace::read_trace(trace, r.samples.len() + 1).map_err(CheckError::from)?;
     let ev = events
-        .map(rotor_compare::trace::read_events)
+        .map(rotor_grade::trace::read_events)
         .transpose()
         .map_err(CheckError::from)?;
     let report = check(&sc, &r, &t, ev.as_ref(), level)?;

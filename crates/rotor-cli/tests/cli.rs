@@ -898,13 +898,13 @@ fn without_timings(v: &serde_json::Value, timing: bool) -> serde_json::Value {
 fn job_prints_the_job_file_with_x0_at_full_precision() {
     let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
     let path = root.join("fixtures/scenarios/t1-u2.5-eq-pert.toml");
-    let sc = rotor_compare::load_scenario(&path).unwrap();
+    let sc = rotor_solvers::load_scenario(&path).unwrap();
     let json = |o: std::process::Output| -> serde_json::Value {
         assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
         serde_json::from_slice(&o.stdout).unwrap()
     };
     let by_name = json(rotor(&["job", "t1-u2.5-eq-pert", "--h", "1e-3"]));
-    assert_eq!(by_name["benchmark"], rotor_compare::check::BENCHMARK);
+    assert_eq!(by_name["benchmark"], rotor_grade::check::BENCHMARK);
     assert_eq!(by_name["scenario"], "t1-u2.5-eq-pert");
     assert_eq!(by_name["h"], 1e-3);
     assert!(by_name["tol"].is_null());

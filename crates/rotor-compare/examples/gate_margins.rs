@@ -12,8 +12,8 @@
 use std::path::Path;
 
 use rotor_compare::margins::{floor_violations, margins};
-use rotor_compare::run_scenario;
 use rotor_model::Scenario;
+use rotor_solvers::run_scenario;
 
 fn main() {
     let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../fixtures/scenarios");
@@ -23,7 +23,7 @@ fn main() {
     );
     let (mut rows, mut bad) = (0, Vec::new());
     for f in Scenario::list_dir(&dir).expect("fixtures/scenarios") {
-        let sc = rotor_compare::load_scenario(&f).unwrap_or_else(|e| panic!("{e}"));
+        let sc = rotor_solvers::load_scenario(&f).unwrap_or_else(|e| panic!("{e}"));
         bad.extend(floor_violations(&sc));
         let r = run_scenario(&sc);
         for m in margins(&r) {

@@ -10,6 +10,9 @@
 
 use rotor_model::{Disc, EventKind, PairTolerance, SteadyState, Trajectory};
 
+use rotor_solvers::run::ScenarioResult;
+use rotor_solvers::solvers::{SolverKind, pair_name, pairs};
+
 /// A measured difference with its gate.
 #[derive(Debug, Clone, PartialEq, serde::Serialize)]
 pub struct Measured {
@@ -250,6 +253,46 @@ pub fn steady_differences(
 /// The steady metrics of a trajectory, if computed.
 pub fn metrics(tr: &Trajectory) -> Option<SteadyState> {
     tr.metrics
+}
+
+/// Gates every pair of one scenario. A solver error, or a pair without a tolerance in the
+/// scenario file, is a failure too.
+pub fn gate_scenario(r: &ScenarioResult) -> (Vec<GateResult>, Vec<Failure>) {
+    let sc = &r.scenario;
+    let mut gates = Vec::new();
+    let mut fails = Vec::new();
+    for run in &r.runs {
+        if let Err(e) = &run.result {
+            fails.push(Failure {
+                scenario: sc.name.clone(),
+                pair: run.kind.name().into(),
+                quantity: format!("run failed: {e}"),
+                diff: f64::INFINITY,
+                tol: 0.0,
+            });
+        }
+    }
+    let kinds: Vec<SolverKind> = r.runs.iter().map(|run| run.kind).collect();
+    for (a, b) in pairs(&kinds) {
+        let pair = pair_name(a, b);
+        let Some(tol) = sc.tolerance.get(&pair) else {
+            fails.push(Failure {
+                scenario: sc.name.clone(),
+                pair: pair.clone(),
+                quantity: "no [tolerance] stated for this pair in the scenario file".into(),
+                diff: f64::INFINITY,
+                tol: 0.0,
+            });
+            continue;
+        };
+        let (Some(ta), Some(tb)) = (r.traj(a), r.traj(b)) else {
+            continue;
+        };
+        let g = check_pair(&pair, ta, tb, sc.compare.transient, tol);
+        fails.extend(g.failures(&sc.name));
+        gates.push(g);
+    }
+    (gates, fails)
 }
 
 #[cfg(test)]

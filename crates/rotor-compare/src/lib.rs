@@ -1,30 +1,11 @@
 //! Cross-validation: identical scenarios through the three independent solvers, agreement
 //! gates on θ̇_u and θ̇_l, and the report.
 
-pub mod check;
-pub mod fixtures;
 pub mod gate;
-pub mod gridmetrics;
 pub mod margins;
-pub mod orbit;
-pub mod probes;
-pub mod reference;
 pub mod report;
-pub mod request;
-pub mod run;
-pub mod settle;
 pub mod snapshot;
-pub mod solvers;
-pub mod steady;
 pub mod stress;
-pub mod sweep;
 pub mod threads;
-pub mod trace;
 
 pub use gate::{Failure, GateResult, Measured, check_pair};
-pub use run::{RunResult, ScenarioResult, run_scenario, run_scenario_with, solver_settings};
-pub use settle::{SettleError, SettleOptions, Settled, Unsettled, settle};
-pub use solvers::{
-    Knob, SOLVERS, SolverInfo, SolverKind, load_scenario, load_scenario_for, pair_name, pairs,
-};
-pub use steady::{SteadyAnswer, SteadyError, SteadyMethod, SteadyOptions, steady};

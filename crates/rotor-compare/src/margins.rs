@@ -17,10 +17,10 @@
 
 use rotor_model::{STEADY_QUANTITIES, Scenario};
 
-use crate::report::gate_scenario;
-use crate::run::ScenarioResult;
-use crate::solvers::{SolverKind, pair_name, pairs};
+use crate::gate::gate_scenario;
 pub use crate::stress::MAX_LOOSENESS;
+use rotor_solvers::run::ScenarioResult;
+use rotor_solvers::solvers::{SolverKind, pair_name, pairs};
 
 /// The rule's margin over the measured difference.
 pub const MARGIN: f64 = 5.0;

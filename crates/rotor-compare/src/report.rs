@@ -1,4 +1,4 @@
-//! Gating a scenario's results and writing the report (CSV, SVG, README.md), atomically.
+//! Writing the report (CSV, SVG, README.md), atomically; the gates it shows are [`crate::gate`]'s.
 
 use std::fmt::Write as _;
 use std::io::Write as _;
@@ -6,11 +6,11 @@ use std::path::Path;
 
 use rotor_model::{Disc, Friction, Model, Params, Scenario, SteadyState};
 
-use crate::gate::{Failure, GateResult, check_pair};
-use crate::run::{ScenarioResult, solver_settings};
+use crate::gate::{Failure, GateResult, gate_scenario};
 use crate::snapshot::round_sig;
-use crate::solvers::{SolverKind, pair_name, pairs};
 use rotor_plot::{Panel, Series, render};
+use rotor_solvers::run::{ScenarioResult, solver_settings};
+use rotor_solvers::solvers::SolverKind;
 
 /// One row of the report's gate table. A quantity that could not be measured (steady
 /// states of different kinds, or missing: `diff` not finite) has no numbers, only its FAIL.
@@ -42,46 +42,6 @@ fn unmeasured<'a>(gates: &[GateResult], fails: &'a [Failure]) -> Vec<&'a Failure
             .any(|g| g.pair == f.pair && g.measured.iter().any(|m| m.quantity == f.quantity))
     };
     fails.iter().filter(|f| !measured(f)).collect()
-}
-
-/// Gates every pair of one scenario. A solver error, or a pair without a tolerance in the
-/// scenario file, is a failure too.
-pub fn gate_scenario(r: &ScenarioResult) -> (Vec<GateResult>, Vec<Failure>) {
-    let sc = &r.scenario;
-    let mut gates = Vec::new();
-    let mut fails = Vec::new();
-    for run in &r.runs {
-        if let Err(e) = &run.result {
-            fails.push(Failure {
-                scenario: sc.name.clone(),
-                pair: run.kind.name().into(),
-                quantity: format!("run failed: {e}"),
-                diff: f64::INFINITY,
-                tol: 0.0,
-            });
-        }
-    }
-    let kinds: Vec<SolverKind> = r.runs.iter().map(|run| run.kind).collect();
-    for (a, b) in pairs(&kinds) {
-        let pair = pair_name(a, b);
-        let Some(tol) = sc.tolerance.get(&pair) else {
-            fails.push(Failure {
-                scenario: sc.name.clone(),
-                pair: pair.clone(),
-                quantity: "no [tolerance] stated for this pair in the scenario file".into(),
-                diff: f64::INFINITY,
-                tol: 0.0,
-            });
-            continue;
-        };
-        let (Some(ta), Some(tb)) = (r.traj(a), r.traj(b)) else {
-            continue;
-        };
-        let g = check_pair(&pair, ta, tb, sc.compare.transient, tol);
-        fails.extend(g.failures(&sc.name));
-        gates.push(g);
-    }
-    (gates, fails)
 }
 
 /// Writes `bytes` to `path`, or to standard output if `path` is `-` (as Unix tools do);
@@ -172,12 +132,12 @@ pub fn scenario_csv(r: &ScenarioResult) -> String {
         .map(|k| r.traj(*k).map_or(0, |t| t.samples.len()))
         .min()
         .unwrap_or(0);
-    let digits = crate::trace::time_digits(r.scenario.compare.dt);
+    let digits = rotor_grade::trace::time_digits(r.scenario.compare.dt);
     let mut row: Vec<f64> = Vec::with_capacity(1 + 2 * kinds.len());
     for i in 0..n {
         row.clear();
         let t = r.traj(kinds[0]).map_or(0.0, |tr| tr.samples[i].t);
-        row.push(crate::trace::round_to(t, digits));
+        row.push(rotor_grade::trace::round_to(t, digits));
         for k in &kinds {
             let x = r.traj(*k).map(|tr| tr.samples[i].x).unwrap_or_default();
             row.push(round_sig(x[1], 12, 0.0));

@@ -27,7 +27,7 @@ use std::collections::BTreeMap;
 use rotor_model::{Stats, SteadyState};
 use serde::Serialize;
 
-use crate::run::ScenarioResult;
+use rotor_solvers::run::ScenarioResult;
 
 /// One solver's record.
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -141,7 +141,7 @@ pub fn digits_for(tol: f64) -> u32 {
     }
 }
 
-/// The snapshot of one scenario's results (the differences from [`crate::report::gate_scenario`]).
+/// The snapshot of one scenario's results (the differences from [`crate::gate::gate_scenario`]).
 pub fn snapshot(r: &ScenarioResult) -> ScenarioSnapshot {
     let sc = &r.scenario;
     let floor = sc
@@ -206,7 +206,7 @@ pub fn snapshot(r: &ScenarioResult) -> ScenarioSnapshot {
             }
         })
         .collect();
-    let differences = crate::report::gate_scenario(r)
+    let differences = crate::gate::gate_scenario(r)
         .0
         .into_iter()
         .map(|g| {

@@ -32,7 +32,7 @@ use rotor_model::{
     State, Stats, SteadyState, Trajectory, UpperFriction,
 };
 
-use crate::solvers::{SOLVERS, SolverKind};
+use rotor_solvers::solvers::{SOLVERS, SolverKind};
 
 /// The event-driven reference's tolerance (as in the comparison, `run.rs`).
 pub const REFERENCE_TOL: f64 = 1e-12;

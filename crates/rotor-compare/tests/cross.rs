@@ -1,8 +1,8 @@
 //! Cross-solver checks of single solver features against the event-driven reference (the
 //! solver crates test themselves; what needs a second solver lives here).
 
-use rotor_compare::SolverKind;
 use rotor_model::{Disc, EventKind, Model, OMEGA_L, Output, Scene, Solver, State, Trajectory};
+use rotor_solvers::SolverKind;
 
 fn run(kind: SolverKind, tol: f64, scene: &Scene) -> Trajectory {
     kind.solver()

@@ -9,8 +9,8 @@
 //! Moreau–Jean extrema are sign changes of the discrete acceleration, whose rounding noise
 //! must not produce them either.
 
-use rotor_compare::{SOLVERS, SolverKind};
 use rotor_model::{Disc, EventKind, Model, Output, Scene, State};
+use rotor_solvers::{SOLVERS, SolverKind};
 
 #[test]
 fn no_solver_reports_turns_below_its_resolution() {

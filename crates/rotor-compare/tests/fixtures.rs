@@ -5,11 +5,11 @@ use std::path::Path;
 
 use std::sync::OnceLock;
 
+use rotor_compare::gate::gate_scenario;
 use rotor_compare::margins::{MAX_LOOSENESS, floor_violations, margins};
-use rotor_compare::report::gate_scenario;
 use rotor_compare::snapshot::snapshot;
-use rotor_compare::{SOLVERS, ScenarioResult, SolverKind, pair_name, pairs, run_scenario};
 use rotor_model::{Disc, Event, EventKind, Scenario, State, SteadyState, Trajectory};
+use rotor_solvers::{SOLVERS, ScenarioResult, SolverKind, pair_name, pairs, run_scenario};
 
 /// Every fixture through the three solvers, once per test binary (shared by the tests).
 fn all() -> Vec<ScenarioResult> {
@@ -21,7 +21,7 @@ fn all() -> Vec<ScenarioResult> {
             assert!(files.len() >= 14);
             files
                 .par_iter()
-                .map(|f| run_scenario(&rotor_compare::load_scenario(f).unwrap()))
+                .map(|f| run_scenario(&rotor_solvers::load_scenario(f).unwrap()))
                 .collect()
         })
         .clone()

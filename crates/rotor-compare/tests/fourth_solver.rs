@@ -6,11 +6,12 @@
 //! The solver is explicit Euler on the switch model (band η): first order, deliberately
 //! crude, with a coarse gate measured on the scenario.
 
+use rotor_compare::gate::gate_scenario;
 use rotor_compare::margins::margins;
-use rotor_compare::report::{gate_scenario, scenario_csv, scenario_svg};
+use rotor_compare::report::{scenario_csv, scenario_svg};
 use rotor_compare::snapshot::snapshot;
-use rotor_compare::solvers::Style;
-use rotor_compare::{Knob, SolverInfo, SolverKind, load_scenario_for, run_scenario_with};
+use rotor_solvers::solvers::Style;
+use rotor_solvers::{Knob, SolverInfo, SolverKind, load_scenario_for, run_scenario_with};
 
 /// The solver's "crate".
 mod euler {
@@ -214,7 +215,7 @@ fn a_fourth_solver_needs_its_crate_one_entry_and_its_tolerances() {
         SolverKind(&EULER),
     ];
     // The three solvers' loader refuses the new pair; with the fourth one it loads.
-    let e = rotor_compare::load_scenario(&file).unwrap_err().to_string();
+    let e = rotor_solvers::load_scenario(&file).unwrap_err().to_string();
     assert!(
         e.contains("event-euler") && e.contains("unknown solver pair"),
         "{e}"

@@ -7,11 +7,11 @@
 use std::path::Path;
 use std::sync::OnceLock;
 
-use rotor_compare::run::scene_for;
-use rotor_compare::{SOLVERS, SolverKind};
 use rotor_event::{EventOptions, EventSolver};
 use rotor_model::{Output, Scenario, Scene, Solver, SteadyState, Trajectory};
 use rotor_moreau::{MoreauOptions, MoreauSolver};
+use rotor_solvers::run::scene_for;
+use rotor_solvers::{SOLVERS, SolverKind};
 use rotor_switch::{SwitchOptions, SwitchSolver};
 
 /// How far a solver's metrics-only answer may lie from its own full run, relative to
@@ -51,7 +51,7 @@ fn scenarios() -> &'static [Scenario] {
         let v: Vec<Scenario> = Scenario::list_dir(&dir)
             .unwrap()
             .iter()
-            .map(|f| rotor_compare::load_scenario(f).unwrap())
+            .map(|f| rotor_solvers::load_scenario(f).unwrap())
             .collect();
         assert!(v.len() >= 14);
         v

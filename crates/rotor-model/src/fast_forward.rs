@@ -35,7 +35,8 @@
 //! the phase error a full run accumulates over those periods.
 
 use crate::dynamics::{Disc, OMEGA_L, State};
-use crate::scene::{Event, EventKind, Output, Scene, Stats};
+use crate::event::{Event, EventKind};
+use crate::scene::{Output, Scene, Stats};
 
 /// A return after the jump must lie within this many tolerances of the return before it: both
 /// lie within one tolerance of the fixed point (the skip criterion), and the integration adds

@@ -7,6 +7,7 @@
 
 pub mod dynamics;
 pub mod equilibrium;
+pub mod event;
 pub mod fast_forward;
 pub mod friction;
 pub mod lagrangian;
@@ -19,6 +20,7 @@ pub mod steady;
 
 pub use dynamics::{ALPHA, Disc, DiscMode, Mode, Model, OMEGA_L, OMEGA_U, State};
 pub use equilibrium::{SlipEquilibrium, StuckSet};
+pub use event::{Event, EventKind};
 pub use fast_forward::{FastForward, Verdict};
 pub use friction::Friction;
 pub use lagrangian::{Coords, Lagrangian};
@@ -30,7 +32,6 @@ pub use scenario::{
     Scenario, ScenarioError, SteadyQuantity, TOLERANCE_KEYS,
 };
 pub use scene::{
-    Event, EventKind, Output, OutputGrid, Sample, Scene, SolveError, Solver, Stats, Trajectory,
-    check_finite,
+    Output, OutputGrid, Sample, Scene, SolveError, Solver, Stats, Trajectory, check_finite,
 };
 pub use steady::{MetricsAccumulator, SteadyKind, SteadyState};

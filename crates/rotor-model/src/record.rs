@@ -13,8 +13,9 @@
 //! that they integrate independently, not that they record differently.
 
 use crate::dynamics::{Mode, State};
+use crate::event::Event;
 use crate::fast_forward::{FastForward, Verdict};
-use crate::scene::{Event, Output, OutputGrid, Sample, Scene, SolveError, Stats, Trajectory};
+use crate::scene::{Output, OutputGrid, Sample, Scene, SolveError, Stats, Trajectory};
 use crate::steady::MetricsAccumulator;
 
 /// What a scene keeps of a run, collected as the solver goes.
@@ -225,7 +226,7 @@ impl Recorder {
 mod tests {
     use super::*;
     use crate::dynamics::{Disc, DiscMode};
-    use crate::scene::EventKind;
+    use crate::event::EventKind;
     use crate::steady::SteadyState;
 
     /// A triangle wave of period 4 and amplitude 1 (exact in binary arithmetic).

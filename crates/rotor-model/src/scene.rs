@@ -3,7 +3,8 @@
 use serde::Serialize;
 use thiserror::Error;
 
-use crate::dynamics::{Disc, Mode, Model, State};
+use crate::dynamics::{Mode, Model, State};
+use crate::event::Event;
 use crate::steady::SteadyState;
 
 /// What a solver keeps while it runs. Every level keeps the final state and the counters.
@@ -252,32 +253,6 @@ pub struct Sample {
     pub x: State,
 }
 
-/// What happened at an event.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
-#[serde(rename_all = "snake_case")]
-pub enum EventKind {
-    /// The disc's velocity reached 0 and it sticks.
-    StickStart(Disc),
-    /// The stuck disc's applied torque left the stick interval; it slips again.
-    StickEnd(Disc),
-    /// The disc's velocity crossed 0 without sticking.
-    Reversal(Disc),
-    /// A local maximum of the disc's velocity (only when metrics are asked). The adaptive
-    /// solvers report a turn only if ω moved by more than 10 tolerances since the extremum
-    /// before it: smaller ones are below their resolution (rounding noise near equilibria).
-    Max(Disc),
-    /// A local minimum of the disc's velocity (only when metrics are asked).
-    Min(Disc),
-}
-
-/// An event with its time and the state there.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
-pub struct Event {
-    pub t: f64,
-    pub x: State,
-    pub kind: EventKind,
-}
-
 /// Work counters, for benchmarks and snapshots.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, serde::Deserialize)]
 pub struct Stats {
@@ -462,7 +437,7 @@ pub fn check_finite(t: f64, x: &State) -> Result<(), SolveError> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::{Disc, DiscMode, SteadyState};
+    use crate::{Disc, DiscMode, EventKind, SteadyState};
 
     #[test]
     fn check_finite_names_the_first_non_finite_output() {

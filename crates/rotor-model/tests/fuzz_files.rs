@@ -5,7 +5,7 @@
 //!
 //! "Admissible" is checked independently of the loader: parameters pass `Params::validate`,
 //! and a loaded scenario yields a `Scene` that the solvers accept (`Scene::validate`) at the
-//! settings rotor-compare runs it with (its own `tol`/`h`, else the defaults).
+//! settings rotor-solvers runs it with (its own `tol`/`h`, else the defaults).
 
 use std::path::{Path, PathBuf};
 use std::sync::OnceLock;
@@ -207,7 +207,7 @@ fn check(which: usize, muts: &[Mutation]) -> Result<(), TestCaseError> {
         match Scenario::from_file(&path) {
             Ok(sc) => {
                 prop_assert!(sc.model.params.validate().is_ok());
-                // The settings rotor-compare runs a scenario with (run.rs solver_settings).
+                // The settings rotor-solvers runs a scenario with (run.rs solver_settings).
                 let d = Scene::default();
                 for (tol, h) in [
                     (1e-12, d.h),

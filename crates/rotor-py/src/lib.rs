@@ -1,9 +1,9 @@
 //! `rotorbench._rotorbench`: the native module of the Python package (docs/python.md).
 //!
 //! A thin layer. Every check, run and answer belongs to the Rust crates: the inputs go through
-//! [`rotor_compare::request`] (the checks and the words of the command line), the runs through
-//! the solvers, [`rotor_compare::steady`], [`rotor_bifurcation::diagram`] and
-//! [`rotor_compare::check::grade`]. This file converts arguments and results, releases the GIL
+//! [`rotor_jobs::request`] (the checks and the words of the command line), the runs through
+//! the solvers, [`rotor_steady::steady`], [`rotor_bifurcation::diagram`] and
+//! [`rotor_grade::check::grade`]. This file converts arguments and results, releases the GIL
 //! around every run, and maps errors to exceptions:
 //!
 //! * bad input → `ValueError` (a wrong type → `TypeError`), naming the argument or field and
@@ -22,11 +22,11 @@ use pyo3::prelude::*;
 use pyo3::types::{PyBool, PyDict, PyList, PyString};
 use rayon::prelude::*;
 use rotor_bifurcation::{BifError, DiagramOptions};
-use rotor_compare::check::{GradeError, Level};
-use rotor_compare::request::{BadInput, Request};
-use rotor_compare::trace::{EventsFile, Trace, disc_name, event_row, round_to, time_digits};
-use rotor_compare::{SettleError, SteadyAnswer, SteadyError};
+use rotor_grade::check::{GradeError, Level};
+use rotor_grade::trace::{EventsFile, Trace, disc_name, event_row, round_to, time_digits};
+use rotor_jobs::request::{BadInput, Request};
 use rotor_model::{Model, Params, Stats};
+use rotor_steady::{SettleError, SteadyAnswer, SteadyError};
 
 pyo3::create_exception!(
     rotorbench,
@@ -106,7 +106,7 @@ fn from_bif(py: Python<'_>, e: BifError) -> PyErr {
 }
 
 fn from_grade(e: GradeError) -> PyErr {
-    use rotor_compare::reference::ReferenceError;
+    use rotor_grade::reference::ReferenceError;
     match e {
         GradeError::Scenario(rotor_model::ScenarioError::Io { .. })
         | GradeError::Reference(ReferenceError::File { .. }) => PyOSError::new_err(e.to_string()),
@@ -127,7 +127,7 @@ fn warn_ignored(py: Python<'_>, req: &Request<'_>) -> PyResult<()> {
 }
 
 fn warn_inexact(py: Python<'_>, stats: &Stats) -> PyResult<()> {
-    match rotor_compare::request::inexact_warning(stats, "h") {
+    match rotor_jobs::request::inexact_warning(stats, "h") {
         Some(w) => warn(py, &w),
         None => Ok(()),
     }
@@ -146,7 +146,7 @@ fn fixtures() -> Option<PathBuf> {
 }
 
 /// A file argument: a path, or the name of a file of `fixtures/<kind>/` (without `.toml`;
-/// [`rotor_compare::fixtures::resolve`]), else a `ValueError` naming the argument and what
+/// [`rotor_solvers::fixtures::resolve`]), else a `ValueError` naming the argument and what
 /// was looked for.
 fn resolve(arg: &str, value: &Bound<'_, PyAny>, kind: &str) -> PyResult<PathBuf> {
     let path: PathBuf = value.extract().map_err(|_| {
@@ -156,13 +156,13 @@ fn resolve(arg: &str, value: &Bound<'_, PyAny>, kind: &str) -> PyResult<PathBuf>
         ))
     })?;
     let dir = fixtures().map(|f| f.join(kind));
-    if let Some(p) = rotor_compare::fixtures::resolve(&path, dir.as_deref()) {
+    if let Some(p) = rotor_solvers::fixtures::resolve(&path, dir.as_deref()) {
         return Ok(p);
     }
     let name = path.to_string_lossy().into_owned();
     let known = dir
         .as_deref()
-        .map(|d| rotor_compare::fixtures::names(d).join(", "));
+        .map(|d| rotor_solvers::fixtures::names(d).join(", "));
     Err(PyValueError::new_err(match known {
         Some(known) => format!(
             "{arg} = {name:?}: no such file, nor a name in {} (names: {known})",
@@ -404,7 +404,7 @@ fn steady<'py>(
     let model = Model::new(params_of(params)?);
     warn_ignored(py, &req)?;
     let answer = detached(py, move || {
-        rotor_compare::steady(kind, &model, &scene, &opts)
+        rotor_steady::steady(kind, &model, &scene, &opts)
     })?
     .map_err(|e| from_steady(py, e))?;
     warn_inexact(py, &answer.stats)?;
@@ -469,7 +469,7 @@ fn sweep<'py>(
     let answers: Vec<Result<SteadyAnswer, SteadyError>> = detached(py, move || {
         pool.install(|| {
             jobs.par_iter()
-                .map(|(kind, scene, opts)| rotor_compare::steady(*kind, &model, scene, opts))
+                .map(|(kind, scene, opts)| rotor_steady::steady(*kind, &model, scene, opts))
                 .collect()
         })
     })?;
@@ -594,7 +594,7 @@ fn check<'py>(
         Trace::from_columns([&cols[0], &cols[1], &cols[2], &cols[3]]).map_err(value_error)?;
     let events = events.filter(|e| !e.is_none()).map(events_of).transpose()?;
     let report = detached(py, move || {
-        rotor_compare::check::grade(&path, &trace, events.as_ref(), level)
+        rotor_grade::check::grade(&path, &trace, events.as_ref(), level)
     })?
     .map_err(from_grade)?;
     to_py(py, &report)
@@ -615,7 +615,7 @@ fn params<'py>(py: Python<'py>, source: Option<&Bound<'py, PyAny>>) -> PyResult<
 #[pyfunction]
 fn scenario<'py>(py: Python<'py>, source: &Bound<'py, PyAny>) -> PyResult<Bound<'py, PyDict>> {
     let path = resolve("scenario", source, "scenarios")?;
-    let sc = rotor_compare::load_scenario(&path).map_err(value_error)?;
+    let sc = rotor_solvers::load_scenario(&path).map_err(value_error)?;
     let d = PyDict::new(py);
     d.set_item("name", &sc.name)?;
     d.set_item("description", &sc.description)?;

@@ -105,7 +105,7 @@ pub fn short_horizon_scenario() -> String {
 }
 
 /// Scenario files that load but name a solver pair the runner does not have: a misspelt pair
-/// would leave that pair ungated. The loaders that know the solvers (rotor-compare's, the
+/// would leave that pair ungated. The loaders that know the solvers (rotor-solvers', the
 /// CLI's) refuse them.
 pub fn bad_pair_cases() -> Vec<BadFile> {
     vec![edited(

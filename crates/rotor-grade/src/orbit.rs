@@ -18,7 +18,7 @@
 
 use rotor_model::{Output, Sample, Scenario, Scene, SolveError, State};
 
-use crate::solvers::SolverKind;
+use rotor_solvers::solvers::SolverKind;
 
 /// Sampling step of the dense orbit [s].
 pub const ORBIT_DT: f64 = 2e-5;

@@ -15,8 +15,8 @@ use rotor_bifurcation::periodic::Shooter;
 use rotor_bifurcation::{Diagram, PointKind};
 use rotor_model::{Model, Scene, State, SteadyState};
 
-use crate::solvers::SolverKind;
 use crate::steady::{SteadyAnswer, SteadyError, SteadyOptions, steady};
+use rotor_solvers::solvers::SolverKind;
 
 /// The offsets from each special point [V].
 pub const OFFSETS: [f64; 6] = [-1e-3, -1e-4, -1e-6, 1e-6, 1e-4, 1e-3];
@@ -539,7 +539,7 @@ pub fn probe_table_markdown(rows: &[ProbeRow], solvers: &[SolverKind]) -> String
 /// and Moreau–Jean's from rest at ±1e-3 V (its other probes cost most of a minute: a
 /// transient too slow to settle is followed up to 20 000 s, 2·10⁷ steps).
 pub fn selection(d: &Diagram, full: bool) -> Vec<Probe> {
-    probes(d, &crate::SOLVERS)
+    probes(d, &rotor_solvers::SOLVERS)
         .into_iter()
         .filter(|p| {
             full || !p.kind.is_fixed_step() || (p.start == Start::Rest && p.offset.abs() == 1e-3)

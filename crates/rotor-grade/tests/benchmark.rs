@@ -5,13 +5,11 @@ use std::path::{Path, PathBuf};
 
 use proptest::prelude::*;
 use rayon::prelude::*;
-use rotor_compare::check::{CheckError, Level, check};
-use rotor_compare::reference::{self, Reference};
-use rotor_compare::trace::{
-    EventsFile, Trace, parse_events, parse_trace, write_events, write_trace,
-};
-use rotor_compare::{SolverKind, load_scenario, run::scene_for};
+use rotor_grade::check::{CheckError, Level, check};
+use rotor_grade::reference::{self, Reference};
+use rotor_grade::trace::{EventsFile, Trace, parse_events, parse_trace, write_events, write_trace};
 use rotor_model::{Scenario, Trajectory};
+use rotor_solvers::{SolverKind, load_scenario, run::scene_for};
 
 fn fixtures() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../../fixtures")
@@ -154,7 +152,7 @@ fn every_solver_passes_check_at_its_level() {
             let rep = check(sc, &r, &own.unwrap(), Some(&ev), Level::Strict).unwrap();
             // The orbit is the reference solver's own, recomputed densely: it differs from
             // the stored trace by the stored trace's error and the polyline's chord error
-            // (about 3e-9 of the scale at most: `rotor_compare::orbit`), not by 0.
+            // (about 3e-9 of the scale at most: `rotor_grade::orbit`), not by 0.
             let orbit_err =
                 r.error("omega_l") / r.samples.iter().map(|s| s.x[2].abs()).fold(1e-3, f64::max);
             if !rep.quantities.iter().all(|q| {
@@ -225,7 +223,7 @@ fn malformed_traces_are_unusable_with_the_line_named() {
     assert!(m.contains("line 1: the header"), "{m}");
     assert!(msg(String::new()).contains("empty"));
     let dir = std::env::temp_dir();
-    let e = rotor_compare::trace::read_trace(&dir, usize::MAX)
+    let e = rotor_grade::trace::read_trace(&dir, usize::MAX)
         .unwrap_err()
         .to_string();
     assert!(e.contains(&dir.display().to_string()), "{e}");

@@ -4,9 +4,9 @@
 
 use rayon::prelude::*;
 use rotor_bifurcation::plane::{CurveKind, PlaneOptions, plane, solve_u};
-use rotor_compare::SolverKind;
-use rotor_compare::sweep::{Axis, Sweep, SweepStart};
+use rotor_jobs::sweep::{Axis, Sweep, SweepStart};
 use rotor_model::{Params, State};
+use rotor_solvers::SolverKind;
 
 #[test]
 fn a_sweep_classifies_every_point_as_the_curves_region() {

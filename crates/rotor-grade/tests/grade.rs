@@ -4,13 +4,13 @@
 
 use std::path::{Path, PathBuf};
 
-use rotor_compare::check::{
+use rotor_grade::check::{
     CheckError, CheckReport, LOOSE_DIGITS, Level, STRICT_DIGITS, check, reference_error,
 };
-use rotor_compare::reference::{self, Reference};
-use rotor_compare::trace::{EventsFile, Trace, parse_trace};
-use rotor_compare::{SolverKind, load_scenario, run::scene_for};
+use rotor_grade::reference::{self, Reference};
+use rotor_grade::trace::{EventsFile, Trace, parse_trace};
 use rotor_model::{Event, Scenario, Scene};
+use rotor_solvers::{SolverKind, load_scenario, run::scene_for};
 
 fn fixtures() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../../fixtures")
@@ -249,7 +249,7 @@ fn each_quantity_alone_fails_at_twice_its_tolerance_and_passes_at_half() {
                 r.samples
                     .iter()
                     .map(|s| s.x[i].abs())
-                    .fold(rotor_compare::check::FLOOR, f64::max)
+                    .fold(rotor_grade::check::FLOOR, f64::max)
             });
             let tangent: Vec<f64> = (0..3)
                 .map(|i| (r.samples[ks + 1].x[i] - r.samples[ks - 1].x[i]) / sc_[i])

@@ -49,8 +49,8 @@ use serde::{Serialize, Serializer};
 use crate::gridmetrics::{STUCK, StickExit, grid_metrics};
 use crate::orbit::Orbit;
 use crate::reference::Reference;
-use crate::request::BadInput;
 use crate::trace::{At, EventsFile, Trace, disc_name, event_row};
+use rotor_solvers::BadInput;
 
 /// The benchmark's version: named in every verdict.
 pub const BENCHMARK: &str = "rotorbench-1.0";
@@ -865,7 +865,7 @@ pub fn grade(
     events: Option<&EventsFile>,
     level: Level,
 ) -> Result<CheckReport, GradeError> {
-    let sc = crate::load_scenario(scenario)?;
+    let sc = rotor_solvers::load_scenario(scenario)?;
     let r = crate::reference::read(&crate::reference::dir_for(scenario), &sc.name)?;
     Ok(check(&sc, &r, trace, events, level)?)
 }

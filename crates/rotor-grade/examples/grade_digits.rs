@@ -4,15 +4,15 @@
 //! levels' digits (`check::STRICT_DIGITS`, `check::LOOSE_DIGITS`) were chosen:
 //!
 //! ```sh
-//! cargo run --release -p rotor-compare --example grade_digits
+//! cargo run --release -p rotor-grade --example grade_digits
 //! ```
 
 use std::path::Path;
 
-use rotor_compare::check::{Level, check, reference_error};
-use rotor_compare::solvers::SolverKind;
-use rotor_compare::trace::{EventsFile, Trace};
+use rotor_grade::check::{Level, check, reference_error};
+use rotor_grade::trace::{EventsFile, Trace};
 use rotor_model::{Output, Scenario, Scene};
+use rotor_solvers::solvers::SolverKind;
 
 fn main() {
     let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
@@ -26,8 +26,8 @@ fn main() {
         (SolverKind::MOREAU, 1e-4),
     ];
     for f in Scenario::list_dir(&root.join("fixtures/scenarios")).expect("fixtures") {
-        let sc = rotor_compare::load_scenario(&f).unwrap_or_else(|e| panic!("{e}"));
-        let r = rotor_compare::reference::read(&root.join("fixtures/reference"), &sc.name)
+        let sc = rotor_solvers::load_scenario(&f).unwrap_or_else(|e| panic!("{e}"));
+        let r = rotor_grade::reference::read(&root.join("fixtures/reference"), &sc.name)
             .unwrap_or_else(|e| panic!("{e}"));
         println!("== {}", sc.name);
         for &(kind, setting) in &runs {

@@ -3,64 +3,15 @@
 //! `rotor simulate`/`rotor steady` and the Python package's `simulate`/`steady`/`sweep` take
 //! the same inputs (a solver name, u, x0, a horizon, tol or h). A [`Request`] turns them into
 //! a solver and a validated [`Scene`], and refuses bad input with a [`BadInput`] that names
-//! the input and the value. The reason is worded once, here; each front end only spells the
-//! name its own way ([`BadInput::as_flag`] for the command line, `name = value` for Python).
+//! the input and the value. The reason is worded once, here and in [`rotor_solvers`]
+//! ([`check_number`], [`solver_kind`]); each front end only spells the name its own way
+//! ([`BadInput::as_flag`] for the command line, `name = value` for Python).
 
 use rotor_model::{Num, Output, Scene, State, Stats};
-use thiserror::Error;
 
-use crate::{SOLVERS, SolverKind, SteadyOptions};
-
-/// An input refused before any run: its name (as the Python argument: `t_end`, `x0`), its
-/// value as typed or printed, and why.
-#[derive(Debug, Clone, PartialEq, Error)]
-#[error("{name} = {value}: {reason}")]
-pub struct BadInput {
-    pub name: &'static str,
-    pub value: String,
-    pub reason: String,
-}
-
-impl BadInput {
-    fn num(name: &'static str, v: f64, reason: impl Into<String>) -> BadInput {
-        BadInput {
-            name,
-            value: Num(v).to_string(),
-            reason: reason.into(),
-        }
-    }
-
-    /// The same message as the command line spells it: `--t-end 0: must be positive and
-    /// finite`.
-    pub fn as_flag(&self) -> String {
-        format!(
-            "--{} {}: {}",
-            self.name.replace('_', "-"),
-            self.value,
-            self.reason
-        )
-    }
-}
-
-/// Checks a number: finite and `ok`, else a [`BadInput`] naming it.
-pub fn check_number(name: &'static str, v: f64, ok: bool, reason: &str) -> Result<(), BadInput> {
-    if !v.is_finite() || !ok {
-        return Err(BadInput::num(name, v, reason));
-    }
-    Ok(())
-}
-
-/// The solver of a name, or a [`BadInput`] listing the names.
-pub fn solver_kind(name: &str) -> Result<SolverKind, BadInput> {
-    SolverKind::by_name(name).ok_or_else(|| BadInput {
-        name: "solver",
-        value: format!("{name:?}"),
-        reason: format!(
-            "unknown solver (expected one of: {})",
-            SOLVERS.map(SolverKind::name).join(", ")
-        ),
-    })
-}
+use rotor_solvers::SolverKind;
+pub use rotor_solvers::{BadInput, check_number, solver_kind};
+use rotor_steady::SteadyOptions;
 
 /// A setting the chosen solver has no use for (the adaptive solvers take no step size,
 /// Moreau–Jean no tolerance): said so, not silently dropped.
@@ -196,7 +147,7 @@ impl Request<'_> {
         Ok((kind, self.scene(t_end, Output::Grid { dt })?))
     }
 
-    /// A steady-state computation ([`crate::steady`]): the solver, the scene and the options
+    /// A steady-state computation ([`rotor_steady::steady`]): the solver, the scene and the options
     /// (the event-driven solver's refinement runs at `tol`).
     pub fn steady(&self) -> Result<(SolverKind, Scene, SteadyOptions), BadInput> {
         let mut opts = SteadyOptions::default();

@@ -19,7 +19,7 @@ use std::sync::atomic::{AtomicBool, Ordering};
 
 use rotor_model::{Model, Output, Params, Scene, State, SteadyState};
 
-use crate::solvers::SolverKind;
+use rotor_solvers::solvers::SolverKind;
 
 /// The header of a sweep file.
 pub const HEADER: &str = "u,p,kind,period,omega_l_max,omega_l_min,stick_time";
@@ -374,7 +374,7 @@ pub fn run(
     }
     if !stdout {
         let text = serde_json::to_string_pretty(&sweep.info(shard)).expect("plain fields");
-        crate::report::write_atomic(&info_path(out), text.as_bytes()).map_err(|e| {
+        rotor_compare::report::write_atomic(&info_path(out), text.as_bytes()).map_err(|e| {
             SweepError::File {
                 path: info_path(out),
                 message: e.to_string(),
@@ -545,7 +545,7 @@ pub fn merge(paths: &[PathBuf]) -> Result<Merged, SweepError> {
         };
         let f = std::fs::File::open(path).map_err(io)?;
         // Lines are capped: a file without line ends fails at once instead of being read whole.
-        let f = crate::trace::LineCap::new(f, crate::trace::MAX_LINE);
+        let f = rotor_grade::trace::LineCap::new(f, rotor_grade::trace::MAX_LINE);
         let mut lines = std::io::BufReader::new(f).lines();
         match lines.next() {
             Some(Ok(h)) if h == HEADER => {}
@@ -821,7 +821,7 @@ mod tests {
             Params::from_file(std::path::Path::new(stribeck)).unwrap(),
         ] {
             let u = 0.5 * base.get("lower.t_s").unwrap() / base.get("k_m").unwrap();
-            for solver in crate::solvers::SOLVERS {
+            for solver in rotor_solvers::solvers::SOLVERS {
                 let sw = Sweep {
                     base,
                     u: Axis::parse("--u", &format!("{u}:{}:2", 0.5 * u)).unwrap(),

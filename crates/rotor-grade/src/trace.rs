@@ -401,7 +401,7 @@ const CHUNK: usize = 1 << 13;
 /// `\r`), counted across reads. A line that lies inside one read is not measured: it is
 /// bounded by the read's size. So the CSV reader above never holds more than `limit` plus
 /// one chunk of a line.
-pub(crate) struct LineCap<R> {
+pub struct LineCap<R> {
     inner: R,
     limit: usize,
     /// Bytes since the last line end.
@@ -411,7 +411,7 @@ pub(crate) struct LineCap<R> {
 }
 
 impl<R: Read> LineCap<R> {
-    pub(crate) fn new(inner: R, limit: usize) -> LineCap<R> {
+    pub fn new(inner: R, limit: usize) -> LineCap<R> {
         LineCap {
             inner,
             limit,

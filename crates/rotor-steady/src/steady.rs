@@ -19,7 +19,7 @@ use rotor_model::{Model, Scene, SolveError, State, Stats, SteadyState};
 use serde::Serialize;
 
 use crate::settle::{SettleError, SettleOptions, settle};
-use crate::solvers::SolverKind;
+use rotor_solvers::solvers::SolverKind;
 
 /// How a steady state was obtained.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]

@@ -11,7 +11,7 @@
 
 use rotor_model::{Model, Output, Scene, SolveError, Stats, SteadyState};
 
-use crate::solvers::SolverKind;
+use rotor_solvers::solvers::SolverKind;
 
 /// Options of [`settle`].
 #[derive(Debug, Clone, Copy, PartialEq)]

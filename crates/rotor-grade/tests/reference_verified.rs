@@ -24,7 +24,7 @@ use std::path::{Path, PathBuf};
 
 use independent::{Ev, Problem, Run, Tableau};
 use rayon::prelude::*;
-use rotor_compare::reference;
+use rotor_grade::reference;
 use rotor_model::{Disc, EventKind, OMEGA_L, OMEGA_U, Scenario, State, SteadyState};
 
 fn fixtures() -> PathBuf {
@@ -259,7 +259,7 @@ fn verify(case: &Case, r: &reference::Reference) -> (Vec<Check>, Vec<String>) {
 
     // Events, one to one: disc, kind, time.
     let kind_of = |k: EventKind| -> (Disc, &'static str) {
-        rotor_compare::trace::event_row(k).expect("a switch")
+        rotor_grade::trace::event_row(k).expect("a switch")
     };
     let n_ref = r.events.len();
     let same_sequence = |run: &Run| {
@@ -373,7 +373,7 @@ fn the_tableau_is_gauss_legendre_of_order_2s() {
 
 #[test]
 fn every_stated_error_of_the_reference_holds_against_an_independent_solution() {
-    let names = rotor_compare::fixtures::names(&fixtures().join("scenarios"));
+    let names = rotor_solvers::fixtures::names(&fixtures().join("scenarios"));
     assert_eq!(names.len(), 14, "{names:?}");
     let cases: Vec<Case> = names.par_iter().map(|n| case(n)).collect();
     let mut failures = Vec::new();

@@ -1,0 +1,5 @@
+//! Front-end jobs shared by the command line and the Python package: a user's request,
+//! checked in one place, and sweeps over a parameter plane (run, sharded, merged).
+
+pub mod request;
+pub mod sweep;

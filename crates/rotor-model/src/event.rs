@@ -1,0 +1,31 @@
+//! What happened during a run: the events a solver reports.
+
+use serde::Serialize;
+
+use crate::dynamics::{Disc, State};
+
+/// What happened at an event.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum EventKind {
+    /// The disc's velocity reached 0 and it sticks.
+    StickStart(Disc),
+    /// The stuck disc's applied torque left the stick interval; it slips again.
+    StickEnd(Disc),
+    /// The disc's velocity crossed 0 without sticking.
+    Reversal(Disc),
+    /// A local maximum of the disc's velocity (only when metrics are asked). The adaptive
+    /// solvers report a turn only if ω moved by more than 10 tolerances since the extremum
+    /// before it: smaller ones are below their resolution (rounding noise near equilibria).
+    Max(Disc),
+    /// A local minimum of the disc's velocity (only when metrics are asked).
+    Min(Disc),
+}
+
+/// An event with its time and the state there.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct Event {
+    pub t: f64,
+    pub x: State,
+    pub kind: EventKind,
+}

@@ -1,0 +1,14 @@
+//! The project's solvers behind one name: what a solver is ([`SolverKind`], [`SOLVERS`]),
+//! scenario files loaded for them, one scenario run through each, and input refused before
+//! any run.
+
+pub mod fixtures;
+mod input;
+pub mod run;
+pub mod solvers;
+
+pub use input::{BadInput, check_number, solver_kind};
+pub use run::{RunResult, ScenarioResult, run_scenario, run_scenario_with, solver_settings};
+pub use solvers::{
+    Knob, SOLVERS, SolverInfo, SolverKind, load_scenario, load_scenario_for, pair_name, pairs,
+};

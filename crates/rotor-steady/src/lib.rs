@@ -1,0 +1,10 @@
+//! Steady states: a cycle or equilibrium found by continuation (the event-driven solver) or
+//! by simulating until the metrics stop changing (every solver), and the probes next to the
+//! bifurcation diagram's special points.
+
+pub mod probes;
+mod settle;
+mod steady;
+
+pub use settle::{SettleError, SettleOptions, Settled, Unsettled, settle};
+pub use steady::{SteadyAnswer, SteadyError, SteadyMethod, SteadyOptions, steady};
