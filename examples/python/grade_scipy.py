@@ -73,7 +73,10 @@ for gate in ("loose", "strict"):
     print(f"  {'quantity':<18} {'difference':>11} {'tolerance':>11} {'digits':>6}")
     for q in v["quantities"]:
         mark = "" if q["passed"] else "  <- fails"
-        print(f"  {q['name']:<18} {q['difference']:>11.2e} {q['tolerance']:>11.2e} {q['digits']:>6.1f}{mark}")
+        # difference is None where it cannot be measured (JSON null: a missing stick
+        # interval or event, another kind of steady state); its digits are then 0
+        diff = "unmatched" if q["difference"] is None else f"{q['difference']:.2e}"
+        print(f"  {q['name']:<18} {diff:>11} {q['tolerance']:>11.2e} {q['digits']:>6.1f}{mark}")
 
 t0 = time.perf_counter()
 ref = rotorbench.simulate("event", sc["u"], p, sc["x0"], sc["t_end"], sc["dt"])

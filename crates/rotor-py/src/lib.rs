@@ -569,12 +569,14 @@ fn events_of(events: &Bound<'_, PyAny>) -> PyResult<EventsFile> {
 ///
 /// ``scenario`` is a scenario file's path or its name (``"t1-u1.5-rest"``; see
 /// ``rotorbench.scenario``); the trace is the four arrays on the scenario's grid
-/// (``scenario(...)["dt"]``, from 0 to ``t_end``); ``gate`` is ``"loose"`` (the Moreau–Jean
-/// tolerances) or ``"strict"`` (the switch model's); ``events`` optionally the trace's events
-/// (as ``simulate`` returns them) to grade the event times. Returns a dict: ``scenario``,
-/// ``passed``, ``gate`` and ``quantities`` (each with ``name``, ``difference``,
-/// ``tolerance``, ``passed`` and ``digits``, the correct significant digits). A trace that
-/// cannot be graded (off the grid, too short, a NaN) raises ValueError naming the index.
+/// (``scenario(...)["dt"]``, from 0 to ``t_end``); ``gate`` is ``"loose"`` (3 significant
+/// digits), ``"strict"`` (7) or ``"digits=N"``; ``events`` optionally the trace's events (as
+/// ``simulate`` returns them) to grade every event, else ``not_graded`` names them. Returns
+/// the dict of ``rotor check --json``: ``scenario``, ``benchmark``, ``passed``, ``gate``,
+/// ``digits``, ``not_graded``, ``file_digits`` and ``quantities`` (each with ``name``,
+/// ``difference`` (None where it cannot be measured), ``scale``, ``tolerance``, ``passed``
+/// and ``digits``, the correct significant digits). A trace that cannot be graded (off the
+/// grid, too short, a NaN) raises ValueError naming the index.
 #[pyfunction]
 #[pyo3(signature = (scenario, t, alpha, omega_u, omega_l, gate="loose", events=None))]
 fn check<'py>(

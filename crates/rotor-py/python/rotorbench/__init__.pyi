@@ -104,12 +104,15 @@ def check(
     alpha: ArrayLike,
     omega_u: ArrayLike,
     omega_l: ArrayLike,
-    gate: Literal["loose", "strict"] = "loose",
+    gate: str = "loose",
     events: Optional[Sequence[Union[Event, Tuple[float, str, str]]]] = None,
 ) -> Dict[str, Any]:
     """Grades a trace on the scenario's grid against the reference, as ``rotor check --json``.
 
-    Keys: scenario, passed, gate, quantities (name, difference, tolerance, passed, digits).
+    ``gate`` is ``"loose"``, ``"strict"`` or ``"digits=N"``. Keys: scenario, benchmark,
+    passed, gate, digits, not_graded, file_digits, quantities (name, difference, scale,
+    tolerance, passed, digits, and at/note where they apply). A difference that cannot be
+    measured (a missing stick interval or event) is None, as JSON's null; its digits are 0.
     """
 
 def params(source: ParamsLike = None) -> Dict[str, Any]:
