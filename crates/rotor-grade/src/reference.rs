@@ -371,8 +371,6 @@ pub fn compute(sc: &Scenario) -> Result<Reference, ReferenceError> {
         transient: sc.compare.transient,
         trace_digits,
         error,
-        // The path as the published reference files record it: the test moved to
-        // crates/rotor-grade/tests/reference_verified.rs (issue 29); the files stay as they are.
         error_method: format!(
             "{ERROR_MARGIN} x the largest difference from the event-driven solver at tol \
              {CHECK_TOL:e} (trace: over every sample of the run; event_time: over the matched \
@@ -382,7 +380,7 @@ pub fn compute(sc: &Scenario) -> Result<Reference, ReferenceError> {
              the trace's; the trace is rounded to {trace_digits} significant digits. Verified \
              against an independent solution (Gauss-Legendre collocation of order 10, own \
              event location, error estimated by step halving): \
-             crates/rotor-compare/tests/reference_verified.rs"
+             crates/rotor-grade/tests/reference_verified.rs"
         ),
         cross_check,
     };
