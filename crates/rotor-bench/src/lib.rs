@@ -111,6 +111,9 @@ pub enum BenchError {
 /// The whole benchmark's result.
 #[derive(Debug, Clone, Serialize, Deserialize)]
 pub struct BenchReport {
+    /// The suite's version ([`rotor_grade::check::BENCHMARK`]) the points were graded against.
+    #[serde(default)]
+    pub benchmark: String,
     /// Per scene: reference and ladders.
     pub scenes: Vec<SceneReport>,
     /// Metrics-only vs full-trace run time per solver (first scene).
@@ -299,6 +302,7 @@ pub fn run(opts: &BenchOptions, mut progress: impl FnMut(&str)) -> Result<BenchR
     }
     let profile = profile::profile(&scenes, &clients);
     Ok(BenchReport {
+        benchmark: rotor_grade::check::BENCHMARK.to_owned(),
         scenes,
         output_levels,
         clients,

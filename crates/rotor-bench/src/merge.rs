@@ -169,6 +169,14 @@ pub fn merge(shards: &[(String, BenchReport)]) -> Result<BenchReport, BenchError
     // Scene k of the suite is scene k / N of shard k % N + 1.
     let scene_of = |k: usize| &parts[k % n].1.scenes[k / n];
     let scenes: Vec<_> = (0..total).map(|k| scene_of(k).clone()).collect();
+    for (name, r) in &parts {
+        if r.benchmark != parts[0].1.benchmark {
+            return Err(refuse(format!(
+                "{name}: graded against {}, but {}: {}",
+                r.benchmark, parts[0].0, parts[0].1.benchmark
+            )));
+        }
+    }
     let names = |r: &BenchReport| r.clients.iter().map(|c| c.name.clone()).collect::<Vec<_>>();
     let client_names = names(&parts[0].1);
     for (name, r) in &parts {
@@ -207,6 +215,7 @@ pub fn merge(shards: &[(String, BenchReport)]) -> Result<BenchReport, BenchError
         ..parts[0].1.environment.clone()
     };
     Ok(BenchReport {
+        benchmark: parts[0].1.benchmark.clone(),
         scenes,
         output_levels: parts[0].1.output_levels.clone(),
         clients,

@@ -94,6 +94,9 @@ impl BenchReport {
     /// ratios and the peers.
     pub fn table(&self) -> String {
         let mut s = String::new();
+        if !self.benchmark.is_empty() {
+            let _ = writeln!(s, "suite {}\n", self.benchmark);
+        }
         for sc in &self.scenes {
             let r = &sc.reference;
             let _ = writeln!(

@@ -5,6 +5,7 @@ use std::process::ExitCode;
 
 mod open;
 mod out;
+mod scenarios;
 
 use anyhow::{Context, Result, anyhow, bail};
 use clap::{Parser, Subcommand};
@@ -219,6 +220,13 @@ enum Command {
         #[arg(long, value_name = "P", default_value = "events.csv")]
         events: PathBuf,
     },
+    /// List the benchmark suite: every scenario with its tier (table1: only the lower disc
+    /// sticks; full: both may), what it tests, and the suite's version.
+    Scenarios {
+        /// Also write the list as JSON (`-`: standard output).
+        #[arg(long)]
+        json: Option<PathBuf>,
+    },
     /// Write the benchmark's reference data for every scenario: trace, events and steady
     /// state of the event-driven solver, with their stated errors.
     Reference {
@@ -298,7 +306,7 @@ fn kind_by_name(name: &str) -> Result<SolverKind> {
 
 /// Prints a command's summary: on standard output, unless one of its outputs goes there
 /// (`-`), then on standard error.
-fn say<const N: usize>(text: &str, outputs: [Option<&Path>; N]) -> std::io::Result<()> {
+pub(crate) fn say<const N: usize>(text: &str, outputs: [Option<&Path>; N]) -> std::io::Result<()> {
     if outputs.iter().flatten().any(|p| p.as_os_str() == "-") {
         eprint!("{text}");
         Ok(())
@@ -321,7 +329,7 @@ fn load_model(params: Option<&Path>) -> Result<Model> {
 /// ([`rotor_solvers::fixtures::resolve`]). A name that is neither is an error naming `flag`
 /// and listing the names there.
 pub(crate) fn fixture_path(flag: &str, p: &Path, kind: &str) -> Result<PathBuf> {
-    let dir = fixtures_dir().join(kind);
+    let dir = fixtures_dir()?.join(kind);
     rotor_solvers::fixtures::resolve(p, Some(&dir)).ok_or_else(|| {
         anyhow!(
             "{flag} {}: no such file, nor a name in {} (names: {})",
@@ -798,13 +806,26 @@ fn write_bench(
     Ok(())
 }
 
-/// The fixtures directory: next to the workspace root when run through cargo, else ./fixtures.
-fn fixtures_dir() -> PathBuf {
+/// The checkout's fixtures directory, which `rotor reference` writes: ./fixtures when run in
+/// the workspace root, else the one this binary was built from.
+fn checkout_fixtures() -> PathBuf {
     let local = PathBuf::from("fixtures");
     if local.is_dir() {
         return local;
     }
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../../fixtures")
+}
+
+/// The suite's directory, for scenarios and parameter sets given by name: ./fixtures in a
+/// checkout's root, else what [`rotor_suite::locate`] finds (`$ROTORBENCH_FIXTURES`, the
+/// checkout this binary was built from, or the suite embedded in it). With
+/// `ROTORBENCH_SUITE=embedded`, always the embedded suite.
+fn fixtures_dir() -> Result<PathBuf> {
+    let local = PathBuf::from("fixtures");
+    if std::env::var_os("ROTORBENCH_SUITE").is_none() && local.join("scenarios").is_dir() {
+        return Ok(local);
+    }
+    Ok(rotor_suite::locate()?.dir)
 }
 
 /// The report section with the bifurcation diagrams of both parameter sets (the source's
@@ -1005,7 +1026,7 @@ fn probe_section(
             "## Steady states near special points\n\n\
              `rotor steady` at ±1e-3, ±1e-4 and ±1e-6 V from every special point of both \
              diagrams, from rest and from the equilibrium perturbed by 1e-3 rad/s, for every \
-             solver (crate `rotor-compare`, module `probes`). Each answer is checked against \
+             solver (crate `rotor-steady`, module `probes`). Each answer is checked against \
              what the continuation says is stable at that input (the stable equilibria, the \
              stuck set, the stable cycles found by Newton's method from the branch and from \
              the Hopf eigenvector): it must be one of them in kind, period and ω_l extremes \
@@ -1080,7 +1101,7 @@ fn stress_section() -> rotor_compare::report::Section {
 fn compare(files: &[PathBuf], report: &Path, main_job: bool, threads: Option<usize>) -> Result<()> {
     use rayon::prelude::*;
     let files = if files.is_empty() {
-        let dir = fixtures_dir().join("scenarios");
+        let dir = fixtures_dir()?.join("scenarios");
         rotor_model::Scenario::list_dir(&dir)
             .with_context(|| format!("{}: cannot list scenarios", dir.display()))?
     } else {
@@ -1104,7 +1125,7 @@ fn compare(files: &[PathBuf], report: &Path, main_job: bool, threads: Option<usi
             );
         }
     }
-    let stribeck = Params::from_file(&fixtures_dir().join("params/stribeck.toml"))?;
+    let stribeck = Params::from_file(&fixtures_dir()?.join("params/stribeck.toml"))?;
     let threads = thread_pool(threads)?;
     eprintln!("{} scenarios on {threads}", scenarios.len());
     let t0 = std::time::Instant::now();
@@ -1237,6 +1258,7 @@ impl Command {
             Merge { .. } => "merge",
             Bench { .. } => "bench",
             Job { .. } => "job",
+            Scenarios { .. } => "scenarios",
             Reference { .. } => "reference",
             Check { .. } => "check",
             Compare { .. } => "compare",
@@ -1258,7 +1280,7 @@ impl Command {
             Bifurcation { json, svg, csv, .. } => (csv.as_ref(), Some(json), svg.as_ref()),
             Bifurcation2 { json, svg, .. } => (None, Some(json), svg.as_ref()),
             Bench { json, svg, csv, .. } => (csv.as_ref(), json.as_ref(), svg.as_ref()),
-            Check { json, .. } => (None, json.as_ref(), None),
+            Check { json, .. } | Scenarios { json } => (None, json.as_ref(), None),
             Steady { .. } | Compare { .. } | Reference { .. } | Job { .. } => (None, None, None),
         };
         [("--csv", csv), ("--json", json), ("--svg", svg)]
@@ -1361,6 +1383,7 @@ fn main() -> ExitCode {
             trace,
             events,
         }) => job(scenario, *tol, *h, trace, events),
+        Some(Command::Scenarios { json }) => scenarios::run(json.as_deref()),
         Some(Command::Compare {
             scenarios,
             report,
@@ -1413,7 +1436,7 @@ fn main() -> ExitCode {
                 }
             };
             eprintln!("reference data on {threads}");
-            let fixtures = fixtures_dir();
+            let fixtures = checkout_fixtures();
             let out = out.clone().unwrap_or_else(|| open::default_out(&fixtures));
             open::write_reference(&fixtures.join("scenarios"), &out)
         }

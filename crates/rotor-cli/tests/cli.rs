@@ -1000,3 +1000,63 @@ fn bench_keeps_runs_and_names_an_unsolved_client() {
         "cannot read the job\n"
     );
 }
+
+/// An installed `rotor` works from an empty directory with the suite embedded in it
+/// (`ROTORBENCH_SUITE=embedded`, as where no checkout is): `scenarios` prints the version
+/// and every scene with its tier, `job` writes a scene's job, and `check` grades a trace by
+/// the scenario's name, with the version on its verdict.
+#[test]
+fn an_installed_rotor_grades_by_name_from_an_empty_directory() {
+    let dir = std::env::temp_dir().join(format!("rotor-cli-installed-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
+    std::fs::copy(
+        root.join("fixtures/reference/t1-u1.5-rest.csv"),
+        dir.join("X.csv"),
+    )
+    .unwrap();
+    let run = |args: &[&str]| {
+        Command::new(env!("CARGO_BIN_EXE_rotor"))
+            .args(args)
+            .current_dir(&dir)
+            .env("ROTORBENCH_SUITE", "embedded")
+            .env("ROTORBENCH_CACHE", dir.join("cache"))
+            .env_remove("ROTORBENCH_FIXTURES")
+            .output()
+            .unwrap()
+    };
+    let ok = |o: &std::process::Output| {
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        String::from_utf8_lossy(&o.stdout).into_owned()
+    };
+    let version = rotor_suite::VERSION;
+    let list = ok(&run(&["scenarios", "--json", "list.json"]));
+    assert!(list.starts_with(version), "{list}");
+    assert!(list.contains("embedded in this build"), "{list}");
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("list.json")).unwrap()).unwrap();
+    assert_eq!(json["benchmark"], version);
+    let scenes = json["scenarios"].as_array().unwrap();
+    assert_eq!(scenes.len(), 14);
+    let tier = |n: &str| {
+        scenes.iter().find(|s| s["name"] == n).unwrap()["tier"]
+            .as_str()
+            .unwrap()
+            .to_owned()
+    };
+    assert_eq!(tier("t1-u1.5-rest"), "table1");
+    assert_eq!(tier("st-u1.5-rest"), "full");
+    let job: serde_json::Value =
+        serde_json::from_str(&ok(&run(&["job", "t1-u1.5-rest", "--h", "1e-3"]))).unwrap();
+    assert_eq!(job["benchmark"], version);
+    assert_eq!(job["h"], 1e-3);
+    let verdict = ok(&run(&["check", "t1-u1.5-rest", "--trace", "X.csv"]));
+    assert!(
+        verdict.contains("PASSED") && verdict.contains(version),
+        "{verdict}"
+    );
+    // The cache holds the suite under its version, whole.
+    assert!(dir.join("cache").join(version).join(".complete").is_file());
+    std::fs::remove_dir_all(&dir).ok();
+}

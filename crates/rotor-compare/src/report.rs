@@ -307,6 +307,11 @@ pub fn write_report(
     let mut md = String::new();
     let mut all_fails = Vec::new();
     md.push_str(include_str!("report_intro.md"));
+    md.push_str(&format!(
+        "\nSuite: `{}` (the scenarios, parameter sets and reference data, named by their \
+         checksum; `rotor scenarios` lists them).\n",
+        rotor_grade::check::BENCHMARK
+    ));
     md.push_str("\n## Agreement and work per scenario\n\n");
     md.push_str("| scenario | solver | steady state (second half of the run) | steps | rejected | RHS evals | events | LCP solves / skipped |\n|---|---|---|---|---|---|---|---|\n");
     let mut times = String::from(

@@ -53,7 +53,7 @@ use crate::trace::{At, EventsFile, Trace, disc_name, event_row};
 use rotor_solvers::BadInput;
 
 /// The benchmark's version: named in every verdict.
-pub const BENCHMARK: &str = "rotorbench-1.0";
+pub const BENCHMARK: &str = rotor_suite::VERSION;
 
 /// Digits of the `loose` level: engineering accuracy, 0.1 % of each quantity's scale. What
 /// any converging method reaches at a reasonable cost: a first-order time-stepper at

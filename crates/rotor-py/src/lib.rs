@@ -133,16 +133,12 @@ fn warn_inexact(py: Python<'_>, stats: &Stats) -> PyResult<()> {
     }
 }
 
-/// The repository's fixtures: `$ROTORBENCH_FIXTURES`, else those of the source checkout this
-/// module was built from, if it is still there.
+/// The suite's fixtures ([`rotor_suite::locate`]): `$ROTORBENCH_FIXTURES`, else those of the
+/// source checkout this module was built from, if it is still there, else the suite embedded
+/// in the module (written once to a cache directory); always the embedded one with
+/// `ROTORBENCH_SUITE=embedded`. `None` if none can be given (the cache is not writable).
 fn fixtures() -> Option<PathBuf> {
-    if let Some(dir) = std::env::var_os("ROTORBENCH_FIXTURES") {
-        return Some(PathBuf::from(dir));
-    }
-    let built = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../fixtures");
-    built
-        .is_dir()
-        .then(|| built.canonicalize().unwrap_or(built))
+    rotor_suite::locate().ok().map(|l| l.dir)
 }
 
 /// A file argument: a path, or the name of a file of `fixtures/<kind>/` (without `.toml`;
@@ -169,8 +165,10 @@ fn resolve(arg: &str, value: &Bound<'_, PyAny>, kind: &str) -> PyResult<PathBuf>
             dir.map(|d| d.display().to_string()).unwrap_or_default()
         ),
         None => format!(
-            "{arg} = {name:?}: no such file (names of fixtures need the source checkout or \
-             $ROTORBENCH_FIXTURES)"
+            "{arg} = {name:?}: no such file, and the suite's files cannot be given: {}",
+            rotor_suite::locate()
+                .err()
+                .map_or(String::new(), |e| e.to_string())
         ),
     }))
 }
@@ -692,6 +690,7 @@ fn _rotorbench(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("SolveError", py.get_type::<SolveError>())?;
     m.add("InternalError", py.get_type::<InternalError>())?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
+    m.add("SUITE_VERSION", rotor_suite::VERSION)?;
     m.add(
         "FIXTURES",
         fixtures().map(|p| p.to_string_lossy().into_owned()),

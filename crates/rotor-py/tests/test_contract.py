@@ -167,3 +167,31 @@ def test_the_package_is_typed_and_documented():
         "(solver='event', u=1.5, params=None, x0=(0.0, 0.0, 0.0), t_end=100.0, dt=0.01, tol=None, h=None)"
     )
     assert rotorbench.__version__ == "0.1.0"
+
+
+def test_the_wheel_grades_by_name_from_any_directory_with_its_embedded_suite(tmp_path):
+    """An installed package grades a scenario by name with the suite embedded in it, from an
+    empty directory (ROTORBENCH_SUITE=embedded: as where no checkout is), and names the
+    suite's version in the verdict, as the CLI does."""
+    import json
+    import subprocess
+    import sys
+
+    ref = os.path.join(rotorbench.FIXTURES, "reference", "t1-u1.5-rest.csv")
+    code = (
+        "import json, sys, numpy as np, rotorbench\n"
+        "d = np.loadtxt(sys.argv[1], delimiter=',', skiprows=1)\n"
+        "v = rotorbench.check('t1-u1.5-rest', d[:, 0], d[:, 1], d[:, 2], d[:, 3], gate='strict')\n"
+        "print(json.dumps({'passed': v['passed'], 'benchmark': v['benchmark'],\n"
+        "                  'version': rotorbench.SUITE_VERSION, 'fixtures': rotorbench.FIXTURES}))\n"
+    )
+    env = dict(os.environ, ROTORBENCH_SUITE="embedded", ROTORBENCH_CACHE=str(tmp_path / "cache"))
+    env.pop("ROTORBENCH_FIXTURES", None)
+    p = subprocess.run([sys.executable, "-c", code, ref], cwd=tmp_path, env=env,
+                       capture_output=True, text=True, timeout=300)
+    assert p.returncode == 0, p.stderr
+    out = json.loads(p.stdout)
+    assert out["passed"] is True
+    assert out["benchmark"] == out["version"] == rotorbench.SUITE_VERSION
+    assert out["version"].startswith("rotorbench-1.0+")
+    assert out["fixtures"].startswith(str(tmp_path / "cache"))

@@ -36,6 +36,8 @@ pub const VERSION: &str = concat!("rotorbench-1.0+", env!("ROTORBENCH_CHECKSUM12
 pub enum SuiteError {
     #[error("ROTORBENCH_FIXTURES = {0}: not a directory")]
     NotADirectory(PathBuf),
+    #[error("ROTORBENCH_SUITE = {0:?}: expected embedded (or unset)")]
+    Choice(String),
     #[error(
         "{path}: cannot write the embedded suite there ({source}); set ROTORBENCH_CACHE to a \
          writable directory, or ROTORBENCH_FIXTURES to a copy of the suite's fixtures/"
@@ -75,10 +77,21 @@ pub struct Located {
     pub source: Source,
 }
 
-/// The suite's directory: `$ROTORBENCH_FIXTURES`, else the checkout's `fixtures/`, else the
-/// embedded files in the cache (`$ROTORBENCH_CACHE`, else `$XDG_CACHE_HOME/rotorbench`, else
+/// The suite's directory: the embedded suite when `ROTORBENCH_SUITE=embedded` (to grade
+/// against exactly this build's version, even inside a checkout), else `$ROTORBENCH_FIXTURES`,
+/// else the checkout's `fixtures/`, else the embedded files in the cache (`$ROTORBENCH_CACHE`, else `$XDG_CACHE_HOME/rotorbench`, else
 /// `~/.cache/rotorbench`, each in a directory named by [`VERSION`]).
 pub fn locate() -> Result<Located, SuiteError> {
+    match std::env::var("ROTORBENCH_SUITE").as_deref() {
+        Ok("embedded") => {
+            return Ok(Located {
+                dir: extract(&cache_root())?,
+                source: Source::Embedded,
+            });
+        }
+        Ok(other) => return Err(SuiteError::Choice(other.to_owned())),
+        Err(_) => {}
+    }
     if let Some(dir) = std::env::var_os("ROTORBENCH_FIXTURES") {
         let dir = PathBuf::from(dir);
         if !dir.is_dir() {

@@ -21,6 +21,7 @@ repository's docs/ (docs/python.md for this package).
 
 from ._rotorbench import (
     FIXTURES,
+    SUITE_VERSION,
     InternalError,
     SolveError,
     __version__,
@@ -35,6 +36,7 @@ from ._rotorbench import (
 
 __all__ = [
     "FIXTURES",
+    "SUITE_VERSION",
     "InternalError",
     "SolveError",
     "__version__",

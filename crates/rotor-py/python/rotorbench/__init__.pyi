@@ -7,9 +7,13 @@ import numpy as np
 import numpy.typing as npt
 
 __version__: str
-#: The repository's fixtures directory (scenarios, params, reference), or None when neither
-#: $ROTORBENCH_FIXTURES nor the source checkout the package was built from is there.
+#: The suite's directory (scenarios, params, reference): $ROTORBENCH_FIXTURES, the source
+#: checkout the package was built from, or the suite embedded in the package (written once to
+#: a cache directory; always that one with ROTORBENCH_SUITE=embedded); None if none can be given.
 FIXTURES: Optional[str]
+#: The suite's version, e.g. "rotorbench-1.0+646a96e8215c": the problem set's name and the
+#: start of the sha256 of its files (as ``rotor scenarios`` prints it and every verdict holds).
+SUITE_VERSION: str
 
 Solver = Literal["event", "switch", "moreau"]
 #: None (Table 1), a parameter file's path or name ("table1", "stribeck"), or a dict of its keys.

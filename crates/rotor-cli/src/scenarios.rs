@@ -1,0 +1,97 @@
+//! `rotor scenarios`: the versioned suite, scene by scene.
+
+use std::path::Path;
+
+use anyhow::{Context, Result};
+use rotor_model::{Disc, Scenario};
+use serde::Serialize;
+
+/// A scene's tier: `table1` when only the lower disc has static friction (what a solver that
+/// treats one switching surface handles), `full` when the upper disc sticks too.
+pub fn tier(sc: &Scenario) -> &'static str {
+    if sc.model.friction(Disc::Upper).is_set_valued() {
+        "full"
+    } else {
+        "table1"
+    }
+}
+
+#[derive(Serialize)]
+struct Row<'a> {
+    name: &'a str,
+    tier: &'static str,
+    description: &'a str,
+    u: f64,
+    t_end: f64,
+}
+
+#[derive(Serialize)]
+struct Listing<'a> {
+    benchmark: &'static str,
+    checksum: &'static str,
+    source: &'static str,
+    dir: String,
+    scenarios: Vec<Row<'a>>,
+}
+
+/// Lists every scenario of the suite (name, tier, what it tests), with the suite's version and
+/// where its files were found; `--json` writes the same as JSON.
+pub fn run(json: Option<&Path>) -> Result<()> {
+    let (dir, source) = match std::env::var_os("ROTORBENCH_SUITE") {
+        None if Path::new("fixtures/scenarios").is_dir() => {
+            (Path::new("fixtures").to_owned(), "./fixtures")
+        }
+        _ => {
+            let l = rotor_suite::locate()?;
+            (l.dir, l.source.as_str())
+        }
+    };
+    let files = Scenario::list_dir(&dir.join("scenarios"))
+        .with_context(|| format!("{}: cannot list the scenarios", dir.display()))?;
+    let scenarios = files
+        .iter()
+        .map(|f| rotor_solvers::load_scenario(f))
+        .collect::<Result<Vec<_>, _>>()?;
+    let rows: Vec<Row> = scenarios
+        .iter()
+        .map(|sc| Row {
+            name: &sc.name,
+            tier: tier(sc),
+            description: &sc.description,
+            u: sc.u,
+            t_end: sc.t_end,
+        })
+        .collect();
+    let mut text = format!(
+        "{} ({} scenarios; {source}: {})\n{:<18} {:<7} {:>5} {:>6}  {}\n",
+        rotor_suite::VERSION,
+        rows.len(),
+        dir.display(),
+        "name",
+        "tier",
+        "u [V]",
+        "t_end",
+        "what it tests"
+    );
+    for r in &rows {
+        text.push_str(&format!(
+            "{:<18} {:<7} {:>5} {:>6}  {}\n",
+            r.name, r.tier, r.u, r.t_end, r.description
+        ));
+    }
+    crate::say(&text, [json])?;
+    if let Some(path) = json {
+        let listing = Listing {
+            benchmark: rotor_suite::VERSION,
+            checksum: rotor_suite::CHECKSUM,
+            source,
+            dir: dir.display().to_string(),
+            scenarios: rows,
+        };
+        let mut s = serde_json::to_string_pretty(&listing)?;
+        s.push('\n');
+        rotor_compare::report::write_output(path, s.as_bytes())
+            .with_context(|| format!("--json {}: cannot write", path.display()))?;
+    }
+    Ok(())
+}
