@@ -45,6 +45,14 @@ enum Command {
     Steady {
         #[command(flatten)]
         common: Common,
+        /// How: `simulate` (the default: the event-driven solver refines the cycle a run
+        /// reaches on its own flow with saltation matrices; switch and moreau run until the
+        /// metrics settle, which answers equilibria too), or `shoot` (Newton on the
+        /// solver's own return map from a 300 s run's last section crossing: any solver, the
+        /// orbit stable or not, in a few periods where settling next to a Hopf point takes
+        /// thousands of seconds; the JSON adds "stable" and "multipliers").
+        #[arg(long, value_name = "shoot|simulate")]
+        method: Option<String>,
     },
     /// Bifurcation diagram over u: equilibria, periodic branches with Floquet multipliers,
     /// special points (Hopf, grazing, folds), as JSON, and optionally CSV and an SVG figure.
@@ -436,13 +444,22 @@ fn simulate(common: &Common, t_end: f64, dt: f64, csv_path: &Path) -> Result<()>
     Ok(())
 }
 
-fn steady(common: &Common) -> Result<()> {
+fn steady(common: &Common, method: Option<&str>) -> Result<()> {
+    let shoot = match method {
+        None | Some("simulate") => false,
+        Some("shoot") => true,
+        Some(other) => bail!("--method {other:?}: expected shoot or simulate"),
+    };
     let (kind, scene, opts) = request(common)?
         .steady()
         .map_err(|e| anyhow!(e.as_flag()))?;
     let model = load_model(common.params.as_deref())?;
-    let answer = rotor_steady::steady(kind, &model, &scene, &opts)
-        .with_context(|| format!("solver {}", kind.name()))?;
+    let answer = if shoot {
+        rotor_steady::shot(kind, &model, &scene)
+    } else {
+        rotor_steady::steady(kind, &model, &scene, &opts)
+    }
+    .with_context(|| format!("solver {}", kind.name()))?;
     warn_inexact(&answer.stats);
     out::line(format_args!("{}", steady_json(&answer)))?;
     Ok(())
@@ -1327,7 +1344,7 @@ fn main() -> ExitCode {
             dt,
             csv,
         }) => simulate(common, *t_end, *dt, csv),
-        Some(Command::Steady { common }) => steady(common),
+        Some(Command::Steady { common, method }) => steady(common, method.as_deref()),
         Some(Command::Bifurcation {
             params,
             u_min,

@@ -1060,3 +1060,57 @@ fn an_installed_rotor_grades_by_name_from_an_empty_directory() {
     assert!(dir.join("cache").join(version).join(".complete").is_file());
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// `rotor steady --method shoot`: every solver finds the 1.5 V stick-slip cycle on its own
+/// return map, says it is stable with its multipliers `[1, λ, 0]`, and agrees with the
+/// default method's answer (the event solver's refined cycle; the others' settled runs)
+/// within each solver's own error; an equilibrium and an unknown method are refused by name.
+#[test]
+fn steady_shoot_finds_the_cycle_with_every_solver() {
+    let json = |args: &[&str]| -> serde_json::Value {
+        let o = rotor(args);
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        serde_json::from_slice(&o.stdout).unwrap()
+    };
+    for (solver, gate) in [
+        // Relative period difference, shot against the default answer, about 5× the
+        // measured: event 3.3e-11 (its refined cycle: both fixed points of a map, each to
+        // its Newton tolerance), Moreau–Jean 1.3e-10 (its settled run); the switch model's
+        // settled run, 1.2e-14, gets the fixtures' rounding floor, 1e-12.
+        ("event", 2e-10),
+        ("switch", 1e-12),
+        ("moreau", 7e-10),
+    ] {
+        let base = ["steady", "--solver", solver, "--u", "1.5"];
+        let shot = json(&[&base[..], &["--method", "shoot"]].concat());
+        let default = json(&base);
+        assert_eq!(shot["method"], "shoot");
+        assert_eq!(shot["stable"], true);
+        assert_eq!(shot["kind"], "limit_cycle");
+        let m = shot["multipliers"].as_array().unwrap();
+        assert_eq!(m.len(), 3, "{shot}");
+        assert_eq!(m[0][0], 1.0);
+        let (a, b) = (
+            shot["period"].as_f64().unwrap(),
+            default["period"].as_f64().unwrap(),
+        );
+        assert!((a - b).abs() <= gate * b, "{solver}: {a} vs {b}");
+        assert!(json(&[&base[..], &["--method", "simulate"]].concat()) == default);
+    }
+    let o = rotor(&[
+        "steady", "--solver", "switch", "--u", "6.0", "--method", "shoot",
+    ]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        !o.status.success() && err.contains("--method simulate"),
+        "{err}"
+    );
+    let o = rotor(&[
+        "steady", "--solver", "event", "--u", "1.5", "--method", "bogus",
+    ]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        !o.status.success() && err.contains("--method \"bogus\""),
+        "{err}"
+    );
+}

@@ -7,4 +7,4 @@ mod settle;
 mod steady;
 
 pub use settle::{SettleError, SettleOptions, Settled, Unsettled, settle};
-pub use steady::{SteadyAnswer, SteadyError, SteadyMethod, SteadyOptions, steady};
+pub use steady::{SHOOT_RUN, SteadyAnswer, SteadyError, SteadyMethod, SteadyOptions, shot, steady};

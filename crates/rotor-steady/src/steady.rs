@@ -34,6 +34,9 @@ pub enum SteadyMethod {
     Settled,
     /// The metrics of a simulation once they stopped changing (see [`crate::settle`]).
     Simulated,
+    /// A periodic orbit found by shooting on the solver's own return map ([`shot`]), stable
+    /// or not.
+    Shoot,
 }
 
 /// Settings of [`steady`].
@@ -57,6 +60,10 @@ pub struct SteadyAnswer {
     /// equilibrium and for a simulated cycle.
     #[serde(serialize_with = "complex_list")]
     pub multipliers: Option<Vec<Complex<f64>>>,
+    /// Whether a cycle found by shooting is stable (every multiplier but the trivial one
+    /// inside the unit circle); absent otherwise.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub stable: Option<bool>,
     #[serde(skip)]
     pub stats: Stats,
 }
@@ -76,6 +83,11 @@ fn complex_list<S: serde::Serializer>(
 pub enum SteadyError {
     #[error(transparent)]
     Solve(#[from] SolveError),
+    #[error(
+        "shooting found no periodic orbit (if the run settles to an equilibrium, --method \
+         simulate answers it)"
+    )]
+    Shoot(#[from] rotor_shoot::ShootError),
     #[error(transparent)]
     Settle(#[from] SettleError),
     /// The refined cycle's saltation multipliers put it outside the unit circle although the
@@ -112,6 +124,7 @@ pub fn steady(
             state: s.state,
             method: SteadyMethod::Simulated,
             multipliers: None,
+            stable: None,
             stats: s.stats,
         }
     };
@@ -121,6 +134,55 @@ pub fn steady(
         }
     }
     Ok(answer)
+}
+
+/// How long the run from the start is before shooting starts from its last crossing of the
+/// section [s]: enough to come near a cycle that attracts at a multiplier ≤ 0.99 per ~4.5 s
+/// period from rest (e^(-0.01·300/4.5) ≈ 0.5 of the start's distance is left, which Newton
+/// removes); a slower one needs a start nearer the cycle (`--x0`).
+pub const SHOOT_RUN: f64 = 300.0;
+
+/// The periodic orbit near the one a run from `scene.x0` approaches, by shooting on `kind`'s
+/// own return map ([`rotor_shoot`]), stable or not: its metrics (one run over two periods
+/// from the fixed point), the Floquet multipliers `[1, λ, 0]` (a stick phase) or
+/// `[1, λ1, λ2]`, and whether it is stable. An error when the run settles to an equilibrium.
+pub fn shot(kind: SolverKind, model: &Model, scene: &Scene) -> Result<SteadyAnswer, SteadyError> {
+    scene.validate()?;
+    let solver = kind.solver();
+    let opts = rotor_shoot::ShootOptions::default();
+    let (section, z0) = rotor_shoot::Section::of_run(&*solver, model, scene, scene.x0, SHOOT_RUN)?;
+    let orbit = rotor_shoot::shoot(&*solver, model, scene, section, &z0, &opts)?;
+    // The metrics of the orbit: its last complete cycle of a run over two periods.
+    let t_end = 2.0 * orbit.period + opts.skip;
+    let run = solver.simulate_finite(
+        model,
+        &Scene {
+            x0: orbit.x,
+            t_end,
+            output: rotor_model::Output::Final,
+            metrics_from: Some(0.0),
+            ..scene.clone()
+        },
+    )?;
+    let state = run
+        .metrics
+        .ok_or(SteadyError::Shoot(rotor_shoot::ShootError::NoReturn {
+            what: section.as_str(),
+            horizon: t_end,
+            z: orbit.z.clone(),
+        }))?;
+    let mut multipliers = vec![Complex::new(1.0, 0.0)];
+    multipliers.extend(orbit.multipliers.iter().map(|m| Complex::new(m[0], m[1])));
+    if multipliers.len() == 2 {
+        multipliers.push(Complex::new(0.0, 0.0));
+    }
+    Ok(SteadyAnswer {
+        state,
+        method: SteadyMethod::Shoot,
+        multipliers: Some(multipliers),
+        stable: Some(orbit.is_stable()),
+        stats: run.stats,
+    })
 }
 
 /// The event-driven solver's refined steady state, with the saltation multipliers of a
@@ -146,6 +208,7 @@ fn refined(
             rotor_event::Method::Settled => SteadyMethod::Settled,
         },
         multipliers: None,
+        stable: None,
         stats: Stats::default(),
     };
     let (rotor_event::Method::Refined, Some(x)) = (st.method, st.on_cycle) else {
