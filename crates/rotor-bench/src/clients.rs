@@ -64,7 +64,7 @@ pub struct ClientPoint {
     pub failing: Vec<String>,
     pub failure: Option<Failure>,
     /// The protocol's own cost of this run, not the client's: writing the job file, and
-    /// reading and grading the trace [s].
+    /// reading and grading the trace \[s\].
     pub protocol_s: Option<f64>,
 }
 
@@ -145,7 +145,7 @@ impl ClientStatus {
     }
 }
 
-/// The protocol's overhead for one client, medians over its runs [s].
+/// The protocol's overhead for one client, medians over its runs \[s\].
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct Overhead {
     /// Writing the job file, reading and grading the trace.

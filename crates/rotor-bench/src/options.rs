@@ -116,7 +116,7 @@ pub struct BenchOptions {
     /// The ladder of an external client with a step h (1e-2 … 1e-4).
     pub client_hs: Vec<f64>,
     /// Run only every N-th scene from the I-th (`rotor bench --shard I/N`, for job arrays);
-    /// [`crate::merge`] joins the shards' reports.
+    /// [`crate::merge()`] joins the shards' reports.
     pub shard: Option<rotor_jobs::sweep::Shard>,
     /// Where to keep every external run's files (`DIR/CLIENT/SCENE/runK`: job.json,
     /// trace.csv, events.csv, stderr.txt); `None`: a temporary directory, deleted after.

@@ -18,7 +18,7 @@ pub use crate::word::CRITERION;
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct ProfileEntry {
     pub name: String,
-    /// Its time per scene [s] (`None`: not solved).
+    /// Its time per scene \[s\] (`None`: not solved).
     pub times: Vec<Option<f64>>,
     /// Its time over the best time per scene (`None`: not solved).
     pub ratios: Vec<Option<f64>>,

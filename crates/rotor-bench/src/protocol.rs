@@ -224,7 +224,7 @@ pub enum Ended {
 #[derive(Debug, Clone, PartialEq)]
 pub struct RunOutput {
     pub ended: Ended,
-    /// From the spawn to the exit (or the kill) [s].
+    /// From the spawn to the exit (or the kill) \[s\].
     pub wall_s: f64,
     pub stdout: String,
     pub stderr: String,

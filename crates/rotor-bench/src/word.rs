@@ -10,7 +10,7 @@ pub const CRITERION: &str = "fastest point whose trace passes the scene's loose 
                              (solve_seconds, else wall)";
 
 /// A `&'static str` field of the report (a setting's name, a ratio's kind). Named, so that
-/// serde's derive reads it with [`static_str`] instead of borrowing it from the input.
+/// serde's derive reads it with `static_str` instead of borrowing it from the input.
 pub type Word = &'static str;
 
 /// Reads a `&'static str` field of a report back (a setting's name, a ratio's kind): the

@@ -299,7 +299,7 @@ pub struct StressRow {
     pub gate_kind: Gate,
     /// Events per period seen in a [`Measure::Drift`] run: (min, max).
     pub events_per_period: Option<(usize, usize)>,
-    /// Wall-clock run time [s] (reported, never asserted).
+    /// Wall-clock run time \[s\] (reported, never asserted).
     pub seconds: f64,
 }
 

@@ -38,7 +38,7 @@ use crate::dop853::{Dense, Dop853};
 /// Options of the event-driven solver.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct EventOptions {
-    /// Largest step [s]; a quarter of the lower disc's natural period (2π/√(k_θ/J_l) ≈ 4.2 s)
+    /// Largest step \[s\]; a quarter of the lower disc's natural period (2π/√(k_θ/J_l) ≈ 4.2 s)
     /// is far above what the tolerance allows on a cycle, so it only matters on equilibria.
     pub h_max: f64,
     /// Limit on accepted + rejected steps.

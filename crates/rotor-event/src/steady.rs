@@ -71,9 +71,9 @@ impl Steady {
 pub struct SteadyOptions {
     /// Integration tolerance.
     pub tol: f64,
-    /// Length of one settling chunk [s]; metrics are read over its second half.
+    /// Length of one settling chunk \[s\]; metrics are read over its second half.
     pub settle: f64,
-    /// Longest total settling time [s] (a focus with Re λ = −1e-3 /s near a Hopf point
+    /// Longest total settling time \[s\] (a focus with Re λ = −1e-3 /s near a Hopf point
     /// decays by e^-20 in 20 000 s).
     pub max_settle: f64,
     /// Newton/secant stopping tolerance on the fixed-point residual (rad/s).

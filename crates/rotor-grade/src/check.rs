@@ -68,7 +68,7 @@ pub const LOOSE_DIGITS: u32 = 3;
 /// every error until the cycle.
 pub const STRICT_DIGITS: u32 = 7;
 
-/// Absolute floor of the scale of α [rad] and of ω_u, ω_l [rad/s]: for a variable that
+/// Absolute floor of the scale of α \[rad\] and of ω_u, ω_l [rad/s]: for a variable that
 /// stays near 0 over the whole run (both discs stuck), digits are counted against this.
 pub const FLOOR: f64 = 1e-3;
 
@@ -155,7 +155,7 @@ pub struct Graded {
     pub passed: bool,
     /// Significant correct digits, `−log10(difference/scale)` (0 … 16, one decimal).
     pub digits: f64,
-    /// Where the difference is largest [s], when it is at one time.
+    /// Where the difference is largest \[s\], when it is at one time.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub at: Option<f64>,
     /// What went wrong, when the difference alone does not say (missing or extra events).
@@ -302,7 +302,7 @@ pub enum CheckError {
     },
 }
 
-/// Times within this of the grid's are the grid's [s].
+/// Times within this of the grid's are the grid's \[s\].
 pub const TIME_TOL: f64 = 1e-9;
 
 /// Checks that the trace has exactly the reference's grid times.
@@ -398,7 +398,7 @@ pub fn state_scales(reference: &[Sample]) -> [f64; 3] {
     s
 }
 
-/// The motion's time scale [s]: the period of the reference's steady cycle, else 1 s (a
+/// The motion's time scale \[s\]: the period of the reference's steady cycle, else 1 s (a
 /// transient to an equilibrium has no period to measure event times against).
 pub fn time_scale(reference: &Reference) -> f64 {
     match reference.steady() {

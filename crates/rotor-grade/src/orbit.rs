@@ -20,7 +20,7 @@ use rotor_model::{Output, Sample, Scenario, Scene, SolveError, State};
 
 use rotor_solvers::solvers::SolverKind;
 
-/// Sampling step of the dense orbit [s].
+/// Sampling step of the dense orbit \[s\].
 pub const ORBIT_DT: f64 = 2e-5;
 
 /// A closed orbit as a polyline in scaled coordinates, with the time of
@@ -101,7 +101,7 @@ impl Orbit {
     /// orbit: the largest, and the time of the sample where it is.
     ///
     /// Each sample is looked for near where the previous one was found, advanced by the time
-    /// between them (a window of ±[`WINDOW`] s along the orbit); when the nearest vertex lies
+    /// between them (a window of ±`WINDOW` s along the orbit); when the nearest vertex lies
     /// at the window's edge, the whole orbit is searched.
     pub fn largest_distance(&self, samples: &[Sample]) -> (f64, f64) {
         let mut worst = (0.0f64, f64::NAN);
@@ -159,7 +159,7 @@ impl Orbit {
     }
 }
 
-/// Half-width of the first search window along the orbit [s] (15 vertices each side): a
+/// Half-width of the first search window along the orbit \[s\] (15 vertices each side): a
 /// trace's phase relative to the reference moves by its period error per period, far less
 /// than this between two samples.
 const WINDOW: f64 = 3e-4;

@@ -172,7 +172,7 @@ pub struct Sweep {
     pub p: Axis,
     pub start: SweepStart,
     pub solver: SolverKind,
-    /// Horizon of each run [s]; the metrics are read over its second half.
+    /// Horizon of each run \[s\]; the metrics are read over its second half.
     pub t_end: f64,
 }
 

@@ -225,7 +225,7 @@ impl Friction {
 
     /// `(level_ext(x), d level_ext/dx)` together, sharing the exponentials: one `exp` per
     /// tanh term of the exponential family, whose slope is `(w/2)·T·sech²(wx/2)` with
-    /// `sech² y = 4e/(e + 1)²`, `e = e^{2|y|}` (the `e` of [`tanh_fast`]); one `exp` and one
+    /// `sech² y = 4e/(e + 1)²`, `e = e^{2|y|}` (the `e` of `tanh_fast`); one `exp` and one
     /// `powf` for the Stribeck family. The level equals [`Friction::level_ext`] bit for bit.
     #[inline]
     pub fn level_ext_with_slope(&self, x: f64) -> (f64, f64) {

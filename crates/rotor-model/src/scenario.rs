@@ -61,7 +61,7 @@ pub struct CompareSpec {
     /// Window `[t0, t1]` compared sample by sample on a common grid.
     #[serde(default)]
     pub transient: Option<[f64; 2]>,
-    /// Grid step of the transient comparison and of the report's CSVs [s].
+    /// Grid step of the transient comparison and of the report's CSVs \[s\].
     #[serde(default = "default_dt")]
     pub dt: f64,
     /// Steady-state metrics over `[steady_from, t_end]`; `None`: no steady comparison.
@@ -93,7 +93,7 @@ pub struct PairTolerance {
     pub transient_max: Option<f64>,
     /// RMS of Δω (both discs) over the transient window [rad/s].
     pub transient_rms: Option<f64>,
-    /// Max difference of matched lower-disc stick event times in the window [s].
+    /// Max difference of matched lower-disc stick event times in the window \[s\].
     pub event_time: Option<f64>,
     /// Period of a limit cycle, relative.
     pub period_rel: Option<f64>,
@@ -107,7 +107,7 @@ pub struct PairTolerance {
     pub omega_u_max_rel: Option<f64>,
     /// Min of ω_u over a cycle, relative.
     pub omega_u_min_rel: Option<f64>,
-    /// Time per period with ω_l = 0 [s].
+    /// Time per period with ω_l = 0 \[s\].
     pub stick_time: Option<f64>,
     /// The equilibrium's ω_u, relative.
     pub equilibrium_omega_u_rel: Option<f64>,

@@ -42,15 +42,15 @@ pub const MIN_TOL: f64 = 10.0 * (f64::EPSILON / 2.0);
 /// One simulation request: input, initial state, horizon, accuracy, and what to keep.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Scene {
-    /// Motor input voltage u [V].
+    /// Motor input voltage u \[V\].
     pub u: f64,
     /// Initial state `[α, ω_u, ω_l]`.
     pub x0: State,
-    /// Horizon [s]; the run covers `[0, t_end]`.
+    /// Horizon \[s\]; the run covers `[0, t_end]`.
     pub t_end: f64,
     /// Tolerance of the adaptive solvers (relative = absolute).
     pub tol: f64,
-    /// Step size of the time-stepping solver [s].
+    /// Step size of the time-stepping solver \[s\].
     pub h: f64,
     /// What to keep.
     pub output: Output,

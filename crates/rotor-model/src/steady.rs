@@ -21,7 +21,7 @@ pub enum SteadyState {
         omega_l: f64,
         alpha: f64,
     },
-    /// A periodic orbit: period [s], extremes [rad/s], time per period with ω_l = 0 [s].
+    /// A periodic orbit: period \[s\], extremes [rad/s], time per period with ω_l = 0 \[s\].
     LimitCycle {
         period: f64,
         omega_l_max: f64,

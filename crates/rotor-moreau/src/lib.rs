@@ -70,8 +70,8 @@
 //! `v_free,i` satisfy `|v_free,i| > 2 Σ_j |W_ij| P_j` (W = M̂⁻¹, P_j the cone bounds), no
 //! admissible impulse can bring a velocity to zero: the slip mode `sign(v)` is taken,
 //! Newton runs in that mode only, and its result is checked against the sign conditions
-//! (a failed check falls back to the enumeration). Counted in [`Stats::lcp_skipped`]
-//! (vs [`Stats::lcp_solves`]).
+//! (a failed check falls back to the enumeration). Counted in [`rotor_model::Stats::lcp_skipped`]
+//! (vs [`rotor_model::Stats::lcp_solves`]).
 //!
 //! # Order
 //!
@@ -167,7 +167,7 @@ pub struct MoreauOptions {
     pub newton_estimate_stop: bool,
     /// Maximum number of steps of one run (default 1e9).
     pub max_steps: u64,
-    /// [`Output::Metrics`]: how close, in units of h², the first return after skipped
+    /// [`rotor_model::Output::Metrics`]: how close, in units of h², the first return after skipped
     /// periods must come to the return before them ([`rotor_model::FastForward`]); 0 rejects
     /// every skip (a check of the undo).
     pub skip_verify: f64,

@@ -135,9 +135,9 @@ pub struct ShootOptions {
     /// tolerance, 1e-10) over the step stays ≤ 1e-4 of the derivative, and the truncation
     /// error (≈ step·|P''|) is as small.
     pub fd_rel: f64,
-    /// Longest return time [s]; the periods here are 4–6 s.
+    /// Longest return time \[s\]; the periods here are 4–6 s.
     pub horizon: f64,
-    /// Crossings earlier than this after the start [s] are the start itself (a solver may
+    /// Crossings earlier than this after the start \[s\] are the start itself (a solver may
     /// report the stick exit it starts on).
     pub skip: f64,
 }
@@ -162,7 +162,7 @@ pub struct Orbit {
     pub z: Vec<f64>,
     /// The state there.
     pub x: State,
-    /// The return time [s].
+    /// The return time \[s\].
     pub period: f64,
     /// The nontrivial Floquet multipliers `[re, im]` (eigenvalues of `DP` at the fixed point).
     pub multipliers: Vec<[f64; 2]>,

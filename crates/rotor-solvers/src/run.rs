@@ -31,7 +31,7 @@ pub fn solver_settings(kind: SolverKind, sc: &Scenario) -> (f64, f64) {
 pub struct RunResult {
     pub kind: SolverKind,
     pub result: Result<Trajectory, SolveError>,
-    /// Wall-clock run time [s] (for the report; never asserted).
+    /// Wall-clock run time \[s\] (for the report; never asserted).
     pub seconds: f64,
 }
 

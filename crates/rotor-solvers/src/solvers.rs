@@ -15,7 +15,7 @@ use serde::{Serialize, Serializer};
 pub enum Knob {
     /// An error tolerance (relative = absolute): `Scene::tol`, the CLI's `--tol`.
     Tolerance,
-    /// A fixed step size [s]: `Scene::h`, the CLI's `--h`.
+    /// A fixed step size \[s\]: `Scene::h`, the CLI's `--h`.
     Step,
 }
 

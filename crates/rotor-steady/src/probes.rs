@@ -18,7 +18,7 @@ use rotor_model::{Model, Scene, State, SteadyState};
 use crate::steady::{SteadyAnswer, SteadyError, SteadyOptions, steady};
 use rotor_solvers::solvers::SolverKind;
 
-/// The offsets from each special point [V].
+/// The offsets from each special point \[V\].
 pub const OFFSETS: [f64; 6] = [-1e-3, -1e-4, -1e-6, 1e-6, 1e-4, 1e-3];
 
 /// Where a probe starts.
@@ -458,7 +458,7 @@ pub struct ProbeRow {
     pub verdict: Verdict,
     /// How the answer was obtained, if there is one.
     pub method: Option<crate::steady::SteadyMethod>,
-    /// Wall-clock time of the probe [s] (for the timings file only).
+    /// Wall-clock time of the probe \[s\] (for the timings file only).
     pub seconds: f64,
 }
 

@@ -16,9 +16,9 @@ use rotor_solvers::solvers::SolverKind;
 /// Options of [`settle`].
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct SettleOptions {
-    /// Length of one chunk [s]; its metrics are read over its second half.
+    /// Length of one chunk \[s\]; its metrics are read over its second half.
     pub chunk: f64,
-    /// Longest total simulated time [s].
+    /// Longest total simulated time \[s\].
     pub max_time: f64,
     /// Agreement of two consecutive chunks' metrics, relative.
     pub rel: f64,

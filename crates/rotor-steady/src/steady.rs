@@ -137,7 +137,7 @@ pub fn steady(
 }
 
 /// How long the run from the start is before shooting starts from its last crossing of the
-/// section [s]: enough to come near a cycle that attracts at a multiplier ≤ 0.99 per ~4.5 s
+/// section \[s\]: enough to come near a cycle that attracts at a multiplier ≤ 0.99 per ~4.5 s
 /// period from rest (e^(-0.01·300/4.5) ≈ 0.5 of the start's distance is left, which Newton
 /// removes); a slower one needs a start nearer the cycle (`--x0`).
 pub const SHOOT_RUN: f64 = 300.0;
