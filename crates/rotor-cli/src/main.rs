@@ -77,6 +77,12 @@ enum Command {
         /// Output CSV of every branch point (`-`: standard output).
         #[arg(long)]
         csv: Option<PathBuf>,
+        /// Which solver computes the periodic branches: event (the continuation with
+        /// saltation matrices; default), or switch or moreau (each orbit shot again on that
+        /// solver's own return map, with its own multipliers; grazing and folds are not
+        /// located by them yet, which the JSON's "not_located" says).
+        #[arg(long, default_value = "event")]
+        solver: String,
     },
     /// Two-parameter analysis: every codimension-one point of the u-diagram (Hopf, grazing,
     /// folds, the stuck boundary) continued in (p, u), and the codimension-two points where
@@ -466,6 +472,7 @@ fn steady(common: &Common, method: Option<&str>) -> Result<()> {
 }
 
 fn bifurcation(
+    solver: &str,
     params: Option<&Path>,
     u_min: f64,
     u_max: f64,
@@ -489,8 +496,14 @@ fn bifurcation(
                 .replace("u_max", "--u-max")
         )
     })?;
-    let d = rotor_bifurcation::diagram(&model, &opts)?;
-    write_output(json, d.to_json()?.as_bytes())
+    let kind = rotor_jobs::request::solver_kind(solver).map_err(|e| anyhow!(e.as_flag()))?;
+    let event = rotor_bifurcation::diagram(&model, &opts)?;
+    let by = rotor_steady::by_solver::by_solver(kind, &model, &event);
+    let d = &by.diagram;
+    d.check_finite()?;
+    let mut text = serde_json::to_string_pretty(&by)?;
+    text.push('\n');
+    write_output(json, text.as_bytes())
         .with_context(|| format!("{}: cannot write", json.display()))?;
     if let Some(path) = csv {
         let mut buf = Vec::new();
@@ -506,11 +519,19 @@ fn bifurcation(
         .with_context(|| format!("{}: cannot write", path.display()))?;
     }
     let mut summary = format!(
-        "{} equilibria, {} periodic orbits, {} special points\n",
+        "{}: {} equilibria, {} periodic orbits, {} special points\n",
+        by.solver,
         d.equilibria.len(),
         d.periodic.len(),
         d.points.len()
     );
+    if !by.not_found.is_empty() {
+        summary += &format!(
+            "  {} orbits of the continuation not found by {}'s shooting (in the JSON)\n",
+            by.not_found.len(),
+            by.solver
+        );
+    }
     for p in &d.points {
         summary += &format!("  {}\n", serde_json::to_string(p)?);
     }
@@ -1352,7 +1373,9 @@ fn main() -> ExitCode {
             json,
             svg,
             csv,
+            solver,
         }) => bifurcation(
+            solver,
             params.as_deref(),
             *u_min,
             *u_max,

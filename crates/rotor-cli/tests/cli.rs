@@ -1114,3 +1114,60 @@ fn steady_shoot_finds_the_cycle_with_every_solver() {
         "{err}"
     );
 }
+
+/// `rotor bifurcation --solver switch|moreau`: every periodic orbit of the continuation over
+/// 1.4–1.6 V found again by shooting on that solver's own map, with the same stability and
+/// periods within the solver's error; the JSON names the solver and what it does not locate.
+#[test]
+fn bifurcation_by_each_solver_reproduces_the_branch() {
+    let dir = std::env::temp_dir().join(format!("rotor-cli-bif-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let run = |solver: &str| -> serde_json::Value {
+        let path = dir.join(format!("{solver}.json"));
+        let o = rotor(&[
+            "bifurcation",
+            "--solver",
+            solver,
+            "--u-min",
+            "1.4",
+            "--u-max",
+            "1.6",
+            "--json",
+            path.to_str().unwrap(),
+        ]);
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        serde_json::from_str(&std::fs::read_to_string(&path).unwrap()).unwrap()
+    };
+    let event = run("event");
+    assert_eq!(event["solver"], "event");
+    assert!(event.get("not_located").is_none());
+    let rows = |d: &serde_json::Value| d["periodic"].as_array().unwrap().clone();
+    let e_rows = rows(&event);
+    assert!(e_rows.len() > 10);
+    // Relative period gates: the switch model 5× the measured 6.3e-11 (1–2 V); Moreau–Jean
+    // 2× its period error 0.62·h² s at h = 1e-3 over the ~4.5 s period.
+    for (solver, gate) in [("switch", 3e-10), ("moreau", 2.0 * 0.62e-6 / 4.5)] {
+        let d = run(solver);
+        assert_eq!(d["solver"], solver);
+        assert_eq!(d["not_located"][0], "grazing");
+        assert!(d.get("not_found").is_none(), "{}", d["not_found"]);
+        let s_rows = rows(&d);
+        assert_eq!(s_rows.len(), e_rows.len());
+        for (a, b) in s_rows.iter().zip(&e_rows) {
+            assert_eq!(a["u"], b["u"]);
+            assert_eq!(a["stable"], b["stable"], "{solver} at u = {}", a["u"]);
+            let (p, q) = (a["period"].as_f64().unwrap(), b["period"].as_f64().unwrap());
+            assert!(
+                (p - q).abs() <= gate * q,
+                "{solver} at u = {}: {p} vs {q}",
+                a["u"]
+            );
+        }
+    }
+    let o = rotor(&["bifurcation", "--solver", "x", "--json", "-"]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        !o.status.success() && err.contains("--solver \"x\""),
+        "{err}"
+    );
+}

@@ -504,17 +504,22 @@ fn sweep<'py>(
 
 /// The bifurcation diagram over ``u_min <= u <= u_max``, as ``rotor bifurcation`` writes it.
 ///
-/// Returns a dict: ``equilibria`` (the equilibrium branch with its stability), ``periodic``
-/// (the periodic branches with Floquet multipliers and extrema of omega_l) and ``points``
-/// (Hopf, grazing and fold points, each with the residual of its defining condition).
+/// Returns a dict: ``solver``, ``equilibria`` (the equilibrium branch with its stability),
+/// ``periodic`` (the periodic branches with Floquet multipliers and extrema of omega_l) and
+/// ``points`` (Hopf, grazing and fold points, each with the residual of its defining
+/// condition). ``solver="switch"`` or ``"moreau"`` shoots every periodic orbit again on that
+/// solver's own return map (its own multipliers and stability); those diagrams do not locate
+/// grazing and folds yet (``not_located``), and name any orbit not found (``not_found``).
 #[pyfunction]
-#[pyo3(signature = (params=None, u_min=0.0, u_max=7.0))]
+#[pyo3(signature = (params=None, u_min=0.0, u_max=7.0, solver="event"))]
 fn bifurcation<'py>(
     py: Python<'py>,
     params: Option<&Bound<'py, PyAny>>,
     u_min: f64,
     u_max: f64,
+    solver: &str,
 ) -> PyResult<Bound<'py, PyAny>> {
+    let kind = rotor_jobs::request::solver_kind(solver).map_err(bad)?;
     let model = Model::new(params_of(params)?);
     let opts = DiagramOptions {
         u_min,
@@ -524,8 +529,9 @@ fn bifurcation<'py>(
     opts.validate().map_err(|e| from_bif(py, e))?;
     let d = detached(py, move || {
         let d = rotor_bifurcation::diagram(&model, &opts)?;
-        d.check_finite()?;
-        Ok::<_, BifError>(d)
+        let by = rotor_steady::by_solver::by_solver(kind, &model, &d);
+        by.diagram.check_finite()?;
+        Ok::<_, BifError>(by)
     })?
     .map_err(|e| from_bif(py, e))?;
     to_py(py, &d)

@@ -2,6 +2,7 @@
 //! by simulating until the metrics stop changing (every solver), and the probes next to the
 //! bifurcation diagram's special points.
 
+pub mod by_solver;
 pub mod probes;
 mod settle;
 mod steady;

@@ -94,12 +94,13 @@ def sweep(
     """
 
 def bifurcation(
-    params: ParamsLike = None, u_min: float = 0.0, u_max: float = 7.0
+    params: ParamsLike = None, u_min: float = 0.0, u_max: float = 7.0, solver: Solver = "event"
 ) -> Dict[str, Any]:
-    """The bifurcation diagram over u, as ``rotor bifurcation`` writes it.
+    """The bifurcation diagram over u, as ``rotor bifurcation --solver`` writes it.
 
-    Keys: equilibria, periodic (with Floquet multipliers), points (Hopf, grazing, folds, each
-    with the residual of its defining condition).
+    Keys: solver, equilibria, periodic (with Floquet multipliers), points (Hopf, grazing,
+    folds, each with the residual of its defining condition); for switch and moreau also
+    not_located (the kinds of points they do not locate yet) and not_found, if any.
     """
 
 def check(
