@@ -9,7 +9,7 @@ mod filippov;
 pub mod flow;
 mod solver;
 pub mod steady;
-pub mod tableau;
+mod tableau;
 
 pub use filippov::EventOptions;
 pub use flow::{FlowEnd, StopAt, flow};

@@ -785,6 +785,19 @@ fn grade_steady(
 
 /// Grades a trace (and optionally its events) against the reference of scenario `sc` at
 /// `level` (see the module docs for what is graded and how).
+///
+/// ```
+/// use rotor_grade::check::{Level, check};
+/// use rotor_grade::{reference, trace};
+/// let fixtures = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../fixtures");
+/// let sc = rotor_solvers::load_scenario(&fixtures.join("scenarios/t1-u1.5-rest.toml")).unwrap();
+/// let r = reference::read(&fixtures.join("reference"), &sc.name).unwrap();
+/// // The reference's own trace, read as a solver's would be: it passes the strict level.
+/// let tr = trace::read_trace(&fixtures.join("reference/t1-u1.5-rest.csv"), usize::MAX).unwrap();
+/// let report = check(&sc, &r, &tr, None, Level::Strict).unwrap();
+/// assert!(report.passed && report.not_graded == ["events"]);
+/// println!("{}", report.verdict());
+/// ```
 pub fn check(
     sc: &Scenario,
     reference: &Reference,

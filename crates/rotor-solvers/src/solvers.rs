@@ -149,7 +149,19 @@ impl SolverKind {
         self.0.knob == Knob::Step
     }
 
-    /// The solver, with its default options.
+    /// The solver, with its default options. Every solver runs a [`rotor_model::Scene`]
+    /// through [`Solver::simulate`] and returns a [`rotor_model::Trajectory`]:
+    ///
+    /// ```
+    /// use rotor_model::{Model, Output, Scene};
+    /// use rotor_solvers::SOLVERS;
+    /// let scene = Scene { u: 1.5, t_end: 20.0, output: Output::Grid { dt: 0.01 }, ..Scene::default() };
+    /// for kind in SOLVERS {
+    ///     let tr = kind.solver().simulate(&Model::table1(), &scene).unwrap();
+    ///     assert_eq!(tr.samples.len(), 2001); // 0, 0.01, ..., 20 s
+    ///     println!("{}: {} steps, {} events", kind.name(), tr.stats.steps, tr.events.len());
+    /// }
+    /// ```
     pub fn solver(self) -> Box<dyn Solver> {
         (self.0.make)()
     }

@@ -109,6 +109,16 @@ pub enum SteadyError {
 /// The steady state that `kind` reaches from `scene.x0` at `scene.u` (the scene's `tol` or
 /// `h` is the solver's setting; its `t_end`, `output` and `metrics_from` are not used).
 /// For the event-driven solver the integration tolerance is `opts.event.tol`.
+///
+/// ```
+/// use rotor_model::{Model, Scene, SteadyState};
+/// use rotor_solvers::SolverKind;
+/// let scene = Scene { u: 1.5, ..Scene::default() };
+/// let a = rotor_steady::steady(SolverKind::EVENT, &Model::table1(), &scene, &Default::default())
+///     .unwrap();
+/// let SteadyState::LimitCycle { period, .. } = a.state else { panic!("{a:?}") };
+/// assert!((period - 4.5777579).abs() < 1e-6); // the 1.5 V stick-slip cycle
+/// ```
 pub fn steady(
     kind: SolverKind,
     model: &Model,
