@@ -1,52 +1,45 @@
-//! The open benchmark's commands: `rotor reference` and `rotor check`.
+//! `rotor check`: one trace graded against the reference (exit 0, 1 or 2).
 
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 use anyhow::{Context, Result};
-use rayon::prelude::*;
 use rotor_grade::check::{CheckError, Level, check};
 use rotor_grade::reference;
 
-/// `rotor reference [--out DIR]`: the reference files of every scenario.
-pub fn write_reference(scenarios_dir: &Path, out: &Path) -> Result<()> {
-    let files = rotor_model::Scenario::list_dir(scenarios_dir)
-        .with_context(|| format!("{}: cannot list scenarios", scenarios_dir.display()))?;
-    let scenarios = files
-        .iter()
-        .map(|f| rotor_solvers::load_scenario(f))
-        .collect::<Result<Vec<_>, _>>()?;
-    std::fs::create_dir_all(out).with_context(|| format!("{}: cannot create", out.display()))?;
-    let refs = scenarios
-        .par_iter()
-        .map(reference::compute)
-        .collect::<Result<Vec<_>, _>>()?;
-    for r in &refs {
-        let name = &r.json.scenario;
-        for (path, bytes) in reference::paths(out, name)
-            .iter()
-            .zip(reference::to_files(r))
-        {
-            rotor_compare::report::write_atomic(path, &bytes)
-                .with_context(|| format!("{}: cannot write", path.display()))?;
-        }
-        let worst = |n: &str| r.error(n);
-        crate::out::line(format_args!(
-            "{name}: {} samples, {} events, {} significant digits; stated error omega_l {:.1e} \
-             rad/s, event times {:.1e} s",
-            r.samples.len(),
-            r.events.len(),
-            r.json.trace_digits,
-            worst("omega_l"),
-            worst("event_time"),
-        ))?;
-    }
-    crate::out::line(format_args!(
-        "{} references in {}",
-        refs.len(),
-        out.display()
-    ))?;
-    Ok(())
+#[derive(clap::Args, Debug)]
+pub struct Args {
+    /// Scenario file, or a name in fixtures/scenarios (`t1-u1.5-rest`); its reference is
+    /// read from the reference directory beside it.
+    pub scenario: PathBuf,
+    /// The trace to grade.
+    #[arg(long)]
+    pub trace: PathBuf,
+    /// The trace's events (CSV t,disc,kind). Without them the verdict says "events not
+    /// graded".
+    #[arg(long)]
+    pub events: Option<PathBuf>,
+    /// The level: strict (7 significant digits on every quantity: a well-converged
+    /// adaptive integrator) or loose (3: engineering accuracy).
+    #[arg(long, default_value = "loose", conflicts_with = "digits")]
+    pub gate: String,
+    /// Pass when every graded quantity reaches N significant digits (instead of --gate).
+    #[arg(long, value_name = "N")]
+    pub digits: Option<String>,
+    /// Write the verdict as JSON (`-`: standard output).
+    #[arg(long)]
+    pub json: Option<PathBuf>,
+}
+
+pub fn run(a: &Args) -> ExitCode {
+    check_trace(
+        &a.scenario,
+        &a.trace,
+        a.events.as_deref(),
+        &a.gate,
+        a.digits.as_deref(),
+        a.json.as_deref(),
+    )
 }
 
 /// `rotor check`: 0 when the level is reached, 1 when not, 2 when the input is unusable.
@@ -83,7 +76,7 @@ fn verdict(
     }
     .map_err(|e| anyhow::anyhow!(e.as_flag()))?;
     // The scenario and its reference first: the trace is read up to one row past their grid.
-    let scenario = crate::fixture_path("scenario", scenario, "scenarios")?;
+    let scenario = crate::common::fixture_path("scenario", scenario, "scenarios")?;
     let sc = rotor_solvers::load_scenario(&scenario)?;
     let r = reference::read(&reference::dir_for(&scenario), &sc.name)?;
     let t = rotor_grade::trace::read_trace(trace, r.samples.len() + 1).map_err(CheckError::from)?;
@@ -108,9 +101,4 @@ fn verdict(
         eprintln!("failing: {}", report.failing().join(", "));
     }
     Ok(report.passed)
-}
-
-/// The default reference directory.
-pub fn default_out(fixtures: &Path) -> PathBuf {
-    fixtures.join("reference")
 }

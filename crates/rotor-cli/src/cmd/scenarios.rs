@@ -1,6 +1,6 @@
 //! `rotor scenarios`: the versioned suite, scene by scene.
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result};
 use rotor_model::{Disc, Scenario};
@@ -14,6 +14,17 @@ pub fn tier(sc: &Scenario) -> &'static str {
     } else {
         "table1"
     }
+}
+
+#[derive(clap::Args, Debug)]
+pub struct Args {
+    /// Also write the list as JSON (`-`: standard output).
+    #[arg(long)]
+    pub json: Option<PathBuf>,
+}
+
+pub fn run(a: &Args) -> Result<()> {
+    scenarios(a.json.as_deref())
 }
 
 #[derive(Serialize)]
@@ -36,7 +47,7 @@ struct Listing<'a> {
 
 /// Lists every scenario of the suite (name, tier, what it tests), with the suite's version and
 /// where its files were found; `--json` writes the same as JSON.
-pub fn run(json: Option<&Path>) -> Result<()> {
+pub fn scenarios(json: Option<&Path>) -> Result<()> {
     let (dir, source) = match std::env::var_os("ROTORBENCH_SUITE") {
         None if Path::new("fixtures/scenarios").is_dir() => {
             (Path::new("fixtures").to_owned(), "./fixtures")
@@ -79,7 +90,7 @@ pub fn run(json: Option<&Path>) -> Result<()> {
             r.name, r.tier, r.u, r.t_end, r.description
         ));
     }
-    crate::say(&text, [json])?;
+    crate::common::say(&text, [json])?;
     if let Some(path) = json {
         let listing = Listing {
             benchmark: rotor_suite::VERSION,

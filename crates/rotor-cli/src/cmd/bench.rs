@@ -1,0 +1,183 @@
+//! `rotor bench`: the work-precision benchmark (`--merge`: [`super::bench_merge`]).
+
+use std::path::{Path, PathBuf};
+
+use anyhow::{Context, Result, anyhow, bail};
+
+use crate::common::{check, fixture_path, say};
+
+#[derive(clap::Args, Debug)]
+pub struct Args {
+    /// Output JSON file (`-`: standard output).
+    #[arg(long)]
+    pub json: Option<PathBuf>,
+    /// Output SVG work-precision plot (error against run time, log-log; `-`: stdout).
+    #[arg(long)]
+    pub svg: Option<PathBuf>,
+    /// Output CSV file (`-`: standard output).
+    #[arg(long)]
+    pub csv: Option<PathBuf>,
+    /// A short ladder over a 30 s horizon without peers (seconds instead of a minute).
+    #[arg(long)]
+    pub quick: bool,
+    /// Skip the peers even when python3 with scipy / Siconos is installed.
+    #[arg(long)]
+    pub no_peers: bool,
+    /// An external solver, NAME=COMMAND (split as a shell splits words; no shell is
+    /// run), started once per scene and setting with a job file's path appended
+    /// (BENCHMARK.md). Repeatable.
+    #[arg(long = "external", value_name = "NAME=COMMAND")]
+    pub external: Vec<String>,
+    /// Treat the external solver NAME as fixed-step (ladder of h instead of tol).
+    #[arg(long = "fixed-step", value_name = "NAME")]
+    pub fixed_step: Vec<String>,
+    /// Seconds after which a client's run is killed (with its process group).
+    #[arg(long, default_value_t = 60.0, allow_hyphen_values = true)]
+    pub timeout: f64,
+    /// Benchmark these scenarios (files, or names in fixtures/scenarios; their horizon,
+    /// windows and grid) instead of the default scenes. Repeatable.
+    #[arg(long = "scenario", value_name = "SCENARIO.toml")]
+    pub scenario: Vec<PathBuf>,
+    /// Run only every N-th scene from the I-th (I from 1), for job arrays; the report
+    /// records the shard, and `--merge` joins the shards' reports.
+    #[arg(long, value_name = "I/N")]
+    pub shard: Option<String>,
+    /// Keep every external run's files (job.json, trace.csv, events.csv, stderr.txt) in
+    /// DIR/CLIENT/SCENE/runK instead of deleting them.
+    #[arg(long, value_name = "DIR")]
+    pub keep: Option<PathBuf>,
+    /// Run nothing: join the reports of `--shard` runs (any order) into the report one
+    /// run writes, timings aside (BENCHMARK.md), written with --json, --svg, --csv.
+    #[arg(
+        long,
+        value_name = "SHARD.json",
+        num_args = 1..,
+        conflicts_with_all = ["shard", "quick", "no_peers", "external", "fixed_step", "scenario", "keep"]
+    )]
+    pub merge: Vec<PathBuf>,
+}
+
+pub fn run(a: &Args) -> Result<()> {
+    let outputs = [a.json.as_deref(), a.svg.as_deref(), a.csv.as_deref()];
+    if !a.merge.is_empty() {
+        return super::bench_merge::bench_merge(&a.merge, outputs);
+    }
+    bench(
+        outputs,
+        a.quick,
+        a.no_peers,
+        BenchClients {
+            external: &a.external,
+            fixed_step: &a.fixed_step,
+            timeout: a.timeout,
+            scenarios: &a.scenario,
+            shard: a.shard.as_deref(),
+            keep: a.keep.as_deref(),
+        },
+    )
+}
+
+/// `rotor bench`'s external clients and scenes.
+pub(crate) struct BenchClients<'a> {
+    external: &'a [String],
+    fixed_step: &'a [String],
+    timeout: f64,
+    scenarios: &'a [PathBuf],
+    shard: Option<&'a str>,
+    keep: Option<&'a Path>,
+}
+
+pub(crate) fn bench(
+    [json, svg, csv]: [Option<&Path>; 3],
+    quick: bool,
+    no_peers: bool,
+    clients: BenchClients,
+) -> Result<()> {
+    let mut opts = if quick {
+        rotor_bench::BenchOptions::quick()
+    } else {
+        rotor_bench::BenchOptions::default()
+    };
+    if no_peers {
+        opts.peers.scipy = false;
+        opts.peers.siconos = false;
+    }
+    check(
+        "timeout",
+        clients.timeout,
+        clients.timeout > 0.0,
+        "must be positive and finite",
+    )?;
+    opts.timeout = clients.timeout;
+    for e in clients.external {
+        opts.clients
+            .push(rotor_bench::ClientSpec::parse(e, clients.fixed_step).map_err(|m| anyhow!(m))?);
+    }
+    for name in clients.fixed_step {
+        if !opts.clients.iter().any(|c| &c.name == name) {
+            bail!("--fixed-step {name:?}: no --external client of that name");
+        }
+    }
+    if !clients.scenarios.is_empty() {
+        opts.scenes = clients
+            .scenarios
+            .iter()
+            .map(|p| {
+                let p = fixture_path("--scenario", p, "scenarios")?;
+                Ok(rotor_bench::SceneSpec::from_scenario(&p)?)
+            })
+            .collect::<Result<_>>()?;
+    }
+    opts.shard = clients
+        .shard
+        .map(rotor_jobs::sweep::Shard::parse)
+        .transpose()?;
+    opts.keep = clients.keep.map(Path::to_path_buf);
+    let report = rotor_bench::run(&opts, |m| eprintln!("{m}"))?;
+    write_bench(&report, [json, svg, csv])?;
+    // The report is written first (nothing is lost); then a named client that placed no
+    // point on any scene fails the command, by name (a peer that is not installed does not).
+    let unsolved: Vec<String> = report
+        .clients
+        .iter()
+        .filter(|c| !c.peer && c.status != rotor_bench::ClientStatus::Ran)
+        .map(|c| {
+            format!(
+                "{} ({})",
+                c.name,
+                c.reason.as_deref().unwrap_or("no usable trace")
+            )
+        })
+        .collect();
+    if !unsolved.is_empty() {
+        bail!(
+            "--external: solved no scene: {}{}",
+            unsolved.join("; "),
+            clients.keep.map_or(String::new(), |d| format!(
+                " (runs kept in {})",
+                d.display()
+            ))
+        );
+    }
+    Ok(())
+}
+
+/// Prints a benchmark report's table and writes its files.
+pub(crate) fn write_bench(
+    report: &rotor_bench::BenchReport,
+    [json, svg, csv]: [Option<&Path>; 3],
+) -> Result<()> {
+    use rotor_compare::report::write_output;
+    say(&report.table(), [json, svg, csv])?;
+    for (path, text) in [
+        (json, report.to_json()?),
+        (svg, report.to_svg()?),
+        (csv, report.to_csv()?),
+    ] {
+        if let Some(path) = path {
+            write_output(path, text.as_bytes())
+                .with_context(|| format!("{}: cannot write", path.display()))?;
+        }
+    }
+    Ok(())
+}

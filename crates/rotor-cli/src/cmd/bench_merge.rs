@@ -1,0 +1,27 @@
+//! `rotor bench --merge`: the reports of `--shard` runs joined into one.
+
+use std::path::{Path, PathBuf};
+
+use anyhow::{Context, Result};
+
+use super::bench::write_bench;
+
+/// `rotor bench --merge`: the shards' reports joined into one.
+pub(crate) fn bench_merge(shards: &[PathBuf], outputs: [Option<&Path>; 3]) -> Result<()> {
+    let reports = shards
+        .iter()
+        .map(|p| {
+            let text = std::fs::read_to_string(p)
+                .with_context(|| format!("--merge {}: cannot read", p.display()))?;
+            let r: rotor_bench::BenchReport = serde_json::from_str(&text).with_context(|| {
+                format!(
+                    "--merge {}: not a report of rotor bench --json",
+                    p.display()
+                )
+            })?;
+            Ok((p.display().to_string(), r))
+        })
+        .collect::<Result<Vec<_>>>()?;
+    let report = rotor_bench::merge(&reports)?;
+    write_bench(&report, outputs)
+}

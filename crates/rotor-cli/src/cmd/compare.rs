@@ -1,0 +1,119 @@
+//! `rotor compare`, and the main job (`rotor` alone): the scenarios through every solver,
+//! gated, and the report written ([`rotor_report`]).
+
+use std::path::{Path, PathBuf};
+
+use anyhow::{Context, Result, bail};
+
+use rotor_model::{Params, SteadyState};
+
+use crate::common::{fixture_path, fixtures_dir, progress_bar, thread_pool, threads_arg};
+use crate::out;
+
+#[derive(clap::Args, Debug)]
+pub struct Args {
+    /// Scenario files or names in fixtures/scenarios (default: every one there).
+    pub scenarios: Vec<PathBuf>,
+    /// Report directory.
+    #[arg(long, default_value = "reports")]
+    pub report: PathBuf,
+    /// Threads to run on (default: SLURM_CPUS_PER_TASK when set, else the cores
+    /// available to the process).
+    #[arg(long, value_name = "N", value_parser = threads_arg)]
+    pub threads: Option<usize>,
+}
+
+pub fn run(a: &Args) -> Result<()> {
+    compare(&a.scenarios, &a.report, false, a.threads)
+}
+
+/// The main job: `rotor compare` of every scenario into `reports/`, with the analysis
+/// sections.
+pub fn main_job(threads: Option<usize>) -> Result<()> {
+    compare(&[], Path::new("reports"), true, threads)
+}
+
+/// `rotor compare`; with `main_job`, the report also gets the bifurcation diagrams.
+pub(crate) fn compare(
+    files: &[PathBuf],
+    report: &Path,
+    main_job: bool,
+    threads: Option<usize>,
+) -> Result<()> {
+    let files = if files.is_empty() {
+        let dir = fixtures_dir()?.join("scenarios");
+        rotor_model::Scenario::list_dir(&dir)
+            .with_context(|| format!("{}: cannot list scenarios", dir.display()))?
+    } else {
+        files
+            .iter()
+            .map(|f| fixture_path("scenario", f, "scenarios"))
+            .collect::<Result<_>>()?
+    };
+    let scenarios = files
+        .iter()
+        .map(|f| rotor_solvers::load_scenario(f))
+        .collect::<Result<Vec<_>, _>>()?;
+    // Report files are named after the scenarios: two of one name would overwrite each other.
+    rotor_report::check_names(&scenarios)?;
+    let stribeck = Params::from_file(&fixtures_dir()?.join("params/stribeck.toml"))?;
+    let threads = thread_pool(threads)?;
+    eprintln!("{} scenarios on {threads}", scenarios.len());
+    let t0 = std::time::Instant::now();
+    let bar = progress_bar(scenarios.len() as u64, "scenarios");
+    let sets = rotor_report::param_sets(stribeck);
+    let compared = rotor_report::run(&scenarios, &sets, main_job, &|| bar.inc(1))?;
+    bar.finish_and_clear();
+    let wall = t0.elapsed().as_secs_f64();
+    let fails = rotor_report::write(report, &compared, stribeck)?;
+    let (results, sections) = (&compared.results, &compared.sections);
+    out::line(format_args!(
+        "{:<18} {:<7} {:<12} {:>10} {:>12} {:>9}",
+        "scenario", "solver", "steady", "period", "omega_l_max", "ms"
+    ))?;
+    for r in results {
+        for run in &r.runs {
+            let (kind, period, wmax) = match run.result.as_ref().ok().and_then(|t| t.metrics) {
+                Some(SteadyState::LimitCycle {
+                    period,
+                    omega_l_max,
+                    ..
+                }) => ("cycle", format!("{period:.6}"), format!("{omega_l_max:.6}")),
+                Some(SteadyState::Equilibrium { omega_l, .. }) => {
+                    ("equilibrium", "-".into(), format!("{omega_l:.6}"))
+                }
+                None => ("error", "-".into(), "-".into()),
+            };
+            out::line(format_args!(
+                "{:<18} {:<7} {:<12} {:>10} {:>12} {:>9.1}",
+                r.scenario.name,
+                run.kind.name(),
+                kind,
+                period,
+                wmax,
+                run.seconds * 1e3
+            ))?;
+        }
+    }
+    out::line(format_args!(
+        "{} scenarios, {} solvers, {:.2} s wall; report in {}",
+        results.len(),
+        rotor_solvers::SOLVERS.len(),
+        wall,
+        report.display()
+    ))?;
+    let checks: Vec<&String> = sections.iter().flat_map(|s| &s.failures).collect();
+    for f in &checks {
+        eprintln!("CHECK FAILED: {f}");
+    }
+    for f in &fails {
+        eprintln!("GATE FAILED: {f}");
+    }
+    match (fails.len(), checks.len()) {
+        (0, 0) => {
+            out::line(format_args!("all agreement gates pass"))?;
+            Ok(())
+        }
+        (g, c) => bail!("{g} agreement gate(s) and {c} report check(s) failed"),
+    }
+}

@@ -1,0 +1,114 @@
+//! The runs of a report and its analysis sections, in parallel, and the report written.
+
+use std::path::Path;
+
+use rotor_compare::report::Section;
+use rotor_model::{Params, Scenario};
+use rotor_solvers::ScenarioResult;
+
+use crate::{ReportError, bifurcation_section, plane_section, probe_section, stress_section};
+
+/// A parameter set of the analysis sections: its name in the report, the slug of its files,
+/// and the parameters.
+pub type ParamSet<'a> = (&'a str, &'a str, Params);
+
+/// The two parameter sets the main job analyses: Table 1 and the Stribeck set.
+pub fn param_sets(stribeck: Params) -> [ParamSet<'static>; 2] {
+    [
+        ("Table 1", "table1", Params::table1()),
+        ("Stribeck set", "stribeck", stribeck),
+    ]
+}
+
+/// Refuses two scenarios of one name: report files are named after the scenarios, so they
+/// would overwrite each other.
+pub fn check_names(scenarios: &[Scenario]) -> Result<(), ReportError> {
+    for (i, a) in scenarios.iter().enumerate() {
+        if let Some(b) = scenarios[..i].iter().find(|b| b.name == a.name) {
+            return Err(ReportError::DuplicateName {
+                path: a.path.clone(),
+                name: a.name.clone(),
+                other: b.path.clone(),
+            });
+        }
+    }
+    Ok(())
+}
+
+/// The main job's analysis sections of `sets`, computed in parallel, in the report's order:
+/// bifurcation diagrams, two parameters, stress, probes.
+pub fn sections(sets: &[ParamSet]) -> Result<Vec<Section>, ReportError> {
+    let (bif, (stress, plane)) = rayon::join(
+        || {
+            let (sec, diagrams) = bifurcation_section(sets)?;
+            Ok::<_, ReportError>((sec, probe_section(sets, &diagrams)))
+        },
+        || rayon::join(stress_section, || plane_section(sets)),
+    );
+    let (bif, probes) = bif?;
+    Ok(vec![bif, plane?, stress, probes])
+}
+
+/// What [`run`] computed: each scenario's runs, in input order, and the sections.
+#[derive(Debug)]
+pub struct Compared {
+    /// Every scenario through every solver, in the order given.
+    pub results: Vec<ScenarioResult>,
+    /// The analysis sections ([`sections`]); none for a plain `rotor compare`.
+    pub sections: Vec<Section>,
+}
+
+/// Every scenario through every solver, in parallel, and with `main_job` the analysis
+/// sections of `sets` beside them; `on_scenario` is called as each scenario's runs end (a
+/// progress bar). Collected in input order, so the output is deterministic.
+pub fn run(
+    scenarios: &[Scenario],
+    sets: &[ParamSet],
+    main_job: bool,
+    on_scenario: &(dyn Fn() + Sync),
+) -> Result<Compared, ReportError> {
+    use rayon::prelude::*;
+    // In parallel across scenarios (and with the diagrams); collected in input order, so the
+    // output is deterministic.
+    let (results, sections) = rayon::join(
+        || {
+            scenarios
+                .par_iter()
+                .map(|sc| {
+                    let r = rotor_solvers::run_scenario(sc);
+                    on_scenario();
+                    r
+                })
+                .collect::<Vec<_>>()
+        },
+        || -> Result<Vec<Section>, ReportError> {
+            if main_job {
+                sections(sets)
+            } else {
+                Ok(Vec::new())
+            }
+        },
+    );
+    Ok(Compared {
+        results,
+        sections: sections?,
+    })
+}
+
+/// Writes the report of `compared` to `dir` ([`rotor_compare::report::write_report`], with
+/// the friction curves of Table 1 and of `stribeck`); returns the failed agreement gates.
+pub fn write(
+    dir: &Path,
+    compared: &Compared,
+    stribeck: Params,
+) -> Result<Vec<rotor_compare::Failure>, ReportError> {
+    let params = [
+        ("Table 1 (exponential)", Params::table1()),
+        ("Stribeck set (unverified)", stribeck),
+    ];
+    rotor_compare::report::write_report(dir, &compared.results, &params, &compared.sections)
+        .map_err(|source| ReportError::Write {
+            dir: dir.to_owned(),
+            source,
+        })
+}

@@ -1,0 +1,72 @@
+//! The section with the steady states probed next to the diagrams' special points.
+
+use rotor_model::{Model, Params};
+
+/// The report section with the steady states probed next to every special point of both
+/// diagrams (`rotor_steady::probes`, all solvers, all offsets, both starts).
+pub fn probe_section(
+    sets: &[(&str, &str, Params)],
+    diagrams: &[rotor_bifurcation::Diagram],
+) -> rotor_compare::report::Section {
+    use rayon::prelude::*;
+    use rotor_steady::probes;
+    let mut rows = Vec::new();
+    for ((_, slug, p), d) in sets.iter().zip(diagrams) {
+        let m = Model::new(*p);
+        let selected = probes::selection(d, true);
+        rows.extend(probes::run_set(slug, &m, d, &selected, |jobs, f| {
+            jobs.par_iter().map(f).collect()
+        }));
+    }
+    let count =
+        |f: &dyn Fn(&probes::Verdict) -> bool| rows.iter().filter(|r| f(&r.verdict)).count();
+    let agree = count(&|v| matches!(v, probes::Verdict::Agrees { .. }));
+    let refused = count(&|v| matches!(v, probes::Verdict::Refused { .. }));
+    let bad: Vec<String> = rows
+        .iter()
+        .filter(|r| !r.verdict.acceptable())
+        .map(|r| {
+            format!(
+                "steady near {} of {} ({:+e} V, from {}): {} {:?}",
+                r.probe.point.label,
+                r.set,
+                r.probe.offset,
+                r.probe.start.as_str(),
+                r.probe.kind.name(),
+                r.verdict
+            )
+        })
+        .collect();
+    let slowest = rows.iter().map(|r| r.seconds).fold(0.0, f64::max);
+    let total: f64 = rows.iter().map(|r| r.seconds).sum();
+    rotor_compare::report::Section {
+        markdown: format!(
+            "## Steady states near special points\n\n\
+             `rotor steady` at ±1e-3, ±1e-4 and ±1e-6 V from every special point of both \
+             diagrams, from rest and from the equilibrium perturbed by 1e-3 rad/s, for every \
+             solver (crate `rotor-steady`, module `probes`). Each answer is checked against \
+             what the continuation says is stable at that input (the stable equilibria, the \
+             stuck set, the stable cycles found by Newton's method from the branch and from \
+             the Hopf eigenvector): it must be one of them in kind, period and ω_l extremes \
+             (within 1e-6 for the event-driven solver, 1e-5 for the switch model, 1e-4 for \
+             Moreau–Jean, each well inside the distance to the nearest other cycle), or a \
+             refusal that names its cause: a transient that decays or grows too slowly to \
+             settle within 20 000 s (next to a Hopf point), a stick phase shorter than ten \
+             steps (Moreau–Jean next to a grazing orbit), no cycle next to a weakly unstable \
+             equilibrium, or a stability the tolerance cannot decide. {} probes: {agree} \
+             answers agree, {refused} refusals, {} wrong or failed.\n\n{}\n\
+             Each probe:\n\n{}",
+            rows.len(),
+            bad.len(),
+            probes::probe_summary_markdown(&rows, &rotor_solvers::SOLVERS),
+            probes::probe_table_markdown(&rows, &rotor_solvers::SOLVERS)
+        ),
+        files: Vec::new(),
+        timings: format!(
+            "\n## Steady states near special points\n\n{} probes, {total:.1} s of solver \
+             time in all, the slowest {slowest:.2} s.\n",
+            rows.len()
+        ),
+        failures: bad,
+    }
+}
