@@ -36,6 +36,21 @@ pub enum FailureKind {
     Skipped,
 }
 
+impl FailureKind {
+    /// The report's and the JSON's name (`"fails_gate"`).
+    pub fn as_str(self) -> &'static str {
+        match self {
+            FailureKind::Spawn => "spawn",
+            FailureKind::Crash => "crash",
+            FailureKind::Exit => "exit",
+            FailureKind::Timeout => "timeout",
+            FailureKind::Unusable => "unusable",
+            FailureKind::FailsGate => "fails_gate",
+            FailureKind::Skipped => "skipped",
+        }
+    }
+}
+
 /// A run's failure with its reason.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Failure {
@@ -669,6 +684,20 @@ fn skipped_point(setting: f64) -> ClientPoint {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The table's name of a failure kind is the one its JSON carries (and `--merge` reads
+    /// back): each variant serialised by serde against `as_str`.
+    #[test]
+    fn failure_kind_names_are_the_json_names() {
+        use FailureKind::*;
+        for k in [Spawn, Crash, Exit, Timeout, Unusable, FailsGate, Skipped] {
+            assert_eq!(
+                serde_json::to_value(k).unwrap(),
+                serde_json::Value::from(k.as_str()),
+                "{k:?}"
+            );
+        }
+    }
 
     fn placed(steady: f64, digits: f64) -> ClientPoint {
         ClientPoint {

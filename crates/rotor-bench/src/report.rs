@@ -536,13 +536,11 @@ fn client_table(s: &mut String, p: &ClientReport) {
                 q.steps.map_or("-".into(), |v| v.to_string()),
                 q.digits.map_or("-".into(), |d| format!("{d:.1}")),
                 gates,
-                q.failure.as_ref().map_or(String::new(), |f| {
-                    let kind = serde_json::to_value(f.kind)
-                        .ok()
-                        .and_then(|v| v.as_str().map(str::to_owned))
-                        .unwrap_or_default();
-                    format!("{kind}: {}", f.detail)
-                })
+                q.failure.as_ref().map_or(String::new(), |f| format!(
+                    "{}: {}",
+                    f.kind.as_str(),
+                    f.detail
+                ))
             );
         }
         if !sc.ratios.is_empty() {

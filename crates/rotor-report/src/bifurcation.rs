@@ -56,15 +56,13 @@ pub fn bifurcation_section(
             d.periodic.len()
         );
         for p in &d.points {
-            let v = serde_json::to_value(p)?;
-            let get = |k: &str| v.get(k).and_then(|x| x.as_f64());
             let _ = writeln!(
                 md,
                 "| {} | {:.10} | {} | {} |",
-                v.get("kind").and_then(|x| x.as_str()).unwrap_or("?"),
-                get("u").unwrap_or(f64::NAN),
-                get("residual").map_or("—".into(), |r| format!("{r:.1e}")),
-                v.get("detail").and_then(|x| x.as_str()).unwrap_or("")
+                p.kind.as_str(),
+                p.u,
+                p.residual.map_or("—".into(), |r| format!("{r:.1e}")),
+                p.detail
             );
         }
         let mut csv = Vec::new();

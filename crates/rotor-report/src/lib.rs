@@ -59,9 +59,6 @@ pub enum ReportError {
     /// A diagram or plane could not be written out as a file's contents.
     #[error(transparent)]
     Bifurcation(#[from] rotor_bifurcation::BifError),
-    /// A special point could not be serialised.
-    #[error(transparent)]
-    Json(#[from] serde_json::Error),
     /// The report directory or one of its files could not be written.
     #[error("{}: cannot write the report", dir.display())]
     Write {
