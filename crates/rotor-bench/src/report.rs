@@ -8,7 +8,7 @@ use rotor_plot::{Panel, Series, render};
 use crate::clients::{ClientReport, FailureKind};
 use crate::measure::Errors;
 use crate::options::SolverKind;
-use crate::{BenchError, BenchReport};
+use crate::{BenchError, BenchReport, OutputLevel, Profile, SceneReport};
 
 fn e(v: Option<f64>) -> String {
     v.map_or("-".into(), |x| format!("{x:.1e}"))
@@ -98,186 +98,23 @@ impl BenchReport {
             let _ = writeln!(s, "suite {}\n", self.benchmark);
         }
         for sc in &self.scenes {
-            let r = &sc.reference;
-            let _ = writeln!(
-                s,
-                "scene {}: u = {} V, x0 = {:?}, {} s; metrics over [{}, {}] s, transient \
-                 [{}, {}] s on a {} s grid",
-                sc.name,
-                sc.u,
-                sc.x0,
-                sc.t_end,
-                sc.metrics_from,
-                sc.t_end,
-                sc.transient[0],
-                sc.transient[1],
-                sc.dt
-            );
-            let _ = writeln!(
-                s,
-                "reference: event tol {:e}: period {:.12} s, max omega_l {:.12} rad/s ({} \
-                 steps, {} ms)",
-                r.tol,
-                r.period,
-                r.omega_l_max,
-                r.stats.steps,
-                ms(r.seconds)
-            );
-            match (&r.check, &r.check_failure) {
-                (Some(c), _) => {
-                    let _ = writeln!(
-                        s,
-                        "reference error estimate (vs tol {:e}): steady {} rel, transient {} \
-                         rad/s",
-                        r.check_tol,
-                        e(c.steady_rel),
-                        e(c.transient_max)
-                    );
-                }
-                (None, f) => {
-                    let _ = writeln!(
-                        s,
-                        "reference check at tol {:e} failed: {}",
-                        r.check_tol,
-                        f.as_deref().unwrap_or("?")
-                    );
-                }
-            }
-            let _ = writeln!(
-                s,
-                "\n{:<7} {:>11} {:>11} {:>4} {:>10} {:>10} {:>10} {:>10} {:>8} {:>8} {:>9} {:>7}",
-                "solver",
-                "setting",
-                "time [ms]",
-                "runs",
-                "steady rel",
-                "period [s]",
-                "wl max",
-                "transient",
-                "steps",
-                "rejected",
-                "rhs",
-                "events"
-            );
-            for p in &sc.points {
-                let setting = format!("{} {:.0e}", p.setting_name, p.setting);
-                match (&p.timing, &p.failure) {
-                    (Some(t), _) => {
-                        let _ = writeln!(
-                            s,
-                            "{:<7} {:>11} {:>11} {:>4} {:>10} {:>10} {:>10} {:>10} {:>8} {:>8} \
-                             {:>9} {:>7}",
-                            p.solver.name(),
-                            setting,
-                            ms(t.median_s),
-                            t.repeats,
-                            e(p.errors.steady_rel),
-                            e(p.errors.period),
-                            e(p.errors.omega_l_max),
-                            e(p.errors.transient_max),
-                            p.stats.steps,
-                            p.stats.rejected,
-                            p.stats.rhs_evals,
-                            p.stats.events
-                        );
-                    }
-                    (None, f) => {
-                        let _ = writeln!(
-                            s,
-                            "{:<7} {:>11} failed: {}",
-                            p.solver.name(),
-                            setting,
-                            f.as_deref().unwrap_or("?")
-                        );
-                    }
-                }
-            }
-            let _ = writeln!(
-                s,
-                "(errors vs the reference: steady rel = max(|dT|/T, |d max wl|/max wl); \
-                 transient = max |d omega_l| [rad/s]; time = median wall clock)\n"
-            );
+            scene_table(&mut s, sc);
         }
         if !self.output_levels.is_empty() {
-            let _ = writeln!(
-                s,
-                "output levels (first scene, metrics on): metrics-only = Output::Metrics (skips \
-                 whole periods once the cycle has converged), final = Output::Final (whole \
-                 horizon, nothing kept), full trace = Output::Grid"
-            );
-            let _ = writeln!(
-                s,
-                "{:<7} {:>11} {:>13} {:>9} {:>13} {:>7} {:>7} {:>8} {:>9} {:>8} {:>6}",
-                "solver",
-                "setting",
-                "metrics-only",
-                "final",
-                "full trace",
-                "ratio",
-                "final",
-                "skipped",
-                "metrics",
-                "kept",
-                "same"
-            );
-            let _ = writeln!(
-                s,
-                "{:<7} {:>11} {:>13} {:>9} {:>13} {:>7} {:>7} {:>8} {:>9} {:>8} {:>6}",
-                "", "", "ms", "ms", "ms", "", "ratio", "periods", "diff", "", ""
-            );
-            for o in &self.output_levels {
-                let _ = writeln!(
-                    s,
-                    "{:<7} {:>11} {:>13} {:>9} {:>13} {:>7.2} {:>7.2} {:>8} {:>9} {:>8} {:>6}",
-                    o.solver.name(),
-                    format!("{} {:.0e}", o.setting_name, o.setting),
-                    ms(o.metrics_only.median_s),
-                    ms(o.final_only.median_s),
-                    ms(o.full_trace.median_s),
-                    o.ratio,
-                    o.final_ratio,
-                    if o.undone_skips > 0 {
-                        format!("{} ({} undone)", o.skipped_periods, o.undone_skips)
-                    } else {
-                        o.skipped_periods.to_string()
-                    },
-                    o.metrics_diff.map_or("KIND".into(), |d| format!("{d:.1e}")),
-                    format!(
-                        "{}/{}/{}",
-                        o.metrics_only_samples, o.metrics_only_events, o.full_trace_samples
-                    ),
-                    if o.same_answer { "yes" } else { "NO" }
-                );
-            }
-            let _ = writeln!(
-                s,
-                "(ratio = full trace / metrics-only, final ratio = full trace / final; metrics \
-                 diff = largest |metrics-only - full trace| / max(|m|, 1); kept = samples/events \
-                 of the metrics-only run / samples of the trace; same = the final run has the \
-                 trace's metrics and final state)\n"
-            );
+            output_levels_table(&mut s, &self.output_levels);
         }
         for p in &self.clients {
             client_table(&mut s, p);
         }
         if !self.profile.entries.is_empty() {
-            let _ = writeln!(
-                s,
-                "performance profile over {} scene(s) (solved: {}); time / best time per scene:",
-                self.profile.scenes.len(),
-                self.profile.criterion
-            );
-            let _ = writeln!(s, "{:<10} {}", "", self.profile.scenes.join("  "));
-            for en in &self.profile.entries {
-                let cells: Vec<String> = en
-                    .ratios
-                    .iter()
-                    .map(|r| r.map_or("unsolved".into(), |r| format!("{r:.2}")))
-                    .collect();
-                let _ = writeln!(s, "{:<10} {}", en.name, cells.join("  "));
-            }
-            let _ = writeln!(s);
+            profile_table(&mut s, &self.profile);
         }
+        self.environment_lines(&mut s);
+        s
+    }
+
+    /// The table's last lines: where and how it was measured, and the shard.
+    fn environment_lines(&self, s: &mut String) {
         let env = &self.environment;
         let load =
             |l: Option<[f64; 3]>| l.map_or("?".into(), |[a, b, c]| format!("{a:.2} {b:.2} {c:.2}"));
@@ -306,7 +143,6 @@ impl BenchReport {
                 sh.suite["scenes"].as_array().map_or(0, Vec::len)
             );
         }
-        s
     }
 
     /// The first non-finite number of the report, as an error naming its path (e.g.
@@ -475,6 +311,191 @@ fn first_non_finite(v: &toml::Value, path: String) -> Option<(String, f64)> {
         }),
         _ => None,
     }
+}
+
+/// One scene's block of [`BenchReport::table`]: the scene, its reference, and each solver's
+/// ladder.
+fn scene_table(s: &mut String, sc: &SceneReport) {
+    let r = &sc.reference;
+    let _ = writeln!(
+        s,
+        "scene {}: u = {} V, x0 = {:?}, {} s; metrics over [{}, {}] s, transient \
+             [{}, {}] s on a {} s grid",
+        sc.name,
+        sc.u,
+        sc.x0,
+        sc.t_end,
+        sc.metrics_from,
+        sc.t_end,
+        sc.transient[0],
+        sc.transient[1],
+        sc.dt
+    );
+    let _ = writeln!(
+        s,
+        "reference: event tol {:e}: period {:.12} s, max omega_l {:.12} rad/s ({} \
+             steps, {} ms)",
+        r.tol,
+        r.period,
+        r.omega_l_max,
+        r.stats.steps,
+        ms(r.seconds)
+    );
+    match (&r.check, &r.check_failure) {
+        (Some(c), _) => {
+            let _ = writeln!(
+                s,
+                "reference error estimate (vs tol {:e}): steady {} rel, transient {} \
+                     rad/s",
+                r.check_tol,
+                e(c.steady_rel),
+                e(c.transient_max)
+            );
+        }
+        (None, f) => {
+            let _ = writeln!(
+                s,
+                "reference check at tol {:e} failed: {}",
+                r.check_tol,
+                f.as_deref().unwrap_or("?")
+            );
+        }
+    }
+    let _ = writeln!(
+        s,
+        "\n{:<7} {:>11} {:>11} {:>4} {:>10} {:>10} {:>10} {:>10} {:>8} {:>8} {:>9} {:>7}",
+        "solver",
+        "setting",
+        "time [ms]",
+        "runs",
+        "steady rel",
+        "period [s]",
+        "wl max",
+        "transient",
+        "steps",
+        "rejected",
+        "rhs",
+        "events"
+    );
+    for p in &sc.points {
+        let setting = format!("{} {:.0e}", p.setting_name, p.setting);
+        match (&p.timing, &p.failure) {
+            (Some(t), _) => {
+                let _ = writeln!(
+                    s,
+                    "{:<7} {:>11} {:>11} {:>4} {:>10} {:>10} {:>10} {:>10} {:>8} {:>8} \
+                         {:>9} {:>7}",
+                    p.solver.name(),
+                    setting,
+                    ms(t.median_s),
+                    t.repeats,
+                    e(p.errors.steady_rel),
+                    e(p.errors.period),
+                    e(p.errors.omega_l_max),
+                    e(p.errors.transient_max),
+                    p.stats.steps,
+                    p.stats.rejected,
+                    p.stats.rhs_evals,
+                    p.stats.events
+                );
+            }
+            (None, f) => {
+                let _ = writeln!(
+                    s,
+                    "{:<7} {:>11} failed: {}",
+                    p.solver.name(),
+                    setting,
+                    f.as_deref().unwrap_or("?")
+                );
+            }
+        }
+    }
+    let _ = writeln!(
+        s,
+        "(errors vs the reference: steady rel = max(|dT|/T, |d max wl|/max wl); \
+             transient = max |d omega_l| [rad/s]; time = median wall clock)\n"
+    );
+}
+
+/// The output levels' block of [`BenchReport::table`].
+fn output_levels_table(s: &mut String, levels: &[OutputLevel]) {
+    let _ = writeln!(
+        s,
+        "output levels (first scene, metrics on): metrics-only = Output::Metrics (skips \
+             whole periods once the cycle has converged), final = Output::Final (whole \
+             horizon, nothing kept), full trace = Output::Grid"
+    );
+    let _ = writeln!(
+        s,
+        "{:<7} {:>11} {:>13} {:>9} {:>13} {:>7} {:>7} {:>8} {:>9} {:>8} {:>6}",
+        "solver",
+        "setting",
+        "metrics-only",
+        "final",
+        "full trace",
+        "ratio",
+        "final",
+        "skipped",
+        "metrics",
+        "kept",
+        "same"
+    );
+    let _ = writeln!(
+        s,
+        "{:<7} {:>11} {:>13} {:>9} {:>13} {:>7} {:>7} {:>8} {:>9} {:>8} {:>6}",
+        "", "", "ms", "ms", "ms", "", "ratio", "periods", "diff", "", ""
+    );
+    for o in levels {
+        let _ = writeln!(
+            s,
+            "{:<7} {:>11} {:>13} {:>9} {:>13} {:>7.2} {:>7.2} {:>8} {:>9} {:>8} {:>6}",
+            o.solver.name(),
+            format!("{} {:.0e}", o.setting_name, o.setting),
+            ms(o.metrics_only.median_s),
+            ms(o.final_only.median_s),
+            ms(o.full_trace.median_s),
+            o.ratio,
+            o.final_ratio,
+            if o.undone_skips > 0 {
+                format!("{} ({} undone)", o.skipped_periods, o.undone_skips)
+            } else {
+                o.skipped_periods.to_string()
+            },
+            o.metrics_diff.map_or("KIND".into(), |d| format!("{d:.1e}")),
+            format!(
+                "{}/{}/{}",
+                o.metrics_only_samples, o.metrics_only_events, o.full_trace_samples
+            ),
+            if o.same_answer { "yes" } else { "NO" }
+        );
+    }
+    let _ = writeln!(
+        s,
+        "(ratio = full trace / metrics-only, final ratio = full trace / final; metrics \
+             diff = largest |metrics-only - full trace| / max(|m|, 1); kept = samples/events \
+             of the metrics-only run / samples of the trace; same = the final run has the \
+             trace's metrics and final state)\n"
+    );
+}
+
+/// The performance profile's block of [`BenchReport::table`].
+fn profile_table(s: &mut String, profile: &Profile) {
+    let _ = writeln!(
+        s,
+        "performance profile over {} scene(s) (solved: {}); time / best time per scene:",
+        profile.scenes.len(),
+        profile.criterion
+    );
+    let _ = writeln!(s, "{:<10} {}", "", profile.scenes.join("  "));
+    for en in &profile.entries {
+        let cells: Vec<String> = en
+            .ratios
+            .iter()
+            .map(|r| r.map_or("unsolved".into(), |r| format!("{r:.2}")))
+            .collect();
+        let _ = writeln!(s, "{:<10} {}", en.name, cells.join("  "));
+    }
+    let _ = writeln!(s);
 }
 
 fn client_table(s: &mut String, p: &ClientReport) {
