@@ -112,3 +112,32 @@ pub fn write(
             source,
         })
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn scenario(name: &str) -> Scenario {
+        let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../fixtures/scenarios");
+        rotor_solvers::load_scenario(&dir.join(format!("{name}.toml"))).unwrap()
+    }
+
+    /// Two scenarios of one name are refused, naming both files; distinct names pass.
+    #[test]
+    fn a_name_twice_is_refused_naming_both_files() {
+        let a = scenario("t1-u1.5-rest");
+        let b = scenario("t1-u0.3-rest");
+        assert!(check_names(&[a.clone(), b.clone()]).is_ok());
+        let mut twin = b.clone();
+        twin.path = "elsewhere/twin.toml".into();
+        let e = check_names(&[a, b.clone(), twin]).unwrap_err().to_string();
+        assert_eq!(
+            e,
+            format!(
+                "elsewhere/twin.toml: name = \"{}\": also the name of {}",
+                b.name,
+                b.path.display()
+            )
+        );
+    }
+}
