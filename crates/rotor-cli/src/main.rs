@@ -2,16 +2,16 @@
 //! command is a module of [`cmd`] (its flags and its `run`); what they share is in
 //! [`common`]; the main job's report is assembled by the `rotor-report` crate.
 
+use std::path::Path;
 use std::process::ExitCode;
+
+use clap::{Parser, Subcommand};
+
+use crate::common::threads_arg;
 
 mod cmd;
 mod common;
 mod out;
-
-use clap::{Parser, Subcommand};
-use std::path::Path;
-
-use crate::common::threads_arg;
 
 /// Two-disc rotor with set-valued friction: three independent solvers, cross-validated.
 #[derive(Parser, Debug)]
@@ -141,7 +141,7 @@ fn main() -> ExitCode {
             .try_for_each(|(f, p)| out::writable(f, p))
     {
         eprintln!("error: {e:#}");
-        let unusable = matches!(cmd, Command::Check { .. });
+        let unusable = matches!(cmd, Command::Check(_));
         return ExitCode::from(if unusable { 2 } else { 1 });
     }
     let res = match &cli.command {
