@@ -159,8 +159,8 @@ enum Command {
         csv: PathBuf,
     },
     /// Work-precision benchmark: each solver over a ladder of tolerances / steps, error
-    /// against a tight reference, median run time, counters; peers (scipy, Siconos) side by
-    /// side when installed. Prints a table.
+    /// against a tight reference, median run time, counters; peers (scipy, Siconos, Octave)
+    /// side by side when installed. Prints a table.
     Bench {
         /// Output JSON file (`-`: standard output).
         #[arg(long)]
@@ -174,7 +174,7 @@ enum Command {
         /// A short ladder over a 30 s horizon without peers (seconds instead of a minute).
         #[arg(long)]
         quick: bool,
-        /// Skip the peers even when python3 with scipy / Siconos is installed.
+        /// Skip the peers even when python3 with scipy / Siconos, or GNU Octave, is installed.
         #[arg(long)]
         no_peers: bool,
         /// An external solver, NAME=COMMAND (split as a shell splits words; no shell is
@@ -703,6 +703,7 @@ fn bench(
     if no_peers {
         opts.peers.scipy = false;
         opts.peers.siconos = false;
+        opts.peers.octave = false;
     }
     check(
         "timeout",
