@@ -21,8 +21,9 @@
 //!   `rotor check` grades a trace, placed beside the three solvers, with time ratios at equal
 //!   error (in-process and whole-process) and, for a fixed-step client that reports its
 //!   steps, time per step against rotor-moreau. The repository's peers, a plain scipy
-//!   `solve_ivp` (`bench/peers/scipy_rotor.py`) and Siconos' `MoreauJeanOSI`
-//!   (`bench/peers/siconos_rotor.py`), are clients of the same protocol, run when installed.
+//!   `solve_ivp` (`bench/peers/scipy_rotor.py`), Siconos' `MoreauJeanOSI`
+//!   (`bench/peers/siconos_rotor.py`) and GNU Octave's `ode45` with event functions
+//!   (`bench/peers/octave_rotor.m`), are clients of the same protocol, run when installed.
 //!   A failure (crash, non-zero exit, timeout, unusable trace, a trace failing the loose
 //!   gate) is recorded with its reason; the bench goes on.
 //! * **Performance profile** ([`profile`]) of the solvers and clients over the scenes.
@@ -55,6 +56,7 @@ pub use measure::{Errors, RefData, Timing, solver, time_at_error, timed};
 pub use merge::{ShardInfo, merge};
 pub use options::{BenchOptions, PeerOptions, SceneSpec, SolverKind, workspace_root};
 pub use peers::available as peer_available;
+pub use peers::octave_available;
 pub use profile::Profile;
 pub use protocol::ClientSpec;
 
@@ -196,6 +198,7 @@ fn validate(opts: &BenchOptions) -> Result<(), BenchError> {
     let peers = [
         ("peers.scipy_tols".to_string(), &opts.peers.scipy_tols),
         ("peers.siconos_hs".to_string(), &opts.peers.siconos_hs),
+        ("peers.octave_tols".to_string(), &opts.peers.octave_tols),
         ("client_tols".to_string(), &opts.client_tols),
         ("client_hs".to_string(), &opts.client_hs),
     ];
@@ -217,7 +220,7 @@ fn validate(opts: &BenchOptions) -> Result<(), BenchError> {
         ));
     }
     let mut names: Vec<&str> = opts.clients.iter().map(|c| c.name.as_str()).collect();
-    names.extend(["scipy", "siconos"]);
+    names.extend(["scipy", "siconos", "octave"]);
     names.extend(rotor_solvers::SOLVERS.map(SolverKind::name));
     names.sort_unstable();
     if let Some(w) = names.windows(2).find(|w| w[0] == w[1]) {

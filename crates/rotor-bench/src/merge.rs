@@ -80,6 +80,8 @@ pub(crate) fn shard_info(opts: &BenchOptions, s: Shard) -> ShardInfo {
                 "scipy_tols": opts.peers.scipy_tols,
                 "siconos": opts.peers.siconos,
                 "siconos_hs": opts.peers.siconos_hs,
+                "octave": opts.peers.octave,
+                "octave_tols": opts.peers.octave_tols,
             },
             "clients": clients,
             "timeout": opts.timeout,

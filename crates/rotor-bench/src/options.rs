@@ -80,6 +80,13 @@ pub struct PeerOptions {
     pub siconos_python: String,
     /// Step sizes at which Siconos and rotor-moreau are compared per step.
     pub siconos_hs: Vec<f64>,
+    /// Run `bench/peers/octave_rotor.m` (GNU Octave's `ode45` with event functions) if
+    /// `octave_cli` has `ode45` and `jsondecode` (GNU Octave 7 or later).
+    pub octave: bool,
+    /// The Octave interpreter (Debian's `octave` package installs `octave-cli`).
+    pub octave_cli: String,
+    /// RelTol = AbsTol ladder of the Octave peer.
+    pub octave_tols: Vec<f64>,
     /// Directory holding the peer scripts.
     pub dir: PathBuf,
 }
@@ -167,6 +174,15 @@ impl Default for BenchOptions {
                 siconos: true,
                 siconos_python: "/usr/bin/python3".into(),
                 siconos_hs: vec![1e-2, 1e-3],
+                octave: true,
+                octave_cli: "octave-cli".into(),
+                // Its run time is mostly Octave's own per output sample (its event function
+                // is evaluated at every grid time), within 2x at every tolerance, and one run
+                // of a 100 s scene takes 6-14 s: two settings, the loosest that reaches loose
+                // and one that reaches strict on both default scenes (measured on
+                // t1-u1.5-rest and st-u1.5-rest over 200 s: 4.6 and 5.4 digits at 1e-6, 6.5
+                // and 7.1 at 1e-8, 7.8 and 8.3 at 1e-10).
+                octave_tols: vec![1e-6, 1e-10],
                 dir: root.join("bench/peers"),
             },
             clients: Vec::new(),
@@ -202,6 +218,7 @@ impl BenchOptions {
             peers: PeerOptions {
                 scipy: false,
                 siconos: false,
+                octave: false,
                 scipy_tols: vec![1e-4, 1e-6, 1e-8],
                 ..full.peers.clone()
             },

@@ -1,7 +1,8 @@
 //! The repository's own peers, bench/peers/scipy_rotor.py (scipy `solve_ivp`, DOP853 with
-//! event functions) and bench/peers/siconos_rotor.py (Siconos `MoreauJeanOSI`): clients of
-//! the same job-file protocol as any external solver, run when their interpreter imports
-//! the library.
+//! event functions), bench/peers/siconos_rotor.py (Siconos `MoreauJeanOSI`) and
+//! bench/peers/octave_rotor.m (GNU Octave's `ode45` with event functions, restarted at every
+//! mode switch): clients of the same job-file protocol as any external solver, run when
+//! their interpreter imports the library (Octave: when it has `ode45` and `jsondecode`).
 
 use std::process::Command;
 
@@ -24,6 +25,36 @@ pub fn available(python: &str, module: &str) -> Result<(), String> {
                 .unwrap_or("")
         )),
         Err(e) => Err(format!("cannot run `{python}`: {e}")),
+    }
+}
+
+/// The command line that starts the Octave peer's launcher, before the job file: no start-up
+/// files, no banner, no history (Octave 7 reports an error at exit when it cannot save it).
+fn octave_argv(octave: &str) -> Vec<String> {
+    [octave, "--norc", "--quiet", "--no-history"]
+        .map(String::from)
+        .to_vec()
+}
+
+/// Whether `octave` runs and has what the Octave peer needs (`ode45`, and `jsondecode`,
+/// which came with GNU Octave 7); the error says why not.
+pub fn octave_available(octave: &str) -> Result<(), String> {
+    let probe = "if exist('ode45') && exist('jsondecode'), exit(0); end; \
+                 fputs(stderr, 'no ode45 or no jsondecode: GNU Octave >= 7 is needed'); exit(1);";
+    match Command::new(octave)
+        .args(octave_argv(octave).into_iter().skip(1))
+        .args(["--eval", probe])
+        .output()
+    {
+        Ok(o) if o.status.success() => Ok(()),
+        Ok(o) => Err(format!(
+            "`{octave}` cannot run the Octave peer: {}",
+            String::from_utf8_lossy(&o.stderr)
+                .lines()
+                .last()
+                .unwrap_or("")
+        )),
+        Err(e) => Err(format!("cannot run `{octave}`: {e}")),
     }
 }
 
@@ -53,7 +84,7 @@ pub(crate) fn peers(opts: &BenchOptions, progress: &mut impl FnMut(&str)) -> Vec
             &p.siconos_hs,
         ),
     ];
-    specs
+    let mut launches: Vec<PeerLaunch> = specs
         .into_iter()
         .map(|(name, on, python, module, script, fixed_step, ladder)| {
             let spec = ClientSpec {
@@ -79,5 +110,34 @@ pub(crate) fn peers(opts: &BenchOptions, progress: &mut impl FnMut(&str)) -> Vec
             }
             Ok((spec, ladder.clone()))
         })
-        .collect()
+        .collect();
+    launches.push(octave(p, progress));
+    launches
+}
+
+/// The Octave peer (`octave-cli ... bench/peers/octave_rotor_cli.m JOB`), or its skip.
+fn octave(p: &crate::options::PeerOptions, progress: &mut impl FnMut(&str)) -> PeerLaunch {
+    let mut argv = octave_argv(&p.octave_cli);
+    argv.push(p.dir.join("octave_rotor_cli.m").display().to_string());
+    let spec = ClientSpec {
+        name: "octave".into(),
+        argv,
+        fixed_step: false,
+        peer: true,
+    };
+    let skip = |why: String| {
+        Err(Box::new(ClientReport::skipped(
+            &spec,
+            ClientStatus::Skipped,
+            why,
+        )))
+    };
+    if !p.octave {
+        return skip("turned off in the options".into());
+    }
+    if let Err(why) = octave_available(&p.octave_cli) {
+        progress(&format!("octave peer skipped: {why}"));
+        return skip(why);
+    }
+    Ok((spec.clone(), p.octave_tols.clone()))
 }

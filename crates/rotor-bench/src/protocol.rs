@@ -21,7 +21,7 @@ pub struct ClientSpec {
     pub name: String,
     pub argv: Vec<String>,
     pub fixed_step: bool,
-    /// One of the repository's own peers (scipy, Siconos), run when installed.
+    /// One of the repository's own peers (scipy, Siconos, Octave), run when installed.
     pub peer: bool,
 }
 

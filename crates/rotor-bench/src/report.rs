@@ -84,6 +84,7 @@ pub(crate) fn color(name: &str) -> &'static str {
         (Some(k), _) => k.info().style.color,
         (None, "scipy") => "#d62728",
         (None, "siconos") => "#2ca02c",
+        (None, "octave") => "#1f77b4",
         // Any other client: a colour fixed by its name (a sum of its bytes).
         (None, _) => OTHERS[name.bytes().map(usize::from).sum::<usize>() % OTHERS.len()],
     }

@@ -315,3 +315,159 @@ fn scipy_peer_solves_the_stribeck_set_with_every_method() {
         );
     }
 }
+
+/// Whether the Octave peer can be tested; a missing `octave-cli` fails when
+/// `ROTOR_REQUIRE_PEERS=1`.
+fn octave_present(octave: &str) -> bool {
+    match rotor_bench::octave_available(octave) {
+        Ok(()) => true,
+        Err(why) if std::env::var("ROTOR_REQUIRE_PEERS").as_deref() == Ok("1") => {
+            panic!("ROTOR_REQUIRE_PEERS=1 but the Octave peer cannot run: {why}")
+        }
+        Err(why) => {
+            eprintln!("Octave peer not tested: {why}");
+            false
+        }
+    }
+}
+
+/// The Octave peer's command line, before the job file (as `rotor bench` starts it).
+fn octave_command(octave: &str) -> std::process::Command {
+    let root = rotor_bench::workspace_root();
+    let mut c = std::process::Command::new(octave);
+    c.args(["--norc", "--quiet", "--no-history"])
+        .arg(root.join("bench/peers/octave_rotor_cli.m"));
+    c
+}
+
+/// The Octave peer (GNU Octave's ode45 with event functions, restarted at every mode switch,
+/// each event located again to the integration's accuracy) runs each scene of the bench's
+/// pair over its whole 200 s scenario at RelTol = AbsTol = 1e-6, and passes the loose level
+/// with its events graded: measured 4.6 digits on t1-u1.5-rest and 5.4 on st-u1.5-rest,
+/// where the upper disc's static friction makes a second switching surface (and 7.8 and 8.3
+/// digits, strict, at 1e-10; `rotor job` and `rotor check` by hand). One run per scene:
+/// Octave's ode45 takes several seconds over 20 000 output samples.
+#[test]
+fn octave_peer_passes_loose_on_both_scenes() {
+    use rotor_grade::check::{Level, check};
+    let o = options();
+    if !octave_present(&o.peers.octave_cli) {
+        return;
+    }
+    let root = rotor_bench::workspace_root();
+    let dir = std::env::temp_dir().join(format!("rotor-octave-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    for name in ["t1-u1.5-rest", "st-u1.5-rest"] {
+        let sc =
+            rotor_solvers::load_scenario(&root.join(format!("fixtures/scenarios/{name}.toml")))
+                .unwrap();
+        let r = rotor_grade::reference::read(&root.join("fixtures/reference"), &sc.name).unwrap();
+        let job = rotor_bench::protocol::Job::new(
+            &sc,
+            sc.t_end,
+            sc.compare.dt,
+            false,
+            1e-6,
+            dir.join(format!("{name}.csv")),
+            dir.join(format!("{name}.events.csv")),
+        );
+        let path = dir.join(format!("{name}.json"));
+        std::fs::write(&path, serde_json::to_string(&job).unwrap()).unwrap();
+        let out = octave_command(&o.peers.octave_cli)
+            .arg(&path)
+            .output()
+            .unwrap();
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert!(out.status.success(), "{name}: {stderr}");
+        let says =
+            rotor_bench::protocol::ClientSays::from_stdout(&String::from_utf8_lossy(&out.stdout));
+        assert!(says.solve_seconds.is_some(), "{name}: no solve_seconds");
+        let t = rotor_grade::trace::read_trace(&job.trace, usize::MAX).unwrap();
+        let e = rotor_grade::trace::read_events(&job.events).unwrap();
+        let rep = check(&sc, &r, &t, Some(&e), Level::Loose).unwrap();
+        assert!(rep.not_graded.is_empty(), "{name}: {:?}", rep.not_graded);
+        assert!(rep.passed, "{name}: {} digits", rep.digits);
+    }
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+/// The Octave peer as `rotor bench` runs it: found, run over its ladder on the bench scene,
+/// graded, placed (it passes loose at 1e-6, as above) and given time ratios against the
+/// event-driven solver.
+#[test]
+fn octave_peer_runs_in_the_bench() {
+    let o = options();
+    if !octave_present(&o.peers.octave_cli) {
+        return;
+    }
+    let o = BenchOptions {
+        peers: rotor_bench::PeerOptions {
+            octave: true,
+            octave_tols: vec![1e-6],
+            ..o.peers.clone()
+        },
+        ..o
+    };
+    let r = run(&o, |m| eprintln!("{m}")).unwrap();
+    let p = client(&r, "octave");
+    assert_eq!(p.status, ClientStatus::Ran, "{:?}", p.reason);
+    assert_eq!(p.method.as_deref(), Some("ode45"));
+    assert_eq!(p.scenes[0].points[0].passes_loose, Some(true));
+    assert!(
+        p.scenes[0]
+            .ratios
+            .iter()
+            .any(|q| q.ratio.is_finite() && q.ratio > 0.0),
+        "{:?}",
+        p.scenes[0].ratios
+    );
+}
+
+/// A bad job makes the Octave peer exit with status 2 (as the protocol's other clients) and
+/// a message naming the field and its value, which `rotor bench` reports as the failure:
+/// a job for a fixed-step client (`tol` null) and an unknown friction family.
+#[test]
+fn octave_peer_refuses_a_bad_job_by_name() {
+    let o = options();
+    if !octave_present(&o.peers.octave_cli) {
+        return;
+    }
+    let root = rotor_bench::workspace_root();
+    let dir = std::env::temp_dir().join(format!("rotor-octave-bad-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let sc =
+        rotor_solvers::load_scenario(&root.join("fixtures/scenarios/t1-u1.5-rest.toml")).unwrap();
+    let job = |fixed_step: bool| {
+        let j = rotor_bench::protocol::Job::new(
+            &sc,
+            1.0,
+            0.01,
+            fixed_step,
+            1e-3,
+            dir.join("trace.csv"),
+            dir.join("events.csv"),
+        );
+        serde_json::to_value(&j).unwrap()
+    };
+    let mut family = job(false);
+    family["params"]["lower"]["family"] = "coulomb".into();
+    for (what, job, says) in [
+        ("tol", job(true), "tol = null must be positive"),
+        ("family", family, "lower.family = \"coulomb\""),
+    ] {
+        let path = dir.join(format!("{what}.json"));
+        std::fs::write(&path, job.to_string()).unwrap();
+        let out = octave_command(&o.peers.octave_cli)
+            .arg(&path)
+            .output()
+            .unwrap();
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{what}: {stderr}");
+        assert!(stderr.contains(says), "{what}: {stderr}");
+        assert!(
+            !dir.join("trace.csv").exists(),
+            "{what}: a trace was written"
+        );
+    }
+    std::fs::remove_dir_all(&dir).ok();
+}

@@ -227,16 +227,18 @@ fn a_missing_peer_is_skipped_with_its_reason() {
     o.peers.python = "/nonexistent/python3".into();
     o.peers.siconos = true;
     o.peers.siconos_python = "/nonexistent/python3".into();
+    o.peers.octave = true;
+    o.peers.octave_cli = "/nonexistent/octave-cli".into();
     let r = run(&o, |_| {}).unwrap();
-    assert_eq!(r.clients.len(), 2);
+    assert_eq!(r.clients.len(), 3);
     for p in &r.clients {
         assert_eq!(p.status.as_str(), "skipped");
-        assert!(
-            p.reason
-                .as_deref()
-                .unwrap()
-                .contains("/nonexistent/python3")
-        );
+        let interpreter = if p.name == "octave" {
+            "/nonexistent/octave-cli"
+        } else {
+            "/nonexistent/python3"
+        };
+        assert!(p.reason.as_deref().unwrap().contains(interpreter));
         assert!(p.scenes.is_empty());
     }
 }

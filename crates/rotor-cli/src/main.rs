@@ -45,8 +45,8 @@ enum Command {
     /// Join sweep shards into exactly what one unsharded run writes.
     Merge(cmd::merge::Args),
     /// Work-precision benchmark: each solver over a ladder of tolerances / steps, error
-    /// against a tight reference, median run time, counters; peers (scipy, Siconos) side by
-    /// side when installed. Prints a table.
+    /// against a tight reference, median run time, counters; peers (scipy, Siconos, Octave)
+    /// side by side when installed. Prints a table.
     Bench(cmd::bench::Args),
     /// Print the job file `rotor bench` hands an external client for a scenario (its own
     /// horizon and grid, as with `bench --scenario`), x0 at full precision (BENCHMARK.md).

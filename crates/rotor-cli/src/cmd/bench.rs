@@ -20,7 +20,7 @@ pub struct Args {
     /// A short ladder over a 30 s horizon without peers (seconds instead of a minute).
     #[arg(long)]
     pub quick: bool,
-    /// Skip the peers even when python3 with scipy / Siconos is installed.
+    /// Skip the peers even when python3 with scipy / Siconos, or GNU Octave, is installed.
     #[arg(long)]
     pub no_peers: bool,
     /// An external solver, NAME=COMMAND (split as a shell splits words; no shell is
@@ -101,6 +101,7 @@ pub(crate) fn bench(
     if no_peers {
         opts.peers.scipy = false;
         opts.peers.siconos = false;
+        opts.peers.octave = false;
     }
     check(
         "timeout",
