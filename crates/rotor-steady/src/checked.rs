@@ -80,8 +80,10 @@ impl Default for CheckOptions {
 /// long run repeat to ~1e-10 (its tolerance; settled metrics agree to 4e-12): 1e-7, 100× the
 /// shooting tolerance 1e-9. Moreau–Jean's stick exits fall between its steps differently
 /// from cycle to cycle (its metrics jitter by 2.5e-7 at h = 1e-3, `SettleOptions`): 1e-5,
-/// 40× that, and still 17× below the distance between the stable and the unstable cycle 1e-6
-/// V from Table 1's fold E.
+/// 40× that, and still about 17× below the distance between the stable and the unstable
+/// cycle 1e-6 V from Table 1's fold E (~1.7e-4 in max ω_l: a fold's square-root law applied
+/// to the 2.4e-3 measured 2e-4 V below it), so a run within the floor of one is not near the
+/// other.
 pub fn floor(kind: SolverKind) -> f64 {
     if kind.is_fixed_step() { 1e-5 } else { 1e-7 }
 }
