@@ -44,15 +44,19 @@ pub fn probe_section(
             "## Steady states near special points\n\n\
              `rotor steady` at ±1e-3, ±1e-4 and ±1e-6 V from every special point of both \
              diagrams, from rest and from the equilibrium perturbed by 1e-3 rad/s, for every \
-             solver (crate `rotor-steady`, module `probes`). Each answer is checked against \
+             solver (crate `rotor-steady`, module `probes`): the event-driven solver by its \
+             own refinement, the switch model and Moreau–Jean by shooting on their own return \
+             maps, accepted only when a run from the start of at most 600 s is seen to go to \
+             the orbit (module `checked`); each cell names the method. Each answer is checked against \
              what the continuation says is stable at that input (the stable equilibria, the \
              stuck set, the stable cycles found by Newton's method from the branch and from \
              the Hopf eigenvector): it must be one of them in kind, period and ω_l extremes \
              (within 1e-6 for the event-driven solver, 1e-5 for the switch model, 1e-4 for \
              Moreau–Jean, each well inside the distance to the nearest other cycle), or a \
-             refusal that names its cause: a transient that decays or grows too slowly to \
-             settle within 20 000 s (next to a Hopf point), a stick phase shorter than ten \
-             steps (Moreau–Jean next to a grazing orbit), no cycle next to a weakly unstable \
+             refusal that names its cause: a transient too slow to settle or to reach the \
+             shot orbit in the time allowed (next to a Hopf point or a fold), no orbit found by \
+             shooting, an orbit with a multiplier too near the unit circle to decide its \
+             stability, no cycle next to a weakly unstable \
              equilibrium, or a stability the tolerance cannot decide. {} probes: {agree} \
              answers agree, {refused} refusals, {} wrong or failed.\n\n{}\n\
              Each probe:\n\n{}",

@@ -3,6 +3,7 @@
 //! bifurcation diagram's special points.
 
 pub mod by_solver;
+pub mod checked;
 pub mod probes;
 mod settle;
 mod steady;

@@ -1,5 +1,10 @@
 //! Steady states probed next to the special points of a bifurcation diagram.
 //!
+//! The event-driven solver answers by its own refinement (Newton on its return map after a
+//! settling run, saltation multipliers); the switch model and Moreau–Jean by shooting on
+//! their own return maps, checked by a bounded simulation from the probe's start
+//! ([`crate::checked`]), so that no probe simulates 20 000 s.
+//!
 //! Away from bifurcations every solver's steady state is right to its tolerance; next to them
 //! the dynamics are slow (a multiplier or eigenvalue near the unit circle), cycles meet (a
 //! fold: a stable and an unstable one close together), or a stick phase shrinks to nothing
@@ -15,6 +20,7 @@ use rotor_bifurcation::periodic::Shooter;
 use rotor_bifurcation::{Diagram, PointKind};
 use rotor_model::{Model, Scene, State, SteadyState};
 
+use crate::checked::{CheckOptions, checked_shot};
 use crate::steady::{SteadyAnswer, SteadyError, SteadyOptions, steady};
 use rotor_solvers::solvers::SolverKind;
 
@@ -292,6 +298,10 @@ fn refusal(e: &SteadyError) -> Option<&'static str> {
             Unsettled::GrazingBelowStep { .. } => "grazing below step",
         }),
         SteadyError::Undecided { .. } => Some("stability undecided"),
+        SteadyError::Unstable { .. } => Some("unstable orbit"),
+        SteadyError::Neutral { .. } => Some("stability undecided"),
+        SteadyError::NotReached { .. } => Some("slow transient"),
+        SteadyError::Shoot(_) => Some("no orbit by shooting"),
         SteadyError::Solve(rotor_model::SolveError::NoConvergence { detail }) => {
             Some(if detail.contains("no cycle near the orbit") {
                 "weakly unstable equilibrium"
@@ -444,7 +454,11 @@ pub fn run_probe(
         x0: probe.start.state(model, u),
         ..Scene::default()
     };
-    let answer = steady(probe.kind, model, &scene, &SteadyOptions::default());
+    let answer = if probe.kind == SolverKind::EVENT {
+        steady(probe.kind, model, &scene, &SteadyOptions::default())
+    } else {
+        checked_shot(probe.kind, model, &scene, &CheckOptions::default()).map(|c| c.answer)
+    };
     let verdict = judge(probe.kind, &answer, expected);
     (answer, verdict)
 }
@@ -472,14 +486,18 @@ where
     let mut inputs: Vec<f64> = probes.iter().map(Probe::u).collect();
     inputs.sort_by(f64::total_cmp);
     inputs.dedup();
-    let expect: Vec<(f64, Vec<Attractor>)> =
-        inputs.iter().map(|&u| (u, expected(model, d, u))).collect();
+    // Computed by the first probe at each input that needs them (so in parallel across
+    // inputs when `map` is parallel), once.
+    let expect: Vec<(f64, std::sync::OnceLock<Vec<Attractor>>)> = inputs
+        .iter()
+        .map(|&u| (u, std::sync::OnceLock::new()))
+        .collect();
     let one = |p: &Probe| {
         let u = p.u();
         let attractors = expect
             .iter()
             .find(|(v, _)| *v == u)
-            .map(|(_, a)| a.as_slice())
+            .map(|(_, a)| a.get_or_init(|| expected(model, d, u)).as_slice())
             .unwrap_or(&[]);
         let t = std::time::Instant::now();
         let (answer, verdict) = run_probe(model, p, attractors);
@@ -525,13 +543,28 @@ pub fn probe_table_markdown(rows: &[ProbeRow], solvers: &[SolverKind]) -> String
             let cell = group
                 .iter()
                 .find(|q| q.probe.kind == *k)
-                .map_or("—".to_string(), |q| q.verdict.short());
+                .map_or("—".to_string(), |q| match q.method {
+                    Some(m) => format!("{} ({})", q.verdict.short(), method_name(m)),
+                    None => q.verdict.short(),
+                });
             out.push_str(&format!(" {cell} |"));
         }
         out.push('\n');
         i += group.len();
     }
     out
+}
+
+/// How an answer was obtained, as the JSON of `rotor steady` names it.
+fn method_name(m: crate::steady::SteadyMethod) -> &'static str {
+    use crate::steady::SteadyMethod::*;
+    match m {
+        Equilibrium => "equilibrium",
+        Refined => "refined",
+        Settled => "settled",
+        Simulated => "simulated",
+        Shoot => "shoot",
+    }
 }
 
 /// The probes of the stress test and the report: in the full form every point × offset ×

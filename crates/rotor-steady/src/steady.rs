@@ -101,6 +101,34 @@ pub enum SteadyError {
         multipliers: String,
         estimate: String,
     },
+    /// Shooting found a periodic orbit near where a run from the start went, but a multiplier
+    /// lies on or outside the unit circle, and the run decays onto no stable equilibrium.
+    #[error(
+        "the periodic orbit shooting found (period {period:.6} s) is unstable: its Floquet \
+         multipliers are {multipliers}; it is not the steady state"
+    )]
+    Unstable { multipliers: String, period: f64 },
+    /// Shooting found a periodic orbit whose largest multiplier is too close to the unit
+    /// circle for its differences to decide its stability, and the run from the start went
+    /// to no attractor within the check's time.
+    #[error(
+        "the periodic orbit shooting found (period {period:.6} s) has a multiplier within \
+         1e-3 of the unit circle ({multipliers}), closer than the return map's differences \
+         resolve: its stability is undecided (the input is next to a bifurcation)"
+    )]
+    Neutral { multipliers: String, period: f64 },
+    /// The orbit shooting found is stable, but a run from the start had not come to it (at
+    /// the rate its multipliers predict, or within the solver's reproducibility) by `t`.
+    #[error(
+        "a run from the start has not reached the stable orbit shooting found (multipliers \
+         {multipliers}) after {t} s: its last return is {distance:.2e} away and not yet \
+         approaching at the multipliers' rate (a slow transient next to a special point)"
+    )]
+    NotReached {
+        t: f64,
+        distance: f64,
+        multipliers: String,
+    },
     /// A value of the answer is not finite.
     #[error("the steady state has a non-finite {name}: {value}")]
     NonFinite { name: &'static str, value: f64 },

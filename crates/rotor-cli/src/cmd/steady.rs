@@ -14,7 +14,9 @@ pub struct Args {
     /// metrics settle, which answers equilibria too), or `shoot` (Newton on the
     /// solver's own return map from a 300 s run's last section crossing: any solver, the
     /// orbit stable or not, in a few periods where settling next to a Hopf point takes
-    /// thousands of seconds; the JSON adds "stable" and "multipliers").
+    /// thousands of seconds; the JSON adds "stable" and "multipliers"). The default is
+    /// the one that is right from every start: shoot is faster next to a special point
+    /// but does not check that the start reaches the orbit (docs/methods.md, 4b).
     #[arg(long, value_name = "shoot|simulate")]
     pub method: Option<String>,
 }

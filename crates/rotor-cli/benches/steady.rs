@@ -1,0 +1,80 @@
+//! The speeds of issue 31 as whole processes (a benchmark, not a test: these machines'
+//! timings move by ±15 %, and more when the cores are shared).
+//!
+//! ```sh
+//! cargo bench -p rotor-cli --bench steady              # rotor steady next to H1
+//! ROTOR_BENCH_MAIN=1 cargo bench -p rotor-cli --bench steady   # and the main job
+//! ```
+//!
+//! * `rotor steady --solver S --u V` at 1e-4 V above Table 1's first Hopf point H1, from
+//!   rest, for every solver, by `--method shoot` and by the default (`simulate`): the median
+//!   wall time of 5 processes each (the default's slow transient next to H1 once each);
+//! * with `ROTOR_BENCH_MAIN=1`, the main job (`rotor` with no arguments) once, in a temporary
+//!   directory (the embedded suite; the report goes there): its wall time and the CPU time
+//!   of the process tree (`/proc/self` children's utime + stime after it ends, on Linux).
+
+use std::path::Path;
+use std::process::{Command, Stdio};
+use std::time::Instant;
+
+use rotor_model::Model;
+
+fn median(mut v: Vec<f64>) -> f64 {
+    v.sort_by(f64::total_cmp);
+    v[v.len() / 2]
+}
+
+/// Wall time of one process, which must succeed.
+fn run(bin: &Path, args: &[&str], dir: &Path) -> f64 {
+    let t0 = Instant::now();
+    let st = Command::new(bin)
+        .args(args)
+        .current_dir(dir)
+        .stdout(Stdio::null())
+        .stderr(Stdio::null())
+        .status()
+        .expect("rotor starts");
+    let t = t0.elapsed().as_secs_f64();
+    assert!(st.success(), "rotor {args:?} failed");
+    t
+}
+
+/// CPU seconds (user + system) of this process's waited-for children so far, from
+/// `/proc/self/stat` (fields 16 and 17, cutime and cstime, in clock ticks of 100 Hz).
+fn children_cpu() -> Option<f64> {
+    let s = std::fs::read_to_string("/proc/self/stat").ok()?;
+    let rest = &s[s.rfind(')')? + 2..];
+    let f: Vec<&str> = rest.split_whitespace().collect();
+    // Fields after the name start at field 3; cutime is field 16, cstime 17.
+    let cu: f64 = f.get(13)?.parse().ok()?;
+    let cs: f64 = f.get(14)?.parse().ok()?;
+    Some((cu + cs) / 100.0)
+}
+
+fn main() {
+    let bin = Path::new(env!("CARGO_BIN_EXE_rotor"));
+    let dir = std::env::temp_dir().join(format!("rotor-steady-bench-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).expect("a temporary directory");
+    let h1 = rotor_bifurcation::equilibria::hopf_points(&Model::table1(), 20.0)[0]
+        .equilibrium
+        .u;
+    let u = format!("{}", h1 + 1e-4);
+    println!("rotor steady at u = {u} V (1e-4 V above H1), from rest; median wall of 5:");
+    for solver in ["event", "switch", "moreau"] {
+        let base = ["steady", "--solver", solver, "--u", &u];
+        let shoot: Vec<&str> = [&base[..], &["--method", "shoot"]].concat();
+        let s = median((0..5).map(|_| run(bin, &shoot, &dir)).collect());
+        let d = run(bin, &base, &dir);
+        println!("  {solver:<7} --method shoot {s:>8.3} s   default (simulate) {d:>8.3} s");
+    }
+    if std::env::var_os("ROTOR_BENCH_MAIN").is_some() {
+        let c0 = children_cpu();
+        let w = run(bin, &[], &dir);
+        let cpu = children_cpu().zip(c0).map(|(a, b)| a - b);
+        println!(
+            "main job: {w:.1} s wall, {} CPU (user + system)",
+            cpu.map_or("?".into(), |c| format!("{c:.1} s"))
+        );
+    }
+    std::fs::remove_dir_all(&dir).ok();
+}

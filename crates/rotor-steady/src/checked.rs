@@ -1,0 +1,629 @@
+//! The steady state by shooting, checked by simulation: the near-special probes' method for
+//! the solvers without a return-map refinement of their own (the switch model, Moreau–Jean).
+//!
+//! Shooting ([`rotor_shoot`]) finds a periodic orbit near a start in a few periods, stable or
+//! not, but Newton's basin is not the orbit's basin of attraction: a start next to a fold of
+//! cycles, or in a bistable band, may go to another attractor than the orbit Newton finds. So
+//! the answer is accepted only when a bounded simulation from the start itself is seen to go
+//! to it:
+//!
+//! 1. a run of [`CheckOptions::first_run`] seconds from the start. If it crosses neither
+//!    section (no stick exit, no maximum of ω_l) in its second half, it is approaching an
+//!    equilibrium, and the simulation method ([`crate::settle`]) continues it until it
+//!    settles;
+//! 2. otherwise Newton on the solver's own return map from the run's last section crossing.
+//!    An orbit is taken as stable only with every multiplier inside the circle of radius
+//!    `1 − NEUTRAL` ([`NEUTRAL`]: closer to 1, the differences cannot decide);
+//! 3. the run is continued in chunks up to [`CheckOptions::max_time`], and after each chunk:
+//!    * an equilibrium the run has come to rest at (ω_l amplitude ≤ 1e-6 rad/s over the
+//!      chunk's second half) is the answer if it is the stuck set or a slipping equilibrium
+//!      whose eigenvalues say it is stable;
+//!    * the run's returns to the stable orbit's section `z_n` are compared with its fixed
+//!      point `z*`. With `e_n = z_n − z*`, the run goes to the orbit when either
+//!      `|e_n|∞ ≤ floor·(1 + |z*|∞)` at its last two returns ([`floor`]: on the orbit to the
+//!      solver's own reproducibility), or the last returns follow the linearised map at the
+//!      rate its multipliers predict: `e_{n+1} = λ e_n` (a one-dimensional map, stick exit)
+//!      or, by Cayley–Hamilton for the 2 × 2 map, `e_{n+2} − (λ1 + λ2) e_{n+1} + λ1 λ2 e_n
+//!      = 0`, each within `rate_tol·(1 − ρ)` of the deviation (ρ the largest |λ|), with `|e|`
+//!      falling ([`goes_to`]). That is a run inside the orbit's linear neighbourhood, where a
+//!      stable orbit attracts;
+//!    * a run whose oscillation decays onto a stable slipping equilibrium at the rate its
+//!      slowest eigenvalue predicts (`a_{k+1}/a_k = e^{σ (t_{k+1} − t_k)}` for the amplitudes
+//!      `a_k` of ω_l at its maxima, within `rate_tol·|σ|`) answers that equilibrium.
+//!
+//! A run that has done none of these by `max_time`, or whose distance from the orbit (or
+//! amplitude about the equilibrium) falls by less than 1 % over a chunk, is a refusal that
+//! names what it saw: the stable orbit not reached (and how far the run still is), an
+//! unstable orbit, a multiplier too near 1 to decide, or no orbit found. The probes do not
+//! wait 20 000 s for a slow transient.
+
+use nalgebra::Complex;
+use rotor_model::{Disc, EventKind, Model, OMEGA_L, OMEGA_U, Output, Scene, Solver, State};
+use rotor_model::{Event, SteadyState};
+use rotor_shoot::{Orbit, Section, ShootOptions, shoot};
+use rotor_solvers::SolverKind;
+
+use crate::steady::{SteadyAnswer, SteadyError, SteadyMethod};
+
+/// Settings of [`checked_shot`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct CheckOptions {
+    /// The first run from the start, before shooting from its last crossing \[s\]: about 20
+    /// periods of the source's cycles (4–6 s), enough for the fast transients to die out.
+    pub first_run: f64,
+    /// Each further chunk of the check run \[s\] (about 10 periods).
+    pub chunk: f64,
+    /// The longest check run from the start \[s\]. 600 s is ~130 periods: a stable orbit with
+    /// multiplier ≤ 0.95 is reached to 1e-3 of the start's distance within 135 periods; next
+    /// to a Hopf point or a fold the run is refused instead (Moreau–Jean: 6·10⁵ steps,
+    /// ~0.1 s).
+    pub max_time: f64,
+    /// The rate check's tolerance, as a fraction of the contraction `1 − ρ`: 0.25 tells a
+    /// run converging to the orbit (its rate → 1 − ρ) from one passing it, and from one still
+    /// in the nonlinear approach, whose rate differs by the relative distance (≥ 25 %).
+    pub rate_tol: f64,
+}
+
+impl Default for CheckOptions {
+    fn default() -> Self {
+        CheckOptions {
+            first_run: 100.0,
+            chunk: 50.0,
+            max_time: 600.0,
+            rate_tol: 0.25,
+        }
+    }
+}
+
+/// How close a run's returns must come to the shot fixed point to be on the orbit, relative
+/// to `1 + |z*|`: the solver's reproducibility of a return. The switch model's returns in a
+/// long run repeat to ~1e-10 (its tolerance; settled metrics agree to 4e-12): 1e-7, 100× the
+/// shooting tolerance 1e-9. Moreau–Jean's stick exits fall between its steps differently
+/// from cycle to cycle (its metrics jitter by 2.5e-7 at h = 1e-3, `SettleOptions`): 1e-5,
+/// 40× that, and still about 17× below the distance between the stable and the unstable
+/// cycle 1e-6 V from Table 1's fold E (~1.7e-4 in max ω_l: a fold's square-root law applied
+/// to the 2.4e-3 measured 2e-4 V below it), so a run within the floor of one is not near the
+/// other.
+pub fn floor(kind: SolverKind) -> f64 {
+    if kind.is_fixed_step() { 1e-5 } else { 1e-7 }
+}
+
+/// What the check saw.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Reached {
+    /// The last returns lie within the floor of the fixed point.
+    OnOrbit,
+    /// The last returns follow the linearised map at the multipliers' rate.
+    AtRate,
+    /// An equilibrium the run came to rest at.
+    AtRest,
+    /// An equilibrium the run's oscillation decays onto at its eigenvalues' rate.
+    Decaying,
+    /// No oscillation to shoot: the simulation method's settled equilibrium.
+    Settled,
+}
+
+/// An answer of [`checked_shot`], with its check.
+#[derive(Debug, Clone)]
+pub struct Checked {
+    pub answer: SteadyAnswer,
+    pub reached: Reached,
+    /// Simulated time from the start when the check passed \[s\].
+    pub t: f64,
+}
+
+/// Runs from the start, kept as one time line.
+struct Run<'a> {
+    solver: Box<dyn Solver>,
+    model: &'a Model,
+    scene: Scene,
+    events: Vec<Event>,
+    t: f64,
+    x: State,
+    last_metrics: Option<SteadyState>,
+}
+
+impl Run<'_> {
+    fn extend(&mut self, dt: f64) -> Result<(), SteadyError> {
+        let tr = self.solver.simulate_finite(
+            self.model,
+            &Scene {
+                x0: self.x,
+                t_end: dt,
+                output: Output::Events,
+                metrics_from: Some(0.5 * dt),
+                ..self.scene.clone()
+            },
+        )?;
+        let t0 = self.t;
+        self.events.extend(tr.events.into_iter().map(|mut e| {
+            e.t += t0;
+            e
+        }));
+        self.t += dt;
+        self.x = tr.x_final;
+        self.last_metrics = tr.metrics;
+        Ok(())
+    }
+
+    /// The returns to `section` after `from` \[s\]: time and section coordinates.
+    fn returns(&self, section: Section, from: f64) -> Vec<(f64, Vec<f64>)> {
+        let kind = match section {
+            Section::StickExit => EventKind::StickEnd(Disc::Lower),
+            Section::LowerMax => EventKind::Max(Disc::Lower),
+        };
+        self.events
+            .iter()
+            .filter(|e| e.kind == kind && e.t >= from)
+            .map(|e| (e.t, project(section, &e.x)))
+            .collect()
+    }
+}
+
+fn project(section: Section, x: &State) -> Vec<f64> {
+    match section {
+        Section::StickExit => vec![x[OMEGA_U]],
+        Section::LowerMax => vec![x[OMEGA_U], x[OMEGA_L]],
+    }
+}
+
+fn norm(v: &[f64]) -> f64 {
+    v.iter().fold(0.0f64, |m, x| m.max(x.abs()))
+}
+
+/// Whether the returns `z` (time order) go to the fixed point `zs` of an orbit with
+/// nontrivial multipliers `mult`: on the orbit (`floor`) or at the linearised rate (see the
+/// module docs). `None` when neither yet.
+pub fn goes_to(
+    z: &[Vec<f64>],
+    zs: &[f64],
+    mult: &[[f64; 2]],
+    floor_rel: f64,
+    rate_tol: f64,
+) -> Option<Reached> {
+    let e: Vec<Vec<f64>> = z
+        .iter()
+        .map(|zi| zi.iter().zip(zs).map(|(a, b)| a - b).collect())
+        .collect();
+    let n = e.len();
+    let floor = floor_rel * (1.0 + norm(zs));
+    if n >= 2 && norm(&e[n - 1]) <= floor && norm(&e[n - 2]) <= floor {
+        return Some(Reached::OnOrbit);
+    }
+    let rho = mult.iter().map(|m| m[0].hypot(m[1])).fold(0.0, f64::max);
+    if rho >= 1.0 {
+        return None;
+    }
+    let tol = rate_tol * (1.0 - rho);
+    let residual = |k: usize| -> f64 {
+        // k indexes the newest deviation of the relation.
+        if zs.len() == 1 {
+            (e[k][0] - mult[0][0] * e[k - 1][0]).abs() / e[k - 1][0].abs().max(e[k][0].abs())
+        } else {
+            let (l1, l2) = (
+                Complex::new(mult[0][0], mult[0][1]),
+                Complex::new(mult[1][0], mult[1][1]),
+            );
+            let (tr, det) = ((l1 + l2).re, (l1 * l2).re);
+            let r: Vec<f64> = (0..2)
+                .map(|c| e[k][c] - tr * e[k - 1][c] + det * e[k - 2][c])
+                .collect();
+            norm(&r) / norm(&e[k]).max(norm(&e[k - 1])).max(norm(&e[k - 2]))
+        }
+    };
+    // Two consecutive relations, each past the floor, and the deviation falling.
+    let need = if zs.len() == 1 { 3 } else { 4 };
+    if n < need {
+        return None;
+    }
+    let last = n - 1;
+    let above = e[n - need..].iter().all(|d| norm(d) > floor);
+    let falling = norm(&e[last]) < norm(&e[n - need]);
+    (above && falling && residual(last) <= tol && residual(last - 1) <= tol)
+        .then_some(Reached::AtRate)
+}
+
+/// The slipping equilibrium nearest ω, if it is stable.
+fn stable_equilibrium(model: &Model, u: f64, omega: f64) -> Option<rotor_model::SlipEquilibrium> {
+    let e = model
+        .slip_equilibria(u)
+        .into_iter()
+        .min_by(|a, b| (a.omega - omega).abs().total_cmp(&(b.omega - omega).abs()))?;
+    model.equilibrium_is_stable(&e).then_some(e)
+}
+
+fn equilibrium_answer(e: &rotor_model::SlipEquilibrium) -> SteadyAnswer {
+    SteadyAnswer {
+        state: SteadyState::Equilibrium {
+            omega_u: e.omega,
+            omega_l: e.omega,
+            alpha: e.alpha,
+        },
+        method: SteadyMethod::Equilibrium,
+        multipliers: None,
+        stable: None,
+        stats: Default::default(),
+    }
+}
+
+/// Whether the run's oscillation decays onto the stable slipping equilibrium nearest its
+/// last ω_l maximum at the rate of the equilibrium's slowest eigenvalue (see the module
+/// docs).
+fn decays_onto(
+    run: &Run,
+    model: &Model,
+    u: f64,
+    rate_tol: f64,
+) -> Option<rotor_model::SlipEquilibrium> {
+    let maxima = run.returns(Section::LowerMax, 0.5 * run.t);
+    let last = maxima.last()?;
+    let e = stable_equilibrium(model, u, last.1[1])?;
+    let sigma = model
+        .equilibrium_eigenvalues(&e)
+        .iter()
+        .map(|l| l.re)
+        .fold(f64::NEG_INFINITY, f64::max);
+    let n = maxima.len();
+    if n < 3 || sigma >= 0.0 {
+        return None;
+    }
+    let amp = |k: usize| (maxima[k].1[1] - e.omega).abs();
+    let ok = (n - 2..n).all(|k| {
+        let (a0, a1) = (amp(k - 1), amp(k));
+        let dt = maxima[k].0 - maxima[k - 1].0;
+        a1 < a0 && ((a1 / a0).ln() / dt - sigma).abs() <= rate_tol * sigma.abs()
+    });
+    ok.then_some(e)
+}
+
+/// The steady state `kind` reaches from `scene.x0` at `scene.u`, by shooting on its own
+/// return map and checked by a bounded simulation from the start (see the module docs).
+pub fn checked_shot(
+    kind: SolverKind,
+    model: &Model,
+    scene: &Scene,
+    opts: &CheckOptions,
+) -> Result<Checked, SteadyError> {
+    scene.validate()?;
+    let u = scene.u;
+    let mut run = Run {
+        solver: kind.solver(),
+        model,
+        scene: scene.clone(),
+        events: Vec::new(),
+        t: 0.0,
+        x: scene.x0,
+        last_metrics: None,
+    };
+    run.extend(opts.first_run)?;
+    // Shooting from the last crossing of the first run's second half.
+    let half = 0.5 * run.t;
+    let start = [Section::StickExit, Section::LowerMax]
+        .into_iter()
+        .find_map(|s| run.returns(s, half).last().map(|r| (s, r.1.clone())));
+    let shot = start.map(|(section, z0)| {
+        shoot(
+            &*run.solver,
+            model,
+            scene,
+            section,
+            &z0,
+            &ShootOptions {
+                // The most iterations a converging Newton took over all the probes was 14
+                // (measured); a start that needs more is outside its basin, and failing
+                // sooner saves up to 30 runs of the horizon.
+                max_iter: 16,
+                ..ShootOptions::default()
+            },
+        )
+    });
+    // An orbit whose largest multiplier is within `NEUTRAL` of the unit circle has a
+    // stability the differences cannot decide.
+    let orbit = match &shot {
+        Some(Ok(o)) if o.is_stable() && spectral_radius(o) < 1.0 - NEUTRAL => Some(o),
+        _ => None,
+    };
+    if shot.is_none() {
+        // No crossing of either section in the run's second half: no cycle to shoot, an
+        // equilibrium being approached (a disc creeping into the stuck set, say). The
+        // simulation method answers it, continuing the run, with its own check that the
+        // run has settled ([`crate::settle`]).
+        let s = crate::settle::settle(
+            kind,
+            model,
+            &Scene {
+                x0: run.x,
+                ..scene.clone()
+            },
+            &crate::settle::SettleOptions {
+                // An equilibrium has no period for a chunk to span: 100 s chunks (the
+                // default's 300 s is 60 periods of a cycle) gave every probe the same verdict.
+                chunk: 100.0,
+                ..Default::default()
+            },
+        )?;
+        return Ok(Checked {
+            t: run.t,
+            answer: SteadyAnswer {
+                state: s.state,
+                method: SteadyMethod::Simulated,
+                multipliers: None,
+                stable: None,
+                stats: s.stats,
+            },
+            reached: Reached::Settled,
+        });
+    }
+    let fl = floor(kind);
+    // The distance of the latest return from the orbit at the end of the previous chunk.
+    let mut previous = f64::INFINITY;
+    loop {
+        if let Some(e) = at_rest(&run, model, u) {
+            return Ok(Checked {
+                answer: e,
+                reached: Reached::AtRest,
+                t: run.t,
+            });
+        }
+        if let Some(o) = orbit {
+            let z: Vec<Vec<f64>> = run
+                .returns(o.section, 0.0)
+                .into_iter()
+                .map(|r| r.1)
+                .collect();
+            if let Some(r) = goes_to(&z, &o.z, &o.multipliers, fl, opts.rate_tol) {
+                return Ok(Checked {
+                    answer: orbit_answer(&*run.solver, model, scene, o)?,
+                    reached: r,
+                    t: run.t,
+                });
+            }
+        }
+        if let Some(e) = decays_onto(&run, model, u, opts.rate_tol) {
+            return Ok(Checked {
+                answer: equilibrium_answer(&e),
+                reached: Reached::Decaying,
+                t: run.t,
+            });
+        }
+        // A run that is not coming nearer to the orbit (by 1 % per chunk, ~10 periods) will
+        // not reach it by `max_time` either: a slow transient or another attractor.
+        // Without an orbit, the same for the oscillation's decay onto an equilibrium.
+        let d = orbit.map_or_else(|| amplitude(&run, model, u), |o| distance(&run, o));
+        if run.t >= opts.max_time || (d.is_finite() && d > 0.99 * previous) {
+            break;
+        }
+        previous = d;
+        run.extend(opts.chunk)?;
+    }
+    Err(match shot {
+        Some(Ok(o)) if orbit.is_some() => SteadyError::NotReached {
+            t: run.t,
+            distance: distance(&run, &o),
+            multipliers: multipliers_text(&o),
+        },
+        Some(Ok(o)) if o.is_stable() || spectral_radius(&o) <= 1.0 + NEUTRAL => {
+            SteadyError::Neutral {
+                multipliers: multipliers_text(&o),
+                period: o.period,
+            }
+        }
+        Some(Ok(o)) => SteadyError::Unstable {
+            multipliers: multipliers_text(&o),
+            period: o.period,
+        },
+        Some(Err(e)) => SteadyError::Shoot(e),
+        None => SteadyError::Shoot(rotor_shoot::ShootError::NotACycle { t_end: run.t }),
+    })
+}
+
+/// How close to the unit circle a multiplier may come before shooting cannot tell a stable
+/// orbit from an unstable one: the return map's differences are accurate to ~1e-4 of the
+/// derivative (`ShootOptions::fd_rel`: the map's rounding over the step), so 1e-3.
+pub const NEUTRAL: f64 = 1e-3;
+
+/// The amplitude of ω_l at the run's latest maximum about the nearest slipping
+/// equilibrium (∞ without one).
+fn amplitude(run: &Run, model: &Model, u: f64) -> f64 {
+    let Some(last) = run.returns(Section::LowerMax, 0.0).pop() else {
+        return f64::INFINITY;
+    };
+    let w = last.1[1];
+    model
+        .slip_equilibria(u)
+        .iter()
+        .map(|e| (w - e.omega).abs())
+        .fold(f64::INFINITY, f64::min)
+}
+
+/// `|z_n − z*|∞` of the run's latest return to the orbit's section.
+fn distance(run: &Run, o: &Orbit) -> f64 {
+    run.returns(o.section, 0.0)
+        .last()
+        .map_or(f64::INFINITY, |zl| {
+            norm(
+                &zl.1
+                    .iter()
+                    .zip(&o.z)
+                    .map(|(a, b)| a - b)
+                    .collect::<Vec<_>>(),
+            )
+        })
+}
+
+fn spectral_radius(o: &Orbit) -> f64 {
+    o.multipliers
+        .iter()
+        .map(|m| m[0].hypot(m[1]))
+        .fold(0.0, f64::max)
+}
+
+/// The equilibrium the run has come to rest at (its last chunk's ω_l amplitude ≤ 1e-6
+/// rad/s): the stuck set, or a slipping equilibrium whose eigenvalues say it is stable.
+fn at_rest(run: &Run, model: &Model, u: f64) -> Option<SteadyAnswer> {
+    let Some(SteadyState::Equilibrium { omega_l, alpha, .. }) = run.last_metrics else {
+        return None;
+    };
+    if omega_l == 0.0 {
+        let s = model.stuck_equilibria(u)?;
+        return (s.alpha_min..=s.alpha_max)
+            .contains(&alpha)
+            .then(|| SteadyAnswer {
+                state: run.last_metrics.expect("matched"),
+                method: SteadyMethod::Equilibrium,
+                multipliers: None,
+                stable: None,
+                stats: Default::default(),
+            });
+    }
+    let e = stable_equilibrium(model, u, omega_l)?;
+    ((e.omega - omega_l).abs() <= 1e-6).then(|| equilibrium_answer(&e))
+}
+
+fn multipliers_text(o: &Orbit) -> String {
+    o.multipliers
+        .iter()
+        .map(|m| format!("{:.6}{:+.6}i", m[0], m[1]))
+        .collect::<Vec<_>>()
+        .join(", ")
+}
+
+/// The orbit's metrics (its last complete cycle of a run over two periods from the fixed
+/// point) and multipliers `[1, λ, 0]` or `[1, λ1, λ2]`.
+pub(crate) fn orbit_answer(
+    solver: &dyn Solver,
+    model: &Model,
+    scene: &Scene,
+    orbit: &Orbit,
+) -> Result<SteadyAnswer, SteadyError> {
+    let skip = ShootOptions::default().skip;
+    let t_end = 2.0 * orbit.period + skip;
+    let run = solver.simulate_finite(
+        model,
+        &Scene {
+            x0: orbit.x,
+            t_end,
+            output: Output::Final,
+            metrics_from: Some(0.0),
+            ..scene.clone()
+        },
+    )?;
+    let state = run
+        .metrics
+        .ok_or(SteadyError::Shoot(rotor_shoot::ShootError::NoReturn {
+            what: orbit.section.as_str(),
+            horizon: t_end,
+            z: orbit.z.clone(),
+        }))?;
+    let mut multipliers = vec![Complex::new(1.0, 0.0)];
+    multipliers.extend(orbit.multipliers.iter().map(|m| Complex::new(m[0], m[1])));
+    if multipliers.len() == 2 {
+        multipliers.push(Complex::new(0.0, 0.0));
+    }
+    Ok(SteadyAnswer {
+        state,
+        method: SteadyMethod::Shoot,
+        multipliers: Some(multipliers),
+        stable: Some(orbit.is_stable()),
+        stats: run.stats,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The rate check on made-up returns of a one-dimensional map with multiplier 0.9: a
+    /// geometric approach passes, an approach at another rate (to a different fixed point)
+    /// and a growing deviation do not; returns within the floor pass as on the orbit.
+    #[test]
+    fn the_rate_check_tells_an_approach_at_the_multipliers_rate() {
+        let zs = [1.0];
+        let mult = [[0.9, 0.0]];
+        let geo: Vec<Vec<f64>> = (0..5).map(|k| vec![1.0 + 0.1 * 0.9f64.powi(k)]).collect();
+        assert_eq!(goes_to(&geo, &zs, &mult, 1e-7, 0.25), Some(Reached::AtRate));
+        // The same returns converging to 1.05 instead: deviations from 1.0 fall at another
+        // rate.
+        let elsewhere: Vec<Vec<f64>> = (0..5).map(|k| vec![1.05 + 0.05 * 0.9f64.powi(k)]).collect();
+        assert_eq!(goes_to(&elsewhere, &zs, &mult, 1e-7, 0.25), None);
+        let growing: Vec<Vec<f64>> = (0..5).map(|k| vec![1.0 + 1e-3 * 1.1f64.powi(k)]).collect();
+        assert_eq!(goes_to(&growing, &zs, &mult, 1e-7, 0.25), None);
+        let on = vec![vec![1.0 + 1e-9], vec![1.0 - 1e-9]];
+        assert_eq!(goes_to(&on, &zs, &mult, 1e-7, 0.25), Some(Reached::OnOrbit));
+        // An unstable orbit is never gone to at a rate.
+        assert_eq!(goes_to(&geo, &zs, &[[1.1, 0.0]], 1e-7, 0.25), None);
+    }
+
+    /// Table 1 at 4.5 V is bistable (between H2 and G2): from rest the run goes to the
+    /// stick-slip cycle, from the perturbed equilibrium it stays at the stable equilibrium
+    /// (the fixtures t1-u4.5-rest and t1-u4.5-eq-pert). Shooting from rest finds the cycle and
+    /// the check passes; the run from the perturbed equilibrium never comes to that cycle, so
+    /// the same orbit is refused as its steady state, and its checked answer is the
+    /// equilibrium.
+    #[test]
+    fn the_check_refuses_an_orbit_the_start_does_not_go_to() {
+        let m = Model::table1();
+        let u = 4.5;
+        for kind in [SolverKind::SWITCH, SolverKind::MOREAU] {
+            let rest = Scene {
+                u,
+                ..Scene::default()
+            };
+            let c = checked_shot(kind, &m, &rest, &CheckOptions::default()).unwrap();
+            assert_eq!(c.answer.method, SteadyMethod::Shoot, "{c:?}");
+            assert_eq!(c.answer.stable, Some(true));
+            // The cycle, shot again from the rest run to have its fixed point.
+            let solver = kind.solver();
+            let (section, z0) =
+                Section::of_run(&*solver, &m, &rest, State::zeros(), 100.0).unwrap();
+            let orbit = shoot(&*solver, &m, &rest, section, &z0, &Default::default()).unwrap();
+            // Returns of a run from the perturbed equilibrium to that orbit's section.
+            let pert = Scene {
+                x0: m.perturbed_equilibrium(u),
+                ..rest.clone()
+            };
+            let mut run = Run {
+                solver: kind.solver(),
+                model: &m,
+                scene: pert.clone(),
+                events: Vec::new(),
+                t: 0.0,
+                x: pert.x0,
+                last_metrics: None,
+            };
+            run.extend(600.0).unwrap();
+            let z: Vec<Vec<f64>> = run.returns(section, 0.0).into_iter().map(|r| r.1).collect();
+            assert_eq!(
+                goes_to(&z, &orbit.z, &orbit.multipliers, floor(kind), 0.25),
+                None,
+                "{}: the run from the equilibrium was taken to go to the cycle",
+                kind.name()
+            );
+            let c = checked_shot(kind, &m, &pert, &CheckOptions::default()).unwrap();
+            assert_eq!(c.answer.method, SteadyMethod::Equilibrium, "{c:?}");
+        }
+    }
+
+    /// A 2 × 2 map with a complex pair of modulus 0.8: its deviations rotate, so their size
+    /// is not monotone, but they satisfy Cayley–Hamilton's relation.
+    #[test]
+    fn the_rate_check_follows_a_rotating_approach() {
+        let (c, s) = (0.8 * 0.5f64.cos(), 0.8 * 0.5f64.sin());
+        let mut e = [1e-2, 0.0];
+        let mut z = Vec::new();
+        for _ in 0..8 {
+            z.push(vec![2.0 + e[0], 3.0 + e[1]]);
+            e = [c * e[0] - s * e[1], s * e[0] + c * e[1]];
+        }
+        let mult = [[c, s], [c, -s]];
+        assert_eq!(
+            goes_to(&z, &[2.0, 3.0], &mult, 1e-9, 0.25),
+            Some(Reached::AtRate)
+        );
+        // Against the wrong multipliers (a real pair 0.8, 0.1) it does not pass.
+        assert_eq!(
+            goes_to(&z, &[2.0, 3.0], &[[0.8, 0.0], [0.1, 0.0]], 1e-9, 0.25),
+            None
+        );
+    }
+}
