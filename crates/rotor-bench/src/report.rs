@@ -113,13 +113,17 @@ impl BenchReport {
                 sc.transient[1],
                 sc.dt
             );
+            let steady = match (r.period, r.omega_l_max) {
+                (Some(p), Some(w)) => format!("period {p:.12} s, max omega_l {w:.12} rad/s"),
+                (_, w) => format!(
+                    "equilibrium, omega_l {} rad/s",
+                    w.map_or("?".into(), |w| format!("{w:.12}"))
+                ),
+            };
             let _ = writeln!(
                 s,
-                "reference: event tol {:e}: period {:.12} s, max omega_l {:.12} rad/s ({} \
-                 steps, {} ms)",
+                "reference: event tol {:e}: {steady} ({} steps, {} ms)",
                 r.tol,
-                r.period,
-                r.omega_l_max,
                 r.stats.steps,
                 ms(r.seconds)
             );
@@ -260,21 +264,30 @@ impl BenchReport {
         for p in &self.clients {
             client_table(&mut s, p);
         }
-        if !self.profile.entries.is_empty() {
+        for prof in std::iter::once(&self.profile).chain(&self.profile_table1) {
+            if prof.entries.is_empty() {
+                continue;
+            }
             let _ = writeln!(
                 s,
-                "performance profile over {} scene(s) (solved: {}); time / best time per scene:",
-                self.profile.scenes.len(),
-                self.profile.criterion
+                "performance profile, tier {}, over {} scene(s) (solved: {}); time / best time \
+                 per scene:",
+                if prof.tier.is_empty() {
+                    "full"
+                } else {
+                    &prof.tier
+                },
+                prof.scenes.len(),
+                prof.criterion
             );
-            let _ = writeln!(s, "{:<10} {}", "", self.profile.scenes.join("  "));
-            for en in &self.profile.entries {
+            let _ = writeln!(s, "{:<12} {}", "", prof.scenes.join("  "));
+            for en in &prof.entries {
                 let cells: Vec<String> = en
                     .ratios
                     .iter()
                     .map(|r| r.map_or("unsolved".into(), |r| format!("{r:.2}")))
                     .collect();
-                let _ = writeln!(s, "{:<10} {}", en.name, cells.join("  "));
+                let _ = writeln!(s, "{:<12} {}", en.name, cells.join("  "));
             }
             let _ = writeln!(s);
         }
@@ -452,6 +465,9 @@ impl BenchReport {
         }
         if self.profile.entries.len() > 1 {
             panels.push(self.profile.panel());
+            if let Some(t1) = &self.profile_table1 {
+                panels.push(t1.panel());
+            }
         }
         Ok(render(&panels, 760.0, 420.0))
     }

@@ -189,9 +189,17 @@ enum Command {
         #[arg(long, default_value_t = 60.0, allow_hyphen_values = true)]
         timeout: f64,
         /// Benchmark these scenarios (files, or names in fixtures/scenarios; their horizon,
-        /// windows and grid) instead of the default scenes. Repeatable.
+        /// windows and grid) instead of the whole suite. Repeatable.
         #[arg(long = "scenario", value_name = "SCENARIO.toml")]
         scenario: Vec<PathBuf>,
+        /// Only the scenes of this tier: table1 (only the lower disc sticks) or full (every
+        /// scene).
+        #[arg(long, value_name = "TIER")]
+        tier: Option<String>,
+        /// Also write the published-results page (Markdown: digits per setting, cheapest
+        /// setting per level, profiles per tier; reports/bench/results.md).
+        #[arg(long, value_name = "FILE.md")]
+        results: Option<PathBuf>,
         /// Run only every N-th scene from the I-th (I from 1), for job arrays; the report
         /// records the shard, and `--merge` joins the shards' reports.
         #[arg(long, value_name = "I/N")]
@@ -206,7 +214,7 @@ enum Command {
             long,
             value_name = "SHARD.json",
             num_args = 1..,
-            conflicts_with_all = ["shard", "quick", "no_peers", "external", "fixed_step", "scenario", "keep"]
+            conflicts_with_all = ["shard", "quick", "no_peers", "external", "fixed_step", "scenario", "keep", "tier"]
         )]
         merge: Vec<PathBuf>,
     },
@@ -687,6 +695,8 @@ struct BenchClients<'a> {
     scenarios: &'a [PathBuf],
     shard: Option<&'a str>,
     keep: Option<&'a Path>,
+    tier: Option<&'a str>,
+    results: Option<&'a Path>,
 }
 
 fn bench(
@@ -720,15 +730,20 @@ fn bench(
             bail!("--fixed-step {name:?}: no --external client of that name");
         }
     }
+    let tier = clients
+        .tier
+        .map(rotor_bench::Tier::parse)
+        .transpose()
+        .map_err(|m| anyhow!(m))?;
     if !clients.scenarios.is_empty() {
-        opts.scenes = clients
+        let paths = clients
             .scenarios
             .iter()
-            .map(|p| {
-                let p = fixture_path("--scenario", p, "scenarios")?;
-                Ok(rotor_bench::SceneSpec::from_scenario(&p)?)
-            })
-            .collect::<Result<_>>()?;
+            .map(|p| fixture_path("--scenario", p, "scenarios"))
+            .collect::<Result<Vec<_>>>()?;
+        opts.scenes = rotor_bench::select(&paths, tier)?;
+    } else if !quick {
+        opts.scenes = rotor_bench::suite(&fixtures_dir()?.join("scenarios"), tier)?;
     }
     opts.shard = clients
         .shard
@@ -737,6 +752,7 @@ fn bench(
     opts.keep = clients.keep.map(Path::to_path_buf);
     let report = rotor_bench::run(&opts, |m| eprintln!("{m}"))?;
     write_bench(&report, [json, svg, csv])?;
+    write_results(&report, clients.results)?;
     // The report is written first (nothing is lost); then a named client that placed no
     // point on any scene fails the command, by name (a peer that is not installed does not).
     let unsolved: Vec<String> = report
@@ -805,7 +821,11 @@ fn job(
 }
 
 /// `rotor bench --merge`: the shards' reports joined into one.
-fn bench_merge(shards: &[PathBuf], outputs: [Option<&Path>; 3]) -> Result<()> {
+fn bench_merge(
+    shards: &[PathBuf],
+    outputs: [Option<&Path>; 3],
+    results: Option<&Path>,
+) -> Result<()> {
     let reports = shards
         .iter()
         .map(|p| {
@@ -821,7 +841,20 @@ fn bench_merge(shards: &[PathBuf], outputs: [Option<&Path>; 3]) -> Result<()> {
         })
         .collect::<Result<Vec<_>>>()?;
     let report = rotor_bench::merge(&reports)?;
-    write_bench(&report, outputs)
+    write_bench(&report, outputs)?;
+    write_results(&report, results)
+}
+
+/// `--results FILE`: the published-results page.
+fn write_results(report: &rotor_bench::BenchReport, path: Option<&Path>) -> Result<()> {
+    if let Some(path) = path {
+        // The command that wrote it, as given (`just bench` runs the whole suite's).
+        let args: Vec<String> = std::env::args().skip(1).collect();
+        let command = format!("rotor {}", args.join(" "));
+        rotor_compare::report::write_output(path, report.to_results_md(&command)?.as_bytes())
+            .with_context(|| format!("--results {}: cannot write", path.display()))?;
+    }
+    Ok(())
 }
 
 /// Prints a benchmark report's table and writes its files.
@@ -1396,6 +1429,8 @@ fn main() -> ExitCode {
             shard,
             keep,
             merge,
+            tier,
+            results,
         }) if merge.is_empty() => bench(
             [json.as_deref(), svg.as_deref(), csv.as_deref()],
             *quick,
@@ -1407,6 +1442,8 @@ fn main() -> ExitCode {
                 scenarios: scenario,
                 shard: shard.as_deref(),
                 keep: keep.as_deref(),
+                tier: tier.as_deref(),
+                results: results.as_deref(),
             },
         ),
         Some(Command::Bench {
@@ -1414,8 +1451,13 @@ fn main() -> ExitCode {
             svg,
             csv,
             merge,
+            results,
             ..
-        }) => bench_merge(merge, [json.as_deref(), svg.as_deref(), csv.as_deref()]),
+        }) => bench_merge(
+            merge,
+            [json.as_deref(), svg.as_deref(), csv.as_deref()],
+            results.as_deref(),
+        ),
         Some(Command::Job {
             scenario,
             tol,
