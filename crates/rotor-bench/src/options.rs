@@ -260,7 +260,13 @@ impl Default for BenchOptions {
                 .map(|k| {
                     // Moreau–Jean's h = 1e-5 (seconds a run on a 200 s scene) is left to
                     // `rotor bench --scenario` runs with a ladder of their own.
-                    let l = k.info().ladder.iter().copied().filter(|&x| x >= 1e-4);
+                    let fixed = k.is_fixed_step();
+                    let l = k
+                        .info()
+                        .ladder
+                        .iter()
+                        .copied()
+                        .filter(|&x| !fixed || x >= 1e-4);
                     (*k, l.collect())
                 })
                 .collect(),
@@ -384,5 +390,21 @@ mod tests {
             .to_string();
         assert!(e.contains("--tier table1"), "{e}");
         assert!(Tier::parse("both").unwrap_err().contains("\"both\""));
+    }
+
+    /// The suite's ladders: the tolerance solvers keep their whole ladder (down to 1e-12),
+    /// Moreau–Jean stops at h = 1e-4.
+    #[test]
+    fn the_suite_keeps_the_tolerance_ladders_whole() {
+        let o = BenchOptions::default();
+        for k in SOLVERS {
+            let want: Vec<f64> = k.info().ladder.to_vec();
+            if k.is_fixed_step() {
+                assert_eq!(o.ladder(k).last(), Some(&1e-4));
+            } else {
+                assert_eq!(o.ladder(k), want.as_slice(), "{}", k.name());
+                assert_eq!(o.ladder(k).last(), Some(&1e-12));
+            }
+        }
     }
 }
