@@ -240,9 +240,9 @@ pub fn workspace_root() -> PathBuf {
 
 impl Default for BenchOptions {
     /// The whole suite ([`suite`]: every scenario of `fixtures/scenarios`, its own horizon,
-    /// windows and grid; both tiers), with ladders chosen so that it runs, peers and all, in
-    /// about ten minutes on two idle cores (most of it the interpreters' start-up, about
-    /// 0.7 s a Python run): event and switch at tol 1e-3 … 1e-12, Moreau–Jean at h = 1e-2 …
+    /// windows and grid; both tiers), with short ladders for the peers and clients (the whole
+    /// run with every peer still takes about half an hour on two cores, BENCHMARK.md; most
+    /// of it Radau and BDF at 1e-10 and Siconos at 2e-3): event and switch at tol 1e-3 … 1e-12, Moreau–Jean at h = 1e-2 …
     /// 1e-4 (1-2-5), reference = event at tol 1e-13, median of up to 15 runs within 0.3 s per
     /// point (a run longer than that is timed once); the scipy peer at rtol = atol = 1e-4,
     /// 1e-7, 1e-10 (DOP853) and 1e-6, 1e-10 (Radau, BDF, LSODA), Siconos at h = 1e-2 and
