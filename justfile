@@ -19,12 +19,14 @@ proptest-long:
     PROPTEST_CASES=50000 cargo test --release -p rotor-moreau --test integration properties
     PROPTEST_CASES=20000 cargo test --release -p rotor-model --test fuzz_files
     PROPTEST_CASES=2000 cargo test --release -p rotor-grade --test benchmark mutated
-# Work-precision benchmark with peers (scipy, Siconos, Octave when installed), into reports/bench/.
-# With the tanh-regularised and first-order clients (bench/clients/), so the published table
-# places a wrong method and an honest first-order one beside the solvers and peers.
+# The whole suite's work-precision benchmark with the peers (scipy DOP853, Radau, BDF, LSODA;
+# Siconos; GNU Octave; any other peer registered in crates/rotor-bench/src/peers.rs, when installed) and
+# the tanh-regularised and first-order clients (bench/clients/), so that the published results
+# place a wrong method and an honest first-order one beside the solvers and peers:
+# reports/bench/results.md (+ bench.svg, .json, .csv, .txt). About half an hour on 2 cores.
 bench:
     mkdir -p target && cc -O2 -o target/first_order bench/clients/first_order.c -lm
-    cargo run --release -- bench --external "tanh=python3 bench/clients/tanh_regularised.py" --external "first_order:h=target/first_order" --json reports/bench/bench.json --svg reports/bench/bench.svg --csv reports/bench/bench.csv > reports/bench/bench.txt
+    cargo run --release -- bench --external "tanh=python3 bench/clients/tanh_regularised.py" --external "first_order:h=target/first_order" --json reports/bench/bench.json --svg reports/bench/bench.svg --csv reports/bench/bench.csv --results reports/bench/results.md > reports/bench/bench.txt
 # The peer tests, failing if scipy, Siconos or Octave is missing (.ci/run installs them and runs this).
 peers:
     ROTOR_REQUIRE_PEERS=1 cargo test --release -p rotor-bench --test peers

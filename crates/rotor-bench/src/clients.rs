@@ -8,11 +8,10 @@ use std::time::Instant;
 use rotor_grade::check::{CheckError, Level, check};
 use rotor_grade::gridmetrics::{StickExit, grid_metrics};
 use rotor_grade::trace::{read_events, read_trace};
-use rotor_model::SteadyState;
 use serde::{Deserialize, Serialize};
 
 use crate::ladder::{LadderPoint, Loaded};
-use crate::measure::{Errors, Timing, run_point, scene_at, time_at_error};
+use crate::measure::{Errors, SteadyRef, Timing, run_point, scene_at, time_at_error};
 use crate::options::{BenchOptions, SolverKind};
 use crate::protocol::{ClientSays, ClientSpec, Ended, Job, RunOutput, run_client, tail};
 
@@ -311,15 +310,8 @@ fn grade(l: &Loaded, job: &Job) -> Result<Grade, Failure> {
         model: &sc.model,
         u: sc.u,
     };
-    let cycle = |m: Result<SteadyState, _>| match m {
-        Ok(SteadyState::LimitCycle {
-            period,
-            omega_l_max,
-            ..
-        }) => Some((period, omega_l_max)),
-        _ => None,
-    };
-    let metrics = cycle(grid_metrics(&trace.samples, l.spec.metrics_from, exit));
+    let steady = grid_metrics(&trace.samples, l.spec.metrics_from, exit).ok();
+    let metrics = SteadyRef::of(steady.as_ref());
     let window: Vec<(f64, f64)> = trace
         .samples
         .iter()
@@ -406,9 +398,16 @@ fn point(
     }
     p.failing = failing;
     // Timed runs: as many as the budget allows after the first (which is not timed: a cold
-    // start of an interpreter is not the client's speed), at least one.
+    // start of an interpreter is not the client's speed), at least one; a first run longer
+    // than the whole budget is its own timing (its start-up is a small part of it), as the
+    // Rust solvers' warm-up run is.
     let n = ((opts.time_budget / first.wall_s.max(1e-9)).floor() as usize).clamp(1, opts.repeats);
     let (mut walls, mut solves) = (Vec::new(), Vec::new());
+    if first.wall_s >= opts.time_budget {
+        p.wall = Some(Timing::of(vec![first.wall_s]));
+        p.solve = first_says.solve_seconds.map(|s| Timing::of(vec![s]));
+        return p;
+    }
     for _ in 0..n {
         match run_once(spec, &job, dir, opts.timeout) {
             Ok((out, _)) => {

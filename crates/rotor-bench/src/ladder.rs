@@ -4,12 +4,12 @@
 use rotor_grade::check::{Level, check};
 use rotor_grade::gridmetrics::{StickExit, grid_metrics};
 use rotor_grade::reference::Reference;
-use rotor_model::{Output, Scenario, Scene, Stats, SteadyState};
+use rotor_model::{Output, Scenario, Scene, Stats};
 use serde::{Deserialize, Serialize};
 
 use crate::BenchError;
 use crate::measure::{
-    Errors, RefData, Timing, cycle_metrics, run_point, scene_at, solver, timed, window,
+    Errors, RefData, SteadyRef, Timing, run_point, scene_at, solver, timed, window,
 };
 use crate::options::{BenchOptions, SceneSpec, SolverKind};
 
@@ -17,6 +17,9 @@ use crate::options::{BenchOptions, SceneSpec, SolverKind};
 #[derive(Debug, Clone, Serialize, Deserialize)]
 pub struct SceneReport {
     pub name: String,
+    /// `table1` or `full` ([`crate::Tier`]).
+    #[serde(default)]
+    pub tier: String,
     pub description: String,
     pub u: f64,
     pub x0: [f64; 3],
@@ -33,10 +36,13 @@ pub struct SceneReport {
 pub struct ReferenceReport {
     pub solver: SolverKind,
     pub tol: f64,
-    /// Period of the last complete cycle (s).
-    pub period: f64,
-    /// Max ω_l over that cycle (rad/s).
-    pub omega_l_max: f64,
+    /// `limit_cycle` or `equilibrium` (the steady state over `[metrics_from, t_end]`).
+    #[serde(default = "cycle_word", deserialize_with = "crate::word::static_str")]
+    pub kind: crate::word::Word,
+    /// Period of the last complete cycle (s); `None` for an equilibrium.
+    pub period: Option<f64>,
+    /// Max ω_l over that cycle (rad/s); for an equilibrium its ω_l.
+    pub omega_l_max: Option<f64>,
     /// One untimed run (s).
     pub seconds: f64,
     pub stats: Stats,
@@ -47,6 +53,10 @@ pub struct ReferenceReport {
     pub check: Option<Errors>,
     /// Why the check run failed, if it did.
     pub check_failure: Option<String>,
+}
+
+fn cycle_word() -> crate::word::Word {
+    "limit_cycle"
 }
 
 /// One solver at one accuracy setting.
@@ -66,6 +76,13 @@ pub struct LadderPoint {
     /// Whether its trace passes the scenario's loose gate, graded as an external trace is
     /// (`rotor check`): the "solved" of the performance profile.
     pub passes_loose: Option<bool>,
+    /// Whether it passes the strict level, graded the same way.
+    #[serde(default)]
+    pub passes_strict: Option<bool>,
+    /// The trace's significant correct digits, as `rotor check` counts them (the fewest of
+    /// any graded quantity, events included).
+    #[serde(default)]
+    pub digits: Option<f64>,
 }
 
 /// A loaded scene with its reference.
@@ -114,6 +131,9 @@ pub(crate) fn load(
         RefData::new(&tr, spec.transient, spec.dt).ok_or_else(|| BenchError::NoReferenceCycle {
             scene: scenario.name.clone(),
         })?;
+    let no_steady = || BenchError::NoReferenceCycle {
+        scene: scenario.name.clone(),
+    };
     progress(&format!(
         "{}: reference check (event, tol {:e})",
         scenario.name, opts.reference_check_tol
@@ -127,12 +147,12 @@ pub(crate) fn load(
             // The reference measured against the tighter run.
             Some(cd) => (
                 Some(cd.errors(
-                    cycle_metrics(tr.metrics.as_ref()),
+                    SteadyRef::of(tr.metrics.as_ref()),
                     &window(&tr, spec.transient, spec.dt),
                 )),
                 None,
             ),
-            None => (None, Some("the check run gives no cycle".into())),
+            None => (None, Some("the check run gives no steady state".into())),
         },
         Err(e) => (None, Some(e.to_string())),
     };
@@ -148,27 +168,25 @@ pub(crate) fn load(
         model: &scenario.model,
         u: scenario.u,
     };
-    let grid_refd = match grid_metrics(&tr.samples, spec.metrics_from, exit) {
-        Ok(SteadyState::LimitCycle {
-            period,
-            omega_l_max,
-            ..
-        }) => RefData {
-            period,
-            omega_l_max,
-            ..refd.clone()
-        },
-        _ => {
-            return Err(BenchError::NoReferenceCycle {
-                scene: scenario.name.clone(),
-            });
-        }
+    // The reference's steady state read off its grid as a trace's is.
+    let grid_steady =
+        grid_metrics(&tr.samples, spec.metrics_from, exit).map_err(|_| no_steady())?;
+    let grid_refd = RefData {
+        steady: SteadyRef::of(Some(&grid_steady)).ok_or_else(no_steady)?,
+        ..refd.clone()
     };
     let reference = ReferenceReport {
         solver: SolverKind::EVENT,
         tol: opts.reference_tol,
-        period: refd.period,
-        omega_l_max: refd.omega_l_max,
+        kind: match refd.steady {
+            SteadyRef::Cycle { .. } => "limit_cycle",
+            SteadyRef::Equilibrium { .. } => "equilibrium",
+        },
+        period: refd.steady.cycle().map(|c| c.0),
+        omega_l_max: Some(match refd.steady {
+            SteadyRef::Cycle { omega_l_max, .. } => omega_l_max,
+            SteadyRef::Equilibrium { omega_l, .. } => omega_l,
+        }),
         seconds: timing.median_s,
         stats: tr.stats,
         check_tol: opts.reference_check_tol,
@@ -213,16 +231,21 @@ pub(crate) fn ladders(
                 opts.repeats,
                 opts.time_budget,
             ) {
-                Ok((tr, timing, errors)) => LadderPoint {
-                    solver: kind,
-                    setting_name: kind.setting_name(),
-                    setting,
-                    timing: Some(timing),
-                    errors,
-                    stats: tr.stats,
-                    failure: None,
-                    passes_loose: Some(passes_loose(l, &tr)),
-                },
+                Ok((tr, timing, errors)) => {
+                    let (loose, strict, digits) = graded(l, &tr);
+                    LadderPoint {
+                        solver: kind,
+                        setting_name: kind.setting_name(),
+                        setting,
+                        timing: Some(timing),
+                        errors,
+                        stats: tr.stats,
+                        failure: None,
+                        passes_loose: loose,
+                        passes_strict: strict,
+                        digits,
+                    }
+                }
                 Err(e) => LadderPoint {
                     solver: kind,
                     setting_name: kind.setting_name(),
@@ -232,6 +255,8 @@ pub(crate) fn ladders(
                     stats: Stats::default(),
                     failure: Some(e.to_string()),
                     passes_loose: None,
+                    passes_strict: None,
+                    digits: None,
                 },
             };
             points.push(point);
@@ -240,11 +265,18 @@ pub(crate) fn ladders(
     points
 }
 
-/// Whether a run's trace and events pass the scene's loose gate, graded as `rotor check`
-/// grades an external trace.
-fn passes_loose(l: &Loaded, tr: &rotor_model::Trajectory) -> bool {
+/// A run's trace and events graded as `rotor check` grades an external trace: whether they
+/// pass the loose and the strict level, and their digits (`None` where the grade cannot be
+/// made).
+fn graded(l: &Loaded, tr: &rotor_model::Trajectory) -> (Option<bool>, Option<bool>, Option<f64>) {
     let (sc, r) = &l.view;
     let trace = rotor_grade::trace::Trace::of_run("run", tr.samples.clone());
     let events = rotor_grade::trace::EventsFile::of_run("run", &tr.events);
-    check(sc, r, &trace, Some(&events), Level::Loose).is_ok_and(|c| c.passed)
+    let loose = check(sc, r, &trace, Some(&events), Level::Loose).ok();
+    let strict = check(sc, r, &trace, Some(&events), Level::Strict).ok();
+    (
+        loose.as_ref().map(|c| c.passed),
+        strict.map(|c| c.passed),
+        loose.map(|c| c.digits),
+    )
 }

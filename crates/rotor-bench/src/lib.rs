@@ -40,6 +40,7 @@ mod peers;
 pub mod profile;
 pub mod protocol;
 mod report;
+mod results;
 mod word;
 
 use rotor_model::{Model, Output, ScenarioError, Scene, SolveError};
@@ -52,9 +53,12 @@ pub use clients::{
 };
 pub use ladder::{LadderPoint, ReferenceReport, SceneReport};
 pub use levels::OutputLevel;
-pub use measure::{Errors, RefData, Timing, solver, time_at_error, timed};
+pub use measure::{Errors, RefData, SteadyRef, Timing, solver, time_at_error, timed};
 pub use merge::{ShardInfo, merge};
-pub use options::{BenchOptions, PeerOptions, SceneSpec, SolverKind, workspace_root};
+pub use options::{
+    BenchOptions, LEAD_SCENES, PeerOptions, SceneSpec, SolverKind, Tier, select, suite, suite_dir,
+    workspace_root,
+};
 pub use peers::available as peer_available;
 pub use peers::octave_available;
 pub use profile::Profile;
@@ -80,10 +84,10 @@ pub enum BenchError {
         #[source]
         source: SolveError,
     },
-    /// The reference run gives no limit cycle, or no sample in the transient window.
+    /// The reference run gives no steady state, or no sample in the transient window.
     #[error(
-        "reference run of {scene} gives no limit cycle in [metrics_from, t_end] or no sample \
-         in the transient window; choose a stick-slip scene and windows inside [0, t_end]"
+        "reference run of {scene} gives no steady state in [metrics_from, t_end] or no sample \
+         in the transient window; choose windows inside [0, t_end]"
     )]
     NoReferenceCycle { scene: String },
     /// A run outside the ladders failed (output-level timing).
@@ -122,8 +126,13 @@ pub struct BenchReport {
     pub output_levels: Vec<OutputLevel>,
     /// The peers and the external clients, over every scene.
     pub clients: Vec<ClientReport>,
-    /// The performance profile of solvers and clients over the scenes.
+    /// The performance profile of solvers and clients over the scenes (the full tier: every
+    /// scene of the run).
     pub profile: Profile,
+    /// The same over the run's table1-tier scenes alone, when the run holds scenes of both
+    /// tiers: a solver that treats only the lower disc's stick is ranked there.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub profile_table1: Option<Profile>,
     /// Where and how it was measured.
     pub environment: Environment,
     /// Which part of the suite this report holds (`rotor bench --shard I/N`); absent from a
@@ -220,7 +229,14 @@ fn validate(opts: &BenchOptions) -> Result<(), BenchError> {
         ));
     }
     let mut names: Vec<&str> = opts.clients.iter().map(|c| c.name.as_str()).collect();
-    names.extend(["scipy", "siconos", "octave"]);
+    names.extend([
+        "scipy",
+        "scipy-radau",
+        "scipy-bdf",
+        "scipy-lsoda",
+        "siconos",
+        "octave",
+    ]);
     names.extend(rotor_solvers::SOLVERS.map(SolverKind::name));
     names.sort_unstable();
     if let Some(w) = names.windows(2).find(|w| w[0] == w[1]) {
@@ -250,6 +266,7 @@ pub fn run(opts: &BenchOptions, mut progress: impl FnMut(&str)) -> Result<BenchR
         let points = ladders(opts, &l, &mut progress);
         scenes.push(SceneReport {
             name: l.scenario.name.clone(),
+            tier: Tier::of(&l.scenario).name().to_owned(),
             description: l.scenario.description.clone(),
             u: l.scenario.u,
             x0: [l.scenario.x0[0], l.scenario.x0[1], l.scenario.x0[2]],
@@ -303,13 +320,14 @@ pub fn run(opts: &BenchOptions, mut progress: impl FnMut(&str)) -> Result<BenchR
     if opts.keep.is_none() {
         let _ = std::fs::remove_dir_all(&work);
     }
-    let profile = profile::profile(&scenes, &clients);
+    let (profile, profile_table1) = profile::by_tier(&scenes, &clients);
     Ok(BenchReport {
         benchmark: rotor_grade::check::BENCHMARK.to_owned(),
         scenes,
         output_levels,
         clients,
         profile,
+        profile_table1,
         environment: Environment {
             cores: std::thread::available_parallelism().map_or(1, |n| n.get()),
             debug_build: cfg!(debug_assertions),

@@ -79,31 +79,67 @@ pub fn scene_at(base: &Scene, kind: SolverKind, setting: f64, output: Output) ->
     s
 }
 
-/// What errors are measured against: the reference's steady metrics and its ω_l on the grid.
+/// A steady state as the errors read it: a cycle's period and max ω_l, or an equilibrium's
+/// state.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum SteadyRef {
+    /// The last complete cycle: period (s), max ω_l (rad/s).
+    Cycle { period: f64, omega_l_max: f64 },
+    /// The equilibrium (or the stuck set): α (rad), ω_u, ω_l (rad/s).
+    Equilibrium {
+        alpha: f64,
+        omega_u: f64,
+        omega_l: f64,
+    },
+}
+
+impl SteadyRef {
+    /// The steady state of a run's metrics (`None`: the run reports none).
+    pub fn of(m: Option<&SteadyState>) -> Option<SteadyRef> {
+        match m? {
+            SteadyState::LimitCycle {
+                period,
+                omega_l_max,
+                ..
+            } => Some(SteadyRef::Cycle {
+                period: *period,
+                omega_l_max: *omega_l_max,
+            }),
+            SteadyState::Equilibrium {
+                omega_u,
+                omega_l,
+                alpha,
+            } => Some(SteadyRef::Equilibrium {
+                alpha: *alpha,
+                omega_u: *omega_u,
+                omega_l: *omega_l,
+            }),
+        }
+    }
+
+    /// The cycle's (period, max ω_l), if it is a cycle.
+    pub fn cycle(&self) -> Option<(f64, f64)> {
+        match *self {
+            SteadyRef::Cycle {
+                period,
+                omega_l_max,
+            } => Some((period, omega_l_max)),
+            SteadyRef::Equilibrium { .. } => None,
+        }
+    }
+}
+
+/// What errors are measured against: the reference's steady state and its ω_l on the grid.
 #[derive(Debug, Clone, PartialEq)]
 pub struct RefData {
-    /// Period of the last complete cycle (s).
-    pub period: f64,
-    /// Max ω_l over that cycle (rad/s).
-    pub omega_l_max: f64,
+    /// The steady state over `[metrics_from, t_end]`.
+    pub steady: SteadyRef,
     /// Grid step of the samples (s).
     pub dt: f64,
     /// Grid index of the first sample in the window.
     pub k0: i64,
     /// ω_l at the grid times `(k0 + i)·dt` in the transient window.
     pub omega_l: Vec<f64>,
-}
-
-/// The limit cycle's (period, max ω_l), if the metrics are a cycle.
-pub fn cycle_metrics(m: Option<&SteadyState>) -> Option<(f64, f64)> {
-    match m {
-        Some(SteadyState::LimitCycle {
-            period,
-            omega_l_max,
-            ..
-        }) => Some((*period, *omega_l_max)),
-        _ => None,
-    }
 }
 
 /// The (t, ω_l) samples of a trajectory inside `[t0, t1]` (with a rounding margin).
@@ -116,45 +152,71 @@ pub fn window(tr: &Trajectory, [t0, t1]: [f64; 2], dt: f64) -> Vec<(f64, f64)> {
         .collect()
 }
 
+/// The floor of an equilibrium coordinate's scale in its relative error (rad, rad/s): a stuck
+/// disc's ω = 0 is compared absolutely, as `rotor check` floors a variable's scale at 1e-3.
+const EQUILIBRIUM_SCALE_FLOOR: f64 = 1e-3;
+
 impl RefData {
-    /// Reads the reference from a full-trace run with metrics; `None` if it is no cycle or
-    /// the window holds no sample.
+    /// Reads the reference from a full-trace run with metrics; `None` if it reports no steady
+    /// state or the window holds no sample.
     pub fn new(tr: &Trajectory, transient: [f64; 2], dt: f64) -> Option<RefData> {
-        let (period, omega_l_max) = cycle_metrics(tr.metrics.as_ref())?;
+        let steady = SteadyRef::of(tr.metrics.as_ref())?;
         let w = window(tr, transient, dt);
         let k0 = grid_index(w.first()?.0, dt)?;
         Some(RefData {
-            period,
-            omega_l_max,
+            steady,
             dt,
             k0,
             omega_l: w.into_iter().map(|(_, v)| v).collect(),
         })
     }
 
-    /// Errors of a candidate: its cycle metrics and its (t, ω_l) samples in the window.
-    pub fn errors(&self, metrics: Option<(f64, f64)>, samples: &[(f64, f64)]) -> Errors {
-        let (period, omega_l_max) = match metrics {
-            Some((p, w)) => (
-                Some((p - self.period).abs()),
-                Some((w - self.omega_l_max).abs()),
-            ),
-            None => (None, None),
-        };
-        let period_rel = period.map(|p| p / self.period);
-        let omega_l_max_rel = omega_l_max.map(|w| w / self.omega_l_max.abs());
-        let steady_rel = match (period_rel, omega_l_max_rel) {
-            (Some(p), Some(w)) => Some(p.max(w)),
-            _ => None,
-        };
-        Errors {
-            period,
-            omega_l_max,
-            period_rel,
-            omega_l_max_rel,
-            steady_rel,
+    /// Errors of a candidate: its steady state and its (t, ω_l) samples in the window.
+    ///
+    /// A cycle: |ΔT|, |Δ max ω_l| and `steady_rel` = max(|ΔT|/T, |Δ max ω_l|/max ω_l). An
+    /// equilibrium: `steady_rel` = max over α, ω_u, ω_l of |Δx| / max(|x_ref|, 1e-3). A
+    /// candidate of the other kind (or none) has no steady error.
+    pub fn errors(&self, steady: Option<SteadyRef>, samples: &[(f64, f64)]) -> Errors {
+        let mut e = Errors {
             transient_max: self.transient_max(samples),
+            ..Errors::default()
+        };
+        match (self.steady, steady) {
+            (
+                SteadyRef::Cycle {
+                    period: p0,
+                    omega_l_max: w0,
+                },
+                Some(SteadyRef::Cycle {
+                    period,
+                    omega_l_max,
+                }),
+            ) => {
+                let (dp, dw) = ((period - p0).abs(), (omega_l_max - w0).abs());
+                e.period = Some(dp);
+                e.omega_l_max = Some(dw);
+                e.period_rel = Some(dp / p0);
+                e.omega_l_max_rel = Some(dw / w0.abs());
+                e.steady_rel = Some((dp / p0).max(dw / w0.abs()));
+            }
+            (
+                SteadyRef::Equilibrium {
+                    alpha: a0,
+                    omega_u: u0,
+                    omega_l: l0,
+                },
+                Some(SteadyRef::Equilibrium {
+                    alpha,
+                    omega_u,
+                    omega_l,
+                }),
+            ) => {
+                let rel = |x: f64, r: f64| (x - r).abs() / r.abs().max(EQUILIBRIUM_SCALE_FLOOR);
+                e.steady_rel = Some(rel(alpha, a0).max(rel(omega_u, u0)).max(rel(omega_l, l0)));
+            }
+            _ => {}
         }
+        e
     }
 
     /// Max |ω_l − ω_l,ref| over the window; `None` unless the samples are exactly the
@@ -192,7 +254,8 @@ pub struct Errors {
     pub period_rel: Option<f64>,
     /// |Δ max ω_l|/max ω_l,ref.
     pub omega_l_max_rel: Option<f64>,
-    /// max(|ΔT|/T_ref, |Δ max ω_l|/max ω_l,ref): the steady-state error.
+    /// The steady-state error: max(|ΔT|/T_ref, |Δ max ω_l|/max ω_l,ref) on a cycle; on an
+    /// equilibrium the largest |Δx|/max(|x_ref|, 1e-3) of α, ω_u, ω_l.
     pub steady_rel: Option<f64>,
     /// max |ω_l − ω_l,ref| over the transient window (rad/s).
     pub transient_max: Option<f64>,
@@ -211,7 +274,7 @@ pub fn run_point(
     let s = solver(kind);
     let (tr, timing) = timed(repeats, budget, || s.simulate(model, scene))?;
     let errors = refd.errors(
-        cycle_metrics(tr.metrics.as_ref()),
+        SteadyRef::of(tr.metrics.as_ref()),
         &window(&tr, transient, refd.dt),
     );
     Ok((tr, timing, errors))
@@ -280,13 +343,21 @@ mod tests {
     #[test]
     fn errors_need_the_reference_grid() {
         let r = RefData {
-            period: 2.0,
-            omega_l_max: 4.0,
+            steady: SteadyRef::Cycle {
+                period: 2.0,
+                omega_l_max: 4.0,
+            },
             dt: 0.5,
             k0: 0,
             omega_l: vec![0.0, 1.0, 2.0],
         };
-        let e = r.errors(Some((2.1, 3.0)), &[(0.0, 0.0), (0.5, 1.5), (1.0, 2.0)]);
+        let cyc = |period, omega_l_max| {
+            Some(SteadyRef::Cycle {
+                period,
+                omega_l_max,
+            })
+        };
+        let e = r.errors(cyc(2.1, 3.0), &[(0.0, 0.0), (0.5, 1.5), (1.0, 2.0)]);
         assert!((e.period.unwrap() - 0.1).abs() < 1e-12);
         assert_eq!(e.omega_l_max, Some(1.0));
         assert_eq!(e.steady_rel, Some(0.25));
@@ -295,5 +366,35 @@ mod tests {
         let e = r.errors(None, &[(0.5, 0.0), (1.0, 1.0), (1.5, 2.0)]);
         assert_eq!((e.transient_max, e.steady_rel), (None, None));
         assert_eq!(r.errors(None, &[(0.0, 0.0)]).transient_max, None);
+    }
+
+    /// An equilibrium's error is the largest relative one of its coordinates, a zero velocity
+    /// (a stuck disc) compared against the 1e-3 floor; a cycle against it has none.
+    #[test]
+    fn equilibrium_errors_are_relative_with_a_floor() {
+        let r = RefData {
+            steady: SteadyRef::Equilibrium {
+                alpha: 2.0,
+                omega_u: 0.0,
+                omega_l: 0.0,
+            },
+            dt: 0.5,
+            k0: 0,
+            omega_l: vec![0.0],
+        };
+        let eq = SteadyRef::Equilibrium {
+            alpha: 2.002,
+            omega_u: 1e-5,
+            omega_l: 0.0,
+        };
+        let e = r.errors(Some(eq), &[(0.0, 0.0)]);
+        // alpha: 0.002 / 2 = 1e-3; omega_u: 1e-5 / 1e-3 (the floor) = 1e-2.
+        assert!((e.steady_rel.unwrap() - 1e-2).abs() < 1e-12, "{e:?}");
+        assert_eq!((e.period, e.omega_l_max), (None, None));
+        let cycle = SteadyRef::Cycle {
+            period: 4.0,
+            omega_l_max: 1.0,
+        };
+        assert_eq!(r.errors(Some(cycle), &[(0.0, 0.0)]).steady_rel, None);
     }
 }

@@ -78,6 +78,7 @@ pub(crate) fn shard_info(opts: &BenchOptions, s: Shard) -> ShardInfo {
             "peers": {
                 "scipy": opts.peers.scipy,
                 "scipy_tols": opts.peers.scipy_tols,
+                "scipy_method_tols": opts.peers.scipy_method_tols,
                 "siconos": opts.peers.siconos,
                 "siconos_hs": opts.peers.siconos_hs,
                 "octave": opts.peers.octave,
@@ -194,7 +195,7 @@ pub fn merge(shards: &[(String, BenchReport)]) -> Result<BenchReport, BenchError
     let clients = (0..client_names.len())
         .map(|c| join_client(&parts, c, total))
         .collect::<Vec<_>>();
-    let profile = crate::profile::profile(&scenes, &clients);
+    let (profile, profile_table1) = crate::profile::by_tier(&scenes, &clients);
     let envs: Vec<&Environment> = parts.iter().map(|(_, r)| &r.environment).collect();
     let max_load = |pick: fn(&Environment) -> Option<[f64; 3]>| {
         envs.iter().filter_map(|e| pick(e)).reduce(|a, b| {
@@ -222,6 +223,7 @@ pub fn merge(shards: &[(String, BenchReport)]) -> Result<BenchReport, BenchError
         output_levels: parts[0].1.output_levels.clone(),
         clients,
         profile,
+        profile_table1,
         environment,
         shard: None,
     })

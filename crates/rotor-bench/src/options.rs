@@ -5,6 +5,54 @@ use std::path::{Path, PathBuf};
 use rotor_solvers::SOLVERS;
 pub use rotor_solvers::SolverKind;
 
+/// A scene's tier: which solvers it is for.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Tier {
+    /// Only the lower disc has static friction (one switching surface): what a solver written
+    /// for Table 1 handles.
+    Table1,
+    /// The upper disc sticks too (two frictional contacts).
+    Full,
+}
+
+impl Tier {
+    /// `table1` or `full`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Tier::Table1 => "table1",
+            Tier::Full => "full",
+        }
+    }
+
+    /// A tier by its name (`--tier`).
+    pub fn parse(s: &str) -> Result<Tier, String> {
+        match s {
+            "table1" => Ok(Tier::Table1),
+            "full" => Ok(Tier::Full),
+            _ => Err(format!("--tier {s:?}: expected table1 or full")),
+        }
+    }
+
+    /// The tier of a scenario: `full` when its upper disc's friction is set-valued.
+    pub fn of(sc: &rotor_model::Scenario) -> Tier {
+        if sc.model.friction(rotor_model::Disc::Upper).is_set_valued() {
+            Tier::Full
+        } else {
+            Tier::Table1
+        }
+    }
+
+    /// Whether a scene of tier `scene` belongs to this tier: the full tier holds every scene,
+    /// the table1 tier its own.
+    pub fn holds(self, scene: Tier) -> bool {
+        self == Tier::Full || scene == Tier::Table1
+    }
+}
+
+/// The scenes that lead the suite, in this order (the first is the output levels' scene):
+/// the two stick-slip cycles at 1.5 V. The other scenes follow, table1 tier first, by name.
+pub const LEAD_SCENES: [&str; 2] = ["t1-u1.5-rest", "st-u1.5-rest"];
+
 /// One benchmark scene: a scenario file, a horizon, and the windows the errors are read on.
 #[derive(Debug, Clone, PartialEq)]
 pub struct SceneSpec {
@@ -65,6 +113,59 @@ impl SceneSpec {
     }
 }
 
+/// The whole suite: every scenario of `dir` (`fixtures/scenarios`) as it stands
+/// ([`SceneSpec::from_scenario`]), with its tier; [`LEAD_SCENES`] first, then the table1 tier,
+/// then the full tier, each by name. `tier` keeps the scenes that tier holds.
+pub fn suite(dir: &Path, tier: Option<Tier>) -> Result<Vec<SceneSpec>, crate::BenchError> {
+    let files = rotor_model::Scenario::list_dir(dir).map_err(|e| {
+        crate::BenchError::Options(format!("{}: cannot list the scenarios: {e}", dir.display()))
+    })?;
+    let mut scenes = Vec::new();
+    for f in files {
+        let sc = rotor_solvers::load_scenario(&f)?;
+        let t = Tier::of(&sc);
+        if tier.is_none_or(|want| want.holds(t)) {
+            let lead = LEAD_SCENES.iter().position(|n| *n == sc.name);
+            scenes.push((
+                (lead.unwrap_or(LEAD_SCENES.len()), t == Tier::Full, sc.name),
+                f,
+            ));
+        }
+    }
+    scenes.sort();
+    scenes
+        .into_iter()
+        .map(|(_, f)| SceneSpec::from_scenario(&f))
+        .collect()
+}
+
+/// The named scenario files as scenes (in the order given), keeping those `tier` holds; an
+/// error names the tier when none is left.
+pub fn select(paths: &[PathBuf], tier: Option<Tier>) -> Result<Vec<SceneSpec>, crate::BenchError> {
+    let mut scenes = Vec::new();
+    for p in paths {
+        let t = Tier::of(&rotor_solvers::load_scenario(p)?);
+        if tier.is_none_or(|want| want.holds(t)) {
+            scenes.push(SceneSpec::from_scenario(p)?);
+        }
+    }
+    if scenes.is_empty()
+        && let Some(t) = tier
+    {
+        return Err(crate::BenchError::Options(format!(
+            "--tier {}: none of the named scenes is in that tier",
+            t.name()
+        )));
+    }
+    Ok(scenes)
+}
+
+/// The suite's scenario directory: `fixtures/scenarios` of the workspace root
+/// ([`workspace_root`]).
+pub fn suite_dir() -> PathBuf {
+    workspace_root().join("fixtures/scenarios")
+}
+
 /// Which peers to run next to the Rust solvers, and how.
 #[derive(Debug, Clone, PartialEq)]
 pub struct PeerOptions {
@@ -87,6 +188,10 @@ pub struct PeerOptions {
     pub octave_cli: String,
     /// RelTol = AbsTol ladder of the Octave peer.
     pub octave_tols: Vec<f64>,
+    /// rtol = atol ladder of the scipy peer's implicit and switching methods (peers
+    /// `scipy-radau`, `scipy-bdf`, `scipy-lsoda`: `scipy_rotor.py --method M`), run with
+    /// `scipy`; empty: not run.
+    pub scipy_method_tols: Vec<f64>,
     /// Directory holding the peer scripts.
     pub dir: PathBuf,
 }
@@ -140,40 +245,52 @@ pub fn workspace_root() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
 }
 
-fn decades(from: i32, to: i32) -> Vec<f64> {
-    (from..=to).map(|e| 10f64.powi(-e)).collect()
-}
-
 impl Default for BenchOptions {
-    /// The full benchmark: Table 1 and the Stribeck set at 1.5 V from rest over 100 s; every
-    /// solver over its own ladder (`SolverInfo::ladder`: event and switch at tol 1e-3 …
-    /// 1e-12, Moreau–Jean at h = 1e-2 … 1e-5), reference = event at tol 1e-13, median of up
-    /// to 15 runs within 3 s per point, peers on (first scene). The tolerance ladders start at
+    /// The whole suite ([`suite`]: every scenario of `fixtures/scenarios`, its own horizon,
+    /// windows and grid; both tiers), with short ladders for the peers and clients (the whole
+    /// run with every peer still takes about half an hour on two cores, BENCHMARK.md; most
+    /// of it Radau and BDF at 1e-10 and Siconos at 2e-3): event and switch at tol 1e-3 … 1e-12, Moreau–Jean at h = 1e-2 …
+    /// 1e-4 (1-2-5), reference = event at tol 1e-13, median of up to 15 runs within 0.3 s per
+    /// point (a run longer than that is timed once); the scipy peer at rtol = atol = 1e-4,
+    /// 1e-7, 1e-10 (DOP853) and 1e-6, 1e-10 (Radau, BDF, LSODA), Siconos at h = 1e-2 and
+    /// 2e-3, external clients at tol 1e-4, 1e-6, 1e-8, 1e-10 (four, so that a client ignoring
+    /// its tolerance is told) or h = 1e-2, 1e-3, 1e-4. The Rust tolerance ladders start at
     /// 1e-3 so that the event solver has a point less accurate than scipy's loosest (tol
-    /// 1e-4): the ratio there is then measured, not only bounded.
+    /// 1e-4): the ratio there is then measured, not only bounded. (A scenario directory that
+    /// cannot be read leaves the scene list empty: [`crate::run`] then says "no scene".)
     fn default() -> Self {
         let root = workspace_root();
         BenchOptions {
-            scenes: vec![
-                SceneSpec::table1_u15(&root, 100.0),
-                SceneSpec::stribeck_u15(&root, 100.0),
-            ],
+            scenes: suite(&suite_dir(), None).unwrap_or_default(),
             ladders: SOLVERS
                 .iter()
-                .map(|k| (*k, k.info().ladder.to_vec()))
+                .map(|k| {
+                    // Moreau–Jean's h = 1e-5 (seconds a run on a 200 s scene) is left to
+                    // `rotor bench --scenario` runs with a ladder of their own.
+                    let fixed = k.is_fixed_step();
+                    let l = k
+                        .info()
+                        .ladder
+                        .iter()
+                        .copied()
+                        .filter(|&x| !fixed || x >= 1e-4);
+                    (*k, l.collect())
+                })
                 .collect(),
             reference_tol: 1e-13,
             reference_check_tol: 1e-14,
             repeats: 15,
-            time_budget: 3.0,
+            time_budget: 0.3,
             output_levels: true,
             peers: PeerOptions {
                 scipy: true,
                 python: "python3".into(),
-                scipy_tols: decades(4, 12),
+                scipy_tols: vec![1e-4, 1e-7, 1e-10],
+                scipy_method_tols: vec![1e-6, 1e-10],
                 siconos: true,
                 siconos_python: "/usr/bin/python3".into(),
-                siconos_hs: vec![1e-2, 1e-3],
+                // Each divides the 0.01 s grid; h = 1e-3 takes 7 s a run on a 200 s scene.
+                siconos_hs: vec![1e-2, 2e-3],
                 octave: true,
                 octave_cli: "octave-cli".into(),
                 // Its run time is mostly Octave's own per output sample (its event function
@@ -187,10 +304,9 @@ impl Default for BenchOptions {
             },
             clients: Vec::new(),
             timeout: 60.0,
-            client_tols: decades(3, 12),
-            // Steps that divide the 0.01 s output grid (every sample falls on a step end), in
-            // the 1-2-5 sequence.
-            client_hs: vec![1e-2, 5e-3, 2e-3, 1e-3, 5e-4, 2e-4, 1e-4],
+            client_tols: vec![1e-4, 1e-6, 1e-8, 1e-10],
+            // Steps that divide the 0.01 s output grid (every sample falls on a step end).
+            client_hs: vec![1e-2, 1e-3, 1e-4],
             shard: None,
             keep: None,
         }
@@ -199,7 +315,7 @@ impl Default for BenchOptions {
 
 impl BenchOptions {
     /// A few-second variant for tests: 30 s horizon, three points per ladder, reference at
-    /// tol 1e-12, median of 3, no peers.
+    /// tol 1e-12, median of 3 within 0.5 s, no peers.
     pub fn quick() -> Self {
         let root = workspace_root();
         let full = BenchOptions::default();
@@ -220,6 +336,7 @@ impl BenchOptions {
                 siconos: false,
                 octave: false,
                 scipy_tols: vec![1e-4, 1e-6, 1e-8],
+                scipy_method_tols: Vec::new(),
                 ..full.peers.clone()
             },
             client_tols: vec![1e-4, 1e-6, 1e-8],
@@ -241,6 +358,70 @@ impl BenchOptions {
         match self.ladders.iter_mut().find(|(k, _)| *k == kind) {
             Some(l) => l.1 = settings,
             None => self.ladders.push((kind, settings)),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The suite is every scenario file, the two 1.5 V cycles first, then the table1 tier,
+    /// then the full tier's own; the table1 tier is the `t1-*` scenes (Table 1 has no upper
+    /// static friction), the full tier every scene.
+    #[test]
+    fn the_suite_leads_with_the_cycles_and_splits_into_tiers() {
+        let dir = suite_dir();
+        let n = rotor_model::Scenario::list_dir(&dir).unwrap().len();
+        let name = |s: &SceneSpec| s.scenario.file_stem().unwrap().to_str().unwrap().to_owned();
+        let all: Vec<String> = suite(&dir, None).unwrap().iter().map(name).collect();
+        assert_eq!(all.len(), n);
+        assert_eq!(all[..2], LEAD_SCENES.map(str::to_owned));
+        let first_full = all
+            .iter()
+            .position(|s| s.starts_with("st-") && s != "st-u1.5-rest");
+        assert!(
+            all[2..first_full.unwrap()]
+                .iter()
+                .all(|s| s.starts_with("t1-")),
+            "{all:?}"
+        );
+        let t1: Vec<String> = suite(&dir, Some(Tier::Table1))
+            .unwrap()
+            .iter()
+            .map(name)
+            .collect();
+        assert!(t1.iter().all(|s| s.starts_with("t1-")), "{t1:?}");
+        assert_eq!(
+            t1.len(),
+            all.iter().filter(|s| s.starts_with("t1-")).count()
+        );
+        assert_eq!(suite(&dir, Some(Tier::Full)).unwrap().len(), n);
+        // A named selection keeps its order and drops what the tier does not hold.
+        let named = [dir.join("st-u2.5-rest.toml"), dir.join("t1-u0.5-rest.toml")];
+        let s = select(&named, Some(Tier::Table1)).unwrap();
+        assert_eq!(s.iter().map(name).collect::<Vec<_>>(), ["t1-u0.5-rest"]);
+        assert_eq!(select(&named, None).unwrap().len(), 2);
+        let e = select(&named[..1], Some(Tier::Table1))
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("--tier table1"), "{e}");
+        assert!(Tier::parse("both").unwrap_err().contains("\"both\""));
+    }
+
+    /// The suite's ladders: the tolerance solvers keep their whole ladder (down to 1e-12),
+    /// Moreau–Jean stops at h = 1e-4.
+    #[test]
+    fn the_suite_keeps_the_tolerance_ladders_whole() {
+        let o = BenchOptions::default();
+        for k in SOLVERS {
+            let want: Vec<f64> = k.info().ladder.to_vec();
+            if k.is_fixed_step() {
+                assert_eq!(o.ladder(k).last(), Some(&1e-4));
+            } else {
+                assert_eq!(o.ladder(k), want.as_slice(), "{}", k.name());
+                assert_eq!(o.ladder(k).last(), Some(&1e-12));
+            }
         }
     }
 }

@@ -1,8 +1,9 @@
 //! The repository's own peers, bench/peers/scipy_rotor.py (scipy `solve_ivp`, DOP853 with
-//! event functions), bench/peers/siconos_rotor.py (Siconos `MoreauJeanOSI`) and
-//! bench/peers/octave_rotor.m (GNU Octave's `ode45` with event functions, restarted at every
-//! mode switch): clients of the same job-file protocol as any external solver, run when
-//! their interpreter imports the library (Octave: when it has `ode45` and `jsondecode`).
+//! event functions; also as `scipy-radau`, `scipy-bdf`, `scipy-lsoda` with `--method`),
+//! bench/peers/siconos_rotor.py (Siconos `MoreauJeanOSI`) and bench/peers/octave_rotor.m
+//! (GNU Octave's `ode45` with event functions, restarted at every mode switch): clients of
+//! the same job-file protocol as any external solver, run when their interpreter imports
+//! the library (Octave: when it has `ode45` and `jsondecode`).
 
 use std::process::Command;
 
@@ -75,6 +76,33 @@ pub(crate) fn peers(opts: &BenchOptions, progress: &mut impl FnMut(&str)) -> Vec
             &p.scipy_tols,
         ),
         (
+            "scipy-radau",
+            p.scipy && !p.scipy_method_tols.is_empty(),
+            &p.python,
+            "scipy",
+            "scipy_rotor.py --method Radau",
+            false,
+            &p.scipy_method_tols,
+        ),
+        (
+            "scipy-bdf",
+            p.scipy && !p.scipy_method_tols.is_empty(),
+            &p.python,
+            "scipy",
+            "scipy_rotor.py --method BDF",
+            false,
+            &p.scipy_method_tols,
+        ),
+        (
+            "scipy-lsoda",
+            p.scipy && !p.scipy_method_tols.is_empty(),
+            &p.python,
+            "scipy",
+            "scipy_rotor.py --method LSODA",
+            false,
+            &p.scipy_method_tols,
+        ),
+        (
             "siconos",
             p.siconos,
             &p.siconos_python,
@@ -87,9 +115,14 @@ pub(crate) fn peers(opts: &BenchOptions, progress: &mut impl FnMut(&str)) -> Vec
     let mut launches: Vec<PeerLaunch> = specs
         .into_iter()
         .map(|(name, on, python, module, script, fixed_step, ladder)| {
+            // The script, then its own arguments (`--method M`).
+            let mut words = script.split(' ');
+            let script = words.next().unwrap_or_default();
+            let mut argv = vec![python.clone(), p.dir.join(script).display().to_string()];
+            argv.extend(words.map(str::to_owned));
             let spec = ClientSpec {
                 name: name.into(),
-                argv: vec![python.clone(), p.dir.join(script).display().to_string()],
+                argv,
                 fixed_step,
                 peer: true,
             };

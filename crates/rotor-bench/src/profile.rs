@@ -27,6 +27,9 @@ pub struct ProfileEntry {
 /// The performance profile.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Profile {
+    /// The tier whose scenes it is over (`full`: every scene of the run; `table1`).
+    #[serde(default)]
+    pub tier: String,
     #[serde(deserialize_with = "crate::word::static_str")]
     pub criterion: crate::word::Word,
     pub scenes: Vec<String>,
@@ -78,7 +81,12 @@ impl Profile {
             .collect();
         let mut panel = Panel::new(
             format!(
-                "Performance profile over {} scene(s): solved = passes the loose gate",
+                "Performance profile, tier {}, over {} scene(s): solved = passes the loose gate",
+                if self.tier.is_empty() {
+                    "full"
+                } else {
+                    &self.tier
+                },
                 self.scenes.len()
             ),
             "tau (time / best time on the scene)",
@@ -88,6 +96,25 @@ impl Profile {
         panel.x_log = true;
         panel
     }
+}
+
+/// The profiles per tier: over every scene (the full tier), and over the table1-tier scenes
+/// alone when the scenes are of both tiers.
+pub fn by_tier(scenes: &[SceneReport], clients: &[ClientReport]) -> (Profile, Option<Profile>) {
+    let full = Profile {
+        tier: "full".into(),
+        ..profile(scenes, clients)
+    };
+    let t1: Vec<SceneReport> = scenes
+        .iter()
+        .filter(|s| s.tier == "table1")
+        .cloned()
+        .collect();
+    let table1 = (!t1.is_empty() && t1.len() < scenes.len()).then(|| Profile {
+        tier: "table1".into(),
+        ..profile(&t1, clients)
+    });
+    (full, table1)
 }
 
 /// The profile of the solvers and clients over the scenes.
@@ -129,6 +156,7 @@ pub fn profile(scenes: &[SceneReport], clients: &[ClientReport]) -> Profile {
         .map(|k| entries.iter().filter_map(|(_, t)| t[k]).reduce(f64::min))
         .collect();
     Profile {
+        tier: String::new(),
         criterion: CRITERION,
         scenes: scenes.iter().map(|s| s.name.clone()).collect(),
         entries: entries

@@ -107,8 +107,10 @@ impl BenchReport {
         for p in &self.clients {
             client_table(&mut s, p);
         }
-        if !self.profile.entries.is_empty() {
-            profile_table(&mut s, &self.profile);
+        for prof in std::iter::once(&self.profile).chain(&self.profile_table1) {
+            if !prof.entries.is_empty() {
+                profile_table(&mut s, prof);
+            }
         }
         self.environment_lines(&mut s);
         s
@@ -289,6 +291,9 @@ impl BenchReport {
         }
         if self.profile.entries.len() > 1 {
             panels.push(self.profile.panel());
+            if let Some(t1) = &self.profile_table1 {
+                panels.push(t1.panel());
+            }
         }
         Ok(render(&panels, 760.0, 420.0))
     }
@@ -332,13 +337,17 @@ fn scene_table(s: &mut String, sc: &SceneReport) {
         sc.transient[1],
         sc.dt
     );
+    let steady = match (r.period, r.omega_l_max) {
+        (Some(p), Some(w)) => format!("period {p:.12} s, max omega_l {w:.12} rad/s"),
+        (_, w) => format!(
+            "equilibrium, omega_l {} rad/s",
+            w.map_or("?".into(), |w| format!("{w:.12}"))
+        ),
+    };
     let _ = writeln!(
         s,
-        "reference: event tol {:e}: period {:.12} s, max omega_l {:.12} rad/s ({} \
-             steps, {} ms)",
+        "reference: event tol {:e}: {steady} ({} steps, {} ms)",
         r.tol,
-        r.period,
-        r.omega_l_max,
         r.stats.steps,
         ms(r.seconds)
     );
@@ -483,18 +492,24 @@ fn output_levels_table(s: &mut String, levels: &[OutputLevel]) {
 fn profile_table(s: &mut String, profile: &Profile) {
     let _ = writeln!(
         s,
-        "performance profile over {} scene(s) (solved: {}); time / best time per scene:",
+        "performance profile, tier {}, over {} scene(s) (solved: {}); time / best time \
+         per scene:",
+        if profile.tier.is_empty() {
+            "full"
+        } else {
+            &profile.tier
+        },
         profile.scenes.len(),
         profile.criterion
     );
-    let _ = writeln!(s, "{:<10} {}", "", profile.scenes.join("  "));
+    let _ = writeln!(s, "{:<12} {}", "", profile.scenes.join("  "));
     for en in &profile.entries {
         let cells: Vec<String> = en
             .ratios
             .iter()
             .map(|r| r.map_or("unsolved".into(), |r| format!("{r:.2}")))
             .collect();
-        let _ = writeln!(s, "{:<10} {}", en.name, cells.join("  "));
+        let _ = writeln!(s, "{:<12} {}", en.name, cells.join("  "));
     }
     let _ = writeln!(s);
 }

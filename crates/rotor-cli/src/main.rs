@@ -107,10 +107,19 @@ impl Command {
             Scenarios(a) => (None, a.json.as_ref(), None),
             Steady(_) | Compare(_) | Reference(_) | Job(_) => (None, None, None),
         };
-        [("--csv", csv), ("--json", json), ("--svg", svg)]
-            .into_iter()
-            .filter_map(|(flag, p)| Some((flag, p?.as_path())))
-            .collect()
+        let results = match self {
+            Bench(a) => a.results.as_ref(),
+            _ => None,
+        };
+        [
+            ("--csv", csv),
+            ("--json", json),
+            ("--svg", svg),
+            ("--results", results),
+        ]
+        .into_iter()
+        .filter_map(|(flag, p)| Some((flag, p?.as_path())))
+        .collect()
     }
 }
 

@@ -143,7 +143,7 @@ fn scene_of(sc: &Scenario, output: Output) -> Scene {
 #[test]
 fn every_fixture_runs_to_t_end() {
     let files = fixtures();
-    assert_eq!(files.len(), 14);
+    assert_eq!(files.len(), 21);
     let s = SwitchSolver::default();
     // The fixtures the name-matched checks below are written for; each must be met.
     let mut checked = Vec::new();
@@ -247,6 +247,7 @@ fn every_fixture_runs_to_t_end() {
             "st-u0.05-rest",
             "st-u1.5-rest",
             "st-u2.5-rest",
+            "st-u3.85-rest",
             "st-u4.5-rest",
             "t1-u0.02-rest"
         ],

@@ -4,7 +4,7 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result, anyhow, bail};
 
-use crate::common::{check, fixture_path, say};
+use crate::common::{check, fixture_path, fixtures_dir, say};
 
 #[derive(clap::Args, Debug)]
 pub struct Args {
@@ -35,9 +35,17 @@ pub struct Args {
     #[arg(long, default_value_t = 60.0, allow_hyphen_values = true)]
     pub timeout: f64,
     /// Benchmark these scenarios (files, or names in fixtures/scenarios; their horizon,
-    /// windows and grid) instead of the default scenes. Repeatable.
+    /// windows and grid) instead of the whole suite. Repeatable.
     #[arg(long = "scenario", value_name = "SCENARIO.toml")]
     pub scenario: Vec<PathBuf>,
+    /// Only the scenes of this tier: table1 (only the lower disc sticks) or full (every
+    /// scene).
+    #[arg(long, value_name = "TIER")]
+    pub tier: Option<String>,
+    /// Also write the published-results page (Markdown: digits per setting, cheapest
+    /// setting per level, profiles per tier; reports/bench/results.md).
+    #[arg(long, value_name = "FILE.md")]
+    pub results: Option<PathBuf>,
     /// Run only every N-th scene from the I-th (I from 1), for job arrays; the report
     /// records the shard, and `--merge` joins the shards' reports.
     #[arg(long, value_name = "I/N")]
@@ -52,7 +60,7 @@ pub struct Args {
         long,
         value_name = "SHARD.json",
         num_args = 1..,
-        conflicts_with_all = ["shard", "quick", "no_peers", "external", "fixed_step", "scenario", "keep"]
+        conflicts_with_all = ["shard", "quick", "no_peers", "external", "fixed_step", "scenario", "keep", "tier"]
     )]
     pub merge: Vec<PathBuf>,
 }
@@ -60,7 +68,7 @@ pub struct Args {
 pub fn run(a: &Args) -> Result<()> {
     let outputs = [a.json.as_deref(), a.svg.as_deref(), a.csv.as_deref()];
     if !a.merge.is_empty() {
-        return super::bench_merge::bench_merge(&a.merge, outputs);
+        return super::bench_merge::bench_merge(&a.merge, outputs, a.results.as_deref());
     }
     bench(
         outputs,
@@ -73,6 +81,8 @@ pub fn run(a: &Args) -> Result<()> {
             scenarios: &a.scenario,
             shard: a.shard.as_deref(),
             keep: a.keep.as_deref(),
+            tier: a.tier.as_deref(),
+            results: a.results.as_deref(),
         },
     )
 }
@@ -85,6 +95,8 @@ pub(crate) struct BenchClients<'a> {
     scenarios: &'a [PathBuf],
     shard: Option<&'a str>,
     keep: Option<&'a Path>,
+    tier: Option<&'a str>,
+    results: Option<&'a Path>,
 }
 
 pub(crate) fn bench(
@@ -119,15 +131,20 @@ pub(crate) fn bench(
             bail!("--fixed-step {name:?}: no --external client of that name");
         }
     }
+    let tier = clients
+        .tier
+        .map(rotor_bench::Tier::parse)
+        .transpose()
+        .map_err(|m| anyhow!(m))?;
     if !clients.scenarios.is_empty() {
-        opts.scenes = clients
+        let paths = clients
             .scenarios
             .iter()
-            .map(|p| {
-                let p = fixture_path("--scenario", p, "scenarios")?;
-                Ok(rotor_bench::SceneSpec::from_scenario(&p)?)
-            })
-            .collect::<Result<_>>()?;
+            .map(|p| fixture_path("--scenario", p, "scenarios"))
+            .collect::<Result<Vec<_>>>()?;
+        opts.scenes = rotor_bench::select(&paths, tier)?;
+    } else if !quick {
+        opts.scenes = rotor_bench::suite(&fixtures_dir()?.join("scenarios"), tier)?;
     }
     opts.shard = clients
         .shard
@@ -136,6 +153,7 @@ pub(crate) fn bench(
     opts.keep = clients.keep.map(Path::to_path_buf);
     let report = rotor_bench::run(&opts, |m| eprintln!("{m}"))?;
     write_bench(&report, [json, svg, csv])?;
+    write_results(&report, clients.results)?;
     // The report is written first (nothing is lost); then a named client that placed no
     // point on any scene fails the command, by name (a peer that is not installed does not).
     let unsolved: Vec<String> = report
@@ -179,6 +197,18 @@ pub(crate) fn write_bench(
             write_output(path, text.as_bytes())
                 .with_context(|| format!("{}: cannot write", path.display()))?;
         }
+    }
+    Ok(())
+}
+
+/// `--results FILE`: the published-results page.
+pub(crate) fn write_results(report: &rotor_bench::BenchReport, path: Option<&Path>) -> Result<()> {
+    if let Some(path) = path {
+        // The command that wrote it, as given (`just bench` runs the whole suite's).
+        let args: Vec<String> = std::env::args().skip(1).collect();
+        let command = format!("rotor {}", args.join(" "));
+        rotor_compare::report::write_output(path, report.to_results_md(&command)?.as_bytes())
+            .with_context(|| format!("--results {}: cannot write", path.display()))?;
     }
     Ok(())
 }

@@ -7,7 +7,11 @@ use anyhow::{Context, Result};
 use super::bench::write_bench;
 
 /// `rotor bench --merge`: the shards' reports joined into one.
-pub(crate) fn bench_merge(shards: &[PathBuf], outputs: [Option<&Path>; 3]) -> Result<()> {
+pub(crate) fn bench_merge(
+    shards: &[PathBuf],
+    outputs: [Option<&Path>; 3],
+    results: Option<&Path>,
+) -> Result<()> {
     let reports = shards
         .iter()
         .map(|p| {
@@ -23,5 +27,6 @@ pub(crate) fn bench_merge(shards: &[PathBuf], outputs: [Option<&Path>; 3]) -> Re
         })
         .collect::<Result<Vec<_>>>()?;
     let report = rotor_bench::merge(&reports)?;
-    write_bench(&report, outputs)
+    write_bench(&report, outputs)?;
+    super::bench::write_results(&report, results)
 }
