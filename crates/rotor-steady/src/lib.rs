@@ -5,6 +5,7 @@
 pub mod by_solver;
 pub mod probes;
 mod settle;
+pub mod solver_points;
 mod steady;
 
 pub use settle::{SettleError, SettleOptions, Settled, Unsettled, settle};
