@@ -940,6 +940,25 @@ fn bifurcation_section(
     Ok((sec, out))
 }
 
+/// The report section with Figure 3 by the three methods (`rotor_steady::figure3`).
+fn figure3_section(
+    sets: &[(&str, &str, Params)],
+    diagrams: &[rotor_bifurcation::Diagram],
+) -> rotor_compare::report::Section {
+    let models: Vec<Model> = sets.iter().map(|(_, _, p)| Model::new(*p)).collect();
+    let s: Vec<_> = (sets.iter().zip(&models).zip(diagrams))
+        .map(|(((n, g, _), m), d)| (*n, *g, m, d))
+        .collect();
+    let r = rotor_steady::figure3::figure3_section(&s);
+    let (markdown, files, failures, timings) = (r.markdown, r.files, r.failures, r.timings);
+    rotor_compare::report::Section {
+        markdown,
+        files,
+        failures,
+        timings,
+    }
+}
+
 /// The report section with the two-parameter pictures: (k_θ, u) and (T_sl, u) for both
 /// parameter sets.
 fn plane_section(sets: &[(&str, &str, Params)]) -> Result<rotor_compare::report::Section> {
@@ -1190,12 +1209,16 @@ fn compare(files: &[PathBuf], report: &Path, main_job: bool, threads: Option<usi
                 let (bif, (stress, plane)) = rayon::join(
                     || {
                         let (sec, diagrams) = bifurcation_section(&sets)?;
-                        Ok::<_, anyhow::Error>((sec, probe_section(&sets, &diagrams)))
+                        let (probes, fig3) = rayon::join(
+                            || probe_section(&sets, &diagrams),
+                            || figure3_section(&sets, &diagrams),
+                        );
+                        Ok::<_, anyhow::Error>((sec, probes, fig3))
                     },
                     || rayon::join(stress_section, || plane_section(&sets)),
                 );
-                let (bif, probes) = bif?;
-                Ok(vec![bif, plane?, stress, probes])
+                let (bif, probes, fig3) = bif?;
+                Ok(vec![bif, fig3, plane?, stress, probes])
             } else {
                 Ok(Vec::new())
             }

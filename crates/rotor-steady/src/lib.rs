@@ -3,6 +3,7 @@
 //! bifurcation diagram's special points.
 
 pub mod by_solver;
+pub mod figure3;
 pub mod probes;
 mod settle;
 pub mod solver_points;

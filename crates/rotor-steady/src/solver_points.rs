@@ -253,7 +253,14 @@ fn grazing(
             &sc,
             Section::LowerMax,
             &z,
-            &shoot_opts(row.period),
+            // Finite-difference steps 1e-7·(1 + |z|) rather than 1e-6: a step must not make
+            // a cycle within 1e-5 rad/s of ω_l = 0 stick (the map is not smooth across
+            // that); the map's rounding (≈ tol 1e-10) over the step stays ≤ 1e-3 of the
+            // derivative.
+            &rotor_shoot::ShootOptions {
+                fd_rel: 1e-7,
+                ..shoot_opts(row.period)
+            },
         )
         .map_err(|e| format!("slipping cycle at u = {u}: {e}"))?;
         let r = row_of(solver, model, &sc, &o, row.branch)?;
@@ -271,26 +278,51 @@ fn grazing(
         .map(|p| (p.u - ug).abs())
         .filter(|d| *d > 1e-6)
         .fold(f64::INFINITY, f64::min);
-    let delta = 1e-4f64.min(0.05 * other);
-    let mut shots: Vec<(f64, PeriodicRow, Orbit)> = Vec::new();
-    for d in [4.0, 2.0, 1.0] {
-        let z0 = shots.last().map(|(_, _, o)| o.z.clone());
-        shots.push(shoot_row(ug + s * d * delta, z0.as_deref(), slips[0])?);
-    }
     let m = |sh: &[(f64, PeriodicRow, Orbit)]| -> Vec<(f64, f64)> {
         sh.iter().map(|(u, r, _)| (*u, r.omega_l_min)).collect()
     };
-    let r1 = quadratic_root(&m(&shots))?;
-    // One more shot, δ/8 beyond the root.
-    let d1 = delta;
-    let z_near = shots[2].2.z.clone();
-    shots.push(shoot_row(r1 + s * d1 / 8.0, Some(&z_near), slips[0])?);
-    let r2 = quadratic_root(&m(&shots[1..]))?;
-    if s * (shots[3].0 - r2) <= 0.0 {
-        return Err(format!(
-            "the root u = {r2} of min omega_l is not beyond the slipping cycles' side"
-        ));
+    let first = 1e-4f64.min(0.05 * other);
+    // Close to a non-smooth fold whose slipping cycle is strongly unstable (the Stribeck
+    // set's E, multiplier 4.65) the shots at 1e-4 V can fall onto the stick-slip cycle; δ
+    // then shrinks 10× per try, down to 1e-6 V (still far above the solvers' shifts of the
+    // point, ≤ 2e-7 V measured).
+    let mut last_err = String::new();
+    let mut done = None;
+    for delta in [first, first / 10.0, first / 100.0] {
+        let attempt = || -> Result<_, String> {
+            let mut shots: Vec<(f64, PeriodicRow, Orbit)> = Vec::new();
+            for d in [4.0, 2.0, 1.0] {
+                // The continuation row nearest in u: at a non-smooth fold the stick-slip
+                // cycle lies as close to the grazing orbit as the slipping one, so a start
+                // from the grazing orbit itself could reach either.
+                let u = ug + s * d * delta;
+                let row = slips
+                    .iter()
+                    .min_by(|a, b| (a.u - u).abs().total_cmp(&(b.u - u).abs()))
+                    .expect("not empty");
+                shots.push(shoot_row(u, None, row)?);
+            }
+            let r1 = quadratic_root(&m(&shots))?;
+            // One more shot, δ/8 beyond the root, from the nearest shot's fixed point.
+            let z_near = shots[2].2.z.clone();
+            shots.push(shoot_row(r1 + s * delta / 8.0, Some(&z_near), slips[0])?);
+            let r2 = quadratic_root(&m(&shots[1..]))?;
+            if s * (shots[3].0 - r2) <= 0.0 {
+                return Err(format!(
+                    "the root u = {r2} of min omega_l is not beyond the slipping cycles' side"
+                ));
+            }
+            Ok((r1, r2, shots))
+        };
+        match attempt() {
+            Ok(v) => {
+                done = Some(v);
+                break;
+            }
+            Err(e) => last_err = e,
+        }
     }
+    let (r1, r2, shots) = done.ok_or(last_err)?;
     let (_, slip_row, slip_orbit) = &shots[3];
     // The stick-slip side: the solver's stick-slip cycle at the nearest continuation row that
     // it sees sticking (a stick phase shorter than Moreau–Jean's step is not seen).
