@@ -7,7 +7,10 @@
 //!   `s` where the continuation has slipping cycles (δ = 1e-4 V, or 5 % of the distance to the
 //!   nearest other special point), reads `m(u) = min ω_l` off each orbit, and takes the root
 //!   of the quadratic through the three; one more shot at `δ/8` beyond that root and the
-//!   quadratic through the last three gives the point. `m(u)` is smooth on the slipping side,
+//!   quadratic through the last three gives the point. If a shot lands on the stick-slip
+//!   cycle, δ shrinks 10× (twice); last, the shots are taken at the u of three continuation
+//!   rows at least 1e-5 V away, each from its own row's state (the Stribeck set's E, whose
+//!   slipping cycle's multiplier 4.65 amplifies a start shifted in u). `m(u)` is smooth on the slipping side,
 //!   so the quadratic's error is `O(δ³)`; the residual is the change of the root between the
 //!   two fits \[V\].
 //! * **Type** (Feigin's rule, [`rotor_bifurcation::feigin`]): σ⁺ = the number of real
@@ -187,9 +190,13 @@ fn beside(event: &Diagram, u: f64) -> (Vec<&PeriodicRow>, Vec<&PeriodicRow>) {
             .min_by(|&a, &b| (rows[a].u - u).abs().total_cmp(&(rows[b].u - u).abs()));
         k.map(|k| {
             // Outward: the direction along the list in which the distance grows.
+            // A neighbour on another branch or of the other kind counts as no neighbour.
             let next = |d: isize| {
                 let j = k as isize + d;
-                (j >= 0 && (j as usize) < rows.len()).then(|| (rows[j as usize].u - u).abs())
+                (j >= 0 && (j as usize) < rows.len())
+                    .then(|| &rows[j as usize])
+                    .filter(|r| r.branch == rows[k].branch && r.stick_slip == ss)
+                    .map(|r| (r.u - u).abs())
             };
             let dir = if next(1).unwrap_or(-1.0) >= next(-1).unwrap_or(-1.0) {
                 1
@@ -265,7 +272,11 @@ fn grazing(
         .map_err(|e| format!("slipping cycle at u = {u}: {e}"))?;
         let r = row_of(solver, model, &sc, &o, row.branch)?;
         if r.stick_time > 0.0 {
-            return Err(format!("the cycle shot at u = {u} sticks"));
+            return Err(format!(
+                "the cycle shot at u = {u} sticks (stick time {:.3e} s, period {:.6} s, \
+                 multipliers {:?}, start row at u = {})",
+                r.stick_time, r.period, o.multipliers, row.u
+            ));
         }
         Ok::<_, String>((u, r, o))
     };
@@ -319,7 +330,48 @@ fn grazing(
                 done = Some(v);
                 break;
             }
-            Err(e) => last_err = e,
+            Err(e) => {
+                if !last_err.is_empty() {
+                    last_err.push_str("; ");
+                }
+                last_err += &format!("delta {delta:e}: {e}");
+            }
+        }
+    }
+    // Last: the shots at the u of three continuation rows themselves (at least 1e-5 V from the
+    // point, so that their min ω_l stays well above the finite-difference steps), each from its
+    // own row's state: no start is off by a change of u, which a strongly unstable cycle
+    // amplifies 4.65× per period (E).
+    if done.is_none() {
+        let rows: Vec<&PeriodicRow> = slips
+            .iter()
+            .copied()
+            .filter(|r| (r.u - ug).abs() >= 1e-5)
+            .take(3)
+            .collect();
+        let attempt = || -> Result<_, String> {
+            if rows.len() < 3 {
+                return Err("fewer than three slipping rows 1e-5 V or more from it".into());
+            }
+            let mut shots = Vec::new();
+            for row in rows.iter().rev() {
+                shots.push(shoot_row(row.u, None, row)?);
+            }
+            let r1 = quadratic_root(&m(&shots))?;
+            let d = (rows[0].u - ug).abs();
+            let z_near = shots[2].2.z.clone();
+            shots.push(shoot_row(r1 + s * d / 8.0, Some(&z_near), rows[0])?);
+            let r2 = quadratic_root(&m(&shots[1..]))?;
+            if s * (shots[3].0 - r2) <= 0.0 {
+                return Err(format!(
+                    "the root u = {r2} of min omega_l is not beyond the slipping cycles' side"
+                ));
+            }
+            Ok((r1, r2, shots))
+        };
+        match attempt() {
+            Ok(v) => done = Some(v),
+            Err(e) => last_err += &format!("; at the continuation's rows: {e}"),
         }
     }
     let (r1, r2, shots) = done.ok_or(last_err)?;

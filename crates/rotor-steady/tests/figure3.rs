@@ -22,11 +22,12 @@ fn every_gated_point_is_located_by_both_solvers_within_its_gate() {
         let sw = locate(&*SolverKind::SWITCH.solver(), &model, &event, &opts);
         let mo = locate(&*SolverKind::MOREAU.solver(), &model, &event, &opts);
         let labels = label_points(&event.points);
-        // Table 1: G1, G2, F1; Stribeck: G1 = D1 (E is not located yet, docs/methods.md).
+        // H1, H2 are shared; Table 1: G1, G2, F1 (smooth); Stribeck: G1 = D1 and G2 = E
+        // (discontinuous folds).
         let want: &[&str] = if name == "table1" {
             &["G1", "G2", "F1"]
         } else {
-            &["G1", "D1"]
+            &["G1", "D1", "G2", "E"]
         };
         for w in want {
             let (_, p) = labels.iter().find(|(l, _)| l == w).unwrap();
@@ -52,6 +53,6 @@ fn every_gated_point_is_located_by_both_solvers_within_its_gate() {
 #[test]
 fn the_gates_file_is_read_and_every_gate_is_positive() {
     let g = gates().unwrap();
-    assert_eq!(g.len(), 5);
+    assert_eq!(g.len(), 7);
     assert!(g.iter().all(|g| g.switch > 0.0 && g.moreau > 0.0));
 }
