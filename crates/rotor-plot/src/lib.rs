@@ -3,6 +3,8 @@
 
 use std::fmt::Write;
 
+pub mod overlay;
+
 /// One polyline with a label and a style. A non-finite point lifts the pen (a gap).
 pub struct Series<'a> {
     /// Legend text; an empty label keeps the series out of the legend.

@@ -508,8 +508,9 @@ fn sweep<'py>(
 /// ``periodic`` (the periodic branches with Floquet multipliers and extrema of omega_l) and
 /// ``points`` (Hopf, grazing and fold points, each with the residual of its defining
 /// condition). ``solver="switch"`` or ``"moreau"`` shoots every periodic orbit again on that
-/// solver's own return map (its own multipliers and stability); those diagrams do not locate
-/// grazing and folds yet (``not_located``), and name any orbit not found (``not_found``).
+/// solver's own return map (its own multipliers and stability) and locates the grazing
+/// orbits and folds again with that solver's own shooting; ``not_found`` names any orbit or
+/// special point it did not find, with the reason.
 #[pyfunction]
 #[pyo3(signature = (params=None, u_min=0.0, u_max=7.0, solver="event"))]
 fn bifurcation<'py>(

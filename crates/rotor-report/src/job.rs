@@ -6,7 +6,9 @@ use rotor_compare::report::Section;
 use rotor_model::{Params, Scenario};
 use rotor_solvers::ScenarioResult;
 
-use crate::{ReportError, bifurcation_section, plane_section, probe_section, stress_section};
+use crate::{
+    ReportError, bifurcation_section, figure3_section, plane_section, probe_section, stress_section,
+};
 
 /// A parameter set of the analysis sections: its name in the report, the slug of its files,
 /// and the parameters.
@@ -36,17 +38,21 @@ pub fn check_names(scenarios: &[Scenario]) -> Result<(), ReportError> {
 }
 
 /// The main job's analysis sections of `sets`, computed in parallel, in the report's order:
-/// bifurcation diagrams, two parameters, stress, probes.
+/// bifurcation diagrams, the diagrams by three methods, two parameters, stress, probes.
 pub fn sections(sets: &[ParamSet]) -> Result<Vec<Section>, ReportError> {
     let (bif, (stress, plane)) = rayon::join(
         || {
             let (sec, diagrams) = bifurcation_section(sets)?;
-            Ok::<_, ReportError>((sec, probe_section(sets, &diagrams)))
+            let (probes, fig3) = rayon::join(
+                || probe_section(sets, &diagrams),
+                || figure3_section(sets, &diagrams),
+            );
+            Ok::<_, ReportError>((sec, probes, fig3))
         },
         || rayon::join(stress_section, || plane_section(sets)),
     );
-    let (bif, probes) = bif?;
-    Ok(vec![bif, plane?, stress, probes])
+    let (bif, probes, fig3) = bif?;
+    Ok(vec![bif, fig3, plane?, stress, probes])
 }
 
 /// What [`run`] computed: each scenario's runs, in input order, and the sections.

@@ -1,7 +1,7 @@
 //! The main job's report (`cargo run --release`, and `rotor compare` without its sections):
 //! every scenario through every solver, gated and written by [`rotor_compare::report`], and
 //! for the main job the analysis sections beside them: the bifurcation diagrams
-//! ([`bifurcation`]), the two-parameter pictures ([`plane`]), the numerical stress cases
+//! ([`bifurcation`]), the same diagram by the three methods ([`figure3`]), the two-parameter pictures ([`plane`]), the numerical stress cases
 //! ([`stress`]) and the steady states probed next to the special points ([`probes`]).
 //!
 //! The front end loads the scenarios and shows the progress; [`run()`] computes, [`write()`]
@@ -10,6 +10,7 @@
 #![warn(missing_docs)]
 
 pub mod bifurcation;
+pub mod figure3;
 mod job;
 pub mod plane;
 pub mod probes;
@@ -18,6 +19,7 @@ pub mod stress;
 use std::path::PathBuf;
 
 pub use bifurcation::bifurcation_section;
+pub use figure3::figure3_section;
 pub use job::{Compared, ParamSet, check_names, param_sets, run, sections, write};
 pub use plane::plane_section;
 pub use probes::probe_section;

@@ -403,6 +403,143 @@ pub fn shoot(
     })
 }
 
+/// A periodic orbit found by [`shoot_with_u`]: the orbit and the input it is at.
+#[derive(Debug, Clone, PartialEq)]
+pub struct OrbitAtU {
+    /// The input u \[V\] solved for.
+    pub u: f64,
+    /// The orbit at that u; its multipliers are those of `DP` at fixed u.
+    pub orbit: Orbit,
+}
+
+/// Solves `A s = r` for n ≤ 2; `None` when singular.
+fn solve_small(a: &[Vec<f64>], r: &[f64]) -> Option<Vec<f64>> {
+    match a.len() {
+        1 => (a[0][0].abs() > 1e-300).then(|| vec![r[0] / a[0][0]]),
+        2 => {
+            let det = a[0][0] * a[1][1] - a[0][1] * a[1][0];
+            let size = a.iter().flatten().fold(0.0f64, |m, v| m.max(v.abs()));
+            (det.abs() > 1e-14 * size * size).then(|| {
+                vec![
+                    (a[1][1] * r[0] - a[0][1] * r[1]) / det,
+                    (a[0][0] * r[1] - a[1][0] * r[0]) / det,
+                ]
+            })
+        }
+        _ => None,
+    }
+}
+
+/// The periodic orbit through the section with section coordinate `fix` held at `z0[fix]`
+/// and the input u free: Newton on `F(z', u) = P(z; u) − z = 0` in the other coordinates `z'`
+/// and u, its Jacobian `[∂P/∂z' − I', ∂P/∂u]` by forward differences of the solver's own map
+/// (steps `fd_rel·(1 + |z|∞)` and `fd_rel·(1 + |u|)`), halving a step that does not reduce the
+/// residual; converged at `|F|∞ ≤ tol·(1 + |z|∞)`.
+///
+/// Where the branch turns back in u (a fold, `det(∂P/∂z − I) = 0`), [`shoot`] at fixed u is
+/// singular, but this system stays regular as long as the branch is not tangent to the
+/// hyperplane `z[fix] = const`: u as a function of `z[fix]` has its extremum at the fold.
+pub fn shoot_with_u(
+    solver: &dyn Solver,
+    model: &Model,
+    scene: &Scene,
+    section: Section,
+    z0: &[f64],
+    fix: usize,
+    opts: &ShootOptions,
+) -> Result<OrbitAtU, ShootError> {
+    let n = z0.len();
+    assert!(
+        fix < n,
+        "fix = {fix} is not a coordinate of a {n}-dimensional section"
+    );
+    let mut map = Map {
+        solver,
+        model,
+        scene: scene.clone(),
+        section,
+        opts: *opts,
+        runs: 0,
+        last_return: None,
+    };
+    let free: Vec<usize> = (0..n).filter(|&c| c != fix).collect();
+    let mut z = z0.to_vec();
+    let mut u = scene.u;
+    let eval = |map: &mut Map, z: &[f64], u: f64| {
+        map.scene.u = u;
+        map.at(z)
+    };
+    let (mut pz, mut period) = eval(&mut map, &z, u)?;
+    let f = |z: &[f64], pz: &[f64]| pz.iter().zip(z).map(|(p, q)| p - q).collect::<Vec<_>>();
+    let mut r = norm(&f(&z, &pz));
+    for it in 0..=opts.max_iter {
+        if r <= opts.tol * (1.0 + norm(&z)) {
+            map.scene.u = u;
+            let j = map.jacobian(&z, &pz, true)?;
+            return Ok(OrbitAtU {
+                u,
+                orbit: Orbit {
+                    section,
+                    x: section.lift(model, &z),
+                    z,
+                    period,
+                    multipliers: eigenvalues(&j),
+                    residual: r,
+                    iterations: it,
+                    runs: map.runs,
+                },
+            });
+        }
+        if it == opts.max_iter {
+            break;
+        }
+        // Columns: the free coordinates, then u.
+        let fz = f(&z, &pz);
+        let dz = opts.fd_rel * (1.0 + norm(&z));
+        let du = opts.fd_rel * (1.0 + u.abs());
+        let mut a = vec![vec![0.0; n]; n];
+        for (col, &c) in free.iter().enumerate() {
+            let mut zp = z.clone();
+            zp[c] += dz;
+            let (pp, _) = eval(&mut map, &zp, u)?;
+            let fp = f(&zp, &pp);
+            for row in 0..n {
+                a[row][col] = (fp[row] - fz[row]) / dz;
+            }
+        }
+        let (pu, _) = eval(&mut map, &z, u + du)?;
+        let fu = f(&z, &pu);
+        for row in 0..n {
+            a[row][n - 1] = (fu[row] - fz[row]) / du;
+        }
+        let step = solve_small(&a, &fz).ok_or_else(|| ShootError::Singular { z: z.clone() })?;
+        let mut lambda = 1.0;
+        loop {
+            let mut trial = z.clone();
+            for (col, &c) in free.iter().enumerate() {
+                trial[c] -= lambda * step[col];
+            }
+            let ut = u - lambda * step[n - 1];
+            let next = eval(&mut map, &trial, ut);
+            if let Ok((pt, tt)) = next {
+                let rt = norm(&f(&trial, &pt));
+                if rt < r || lambda < 1.0 / 64.0 {
+                    (z, u, pz, period, r) = (trial, ut, pt, tt, rt);
+                    break;
+                }
+            } else if lambda < 1.0 / 64.0 {
+                return Err(next.unwrap_err());
+            }
+            lambda *= 0.5;
+        }
+    }
+    Err(ShootError::NoConvergence {
+        iterations: opts.max_iter,
+        residual: r,
+        z,
+    })
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

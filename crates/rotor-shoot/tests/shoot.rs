@@ -241,3 +241,22 @@ fn next_to_h1_shooting_needs_periods_where_settling_needs_hours() {
         );
     }
 }
+
+/// `shoot_with_u` holds one section coordinate and solves for u: from the 1.5 V stick-slip
+/// cycle's fixed point (shot at fixed u) and a start 0.01 V off, it must come back to 1.5 V.
+/// The fixed point moves with u at dz/du = O(1) rad/s per V and Newton stops at a map
+/// residual of 1e-9 relative, so u is found to about 1e-8 V; 1e-7 V leaves 10×.
+#[test]
+fn shooting_with_u_free_returns_to_the_input_of_a_fixed_point() {
+    let model = Model::table1();
+    let solver = rotor_switch::SwitchSolver::default();
+    let (section, z0) =
+        Section::of_run(&solver, &model, &scene(1.5), State::zeros(), 200.0).unwrap();
+    let opts = ShootOptions::default();
+    let orbit = shoot(&solver, &model, &scene(1.5), section, &z0, &opts).unwrap();
+    let found =
+        rotor_shoot::shoot_with_u(&solver, &model, &scene(1.51), section, &orbit.z, 0, &opts)
+            .unwrap();
+    assert!((found.u - 1.5).abs() < 1e-7, "u = {}", found.u);
+    assert!((found.orbit.period - orbit.period).abs() < 1e-6);
+}

@@ -4,8 +4,10 @@
 
 pub mod by_solver;
 pub mod checked;
+pub mod figure3;
 pub mod probes;
 mod settle;
+pub mod solver_points;
 mod steady;
 
 pub use settle::{SettleError, SettleOptions, Settled, Unsettled, settle};

@@ -30,8 +30,8 @@ pub struct Args {
     pub csv: Option<PathBuf>,
     /// Which solver computes the periodic branches: event (the continuation with
     /// saltation matrices; default), or switch or moreau (each orbit shot again on that
-    /// solver's own return map, with its own multipliers; grazing and folds are not
-    /// located by them yet, which the JSON's "not_located" says).
+    /// solver's own return map, with its own multipliers, and the grazing orbits and folds
+    /// located again by that solver's shooting; "not_found" in the JSON names what was not).
     #[arg(long, default_value = "event")]
     pub solver: String,
 }
