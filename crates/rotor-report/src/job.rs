@@ -36,16 +36,16 @@ pub fn check_names(scenarios: &[Scenario]) -> Result<(), ReportError> {
 }
 
 /// The main job's analysis sections of `sets`, computed in parallel, in the report's order:
-/// bifurcation diagrams, two parameters, stress, probes.
+/// bifurcation diagrams, two parameters, stress, probes. The diagrams first (with the
+/// stress cases beside them), since the probes and the planes start from them; then the
+/// probes and the planes together, so both cores stay busy until the end.
 pub fn sections(sets: &[ParamSet]) -> Result<Vec<Section>, ReportError> {
-    let (bif, (stress, plane)) = rayon::join(
-        || {
-            let (sec, diagrams) = bifurcation_section(sets)?;
-            Ok::<_, ReportError>((sec, probe_section(sets, &diagrams)))
-        },
-        || rayon::join(stress_section, || plane_section(sets)),
+    let (bif, stress) = rayon::join(|| bifurcation_section(sets), stress_section);
+    let (bif, diagrams) = bif?;
+    let (probes, plane) = rayon::join(
+        || probe_section(sets, &diagrams),
+        || plane_section(sets, &diagrams),
     );
-    let (bif, probes) = bif?;
     Ok(vec![bif, plane?, stress, probes])
 }
 
