@@ -418,13 +418,13 @@ pub fn checked_shot(
 }
 
 /// `rotor steady`'s default: the fastest method that is right from every start. The
-/// event-driven solver answers by its own refinement ([`crate::steady`], which checks on its
+/// event-driven solver answers by its own refinement ([`crate::steady()`], which checks on its
 /// own flow that the run reaches the cycle); the switch model and Moreau–Jean by
 /// [`checked_shot`], which answers only a stable orbit (or a stable equilibrium) that a run
 /// from the start is seen to go to, in a few hundred seconds of simulated time where settling
 /// next to a Hopf point takes thousands. When the check refuses (a transient too slow for its
 /// `max_time`, an unstable or neutral orbit, no orbit found), the answer is the simulation
-/// method's ([`crate::steady`] with `opts`), which is right from every start but slow there:
+/// method's ([`crate::steady()`] with `opts`), which is right from every start but slow there:
 /// so the default never answers an unstable orbit, and answers whatever `--method simulate`
 /// would where the check cannot decide. The answer's `method` says which answered.
 pub fn checked_or_simulated(
