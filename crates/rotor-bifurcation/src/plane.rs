@@ -389,6 +389,20 @@ fn end_text(e: &ArcEnd) -> String {
 
 /// The two-parameter picture (see the module docs).
 pub fn plane(base: &Params, opts: &PlaneOptions) -> Result<Plane, BifError> {
+    plane_with(base, opts, None)
+}
+
+/// [`plane`], given `known`: the one-parameter diagram of `base` itself over
+/// `DiagramOptions { u_min, u_max, ..Default::default() }` from `opts` (the one
+/// `rotor bifurcation` computes). The continuation starts from that diagram's special points
+/// when it starts at the file's value of the parameter (`p_start` unset and the value in
+/// range), so the result is the same as [`plane`]'s, without computing the diagram again;
+/// otherwise `known` is not used.
+pub fn plane_with(
+    base: &Params,
+    opts: &PlaneOptions,
+    known: Option<&crate::Diagram>,
+) -> Result<Plane, BifError> {
     validate(base, opts)?;
     let name = opts.param.as_str();
     let p_file = base
@@ -399,15 +413,23 @@ pub fn plane(base: &Params, opts: &PlaneOptions) -> Result<Plane, BifError> {
         None if (opts.p_min..=opts.p_max).contains(&p_file) => p_file,
         None => 0.5 * (opts.p_min + opts.p_max),
     };
-    let model0 = Model::new(params_at(base, name, p0)?);
-    let d = diagram(
-        &model0,
-        &DiagramOptions {
-            u_min: opts.u_min,
-            u_max: opts.u_max,
-            ..DiagramOptions::default()
-        },
-    )?;
+    let computed;
+    let d = match known {
+        // The diagram at p0 is the file's own: the same inputs, so the same diagram.
+        Some(d) if p0 == p_file => d,
+        _ => {
+            let model0 = Model::new(params_at(base, name, p0)?);
+            computed = diagram(
+                &model0,
+                &DiagramOptions {
+                    u_min: opts.u_min,
+                    u_max: opts.u_max,
+                    ..DiagramOptions::default()
+                },
+            )?;
+            &computed
+        }
+    };
     let p_scale = p0.abs().max(1e-3 * (opts.p_max - opts.p_min)).max(1e-12);
     let inside_pu =
         |p: f64, u: f64| p >= opts.p_min && p <= opts.p_max && u >= opts.u_min && u <= opts.u_max;

@@ -7,8 +7,10 @@
 //! ```
 //!
 //! * `rotor steady --solver S --u V` at 1e-4 V above Table 1's first Hopf point H1, from
-//!   rest, for every solver, by `--method shoot` and by the default (`simulate`): the median
-//!   wall time of 5 processes each (the default's slow transient next to H1 once each);
+//!   rest, for every solver, by `--method shoot`, by the default (checked shooting, falling
+//!   back to simulation when the check refuses) and by `--method simulate`: the median wall
+//!   time of 5 processes each for shoot and the default, `simulate` (the slow transient next
+//!   to H1) once; and the CPU time (user + system) of each, summed over its processes;
 //! * with `ROTOR_BENCH_MAIN=1`, the main job (`rotor` with no arguments) once, in a temporary
 //!   directory (the embedded suite; the report goes there): its wall time and the CPU time
 //!   of the process tree (`/proc/self` children's utime + stime after it ends, on Linux).
@@ -22,6 +24,17 @@ use rotor_model::Model;
 fn median(mut v: Vec<f64>) -> f64 {
     v.sort_by(f64::total_cmp);
     v[v.len() / 2]
+}
+
+/// Median wall time of `n` processes, which must succeed, and their mean CPU time (user +
+/// system; `NaN` where `/proc` is not there).
+fn timed(bin: &Path, args: &[&str], dir: &Path, n: usize) -> (f64, f64) {
+    let c0 = children_cpu();
+    let w = median((0..n).map(|_| run(bin, args, dir)).collect());
+    let cpu = children_cpu()
+        .zip(c0)
+        .map_or(f64::NAN, |(a, b)| (a - b) / n as f64);
+    (w, cpu)
 }
 
 /// Wall time of one process, which must succeed.
@@ -59,13 +72,21 @@ fn main() {
         .equilibrium
         .u;
     let u = format!("{}", h1 + 1e-4);
-    println!("rotor steady at u = {u} V (1e-4 V above H1), from rest; median wall of 5:");
+    println!(
+        "rotor steady at u = {u} V (1e-4 V above H1), from rest; wall (median of 5; simulate \
+         once) and CPU per process:"
+    );
     for solver in ["event", "switch", "moreau"] {
         let base = ["steady", "--solver", solver, "--u", &u];
         let shoot: Vec<&str> = [&base[..], &["--method", "shoot"]].concat();
-        let s = median((0..5).map(|_| run(bin, &shoot, &dir)).collect());
-        let d = run(bin, &base, &dir);
-        println!("  {solver:<7} --method shoot {s:>8.3} s   default (simulate) {d:>8.3} s");
+        let simulate: Vec<&str> = [&base[..], &["--method", "simulate"]].concat();
+        let (s, sc) = timed(bin, &shoot, &dir, 5);
+        let (d, dc) = timed(bin, &base, &dir, 5);
+        let (m, mc) = timed(bin, &simulate, &dir, 1);
+        println!(
+            "  {solver:<7} shoot {s:>7.3} s ({sc:.3} s CPU)   default {d:>7.3} s ({dc:.3} s CPU)   \
+             simulate {m:>7.3} s ({mc:.3} s CPU)"
+        );
     }
     if std::env::var_os("ROTOR_BENCH_MAIN").is_some() {
         let c0 = children_cpu();

@@ -38,20 +38,23 @@ pub fn check_names(scenarios: &[Scenario]) -> Result<(), ReportError> {
 }
 
 /// The main job's analysis sections of `sets`, computed in parallel, in the report's order:
-/// bifurcation diagrams, the diagrams by three methods, two parameters, stress, probes.
+/// bifurcation diagrams, the diagrams by three methods, two parameters, stress, probes. The
+/// diagrams first (with the stress cases beside them), since the probes, the planes and the
+/// three-method diagrams start from them; then those three together (probes beside the
+/// planes and the three-method diagrams, the longest first), so both cores stay busy until
+/// the end.
 pub fn sections(sets: &[ParamSet]) -> Result<Vec<Section>, ReportError> {
-    let (bif, (stress, plane)) = rayon::join(
+    let (bif, stress) = rayon::join(|| bifurcation_section(sets), stress_section);
+    let (bif, diagrams) = bif?;
+    let (probes, (plane, fig3)) = rayon::join(
+        || probe_section(sets, &diagrams),
         || {
-            let (sec, diagrams) = bifurcation_section(sets)?;
-            let (probes, fig3) = rayon::join(
-                || probe_section(sets, &diagrams),
+            rayon::join(
+                || plane_section(sets, &diagrams),
                 || figure3_section(sets, &diagrams),
-            );
-            Ok::<_, ReportError>((sec, probes, fig3))
+            )
         },
-        || rayon::join(stress_section, || plane_section(sets)),
     );
-    let (bif, probes, fig3) = bif?;
     Ok(vec![bif, fig3, plane?, stress, probes])
 }
 

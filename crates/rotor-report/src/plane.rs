@@ -6,14 +6,26 @@ use crate::ReportError;
 
 /// The report section with the two-parameter pictures: (k_θ, u) and (T_sl, u) for both
 /// parameter sets.
+/// `diagrams` are the sets' one-parameter diagrams over u in [0, 7] (the bifurcation
+/// section's), which the continuation starts from instead of computing them again.
 pub fn plane_section(
     sets: &[(&str, &str, Params)],
+    diagrams: &[rotor_bifurcation::Diagram],
 ) -> Result<rotor_compare::report::Section, ReportError> {
     use rayon::prelude::*;
     use std::fmt::Write as _;
-    let jobs: Vec<(&str, &str, Params, &str, f64, f64)> = sets
+    let jobs: Vec<(
+        &str,
+        &str,
+        Params,
+        &str,
+        f64,
+        f64,
+        &rotor_bifurcation::Diagram,
+    )> = sets
         .iter()
-        .flat_map(|(name, slug, p)| {
+        .zip(diagrams)
+        .flat_map(|((name, slug, p), d)| {
             // T_sl over a range that keeps the law admissible and, for the Stribeck set,
             // reaches the cluster of codimension-two points near 0.13.
             let ts = if *slug == "stribeck" {
@@ -22,18 +34,19 @@ pub fn plane_section(
                 (0.1, 0.25)
             };
             [
-                (*name, *slug, *p, "k_theta", 0.05, 0.11),
-                (*name, *slug, *p, "lower.t_s", ts.0, ts.1),
+                (*name, *slug, *p, "k_theta", 0.05, 0.11, d),
+                (*name, *slug, *p, "lower.t_s", ts.0, ts.1, d),
             ]
         })
         .collect();
     let planes = jobs
         .par_iter()
-        .map(|(_, _, p, param, a, b)| {
+        .map(|(_, _, p, param, a, b, d)| {
             let t0 = std::time::Instant::now();
-            let pl = rotor_bifurcation::plane::plane(
+            let pl = rotor_bifurcation::plane::plane_with(
                 p,
                 &rotor_bifurcation::plane::PlaneOptions::new(param, *a, *b),
+                Some(d),
             );
             (pl, t0.elapsed().as_secs_f64())
         })
@@ -48,7 +61,7 @@ pub fn plane_section(
          bound (docs/methods.md, section 4a). The dashed line is the file's value; its dots \
          are the one-parameter diagram's points.\n",
     );
-    for ((name, slug, _, param, a, b), (pl, secs)) in jobs.iter().zip(planes) {
+    for ((name, slug, _, param, a, b, _), (pl, secs)) in jobs.iter().zip(planes) {
         let pl = pl.map_err(|source| ReportError::Plane {
             set: name.to_string(),
             param: param.to_string(),

@@ -10,14 +10,20 @@ pub fn probe_section(
 ) -> rotor_compare::report::Section {
     use rayon::prelude::*;
     use rotor_steady::probes;
-    let mut rows = Vec::new();
-    for ((_, slug, p), d) in sets.iter().zip(diagrams) {
-        let m = Model::new(*p);
-        let selected = probes::selection(d, true);
-        rows.extend(probes::run_set(slug, &m, d, &selected, |jobs, f| {
-            jobs.par_iter().map(f).collect()
-        }));
-    }
+    // Both sets at once (not one after the other), so that no core waits for the slowest
+    // probe of the first set; rows in the sets' order.
+    let rows: Vec<probes::ProbeRow> = sets
+        .par_iter()
+        .zip(diagrams)
+        .map(|((_, slug, p), d)| {
+            let m = Model::new(*p);
+            let selected = probes::selection(d, true);
+            probes::run_set(slug, &m, d, &selected, |jobs, f| {
+                jobs.par_iter().map(f).collect()
+            })
+        })
+        .collect::<Vec<_>>()
+        .concat();
     let count =
         |f: &dyn Fn(&probes::Verdict) -> bool| rows.iter().filter(|r| f(&r.verdict)).count();
     let agree = count(&|v| matches!(v, probes::Verdict::Agrees { .. }));

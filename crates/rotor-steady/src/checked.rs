@@ -417,6 +417,37 @@ pub fn checked_shot(
     })
 }
 
+/// `rotor steady`'s default: the fastest method that is right from every start. The
+/// event-driven solver answers by its own refinement ([`crate::steady()`], which checks on its
+/// own flow that the run reaches the cycle); the switch model and Moreau–Jean by
+/// [`checked_shot`], which answers only a stable orbit (or a stable equilibrium) that a run
+/// from the start is seen to go to, in a few hundred seconds of simulated time where settling
+/// next to a Hopf point takes thousands. When the check refuses (a transient too slow for its
+/// `max_time`, an unstable or neutral orbit, no orbit found), the answer is the simulation
+/// method's ([`crate::steady()`] with `opts`), which is right from every start but slow there:
+/// so the default never answers an unstable orbit, and answers whatever `--method simulate`
+/// would where the check cannot decide. The answer's `method` says which answered.
+pub fn checked_or_simulated(
+    kind: SolverKind,
+    model: &Model,
+    scene: &Scene,
+    opts: &crate::steady::SteadyOptions,
+) -> Result<SteadyAnswer, SteadyError> {
+    if kind == SolverKind::EVENT {
+        return crate::steady::steady(kind, model, scene, opts);
+    }
+    match checked_shot(kind, model, scene, &CheckOptions::default()) {
+        Ok(c) => Ok(c.answer),
+        Err(
+            SteadyError::NotReached { .. }
+            | SteadyError::Neutral { .. }
+            | SteadyError::Unstable { .. }
+            | SteadyError::Shoot(_),
+        ) => crate::steady::steady(kind, model, scene, opts),
+        Err(e) => Err(e),
+    }
+}
+
 /// How close to the unit circle a multiplier may come before shooting cannot tell a stable
 /// orbit from an unstable one: the return map's differences are accurate to ~1e-4 of the
 /// derivative (`ShootOptions::fd_rel`: the map's rounding over the step), so 1e-3.
@@ -601,6 +632,71 @@ mod tests {
             );
             let c = checked_shot(kind, &m, &pert, &CheckOptions::default()).unwrap();
             assert_eq!(c.answer.method, SteadyMethod::Equilibrium, "{c:?}");
+        }
+    }
+
+    /// `rotor steady`'s default from a start on the unstable slipping cycle near 4.40 V of
+    /// Table 1 (continued from the subcritical Hopf point H2; its multiplier ≈ 1.11, as the
+    /// rotor-shoot tests find): Newton from that start finds the unstable cycle, but the
+    /// default must not answer it. Its answer is stable, and for the switch model the same
+    /// attractor as the simulation method's (kind, and period within 1e-5 relative: the
+    /// probes' agreement for the switch model).
+    #[test]
+    fn the_default_never_answers_the_unstable_cycle() {
+        let m = Model::table1();
+        let d = rotor_bifurcation::diagram(
+            &m,
+            &rotor_bifurcation::DiagramOptions {
+                u_min: 4.2,
+                u_max: 4.45,
+                n: 20,
+                u_start: 4.3,
+                ..Default::default()
+            },
+        )
+        .unwrap();
+        let row = d
+            .periodic
+            .iter()
+            .filter(|r| !r.stable && !r.stick_slip)
+            .min_by(|a, b| (a.u - 4.4).abs().total_cmp(&(b.u - 4.4).abs()))
+            .unwrap();
+        assert!(row.multipliers[1][0] > 1.05, "{:?}", row.multipliers);
+        let x0 = State::new(
+            row.section_state[0],
+            row.section_state[1],
+            row.section_state[2],
+        );
+        let scene = Scene {
+            u: row.u,
+            x0,
+            ..Scene::default()
+        };
+        for kind in [SolverKind::SWITCH, SolverKind::MOREAU] {
+            let solver = kind.solver();
+            // Next to it: Newton from one period's run finds the unstable cycle.
+            let (section, z0) =
+                Section::of_run(&*solver, &m, &scene, x0, 2.0 * row.period).unwrap();
+            let o = shoot(&*solver, &m, &scene, section, &z0, &Default::default()).unwrap();
+            assert!(!o.is_stable(), "{}: {:?}", kind.name(), o.multipliers);
+            let a = checked_or_simulated(kind, &m, &scene, &Default::default()).unwrap();
+            assert_ne!(a.stable, Some(false), "{}: {a:?}", kind.name());
+            if let SteadyState::LimitCycle { period, .. } = a.state {
+                // Not the unstable cycle: its period differs by far more than any solver's
+                // error (1e-4 s, Moreau–Jean's O(h²) period error is ~6e-7 s).
+                assert!((period - row.period).abs() > 1e-4, "{}: {a:?}", kind.name());
+            }
+            if kind == SolverKind::SWITCH {
+                let sim = crate::steady::steady(kind, &m, &scene, &Default::default()).unwrap();
+                match (a.state, sim.state) {
+                    (
+                        SteadyState::LimitCycle { period: p, .. },
+                        SteadyState::LimitCycle { period: q, .. },
+                    ) => assert!((p - q).abs() <= 1e-5 * q, "{a:?} vs {sim:?}"),
+                    (SteadyState::Equilibrium { .. }, SteadyState::Equilibrium { .. }) => {}
+                    _ => panic!("default {a:?} vs simulation {sim:?}"),
+                }
+            }
         }
     }
 

@@ -9,14 +9,16 @@ use crate::out;
 pub struct Args {
     #[command(flatten)]
     pub common: Common,
-    /// How: `simulate` (the default: the event-driven solver refines the cycle a run
-    /// reaches on its own flow with saltation matrices; switch and moreau run until the
-    /// metrics settle, which answers equilibria too), or `shoot` (Newton on the
-    /// solver's own return map from a 300 s run's last section crossing: any solver, the
-    /// orbit stable or not, in a few periods where settling next to a Hopf point takes
-    /// thousands of seconds; the JSON adds "stable" and "multipliers"). The default is
-    /// the one that is right from every start: shoot is faster next to a special point
-    /// but does not check that the start reaches the orbit (docs/methods.md, 4b).
+    /// How. Without it, the fastest that is right from every start: the event-driven
+    /// solver refines the cycle a run reaches on its own flow (saltation multipliers); switch
+    /// and moreau shoot on their own return map from a 100 s run and accept the orbit only
+    /// when a run from the start of at most 600 s is seen to go to it (or to a stable
+    /// equilibrium), and fall back to `simulate` when that check refuses (a slow transient,
+    /// an unstable or neutral orbit); "method" says which answered ("shoot" with "stable"
+    /// and "multipliers", or "simulated"). `simulate`: the event-driven refinement, or
+    /// switch and moreau run until the metrics settle (right from every start, slow next to
+    /// a special point). `shoot`: Newton on the solver's own return map from a 300 s run's
+    /// last section crossing, unchecked: the orbit stable or not (docs/methods.md, 4b).
     #[arg(long, value_name = "shoot|simulate")]
     pub method: Option<String>,
 }
@@ -26,19 +28,25 @@ pub fn run(a: &Args) -> Result<()> {
 }
 
 pub(crate) fn steady(common: &Common, method: Option<&str>) -> Result<()> {
-    let shoot = match method {
-        None | Some("simulate") => false,
-        Some("shoot") => true,
+    enum How {
+        Checked,
+        Shoot,
+        Simulate,
+    }
+    let how = match method {
+        None => How::Checked,
+        Some("simulate") => How::Simulate,
+        Some("shoot") => How::Shoot,
         Some(other) => bail!("--method {other:?}: expected shoot or simulate"),
     };
     let (kind, scene, opts) = request(common)?
         .steady()
         .map_err(|e| anyhow!(e.as_flag()))?;
     let model = load_model(common.params.as_deref())?;
-    let answer = if shoot {
-        rotor_steady::shot(kind, &model, &scene)
-    } else {
-        rotor_steady::steady(kind, &model, &scene, &opts)
+    let answer = match how {
+        How::Shoot => rotor_steady::shot(kind, &model, &scene),
+        How::Simulate => rotor_steady::steady(kind, &model, &scene, &opts),
+        How::Checked => rotor_steady::checked::checked_or_simulated(kind, &model, &scene, &opts),
     }
     .with_context(|| format!("solver {}", kind.name()))?;
     warn_inexact(&answer.stats);
