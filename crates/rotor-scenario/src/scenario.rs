@@ -27,9 +27,9 @@ use std::path::{Path, PathBuf};
 use serde::Deserialize;
 use thiserror::Error;
 
-use crate::dynamics::{Model, State};
-use crate::params::{Params, ParamsError, one_line, read_small, shown, text_of};
-use crate::scene::{MAX_GRID_ROWS, MIN_TOL, Output, Scene};
+use rotor_model::params::{Params, ParamsError, one_line, read_small, shown, text_of};
+use rotor_model::scene::{MAX_GRID_ROWS, MIN_TOL, Output, Scene};
+use rotor_model::{Model, Num, State};
 
 /// A scenario file could not be read or is not admissible.
 #[derive(Debug, Error, Clone, PartialEq)]
@@ -225,7 +225,7 @@ pub const EQUILIBRIUM_KEYS: [&str; 3] = [
 ];
 
 /// The steady-state quantities a [`PairTolerance`] gates, one key per metric of
-/// [`crate::SteadyState::values`]: its key in the file, the metric, and whether the
+/// [`rotor_model::SteadyState::values`]: its key in the file, the metric, and whether the
 /// tolerance is relative.
 pub const STEADY_QUANTITIES: [SteadyQuantity; 9] = [
     SteadyQuantity::relative("period_rel", "period"),
@@ -315,7 +315,7 @@ impl PairTolerance {
             .collect()
     }
 
-    /// The steady-state quantity gating a metric of [`crate::SteadyState::values`], and its
+    /// The steady-state quantity gating a metric of [`rotor_model::SteadyState::values`], and its
     /// tolerance if stated.
     pub fn for_metric(&self, metric: &str) -> Option<(SteadyQuantity, Option<f64>)> {
         STEADY_QUANTITIES
@@ -441,41 +441,33 @@ impl Scenario {
         })?;
         let model = Model::new(params);
         if !raw.u.is_finite() {
-            return Err(bad("u", crate::Num(raw.u).to_string(), "must be finite"));
+            return Err(bad("u", Num(raw.u).to_string(), "must be finite"));
         }
         if !(raw.t_end > 0.0 && raw.t_end.is_finite()) {
             return Err(bad(
                 "t_end",
-                crate::Num(raw.t_end).to_string(),
+                Num(raw.t_end).to_string(),
                 "must be positive and finite",
             ));
         }
         if let Some(tol) = raw.tol
             && !(tol > 0.0 && tol < 1.0)
         {
-            return Err(bad(
-                "tol",
-                crate::Num(tol).to_string(),
-                "must lie in (0, 1)",
-            ));
+            return Err(bad("tol", Num(tol).to_string(), "must lie in (0, 1)"));
         }
         if let Some(tol) = raw.tol
             && tol < MIN_TOL
         {
             return Err(bad(
                 "tol",
-                crate::Num(tol).to_string(),
+                Num(tol).to_string(),
                 "is below 1.1e-15 (10 unit roundoffs): double precision cannot deliver it",
             ));
         }
         if let Some(h) = raw.h
             && !(h > 0.0 && h <= raw.t_end)
         {
-            return Err(bad(
-                "h",
-                crate::Num(h).to_string(),
-                "must lie in (0, t_end]",
-            ));
+            return Err(bad("h", Num(h).to_string(), "must lie in (0, t_end]"));
         }
         // Without `h`, the time-stepping solver takes the default step, which must fit in
         // the horizon (Scene::validate), or every run of the scenario would fail.
@@ -483,7 +475,7 @@ impl Scenario {
         if raw.h.is_none() && raw.t_end < h_default {
             return Err(bad(
                 "t_end",
-                crate::Num(raw.t_end).to_string(),
+                Num(raw.t_end).to_string(),
                 &format!("is shorter than the default step h = {h_default}: set h"),
             ));
         }
@@ -501,7 +493,7 @@ impl Scenario {
                     if !v.is_finite() {
                         return Err(bad(
                             &format!("x0_from_equilibrium[{i}]"),
-                            crate::Num(*v).to_string(),
+                            Num(*v).to_string(),
                             "must be finite",
                         ));
                     }
@@ -529,20 +521,20 @@ impl Scenario {
         };
         for (i, n) in ["x0[0]", "x0[1]", "x0[2]"].iter().enumerate() {
             if !x0[i].is_finite() {
-                return Err(bad(n, crate::Num(x0[i]).to_string(), "must be finite"));
+                return Err(bad(n, Num(x0[i]).to_string(), "must be finite"));
             }
         }
         if !(raw.compare.dt > 0.0 && raw.compare.dt.is_finite()) {
             return Err(bad(
                 "compare.dt",
-                crate::Num(raw.compare.dt).to_string(),
+                Num(raw.compare.dt).to_string(),
                 "must be positive",
             ));
         }
         if raw.t_end / raw.compare.dt > MAX_GRID_ROWS {
             return Err(bad(
                 "compare.dt",
-                crate::Num(raw.compare.dt).to_string(),
+                Num(raw.compare.dt).to_string(),
                 "asks more than 1e7 output rows (t_end/dt): choose a larger dt",
             ));
         }
@@ -570,7 +562,7 @@ impl Scenario {
         {
             return Err(bad(
                 "compare.steady_from",
-                crate::Num(t).to_string(),
+                Num(t).to_string(),
                 "must lie in [0, t_end)",
             ));
         }
@@ -599,7 +591,7 @@ impl Scenario {
                 let instead = RETIRED_KEYS.iter().find(|r| r.0 == key).map_or("", |r| r.1);
                 bad(
                     &format!("tolerance.{pair}.{key}"),
-                    crate::Num(v).to_string(),
+                    Num(v).to_string(),
                     &format!(
                         "is retired: it gated several quantities, and each has its own key now: {instead}"
                     ),
@@ -611,7 +603,7 @@ impl Scenario {
                 if !(v >= 0.0 && v.is_finite()) {
                     return Err(bad(
                         &format!("tolerance.{pair}.{name}"),
-                        crate::Num(v).to_string(),
+                        Num(v).to_string(),
                         "must be non-negative and finite",
                     ));
                 }
@@ -634,7 +626,7 @@ impl Scenario {
                 if !needed {
                     return Err(bad(
                         &format!("tolerance.{pair}.{name}"),
-                        crate::Num(v).to_string(),
+                        Num(v).to_string(),
                         why,
                     ));
                 }
@@ -805,7 +797,7 @@ mod tests {
     /// Every metric of both kinds of steady state has exactly one key, and no key gates two.
     #[test]
     fn one_key_per_steady_metric() {
-        use crate::SteadyState;
+        use rotor_model::SteadyState;
         let cycle = SteadyState::LimitCycle {
             period: 1.0,
             omega_l_max: 1.0,
