@@ -4,7 +4,8 @@
 use rotor_grade::check::{Level, check};
 use rotor_grade::gridmetrics::{StickExit, grid_metrics};
 use rotor_grade::reference::Reference;
-use rotor_model::{Output, Scenario, Scene, Stats};
+use rotor_model::{Output, Scene, Stats};
+use rotor_scenario::Scenario;
 use serde::{Deserialize, Serialize};
 
 use crate::BenchError;
@@ -158,7 +159,7 @@ pub(crate) fn load(
     };
     let mut view_sc = scenario.clone();
     view_sc.t_end = spec.t_end;
-    view_sc.compare = rotor_model::CompareSpec {
+    view_sc.compare = rotor_scenario::CompareSpec {
         transient: Some(spec.transient),
         dt: spec.dt,
         steady_from: Some(spec.metrics_from),

@@ -43,7 +43,8 @@ mod report;
 mod results;
 mod word;
 
-use rotor_model::{Model, Output, ScenarioError, Scene, SolveError};
+use rotor_model::{Model, Output, Scene, SolveError};
+use rotor_scenario::ScenarioError;
 use serde::{Deserialize, Serialize};
 use thiserror::Error;
 

@@ -34,7 +34,7 @@ impl Tier {
     }
 
     /// The tier of a scenario: `full` when its upper disc's friction is set-valued.
-    pub fn of(sc: &rotor_model::Scenario) -> Tier {
+    pub fn of(sc: &rotor_scenario::Scenario) -> Tier {
         if sc.model.friction(rotor_model::Disc::Upper).is_set_valued() {
             Tier::Full
         } else {
@@ -117,7 +117,7 @@ impl SceneSpec {
 /// ([`SceneSpec::from_scenario`]), with its tier; [`LEAD_SCENES`] first, then the table1 tier,
 /// then the full tier, each by name. `tier` keeps the scenes that tier holds.
 pub fn suite(dir: &Path, tier: Option<Tier>) -> Result<Vec<SceneSpec>, crate::BenchError> {
-    let files = rotor_model::Scenario::list_dir(dir).map_err(|e| {
+    let files = rotor_scenario::Scenario::list_dir(dir).map_err(|e| {
         crate::BenchError::Options(format!("{}: cannot list the scenarios: {e}", dir.display()))
     })?;
     let mut scenes = Vec::new();
@@ -372,7 +372,7 @@ mod tests {
     #[test]
     fn the_suite_leads_with_the_cycles_and_splits_into_tiers() {
         let dir = suite_dir();
-        let n = rotor_model::Scenario::list_dir(&dir).unwrap().len();
+        let n = rotor_scenario::Scenario::list_dir(&dir).unwrap().len();
         let name = |s: &SceneSpec| s.scenario.file_stem().unwrap().to_str().unwrap().to_owned();
         let all: Vec<String> = suite(&dir, None).unwrap().iter().map(name).collect();
         assert_eq!(all.len(), n);

@@ -165,7 +165,7 @@ impl Job {
     /// The job of a scene: the scenario's parameters, u and x0 (absolute), the scene's
     /// horizon and grid, and the client's knob: `tol` set and `h` null, or the reverse.
     pub fn new(
-        sc: &rotor_model::Scenario,
+        sc: &rotor_scenario::Scenario,
         t_end: f64,
         dt: f64,
         fixed_step: bool,

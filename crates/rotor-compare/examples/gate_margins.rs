@@ -12,7 +12,7 @@
 use std::path::Path;
 
 use rotor_compare::margins::{floor_violations, margins};
-use rotor_model::Scenario;
+use rotor_scenario::Scenario;
 use rotor_solvers::run_scenario;
 
 fn main() {

@@ -8,7 +8,8 @@
 //! the transient window matched one to one within `event_time`.
 //! Every comparison is written `!(diff <= tol)` so that a NaN fails.
 
-use rotor_model::{Disc, EventKind, PairTolerance, SteadyState, Trajectory};
+use rotor_model::{Disc, EventKind, SteadyState, Trajectory};
+use rotor_scenario::PairTolerance;
 
 use rotor_solvers::run::ScenarioResult;
 use rotor_solvers::solvers::{SolverKind, pair_name, pairs};

@@ -15,7 +15,7 @@
 //! two solvers' metrics: unlike the gate's own scaled difference ([`crate::gate`]), it does not
 //! depend on the gate through the `steady_abs` floor.
 
-use rotor_model::{STEADY_QUANTITIES, Scenario};
+use rotor_scenario::{STEADY_QUANTITIES, Scenario};
 
 use crate::gate::gate_scenario;
 pub use crate::stress::MAX_LOOSENESS;

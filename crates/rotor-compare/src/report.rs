@@ -4,7 +4,8 @@ use std::fmt::Write as _;
 use std::io::Write as _;
 use std::path::Path;
 
-use rotor_model::{Disc, Friction, Model, Params, Scenario, SteadyState};
+use rotor_model::{Disc, Friction, Model, Params, SteadyState};
+use rotor_scenario::Scenario;
 
 use crate::gate::{Failure, GateResult, gate_scenario};
 use crate::snapshot::round_sig;

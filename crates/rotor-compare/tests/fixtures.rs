@@ -8,7 +8,8 @@ use std::sync::OnceLock;
 use rotor_compare::gate::gate_scenario;
 use rotor_compare::margins::{MAX_LOOSENESS, floor_violations, margins};
 use rotor_compare::snapshot::snapshot;
-use rotor_model::{Disc, Event, EventKind, Scenario, State, SteadyState, Trajectory};
+use rotor_model::{Disc, Event, EventKind, State, SteadyState, Trajectory};
+use rotor_scenario::Scenario;
 use rotor_solvers::{SOLVERS, ScenarioResult, SolverKind, pair_name, pairs, run_scenario};
 
 /// Every fixture through the three solvers, once per test binary (shared by the tests).

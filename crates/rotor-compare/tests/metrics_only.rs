@@ -8,8 +8,9 @@ use std::path::Path;
 use std::sync::OnceLock;
 
 use rotor_event::{EventOptions, EventSolver};
-use rotor_model::{Output, Scenario, Scene, Solver, SteadyState, Trajectory};
+use rotor_model::{Output, Scene, Solver, SteadyState, Trajectory};
 use rotor_moreau::{MoreauOptions, MoreauSolver};
+use rotor_scenario::Scenario;
 use rotor_solvers::run::scene_for;
 use rotor_solvers::{SOLVERS, SolverKind};
 use rotor_switch::{SwitchOptions, SwitchSolver};

@@ -6,9 +6,10 @@ use std::path::Path;
 use nalgebra::{Matrix3, Vector3};
 use rotor_event::{EventOptions, EventSolver, SteadyOptions, steady_state};
 use rotor_model::{
-    Disc, EventKind, LowerFriction, Model, Output, Params, Scenario, Scene, SolveError, Solver,
-    State, SteadyState,
+    Disc, EventKind, LowerFriction, Model, Output, Params, Scene, SolveError, Solver, State,
+    SteadyState,
 };
+use rotor_scenario::Scenario;
 
 fn fixtures() -> std::path::PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../../fixtures")

@@ -11,7 +11,8 @@ use std::path::Path;
 
 use rotor_grade::check::{Level, check, reference_error};
 use rotor_grade::trace::{EventsFile, Trace};
-use rotor_model::{Output, Scenario, Scene};
+use rotor_model::{Output, Scene};
+use rotor_scenario::Scenario;
 use rotor_solvers::solvers::SolverKind;
 
 fn main() {

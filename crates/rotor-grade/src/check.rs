@@ -43,7 +43,8 @@
 
 use std::path::PathBuf;
 
-use rotor_model::{Disc, Event, EventKind, Sample, Scenario, SteadyState};
+use rotor_model::{Disc, Event, EventKind, Sample, SteadyState};
+use rotor_scenario::Scenario;
 use serde::{Serialize, Serializer};
 
 use crate::gridmetrics::{STUCK, StickExit, grid_metrics};
@@ -863,7 +864,7 @@ pub fn check(
 #[derive(Debug, thiserror::Error)]
 pub enum GradeError {
     #[error(transparent)]
-    Scenario(#[from] rotor_model::ScenarioError),
+    Scenario(#[from] rotor_scenario::ScenarioError),
     #[error(transparent)]
     Reference(#[from] crate::reference::ReferenceError),
     #[error(transparent)]

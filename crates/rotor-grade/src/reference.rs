@@ -27,7 +27,8 @@
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
-use rotor_model::{Event, Output, Sample, Scenario, Scene, SolveError, SteadyState};
+use rotor_model::{Event, Output, Sample, Scene, SolveError, SteadyState};
+use rotor_scenario::Scenario;
 use serde::{Deserialize, Serialize};
 
 use crate::trace::{TraceError, parse_events, parse_trace, write_events};

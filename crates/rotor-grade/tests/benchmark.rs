@@ -8,7 +8,8 @@ use rayon::prelude::*;
 use rotor_grade::check::{CheckError, Level, check};
 use rotor_grade::reference::{self, Reference};
 use rotor_grade::trace::{EventsFile, Trace, parse_events, parse_trace, write_events, write_trace};
-use rotor_model::{Scenario, Trajectory};
+use rotor_model::Trajectory;
+use rotor_scenario::Scenario;
 use rotor_solvers::{SolverKind, load_scenario, run::scene_for};
 
 fn fixtures() -> PathBuf {

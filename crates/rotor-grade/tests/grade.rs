@@ -9,7 +9,8 @@ use rotor_grade::check::{
 };
 use rotor_grade::reference::{self, Reference};
 use rotor_grade::trace::{EventsFile, Trace, parse_trace};
-use rotor_model::{Event, Scenario, Scene};
+use rotor_model::{Event, Scene};
+use rotor_scenario::Scenario;
 use rotor_solvers::{SolverKind, load_scenario, run::scene_for};
 
 fn fixtures() -> PathBuf {

@@ -25,7 +25,8 @@ use std::path::{Path, PathBuf};
 use independent::{Ev, Problem, Run, Tableau};
 use rayon::prelude::*;
 use rotor_grade::reference;
-use rotor_model::{Disc, EventKind, OMEGA_L, OMEGA_U, Scenario, State, SteadyState};
+use rotor_model::{Disc, EventKind, OMEGA_L, OMEGA_U, State, SteadyState};
+use rotor_scenario::Scenario;
 
 fn fixtures() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../../fixtures")

@@ -14,7 +14,6 @@ pub mod lagrangian;
 pub mod num;
 pub mod params;
 pub mod record;
-pub mod scenario;
 pub mod scene;
 pub mod steady;
 
@@ -27,10 +26,6 @@ pub use lagrangian::{Coords, Lagrangian};
 pub use num::Num;
 pub use params::{LowerFriction, Params, ParamsError, UpperFriction};
 pub use record::{Integration, Recorder};
-pub use scenario::{
-    CYCLE_KEYS, CompareSpec, EQUILIBRIUM_KEYS, PairTolerance, RETIRED_KEYS, STEADY_QUANTITIES,
-    Scenario, ScenarioError, SteadyQuantity, TOLERANCE_KEYS,
-};
 pub use scene::{
     Output, OutputGrid, Sample, Scene, SolveError, Solver, Stats, Trajectory, check_finite,
 };

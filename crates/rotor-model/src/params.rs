@@ -621,7 +621,7 @@ fn exponential_law_minimum(t_s: f64, t_1: f64, t_2: f64, w_1: f64, w_2: f64, b: 
 
 /// A path as it appears in a one-line message: control characters (a newline is legal in a
 /// Unix file name) escaped.
-pub(crate) fn shown(path: &Path) -> String {
+pub fn shown(path: &Path) -> String {
     escape_controls(&path.to_string_lossy())
 }
 
@@ -639,10 +639,10 @@ fn escape_controls(s: &str) -> String {
 
 /// The largest parameter or scenario file that is read: such a file is under 4 kB, and the
 /// cap keeps a wrong path (a binary file, `/dev/zero`) from being read into memory whole.
-pub(crate) const MAX_FILE: u64 = 1 << 20;
+pub const MAX_FILE: u64 = 1 << 20;
 
 /// The bytes of the file at `path`, refused once it runs past [`MAX_FILE`] bytes.
-pub(crate) fn read_small(path: &Path) -> std::io::Result<Vec<u8>> {
+pub fn read_small(path: &Path) -> std::io::Result<Vec<u8>> {
     use std::io::Read;
     let mut bytes = Vec::new();
     std::fs::File::open(path)?
@@ -659,7 +659,7 @@ pub(crate) fn read_small(path: &Path) -> std::io::Result<Vec<u8>> {
 
 /// The bytes of a file as text, or why it is not a text file: not UTF-8, or it holds a NUL
 /// byte (a binary file that happens to be valid UTF-8). Names the byte offset.
-pub(crate) fn text_of(bytes: Vec<u8>) -> Result<String, String> {
+pub fn text_of(bytes: Vec<u8>) -> Result<String, String> {
     let text = String::from_utf8(bytes).map_err(|e| {
         let at = e.utf8_error().valid_up_to();
         let byte = e.as_bytes()[at];
@@ -699,7 +699,7 @@ fn strip_comment(src: &str) -> &str {
 /// Collapses a multi-line parser message into one line. toml prints a source excerpt
 /// (`6 | j_u = "heavy"` and a caret line); the excerpt's source line is kept, since it shows
 /// the offending key and value.
-pub(crate) fn one_line(s: &str) -> String {
+pub fn one_line(s: &str) -> String {
     let mut head: Vec<&str> = Vec::new();
     let mut at: Option<&str> = None;
     for line in s.lines() {

@@ -1,19 +1,17 @@
-//! Bad parameter and scenario files: every kind of bad input is an error, never a
-//! panic, and its message is one line that names the file, the field and the offending value.
+//! Bad parameter files: every kind of bad input is an error, never a panic, and its message
+//! is one line that names the file, the field and the offending value. (Bad scenario files
+//! are rotor-scenario's tests/bad_input.rs.)
 //!
 //! Each case is a mutation of a real fixture file, written to a temporary directory and read
 //! back through `from_file`, so that the path in the message is the path of the file. The
 //! cases that the `rotor` binary is held to as well are in `rotor-testkit`
-//! ([`bad_params_cases`], [`bad_scenario_cases`]); the ones here are the library's own.
+//! ([`bad_params_cases`]); the ones here are the library's own.
 
 use std::path::{Path, PathBuf};
 
 use rotor_model::scene::MAX_GRID_ROWS;
-use rotor_model::{Output, Params, Scenario, Scene};
-use rotor_testkit::{
-    STRIBECK, TABLE1, bad_params_cases, bad_scenario_cases, edit, local_scenario,
-    short_horizon_scenario, write_scenario,
-};
+use rotor_model::{Output, Params, Scene};
+use rotor_testkit::{STRIBECK, TABLE1, bad_params_cases, edit};
 
 /// A fresh directory per call (tests run in parallel).
 fn tmp_dir() -> PathBuf {
@@ -49,28 +47,11 @@ fn params_err(what: &str, text: &[u8], needles: &[&str]) {
     }
 }
 
-/// Writes a scenario (and a good Table 1 parameter file next to it) and expects an error.
-fn scenario_err(what: &str, text: &[u8], needles: &[&str]) -> String {
-    let path = write_scenario(&tmp_dir(), text);
-    match Scenario::from_file(&path) {
-        Ok(s) => panic!(
-            "{what}: accepted {}: {}",
-            s.name,
-            String::from_utf8_lossy(text)
-        ),
-        Err(e) => {
-            let msg = e.to_string();
-            check_message(what, &msg, &path, needles);
-            msg
-        }
-    }
-}
-
 #[test]
 fn the_unmutated_files_load() {
     // Guards every case: each one differs from a file that loads only by its mutation.
     let dir = tmp_dir();
-    Scenario::from_file(&write_scenario(&dir, local_scenario().as_bytes())).unwrap();
+    std::fs::write(dir.join("table1.toml"), TABLE1).unwrap();
     std::fs::write(dir.join("st.toml"), STRIBECK).unwrap();
     Params::from_file(&dir.join("table1.toml")).unwrap();
     Params::from_file(&dir.join("st.toml")).unwrap();
@@ -82,15 +63,6 @@ fn bad_parameter_files() {
     assert!(!cases.is_empty());
     for c in &cases {
         params_err(&c.name, &c.contents, &c.needles);
-    }
-}
-
-#[test]
-fn bad_scenario_files() {
-    let cases = bad_scenario_cases();
-    assert!(!cases.is_empty());
-    for c in &cases {
-        scenario_err(&c.name, &c.contents, &c.needles);
     }
 }
 
@@ -113,61 +85,11 @@ fn params_paths_that_cannot_be_read() {
 }
 
 #[test]
-fn a_short_horizon_loads_once_h_is_set() {
-    // The shared case refuses `short_horizon_scenario()` for the missing h alone.
-    let path = write_scenario(
-        &tmp_dir(),
-        edit(
-            &short_horizon_scenario(),
-            "t_end = 5e-4",
-            "t_end = 5e-4\nh = 1e-4",
-        )
-        .as_bytes(),
-    );
-    Scenario::from_file(&path).unwrap();
-}
-
-#[test]
-fn scenario_params_path_and_bad_params_file() {
-    let s = local_scenario();
-    // The shared case checks the scenario file, the params file and the OS reason; the
-    // params file is named once.
-    let e = scenario_err(
-        "params path does not exist",
-        edit(&s, "\"table1.toml\"", "\"nothere.toml\"").as_bytes(),
-        &["nothere.toml"],
-    );
-    assert_eq!(e.matches("nothere.toml").count(), 1, "{e}");
-    // A parameter file with a bad value: named through the scenario.
-    let dir = tmp_dir();
-    std::fs::write(
-        dir.join("bad.toml"),
-        edit(TABLE1, "j_l = 0.0326", "j_l = 0.0"),
-    )
-    .unwrap();
-    let path = write_scenario(&dir, edit(&s, "\"table1.toml\"", "\"bad.toml\"").as_bytes());
-    let e = Scenario::from_file(&path).unwrap_err().to_string();
-    check_message(
-        "bad params file",
-        &e,
-        &path,
-        &["bad.toml", "j_l = 0", "positive"],
-    );
-}
-
-#[test]
 fn control_characters_in_params_paths_are_escaped() {
     // (A newline in a scenario's params path is a shared scenario case.)
     let odd = tmp_dir().join("a\rb.toml");
     let e = Params::from_file(&odd).unwrap_err().to_string();
     assert!(!e.contains('\r') && e.contains("a\\rb.toml"), "{e}");
-}
-
-#[test]
-fn a_missing_scenario_file() {
-    let missing = tmp_dir().join("nothere.toml");
-    let e = Scenario::from_file(&missing).unwrap_err().to_string();
-    check_message("missing file", &e, &missing, &["cannot read scenario file"]);
 }
 
 #[test]

@@ -108,7 +108,7 @@ fn from_bif(py: Python<'_>, e: BifError) -> PyErr {
 fn from_grade(e: GradeError) -> PyErr {
     use rotor_grade::reference::ReferenceError;
     match e {
-        GradeError::Scenario(rotor_model::ScenarioError::Io { .. })
+        GradeError::Scenario(rotor_scenario::ScenarioError::Io { .. })
         | GradeError::Reference(ReferenceError::File { .. }) => PyOSError::new_err(e.to_string()),
         _ => value_error(e),
     }

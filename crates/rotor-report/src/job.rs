@@ -3,7 +3,8 @@
 use std::path::Path;
 
 use rotor_compare::report::Section;
-use rotor_model::{Params, Scenario};
+use rotor_model::Params;
+use rotor_scenario::Scenario;
 use rotor_solvers::ScenarioResult;
 
 use crate::{

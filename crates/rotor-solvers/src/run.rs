@@ -2,7 +2,8 @@
 
 use std::time::Instant;
 
-use rotor_model::{Model, Output, Scenario, Scene, SolveError, Trajectory};
+use rotor_model::{Model, Output, Scene, SolveError, Trajectory};
+use rotor_scenario::Scenario;
 
 use crate::solvers::{Knob, SOLVERS, SolverKind};
 

@@ -7,7 +7,8 @@
 //! plot styles, ladders, the CLI's `--solver` names. Adding a solver is one crate, one entry
 //! here, and its tolerances in the fixtures (`CONTRIBUTING.md`; a test adds a fourth one).
 
-use rotor_model::{Scenario, ScenarioError, Solver};
+use rotor_model::Solver;
+use rotor_scenario::{Scenario, ScenarioError};
 use serde::{Serialize, Serializer};
 
 /// What a solver's accuracy setting is.

@@ -9,7 +9,8 @@
 use std::path::Path;
 use std::time::Instant;
 
-use rotor_model::{Model, Output, Scenario, Scene, Solver};
+use rotor_model::{Model, Output, Scene, Solver};
+use rotor_scenario::Scenario;
 use rotor_switch::{SwitchOptions, SwitchSolver};
 
 fn main() {

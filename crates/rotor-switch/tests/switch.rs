@@ -3,9 +3,10 @@
 use std::path::{Path, PathBuf};
 
 use rotor_model::{
-    Disc, EventKind, Model, OMEGA_L, OMEGA_U, Output, OutputGrid, Scenario, Scene, SolveError,
-    Solver, SteadyState, Trajectory,
+    Disc, EventKind, Model, OMEGA_L, OMEGA_U, Output, OutputGrid, Scene, SolveError, Solver,
+    SteadyState, Trajectory,
 };
+use rotor_scenario::Scenario;
 use rotor_switch::{SwitchOptions, SwitchSolver};
 
 fn solver(eta: f64) -> SwitchSolver {

@@ -1,17 +1,19 @@
-//! Test support for the bad-input tests of `rotor-model` (through `from_file`) and
-//! `rotor-cli` (through the `rotor` binary).
+//! Test support for the bad-input tests of `rotor-model` and `rotor-scenario` (through
+//! `from_file`) and `rotor-cli` (through the `rotor` binary).
 //!
-//! Both test the same bad files; this crate holds them once, so that the library and the
+//! They test the same bad files; this crate holds them once, so that the library and the
 //! binary are held to the same cases. Each case is a real fixture with one mutation (or a
 //! few raw bytes) and the needles, the substrings its error message must contain. What is
 //! checked around the needles (one line starting with the path, an `error:` line on stderr
 //! with a clean exit code, no report written) stays with each test's own harness.
 //!
-//! It also holds [`arenstorf`], the standard orbit both Runge–Kutta steppers are checked on.
+//! It also holds [`mutate`], the fixture edits of both readers' fuzz tests, and [`arenstorf`],
+//! the standard orbit both Runge–Kutta steppers are checked on.
 //!
 //! Dev-dependency only; nothing here is part of the published crates.
 
 pub mod arenstorf;
+pub mod mutate;
 
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicUsize, Ordering};

@@ -42,7 +42,7 @@ pub(crate) fn compare(
 ) -> Result<()> {
     let files = if files.is_empty() {
         let dir = fixtures_dir()?.join("scenarios");
-        rotor_model::Scenario::list_dir(&dir)
+        rotor_scenario::Scenario::list_dir(&dir)
             .with_context(|| format!("{}: cannot list scenarios", dir.display()))?
     } else {
         files

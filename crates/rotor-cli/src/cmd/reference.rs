@@ -29,7 +29,7 @@ pub fn run(a: &Args) -> Result<()> {
 
 /// `rotor reference [--out DIR]`: the reference files of every scenario.
 pub fn write_reference(scenarios_dir: &Path, out: &Path) -> Result<()> {
-    let files = rotor_model::Scenario::list_dir(scenarios_dir)
+    let files = rotor_scenario::Scenario::list_dir(scenarios_dir)
         .with_context(|| format!("{}: cannot list scenarios", scenarios_dir.display()))?;
     let scenarios = files
         .iter()

@@ -3,7 +3,8 @@
 use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result};
-use rotor_model::{Disc, Scenario};
+use rotor_model::Disc;
+use rotor_scenario::Scenario;
 use serde::Serialize;
 
 /// A scene's tier: `table1` when only the lower disc has static friction (what a solver that

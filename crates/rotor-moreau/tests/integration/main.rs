@@ -5,7 +5,8 @@ mod output;
 mod properties;
 mod scenarios;
 
-use rotor_model::{Model, Params, Scenario};
+use rotor_model::{Model, Params};
+use rotor_scenario::Scenario;
 use std::path::{Path, PathBuf};
 
 /// The fixture directory of the workspace.

@@ -5,7 +5,7 @@ use rotor_moreau::MoreauSolver;
 
 use crate::scenarios;
 
-fn scene(sc: &rotor_model::Scenario, h: f64, output: Output) -> Scene {
+fn scene(sc: &rotor_scenario::Scenario, h: f64, output: Output) -> Scene {
     Scene {
         h,
         ..sc.scene(output)

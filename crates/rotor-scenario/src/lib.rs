@@ -1,0 +1,15 @@
+//! The scenario files: the fixtures' TOML format (one scene, run by every solver), each
+//! section validated on its own, and the comparison settings they carry (`[compare]`, the
+//! `[tolerance.<pair>]` gates), which no solver reads.
+//!
+//! See docs/design.md, "Fixtures", and [`scenario`] for the format; [`tolerance`] holds the
+//! `[tolerance.<pair>]` tables.
+
+pub mod scenario;
+pub mod tolerance;
+
+pub use scenario::{CompareSpec, Scenario, ScenarioError};
+pub use tolerance::{
+    CYCLE_KEYS, EQUILIBRIUM_KEYS, PairTolerance, RETIRED_KEYS, STEADY_QUANTITIES, SteadyQuantity,
+    TOLERANCE_KEYS,
+};
