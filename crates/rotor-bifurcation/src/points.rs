@@ -116,7 +116,8 @@ pub struct SpecialPoint {
 }
 
 impl SpecialPoint {
-    pub(crate) fn new(kind: PointKind, u: f64, detail: String) -> SpecialPoint {
+    /// A point of this kind at `u` with no field set but its `detail`.
+    pub fn new(kind: PointKind, u: f64, detail: String) -> SpecialPoint {
         SpecialPoint {
             kind,
             u,

@@ -88,32 +88,6 @@ pub fn locate(
     out
 }
 
-/// A special point with no fields but these.
-pub(crate) fn blank(kind: PointKind, u: f64, detail: String) -> SpecialPoint {
-    SpecialPoint {
-        kind,
-        u,
-        discontinuous: None,
-        omega: None,
-        frequency: None,
-        period: None,
-        omega_l_max: None,
-        omega_l_min: None,
-        residual: None,
-        condition: None,
-        touch_omega_u: None,
-        section_state: None,
-        l1: None,
-        grazing_type: None,
-        period_doubling: None,
-        sigma_plus: None,
-        sigma_minus: None,
-        slipping_multipliers: None,
-        stick_slip_multipliers: None,
-        detail,
-    }
-}
-
 /// Real multipliers above +1 (σ⁺) and below −1 (σ⁻).
 fn sigma(m: &[[f64; 2]]) -> (usize, usize) {
     let real = m.iter().filter(|z| z[1] == 0.0);
@@ -427,7 +401,7 @@ fn grazing(
         fmt(&ss_orbit.multipliers),
         ss_row.stick_time
     );
-    let mut p = blank(
+    let mut p = SpecialPoint::new(
         PointKind::Grazing,
         r2,
         format!(
@@ -525,7 +499,7 @@ fn smooth_fold(
         .copied()
         .unwrap_or([f64::NAN, 0.0]);
     let row = row_of(solver, model, &opts.scene(at.u), &at.orbit, 0)?;
-    let mut p = blank(
+    let mut p = SpecialPoint::new(
         PointKind::Fold,
         u_est,
         format!(
@@ -570,7 +544,7 @@ pub(crate) fn stability_changes(
             ) && (lo..=hi).contains(&p.u)
         });
         if !explained {
-            let mut p = blank(
+            let mut p = SpecialPoint::new(
                 PointKind::StabilityChange,
                 0.5 * (a.u + b.u),
                 format!(
