@@ -7,12 +7,13 @@
 //! checked around the needles (one line starting with the path, an `error:` line on stderr
 //! with a clean exit code, no report written) stays with each test's own harness.
 //!
-//! It also holds [`mutate`], the fixture edits of both readers' fuzz tests, and [`arenstorf`],
+//! It also holds `mutate` (feature `mutate`), the fixture edits of both readers' fuzz tests, and [`arenstorf`],
 //! the standard orbit both Runge–Kutta steppers are checked on.
 //!
 //! Dev-dependency only; nothing here is part of the published crates.
 
 pub mod arenstorf;
+#[cfg(feature = "mutate")]
 pub mod mutate;
 
 use std::path::{Path, PathBuf};
