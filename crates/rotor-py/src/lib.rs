@@ -402,7 +402,8 @@ fn steady<'py>(
     let model = Model::new(params_of(params)?);
     warn_ignored(py, &req)?;
     let answer = detached(py, move || {
-        rotor_steady::steady(kind, &model, &scene, &opts)
+        // As `rotor steady` without --method: checked shooting, else simulation.
+        rotor_steady::checked::checked_or_simulated(kind, &model, &scene, &opts)
     })?
     .map_err(|e| from_steady(py, e))?;
     warn_inexact(py, &answer.stats)?;
@@ -467,7 +468,9 @@ fn sweep<'py>(
     let answers: Vec<Result<SteadyAnswer, SteadyError>> = detached(py, move || {
         pool.install(|| {
             jobs.par_iter()
-                .map(|(kind, scene, opts)| rotor_steady::steady(*kind, &model, scene, opts))
+                .map(|(kind, scene, opts)| {
+                    rotor_steady::checked::checked_or_simulated(*kind, &model, scene, opts)
+                })
                 .collect()
         })
     })?;
