@@ -539,25 +539,7 @@ pub(crate) fn orbit_answer(
             ..scene.clone()
         },
     )?;
-    let state = run
-        .metrics
-        .ok_or(SteadyError::Shoot(rotor_shoot::ShootError::NoReturn {
-            what: orbit.section.as_str(),
-            horizon: t_end,
-            z: orbit.z.clone(),
-        }))?;
-    let mut multipliers = vec![Complex::new(1.0, 0.0)];
-    multipliers.extend(orbit.multipliers.iter().map(|m| Complex::new(m[0], m[1])));
-    if multipliers.len() == 2 {
-        multipliers.push(Complex::new(0.0, 0.0));
-    }
-    Ok(SteadyAnswer {
-        state,
-        method: SteadyMethod::Shoot,
-        multipliers: Some(multipliers),
-        stable: Some(orbit.is_stable()),
-        stats: run.stats,
-    })
+    crate::steady::shot_answer(orbit, run, t_end)
 }
 
 #[cfg(test)]

@@ -202,10 +202,20 @@ pub fn shot(kind: SolverKind, model: &Model, scene: &Scene) -> Result<SteadyAnsw
             ..scene.clone()
         },
     )?;
+    shot_answer(&orbit, run, t_end)
+}
+
+/// The answer of a shot orbit: the metrics of `run` (two periods from the orbit's state,
+/// `t_end` long) and the orbit's multipliers, with the trivial one first.
+pub(crate) fn shot_answer(
+    orbit: &rotor_shoot::Orbit,
+    run: rotor_model::Trajectory,
+    t_end: f64,
+) -> Result<SteadyAnswer, SteadyError> {
     let state = run
         .metrics
         .ok_or(SteadyError::Shoot(rotor_shoot::ShootError::NoReturn {
-            what: section.as_str(),
+            what: orbit.section.as_str(),
             horizon: t_end,
             z: orbit.z.clone(),
         }))?;
