@@ -272,8 +272,23 @@ fn drain(mut r: impl Read + Send + 'static) -> std::thread::JoinHandle<String> {
     })
 }
 
+/// The thread-count variables of the usual BLAS and OpenMP runtimes. Every client runs with
+/// each one set to 1 unless the bench's own environment sets it: the bench times
+/// single-threaded solvers (the Rust ones are), and a 2 × 2 or 4 × 4 system gains nothing
+/// from threads but loses to their start-up and spinning. Measured: Siconos 4.5's
+/// `TimeStepping` on st-u2.5-rest at h = 1e-2 took 4.8 s with OpenBLAS's default threads
+/// (1.9 s of it in the kernel, 576 507 `sched_yield` calls) and 1.2 s with one; scipy's
+/// Radau and BDF and Octave's ode45 ran in the same CPU time either way.
+pub const SINGLE_THREAD_ENV: [&str; 4] = [
+    "OPENBLAS_NUM_THREADS",
+    "OMP_NUM_THREADS",
+    "MKL_NUM_THREADS",
+    "BLIS_NUM_THREADS",
+];
+
 /// Runs `argv` with the job file's path appended, in its own process group, for at most
-/// `timeout` seconds. `Err` if it cannot be started.
+/// `timeout` seconds, with [`SINGLE_THREAD_ENV`] set to 1 where the bench's environment does
+/// not set them. `Err` if it cannot be started.
 pub fn run_client(argv: &[String], job: &Path, timeout: f64) -> Result<RunOutput, String> {
     let mut cmd = Command::new(&argv[0]);
     cmd.args(&argv[1..])
@@ -281,6 +296,11 @@ pub fn run_client(argv: &[String], job: &Path, timeout: f64) -> Result<RunOutput
         .stdin(Stdio::null())
         .stdout(Stdio::piped())
         .stderr(Stdio::piped());
+    for var in SINGLE_THREAD_ENV {
+        if std::env::var_os(var).is_none() {
+            cmd.env(var, "1");
+        }
+    }
     #[cfg(unix)]
     {
         use std::os::unix::process::CommandExt;
@@ -427,5 +447,26 @@ mod tests {
             Some(0.25)
         );
         assert!(run_client(&["/no/such/binary".into()], &dir, 1.0).is_err());
+    }
+
+    /// A client sees each thread-count variable as 1, or as the bench's environment sets
+    /// it (the sh client prints them; the job path it is given is ignored).
+    #[test]
+    fn a_client_runs_single_threaded_unless_told_otherwise() {
+        let script = SINGLE_THREAD_ENV
+            .iter()
+            .map(|v| format!("echo {v}=${{{v}:-unset}}"))
+            .collect::<Vec<_>>()
+            .join("; ");
+        let argv: Vec<String> = vec!["sh".into(), "-c".into(), script];
+        let r = run_client(&argv, &std::env::temp_dir(), 10.0).unwrap();
+        for v in SINGLE_THREAD_ENV {
+            let want = std::env::var(v).unwrap_or_else(|_| "1".into());
+            assert!(
+                r.stdout.lines().any(|l| l == format!("{v}={want}")),
+                "{v}: {}",
+                r.stdout
+            );
+        }
     }
 }
