@@ -158,6 +158,14 @@ pub struct Environment {
     /// minima-based ones are the least sensitive).
     pub load_start: Option<[f64; 3]>,
     pub load_end: Option<[f64; 3]>,
+    /// External clients run side by side (`BenchOptions::jobs`; 1 in reports written before
+    /// the option existed).
+    #[serde(default = "one")]
+    pub jobs: usize,
+}
+
+fn one() -> usize {
+    1
 }
 
 /// The 1, 5 and 15 minute load averages, where the system reports them.
@@ -296,28 +304,16 @@ pub fn run(opts: &BenchOptions, mut progress: impl FnMut(&str)) -> Result<BenchR
     });
     std::fs::create_dir_all(&work)
         .map_err(|e| BenchError::Work(format!("{}: cannot create: {e}", work.display())))?;
-    let mut clients = Vec::new();
-    for launch in peers::peers(opts, &mut progress) {
-        clients.push(match launch {
-            Ok((spec, ladder)) => clients::run(&spec, &ladder, opts, &loaded, &work, &mut progress),
-            Err(skipped) => *skipped,
-        });
-    }
-    for spec in &opts.clients {
+    let mut launches = peers::peers(opts, &mut progress);
+    launches.extend(opts.clients.iter().map(|spec| {
         let ladder = if spec.fixed_step {
             &opts.client_hs
         } else {
             &opts.client_tols
         };
-        clients.push(clients::run(
-            spec,
-            ladder,
-            opts,
-            &loaded,
-            &work,
-            &mut progress,
-        ));
-    }
+        Ok((spec.clone(), ladder.clone()))
+    }));
+    let clients = run_clients(launches, opts, &loaded, &work, &mut progress);
     if opts.keep.is_none() {
         let _ = std::fs::remove_dir_all(&work);
     }
@@ -336,9 +332,60 @@ pub fn run(opts: &BenchOptions, mut progress: impl FnMut(&str)) -> Result<BenchR
             time_budget_s: opts.time_budget,
             load_start,
             load_end: load_average(),
+            jobs: opts.jobs.max(1),
         },
         shard: shard_info,
     })
+}
+
+/// Runs every client that is not skipped over its ladder, `opts.jobs` clients side by side
+/// (each on its own thread, its runs one after the other), and returns the reports in the
+/// launches' order. The workers' progress lines reach `progress` on this thread.
+fn run_clients(
+    launches: Vec<peers::PeerLaunch>,
+    opts: &BenchOptions,
+    loaded: &[(Loaded, Vec<LadderPoint>)],
+    work: &std::path::Path,
+    progress: &mut impl FnMut(&str),
+) -> Vec<ClientReport> {
+    use std::sync::Mutex;
+    use std::sync::atomic::{AtomicUsize, Ordering};
+    let reports: Vec<Mutex<Option<ClientReport>>> =
+        launches.iter().map(|_| Mutex::new(None)).collect();
+    let next = AtomicUsize::new(0);
+    let (tx, rx) = std::sync::mpsc::channel::<String>();
+    std::thread::scope(|scope| {
+        for _ in 0..opts.jobs.max(1).min(launches.len()) {
+            let tx = tx.clone();
+            let (launches, reports, next) = (&launches, &reports, &next);
+            scope.spawn(move || {
+                let mut say = |m: &str| {
+                    let _ = tx.send(m.to_owned());
+                };
+                loop {
+                    let k = next.fetch_add(1, Ordering::Relaxed);
+                    let Some(launch) = launches.get(k) else {
+                        break;
+                    };
+                    let r = match launch {
+                        Ok((spec, ladder)) => {
+                            clients::run(spec, ladder, opts, loaded, work, &mut say)
+                        }
+                        Err(skipped) => (**skipped).clone(),
+                    };
+                    *reports[k].lock().unwrap_or_else(|e| e.into_inner()) = Some(r);
+                }
+            });
+        }
+        drop(tx);
+        for m in rx {
+            progress(&m);
+        }
+    });
+    reports
+        .into_iter()
+        .filter_map(|r| r.into_inner().unwrap_or_else(|e| e.into_inner()))
+        .collect()
 }
 
 /// The model and base scene of a scene spec (for benches and tests that drive the solvers

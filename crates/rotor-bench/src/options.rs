@@ -233,6 +233,11 @@ pub struct BenchOptions {
     /// Where to keep every external run's files (`DIR/CLIENT/SCENE/runK`: job.json,
     /// trace.csv, events.csv, stderr.txt); `None`: a temporary directory, deleted after.
     pub keep: Option<std::path::PathBuf>,
+    /// External clients (peers included) run side by side, each over its whole ladder; at
+    /// least 1. Each client's runs stay one after the other, each process single-threaded
+    /// ([`crate::protocol::SINGLE_THREAD_ENV`]); the Rust solvers are timed before any client
+    /// starts, alone.
+    pub jobs: usize,
 }
 
 /// The workspace root: the current directory if it holds `fixtures/`, else the checkout
@@ -309,6 +314,7 @@ impl Default for BenchOptions {
             client_hs: vec![1e-2, 1e-3, 1e-4],
             shard: None,
             keep: None,
+            jobs: 1,
         }
     }
 }

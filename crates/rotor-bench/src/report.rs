@@ -123,9 +123,14 @@ impl BenchReport {
             |l: Option<[f64; 3]>| l.map_or("?".into(), |[a, b, c]| format!("{a:.2} {b:.2} {c:.2}"));
         let _ = writeln!(
             s,
-            "measured on {} core(s){}, median of up to {} runs per point within {} s; load \
+            "measured on {} core(s){}{}, median of up to {} runs per point within {} s; load \
              average {} at the start, {} at the end",
             env.cores,
+            if env.jobs > 1 {
+                format!(", {} external clients side by side", env.jobs)
+            } else {
+                String::new()
+            },
             if env.debug_build {
                 ", DEBUG BUILD (times not meaningful)"
             } else {

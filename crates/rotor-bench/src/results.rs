@@ -81,13 +81,22 @@ impl BenchReport {
              Suite **{}**, {} scenes, written by `{command}`. `just bench` regenerates it \
              over the whole suite, with `bench.json`, `bench.csv`, `bench.svg` (the \
              work-precision plots and the performance profiles) and `bench.txt`.\n\n\
-             Measured on {} core(s), one run at a time, load average {} at the start and {} at \
+             Measured on {} core(s), {}, load average {} at the start and {} at \
              the end; times are the median of up to {} runs within {} s per point (a run longer \
              than that is timed once), in-process (`solve_seconds`) where a client reports it. \
              Absolute times move with the machine; compare ratios measured in one run.\n",
             self.benchmark,
             self.scenes.len(),
             env.cores,
+            if env.jobs > 1 {
+                format!(
+                    "the Rust solvers alone, then {} external clients side by side (each \
+                     single-threaded, its own runs one at a time)",
+                    env.jobs
+                )
+            } else {
+                "one run at a time".to_owned()
+            },
             env.load_start
                 .map_or("?".into(), |l| format!("{:.1}", l[0])),
             env.load_end.map_or("?".into(), |l| format!("{:.1}", l[0])),

@@ -165,6 +165,43 @@ fn external_clients_correct_hanging_and_crashing() {
     assert!(r.profile.entries.iter().any(|e| e.name == "minimal"));
 }
 
+/// With `jobs = 2` two clients run side by side: client `a` waits (up to 5 s) for client
+/// `b` to have started, which it sees only if they run at the same time; with `jobs = 1` it
+/// does not. The reports keep the clients' order either way.
+#[test]
+fn two_jobs_run_two_clients_side_by_side() {
+    for jobs in [1, 2] {
+        let dir = std::env::temp_dir().join(format!("rotor-jobs-{}-{jobs}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let d = dir.display();
+        let a = format!(
+            "a=sh -c 'i=0; while [ ! -e {d}/b ] && [ $i -lt 100 ]; do sleep 0.05; i=$((i+1)); \
+             done; [ -e {d}/b ] && touch {d}/a-saw-b; exit 3'"
+        );
+        let b = format!("b=sh -c 'touch {d}/b; sleep 1; exit 3'");
+        let o = BenchOptions {
+            clients: vec![
+                ClientSpec::parse(&a, &[]).unwrap(),
+                ClientSpec::parse(&b, &[]).unwrap(),
+            ],
+            client_tols: vec![1e-6],
+            timeout: 30.0,
+            jobs,
+            ..options()
+        };
+        let r = run(&o, |m| eprintln!("{m}")).unwrap();
+        let names: Vec<&str> = r.clients.iter().map(|c| c.name.as_str()).collect();
+        assert_eq!(names[names.len() - 2..], ["a", "b"], "jobs = {jobs}");
+        assert_eq!(r.environment.jobs, jobs);
+        for c in &r.clients[names.len() - 2..] {
+            let f = c.scenes[0].points[0].failure.as_ref().unwrap();
+            assert_eq!(f.kind, FailureKind::Exit, "jobs = {jobs}: {f:?}");
+        }
+        assert_eq!(dir.join("a-saw-b").exists(), jobs == 2, "jobs = {jobs}");
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+}
+
 /// The regularised client (tanh(omega/1e-3), LSODA) runs, and fails the loose gate with the
 /// failing quantities named, among them the lower disc's stick intervals (its disc creeps
 /// instead of sticking, so the trace shows none of them).

@@ -865,6 +865,10 @@ fn bench_shards_merge_to_one_run_timings_aside() {
     let o = rotor(&["bench", "--quick", "--shard", "2/2", "--json", "-"]);
     let err = String::from_utf8_lossy(&o.stderr);
     assert!(!o.status.success() && err.contains("--shard 2/2"), "{err}");
+    let o = rotor(&["bench", "--quick", "--jobs", "0", "--json", "-"]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(!o.status.success() && err.contains("--jobs 0"), "{err}");
+    assert!(o.stdout.is_empty());
     std::fs::remove_dir_all(&dir).ok();
 }
 

@@ -54,13 +54,18 @@ pub struct Args {
     /// DIR/CLIENT/SCENE/runK instead of deleting them.
     #[arg(long, value_name = "DIR")]
     pub keep: Option<PathBuf>,
+    /// External clients (peers included) to run side by side, each single-threaded with
+    /// its runs one after the other (default: 2, or 1 on a one-core machine). The Rust
+    /// solvers are timed first, alone. 1 gives the quietest times.
+    #[arg(long, value_name = "N")]
+    pub jobs: Option<usize>,
     /// Run nothing: join the reports of `--shard` runs (any order) into the report one
     /// run writes, timings aside (BENCHMARK.md), written with --json, --svg, --csv.
     #[arg(
         long,
         value_name = "SHARD.json",
         num_args = 1..,
-        conflicts_with_all = ["shard", "quick", "no_peers", "external", "fixed_step", "scenario", "keep", "tier"]
+        conflicts_with_all = ["shard", "quick", "no_peers", "external", "fixed_step", "scenario", "keep", "tier", "jobs"]
     )]
     pub merge: Vec<PathBuf>,
 }
@@ -81,6 +86,7 @@ pub fn run(a: &Args) -> Result<()> {
             scenarios: &a.scenario,
             shard: a.shard.as_deref(),
             keep: a.keep.as_deref(),
+            jobs: a.jobs,
             tier: a.tier.as_deref(),
             results: a.results.as_deref(),
         },
@@ -95,6 +101,7 @@ pub(crate) struct BenchClients<'a> {
     scenarios: &'a [PathBuf],
     shard: Option<&'a str>,
     keep: Option<&'a Path>,
+    jobs: Option<usize>,
     tier: Option<&'a str>,
     results: Option<&'a Path>,
 }
@@ -151,6 +158,11 @@ pub(crate) fn bench(
         .map(rotor_jobs::sweep::Shard::parse)
         .transpose()?;
     opts.keep = clients.keep.map(Path::to_path_buf);
+    opts.jobs = match clients.jobs {
+        Some(0) => bail!("--jobs 0: at least one client must run at a time"),
+        Some(n) => n,
+        None => std::thread::available_parallelism().map_or(1, |n| n.get().min(2)),
+    };
     let report = rotor_bench::run(&opts, |m| eprintln!("{m}"))?;
     write_bench(&report, [json, svg, csv])?;
     write_results(&report, clients.results)?;
