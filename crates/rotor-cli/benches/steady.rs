@@ -2,10 +2,12 @@
 //! timings move by ±15 %, and more when the cores are shared).
 //!
 //! ```sh
-//! cargo bench -p rotor-cli --bench steady              # rotor steady next to H1
+//! cargo bench -p rotor-cli --bench steady              # steady next to H1, bifurcation
 //! ROTOR_BENCH_MAIN=1 cargo bench -p rotor-cli --bench steady   # and the main job
 //! ```
 //!
+//! * `rotor bifurcation --solver S` on Table 1 over u ∈ [0, 7] (the command's defaults), for
+//!   every solver: the median wall time of 3 processes and their mean CPU time;
 //! * `rotor steady --solver S --u V` at 1e-4 V above Table 1's first Hopf point H1, from
 //!   rest, for every solver, by `--method shoot`, by the default (checked shooting, falling
 //!   back to simulation when the check refuses) and by `--method simulate`: the median wall
@@ -87,6 +89,18 @@ fn main() {
             "  {solver:<7} shoot {s:>7.3} s ({sc:.3} s CPU)   default {d:>7.3} s ({dc:.3} s CPU)   \
              simulate {m:>7.3} s ({mc:.3} s CPU)"
         );
+    }
+    println!("rotor bifurcation, Table 1, u in [0, 7]; wall (median of 3) and CPU per process:");
+    let json = dir.join("diagram.json");
+    let json = json.to_str().expect("a UTF-8 temporary path");
+    for solver in ["event", "switch", "moreau"] {
+        let (w, c) = timed(
+            bin,
+            &["bifurcation", "--solver", solver, "--json", json],
+            &dir,
+            3,
+        );
+        println!("  {solver:<7} {w:>7.3} s ({c:.3} s CPU)");
     }
     if std::env::var_os("ROTOR_BENCH_MAIN").is_some() {
         let c0 = children_cpu();
