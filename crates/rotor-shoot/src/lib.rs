@@ -207,6 +207,17 @@ pub enum ShootError {
     NotACycle { t_end: f64 },
 }
 
+/// The first run's horizon before any return is known \[s\]: two of the longest periods
+/// here (4–6 s) and a margin, a fifth of the default horizon.
+const FIRST_WINDOW: f64 = 12.0;
+
+/// How long before a run's end a return must lie to be the full horizon's return \[s\]. A
+/// run's last step may be shortened to land on its end, and an extremum is located from the
+/// steps around it, so events in the last steps of a short run can differ from a longer
+/// run's; 1 s is a thousand of Moreau–Jean's steps at h = 1e-3 and more than any adaptive
+/// step of the switch model or the event-driven solver at the shooting's tolerances.
+const END_MARGIN: f64 = 1.0;
+
 /// The return map of one solver on one section.
 struct Map<'a> {
     solver: &'a dyn Solver,
@@ -221,14 +232,23 @@ struct Map<'a> {
 
 impl Map<'_> {
     /// `P(z)` and the return time. Once one return is known, a run covers 1.5× its time (a
-    /// run to the full horizon would integrate ten periods to use one); a return not found
-    /// there is looked for over the whole horizon.
+    /// run to the full horizon would integrate ten periods to use one); before that, a run
+    /// covers [`FIRST_WINDOW`], and a return found there at least [`END_MARGIN`] before its
+    /// end is taken: the steps before that are the full horizon's own, so the return is the
+    /// one the full run would find. A return not found there is looked for over the whole
+    /// horizon.
     fn at(&mut self, z: &[f64]) -> Result<(Vec<f64>, f64), ShootError> {
         if let Some(t) = self.last_return {
             let short = (1.5 * t + self.opts.skip).min(self.opts.horizon);
             if let Some(found) = self.run(z, short)? {
                 return Ok(found);
             }
+        } else if FIRST_WINDOW < self.opts.horizon
+            && let Some(found) = self.run(z, FIRST_WINDOW)?
+            && found.1 <= FIRST_WINDOW - END_MARGIN
+        {
+            self.last_return = Some(found.1);
+            return Ok(found);
         }
         let found = self
             .run(z, self.opts.horizon)?
