@@ -462,8 +462,8 @@ impl SolveError {
 /// `rotor_event::EventSolver` (the accuracy reference), `rotor_switch::SwitchSolver` and
 /// `rotor_moreau::MoreauSolver`; `rotor_solvers::SOLVERS` lists them, with a constructor for
 /// each. For a runnable example of [`Solver::simulate`] on a Table 1 scene see the docs of
-/// `rotor_event::EventSolver`, and those of `rotor_solvers::SolverKind` for all three
-/// solvers picked by name.
+/// `rotor_event::EventSolver`, and those of `rotor_solvers::SolverKind::solver` for all
+/// three solvers in turn.
 pub trait Solver: Sync {
     /// Short name (`"event"`, `"switch"`, `"moreau"`).
     fn name(&self) -> &'static str;
