@@ -15,13 +15,14 @@ use crate::event::{Event, EventKind};
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(tag = "kind", rename_all = "snake_case")]
 pub enum SteadyState {
-    /// An equilibrium (rad, rad/s).
+    /// An equilibrium (rad, rad/s): a run's final state when read off a run
+    /// ([`MetricsAccumulator::finish`]), or the solved equilibrium.
     Equilibrium {
-        /// ω_u [rad/s] at the end of the run (equal to ω_l at an equilibrium).
+        /// ω_u [rad/s] (equal to ω_l at an equilibrium, up to how the run approached it).
         omega_u: f64,
-        /// ω_l [rad/s] at the end of the run; exactly 0 when the lower disc is stuck.
+        /// ω_l [rad/s]; exactly 0 when the lower disc is stuck.
         omega_l: f64,
-        /// α \[rad\]: the spring's twist at the end of the run.
+        /// α \[rad\]: the spring's twist.
         alpha: f64,
     },
     /// A periodic orbit: period \[s\], extremes [rad/s], time per period with ω_l = 0 \[s\].
