@@ -53,29 +53,37 @@ impl FailureKind {
 /// A run's failure with its reason.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Failure {
+    /// What kind of failure.
     pub kind: FailureKind,
+    /// The reason: the exit status, the grade's error, the tail of standard error, ...
     pub detail: String,
 }
 
 /// One setting of a client on one scene.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct ClientPoint {
+    /// The client's tolerance, or its step h (s).
     pub setting: f64,
     /// Wall time of the whole process (from the spawn to the exit).
     pub wall: Option<Timing>,
     /// The client's own in-process time (`solve_seconds`), when every timed run gave one.
     pub solve: Option<Timing>,
+    /// Its errors against the reference, measured as the Rust solvers' are.
     pub errors: Errors,
+    /// The steps it reported taking.
     pub steps: Option<u64>,
+    /// The right-hand-side evaluations it reported.
     pub rhs_evals: Option<u64>,
     /// The trace's significant correct digits, as `rotor check` counts them (the fewest of
     /// any graded quantity).
     pub digits: Option<f64>,
     /// Whether the trace passes the strict and loose levels (as `rotor check`).
     pub passes_strict: Option<bool>,
+    /// Whether the trace passes the loose level (see `passes_strict`).
     pub passes_loose: Option<bool>,
     /// The quantities failing the loose gate.
     pub failing: Vec<String>,
+    /// Why the run gave no usable point, or fails the gate.
     pub failure: Option<Failure>,
     /// The protocol's own cost of this run, not the client's: writing the job file, and
     /// reading and grading the trace \[s\].
@@ -93,6 +101,8 @@ impl ClientPoint {
 /// Client time / Rust time at the client's error.
 #[derive(Debug, Clone, Serialize, Deserialize)]
 pub struct Ratio {
+    /// The Rust solver of the client's class: event-driven for a tolerance, Moreau–Jean for
+    /// a step.
     pub against: SolverKind,
     /// `"steady_rel"` or `"transient_max"`.
     #[serde(deserialize_with = "crate::word::static_str")]
@@ -100,8 +110,11 @@ pub struct Ratio {
     /// `"in_process"` (the client's `solve_seconds`) or `"whole_process"` (its wall time).
     #[serde(deserialize_with = "crate::word::static_str")]
     pub time: crate::word::Word,
+    /// The client point's setting (tolerance, or h in s).
     pub setting: f64,
+    /// Its error of kind `error_kind`.
     pub error: f64,
+    /// Its time (s), median of the timed runs.
     pub client_seconds: f64,
     /// The Rust solver's time at that error (interpolated on its work-precision front).
     pub rust_seconds: f64,
@@ -117,23 +130,32 @@ pub struct Ratio {
 /// Time per step of a fixed-step client vs rotor-moreau at one h.
 #[derive(Debug, Clone, Serialize, Deserialize)]
 pub struct PerStep {
+    /// The step (s).
     pub h: f64,
+    /// The client's in-process time over its reported steps (s, median).
     pub client_s_per_step: f64,
+    /// rotor-moreau's time over its steps at the same h (s, median).
     pub moreau_s_per_step: f64,
     /// client / moreau time per step (medians, the client's in-process time).
     pub ratio: f64,
     /// The same from the fastest runs of each.
     pub ratio_of_minima: f64,
+    /// The client's errors at that h.
     pub client_errors: Errors,
+    /// rotor-moreau's errors at that h.
     pub moreau_errors: Errors,
 }
 
 /// A client on one scene.
 #[derive(Debug, Clone, Serialize, Deserialize)]
 pub struct ClientScene {
+    /// The scene's name.
     pub scene: String,
+    /// One point per setting of the client's ladder.
     pub points: Vec<ClientPoint>,
+    /// Time ratios at equal error against the Rust solver of its class.
     pub ratios: Vec<Ratio>,
+    /// Time per step against rotor-moreau (fixed-step clients that report their steps).
     pub per_step: Vec<PerStep>,
 }
 
@@ -150,6 +172,7 @@ pub enum ClientStatus {
 }
 
 impl ClientStatus {
+    /// The report's name: `ran`, `skipped` or `failed`.
     pub fn as_str(self) -> &'static str {
         match self {
             ClientStatus::Ran => "ran",
@@ -172,19 +195,28 @@ pub struct Overhead {
 /// One client over every scene.
 #[derive(Debug, Clone, Serialize, Deserialize)]
 pub struct ClientReport {
+    /// The client's name.
     pub name: String,
+    /// Its command line, as it is run (without the job file's path).
     pub command: String,
+    /// Whether it is one of the repository's peers (scipy, Siconos, Octave).
     pub peer: bool,
+    /// Whether its knob is a step h rather than a tolerance.
     pub fixed_step: bool,
     /// `"tol"` or `"h"`.
     #[serde(deserialize_with = "crate::word::static_str")]
     pub setting_name: crate::word::Word,
+    /// Whether it ran.
     pub status: ClientStatus,
     /// Why it was skipped or failed.
     pub reason: Option<String>,
+    /// Its version, as it reported it.
     pub version: Option<String>,
+    /// Its method, as it named it.
     pub method: Option<String>,
+    /// Its points and ratios, scene by scene.
     pub scenes: Vec<ClientScene>,
+    /// The protocol's and the process's overhead, if it ran.
     pub overhead: Option<Overhead>,
 }
 

@@ -17,25 +17,37 @@ use crate::options::{BenchOptions, SceneSpec, SolverKind};
 /// One scene: its reference and every ladder point.
 #[derive(Debug, Clone, Serialize, Deserialize)]
 pub struct SceneReport {
+    /// The scenario's name.
     pub name: String,
     /// `table1` or `full` ([`crate::Tier`]).
     #[serde(default)]
     pub tier: String,
+    /// The scenario's description.
     pub description: String,
+    /// Motor input voltage u \[V\].
     pub u: f64,
+    /// Initial state `[α, ω_u, ω_l]` (rad, rad/s, rad/s).
     pub x0: [f64; 3],
+    /// Horizon of every run (s).
     pub t_end: f64,
+    /// Start of the steady-state window `[metrics_from, t_end]` (s).
     pub metrics_from: f64,
+    /// Window `[t0, t1]` (s) on which the transient error is read.
     pub transient: [f64; 2],
+    /// Grid step of the traces (s).
     pub dt: f64,
+    /// The reference run.
     pub reference: ReferenceReport,
+    /// Every solver's ladder points, solver by solver, in the order of the options' ladders.
     pub points: Vec<LadderPoint>,
 }
 
 /// The reference run and the estimate of its own error.
 #[derive(Debug, Clone, Serialize, Deserialize)]
 pub struct ReferenceReport {
+    /// The reference solver (the event-driven one).
     pub solver: SolverKind,
+    /// Its tolerance ([`BenchOptions::reference_tol`]).
     pub tol: f64,
     /// `limit_cycle` or `equilibrium` (the steady state over `[metrics_from, t_end]`).
     #[serde(default = "cycle_word", deserialize_with = "crate::word::static_str")]
@@ -46,6 +58,7 @@ pub struct ReferenceReport {
     pub omega_l_max: Option<f64>,
     /// One untimed run (s).
     pub seconds: f64,
+    /// Work counters of that run.
     pub stats: Stats,
     /// Tolerance of the check run.
     pub check_tol: f64,
@@ -63,14 +76,18 @@ fn cycle_word() -> crate::word::Word {
 /// One solver at one accuracy setting.
 #[derive(Debug, Clone, Serialize, Deserialize)]
 pub struct LadderPoint {
+    /// The solver.
     pub solver: SolverKind,
     /// `tol` or `h`.
     #[serde(deserialize_with = "crate::word::static_str")]
     pub setting_name: crate::word::Word,
+    /// The setting's value (h in s).
     pub setting: f64,
     /// `None` if the run failed.
     pub timing: Option<Timing>,
+    /// Its errors against the reference (all `None` if the run failed).
     pub errors: Errors,
+    /// Work counters of one run.
     pub stats: Stats,
     /// Why the run failed, if it did.
     pub failure: Option<String>,

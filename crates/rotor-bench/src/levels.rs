@@ -12,9 +12,12 @@ use crate::options::{BenchOptions, SolverKind};
 /// Metrics-only vs final-state-only vs full-trace run of one solver (all with metrics).
 #[derive(Debug, Clone, Serialize, Deserialize)]
 pub struct OutputLevel {
+    /// The solver.
     pub solver: SolverKind,
+    /// `tol` or `h`.
     #[serde(deserialize_with = "crate::word::static_str")]
     pub setting_name: crate::word::Word,
+    /// The setting's value (h in s).
     pub setting: f64,
     /// `Output::Metrics`: skips whole periods once the cycle has converged.
     pub metrics_only: Timing,
@@ -28,11 +31,13 @@ pub struct OutputLevel {
     pub final_ratio: f64,
     /// Samples and events the metrics-only run kept (0 and 0 when the level is honoured).
     pub metrics_only_samples: usize,
+    /// Events the metrics-only run kept (see `metrics_only_samples`).
     pub metrics_only_events: usize,
     /// Samples the full-trace run kept.
     pub full_trace_samples: usize,
     /// Whole periods the metrics-only run skipped, and skips it undid.
     pub skipped_periods: u64,
+    /// Skips the metrics-only run undid (see `skipped_periods`).
     pub undone_skips: u64,
     /// Largest difference of a metric between the metrics-only and the full-trace run,
     /// relative to max(|m|, 1); `None` if they do not report the same kind of steady state.

@@ -30,6 +30,8 @@
 //!
 //! Nothing here asserts a speed: ratios are measured side by side and reported.
 
+#![warn(missing_docs)]
+
 mod clients;
 mod ladder;
 mod levels;
@@ -80,8 +82,11 @@ pub enum BenchError {
     /// The reference run failed.
     #[error("reference run of {scene} (event, tol {tol:e}) failed: {source}")]
     Reference {
+        /// The scene's name.
         scene: String,
+        /// The reference's tolerance.
         tol: f64,
+        /// Why the run failed.
         #[source]
         source: SolveError,
     },
@@ -90,14 +95,22 @@ pub enum BenchError {
         "reference run of {scene} gives no steady state in [metrics_from, t_end] or no sample \
          in the transient window; choose windows inside [0, t_end]"
     )]
-    NoReferenceCycle { scene: String },
+    NoReferenceCycle {
+        /// The scene's name.
+        scene: String,
+    },
     /// A run outside the ladders failed (output-level timing).
     #[error("{solver} at {setting_name} = {setting:e} on {scene} failed: {source}")]
     Solve {
+        /// The solver's name.
         solver: &'static str,
+        /// `tol` or `h`.
         setting_name: &'static str,
+        /// Its value (h in s).
         setting: f64,
+        /// The scene's name.
         scene: String,
+        /// Why the run failed.
         #[source]
         source: SolveError,
     },
@@ -106,7 +119,12 @@ pub enum BenchError {
     Work(String),
     /// The report holds a non-finite number (a bug): nothing is written.
     #[error("the benchmark report holds {path} = {value}: not written (JSON has no NaN)")]
-    NonFinite { path: String, value: f64 },
+    NonFinite {
+        /// Where in the report, as a dotted path with indices (`scenes[0].ladders[1]...`).
+        path: String,
+        /// The value found there (NaN or ±∞).
+        value: f64,
+    },
     /// Shard reports that do not fit together (`rotor bench --merge`).
     #[error("{0}")]
     Merge(String),
@@ -157,6 +175,7 @@ pub struct Environment {
     /// count means the times are inflated by other processes (the ratios less so: the
     /// minima-based ones are the least sensitive).
     pub load_start: Option<[f64; 3]>,
+    /// The same when the run ended.
     pub load_end: Option<[f64; 3]>,
     /// External clients run side by side (`BenchOptions::jobs`; 1 in reports written before
     /// the option existed).

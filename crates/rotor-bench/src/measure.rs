@@ -84,11 +84,19 @@ pub fn scene_at(base: &Scene, kind: SolverKind, setting: f64, output: Output) ->
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum SteadyRef {
     /// The last complete cycle: period (s), max ω_l (rad/s).
-    Cycle { period: f64, omega_l_max: f64 },
+    Cycle {
+        /// Period (s).
+        period: f64,
+        /// Largest ω_l over the cycle (rad/s).
+        omega_l_max: f64,
+    },
     /// The equilibrium (or the stuck set): α (rad), ω_u, ω_l (rad/s).
     Equilibrium {
+        /// α (rad).
         alpha: f64,
+        /// ω_u (rad/s).
         omega_u: f64,
+        /// ω_l (rad/s).
         omega_l: f64,
     },
 }

@@ -17,6 +17,7 @@ pub use crate::word::CRITERION;
 /// One solver or client in the profile.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct ProfileEntry {
+    /// The solver's or client's name.
     pub name: String,
     /// Its time per scene \[s\] (`None`: not solved).
     pub times: Vec<Option<f64>>,
@@ -30,9 +31,12 @@ pub struct Profile {
     /// The tier whose scenes it is over (`full`: every scene of the run; `table1`).
     #[serde(default)]
     pub tier: String,
+    /// What counts as solved, and which time is taken ([`CRITERION`]).
     #[serde(deserialize_with = "crate::word::static_str")]
     pub criterion: crate::word::Word,
+    /// The scenes' names, in the order of each entry's `times` and `ratios`.
     pub scenes: Vec<String>,
+    /// The solvers first, then the clients that ran.
     pub entries: Vec<ProfileEntry>,
 }
 

@@ -18,8 +18,12 @@ use serde::Serialize;
 /// knob is a step `h` rather than a tolerance.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct ClientSpec {
+    /// Its name in the report (`NAME` of `--external NAME=COMMAND`).
     pub name: String,
+    /// The command split into words; the job file's path is appended at each run.
     pub argv: Vec<String>,
+    /// Whether its knob is a step h (its ladder is then h = 1e-2, 1e-3, 1e-4) rather than a
+    /// tolerance.
     pub fixed_step: bool,
     /// One of the repository's own peers (scipy, Siconos, Octave), run when installed.
     pub peer: bool,
@@ -148,16 +152,25 @@ pub fn split_words(s: &str) -> Result<Vec<String>, String> {
 pub struct Job {
     /// The suite's version ([`rotor_grade::check::BENCHMARK`]).
     pub benchmark: &'static str,
+    /// The scenario's name.
     pub scenario: String,
     /// Every field of the parameter file, friction family names included.
     pub params: serde_json::Value,
+    /// Motor input voltage u (V).
     pub u: f64,
+    /// Initial state `[α, ω_u, ω_l]` (rad, rad/s, rad/s), at full precision.
     pub x0: [f64; 3],
+    /// Horizon (s): the trace covers `[0, t_end]`.
     pub t_end: f64,
+    /// Grid step of the trace (s): a row at every `k·dt`.
     pub dt: f64,
+    /// Tolerance to run at, for a client with a tolerance knob (else `null`).
     pub tol: Option<f64>,
+    /// Step to run at (s), for a fixed-step client (else `null`).
     pub h: Option<f64>,
+    /// Where to write the trace (`t,alpha,omega_u,omega_l`).
     pub trace: PathBuf,
+    /// Where to write the events (`t,disc,kind`), if the client locates them.
     pub events: PathBuf,
 }
 
@@ -223,10 +236,13 @@ pub enum Ended {
 /// One run of a client.
 #[derive(Debug, Clone, PartialEq)]
 pub struct RunOutput {
+    /// How the process ended.
     pub ended: Ended,
     /// From the spawn to the exit (or the kill) \[s\].
     pub wall_s: f64,
+    /// Its standard output (the first MiB, lossily decoded).
     pub stdout: String,
+    /// Its standard error (the first MiB, lossily decoded).
     pub stderr: String,
 }
 
@@ -234,10 +250,15 @@ pub struct RunOutput {
 /// `solve_seconds` (and the optional `steps`, `rhs_evals`, `version`, `method`).
 #[derive(Debug, Clone, Default, PartialEq, serde::Deserialize)]
 pub struct ClientSays {
+    /// Its in-process solve time (s), start-up excluded.
     pub solve_seconds: Option<f64>,
+    /// The steps it took (a fixed-step client's are compared per step with Moreau–Jean).
     pub steps: Option<u64>,
+    /// Its right-hand-side evaluations.
     pub rhs_evals: Option<u64>,
+    /// Its version, as it reports it.
     pub version: Option<String>,
+    /// Its method, as it names it (`DOP853`, `MoreauJeanOSI`, ...).
     pub method: Option<String>,
 }
 

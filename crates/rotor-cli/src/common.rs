@@ -14,7 +14,7 @@ pub(crate) struct Common {
     /// Solver: switch, event or moreau.
     #[arg(long)]
     pub(crate) solver: String,
-    /// Motor input voltage [V].
+    /// Motor input voltage, in V.
     #[arg(long, allow_hyphen_values = true)]
     pub(crate) u: f64,
     /// Parameter file, or the name of one in fixtures/params (`stribeck`; default: the
@@ -27,7 +27,7 @@ pub(crate) struct Common {
     /// Integration tolerance (switch, event).
     #[arg(long, allow_hyphen_values = true)]
     pub(crate) tol: Option<f64>,
-    /// Step size (moreau) [s].
+    /// Step size (moreau), in s.
     #[arg(long, allow_hyphen_values = true)]
     pub(crate) h: Option<f64>,
 }

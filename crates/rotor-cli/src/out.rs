@@ -21,7 +21,7 @@ pub fn print(text: &str) -> std::io::Result<()> {
     closed_is_fine(o.write_all(text.as_bytes()).and_then(|()| o.flush()))
 }
 
-/// [`print`] of `args` and a newline: `println!` that returns its error.
+/// [`print()`] of `args` and a newline: `println!` that returns its error.
 pub fn line(args: std::fmt::Arguments) -> std::io::Result<()> {
     print(&format!("{args}\n"))
 }

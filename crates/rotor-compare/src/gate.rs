@@ -17,15 +17,21 @@ use rotor_solvers::solvers::{SolverKind, pair_name, pairs};
 /// A measured difference with its gate.
 #[derive(Debug, Clone, PartialEq, serde::Serialize)]
 pub struct Measured {
+    /// What was compared, as the report names it (`transient max abs d_omega`,
+    /// `steady period`, `steady kind (limit_cycle vs equilibrium)`, ...).
     pub quantity: String,
     /// The scenario file's key that states `tol` (`tolerance.<pair>.<key>`); `None` for the
     /// checks that no key states (steady states of different kinds, or missing).
     pub key: Option<&'static str>,
+    /// The difference: rad/s for the transient, s for event and stick times, relative for
+    /// the relative steady metrics; NaN or ∞ where nothing could be compared.
     pub diff: f64,
+    /// Its tolerance, in the same unit.
     pub tol: f64,
 }
 
 impl Measured {
+    /// Whether `diff ≤ tol` (false for a NaN difference).
     pub fn passes(&self) -> bool {
         self.diff <= self.tol
     }
@@ -34,10 +40,15 @@ impl Measured {
 /// A failed gate: which quantity, the measured difference and the tolerance.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Failure {
+    /// The scenario's name.
     pub scenario: String,
+    /// The solver pair (`event-switch`).
     pub pair: String,
+    /// The quantity ([`Measured::quantity`]), or what went wrong when nothing was measured.
     pub quantity: String,
+    /// The measured difference; not finite when nothing could be measured.
     pub diff: f64,
+    /// The tolerance it exceeds.
     pub tol: f64,
 }
 
@@ -60,11 +71,14 @@ impl std::fmt::Display for Failure {
 /// All measurements of one pair on one scenario.
 #[derive(Debug, Clone, PartialEq, serde::Serialize)]
 pub struct GateResult {
+    /// The solver pair (`event-switch`).
     pub pair: String,
+    /// Every quantity gated, passing or not.
     pub measured: Vec<Measured>,
 }
 
 impl GateResult {
+    /// The measurements that fail, as failures of `scenario`.
     pub fn failures(&self, scenario: &str) -> Vec<Failure> {
         self.measured
             .iter()

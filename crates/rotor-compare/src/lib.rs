@@ -1,6 +1,8 @@
 //! Cross-validation: identical scenarios through the three independent solvers, agreement
 //! gates on θ̇_u and θ̇_l, and the report.
 
+#![warn(missing_docs)]
+
 pub mod gate;
 pub mod margins;
 pub mod report;

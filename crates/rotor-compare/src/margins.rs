@@ -52,10 +52,13 @@ pub fn rule(measured: f64, floor: f64) -> f64 {
 /// One gate of one fixture beside what it measures.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Margin {
+    /// The scenario's name.
     pub scenario: String,
+    /// The solver pair (`event-switch`).
     pub pair: String,
     /// The scenario file's key; `None` for a check no key states (a steady kind that differs).
     pub key: Option<&'static str>,
+    /// The quantity, as [`crate::gate::Measured::quantity`] names it.
     pub quantity: String,
     /// Relative (the steady metrics but the stick time) or in s or rad/s.
     pub relative: bool,

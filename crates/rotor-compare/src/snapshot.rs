@@ -32,6 +32,7 @@ use rotor_solvers::run::ScenarioResult;
 /// One solver's record.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct SolverSnapshot {
+    /// The solver's name.
     pub solver: &'static str,
     /// `equilibrium`, `limit_cycle`, `none` (no steady state measured) or `error`.
     pub steady: String,
@@ -39,6 +40,7 @@ pub struct SolverSnapshot {
     pub metrics: BTreeMap<&'static str, f64>,
     /// Digits kept per metric: significant digits, or decimals for `stick_time`.
     pub digits: BTreeMap<&'static str, u32>,
+    /// Its work counters, rounded to 3 significant digits.
     pub counters: Counters,
     /// The typed error, if the run failed.
     pub error: Option<String>,
@@ -47,12 +49,17 @@ pub struct SolverSnapshot {
 /// The work counters a snapshot records.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
 pub struct Counters {
+    /// Accepted steps ([`Stats::steps`]).
     pub steps: u64,
+    /// Rejected steps.
     pub rejected: u64,
+    /// Right-hand-side evaluations.
     pub rhs_evals: u64,
     /// `None` for a run that settles on an equilibrium (see the module docs).
     pub events: Option<u64>,
+    /// One-step complementarity problems solved (Moreau–Jean).
     pub lcp_solves: u64,
+    /// Steps whose complementarity solve was skipped (Moreau–Jean).
     pub lcp_skipped: u64,
 }
 
@@ -81,9 +88,11 @@ impl Counters {
 /// The snapshot of one scenario.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct ScenarioSnapshot {
+    /// The scenario's name.
     pub scenario: String,
     /// Metrics below this are written as 0 (the scenario's tightest `steady_abs`).
     pub floor: f64,
+    /// One record per solver, the reference first.
     pub solvers: Vec<SolverSnapshot>,
     /// Per pair, every gated quantity's measured difference to one significant digit
     /// (written `4e-11`; `0` below [`ROUNDING`]).

@@ -47,19 +47,34 @@ pub const MOREAU_PERIOD_C: f64 = 0.62;
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Measure {
     /// Samples every `dt` against the event-driven solver at [`REFERENCE_TOL`].
-    Transient { dt: f64 },
+    Transient {
+        /// Sample spacing \[s\].
+        dt: f64,
+    },
     /// Samples every `dt` against the exact solution of the friction-free (linear) system:
     /// the matrix exponential of the affine system ([`linear_exact`]).
-    Exact { dt: f64 },
+    Exact {
+        /// Sample spacing \[s\].
+        dt: f64,
+    },
     /// The run from `(−u, −x0)` against the negated run from `(u, x0)` of the same solver,
     /// sample by sample and unscaled: the friction laws are odd, so this is exact.
-    Mirror { dt: f64 },
+    Mirror {
+        /// Sample spacing \[s\].
+        dt: f64,
+    },
     /// The period over `[from, t_end]` against the event-driven solver's (relative).
-    Period { from: f64 },
+    Period {
+        /// Start of the measured window \[s\].
+        from: f64,
+    },
     /// A long run: the periods between successive lower-disc stick exits after `from`, their
     /// largest relative deviation from the event-driven solver's first period there (drift
     /// and bias together), and the number of events in each period (must not change).
-    Drift { from: f64 },
+    Drift {
+        /// Start of the measured window \[s\].
+        from: f64,
+    },
 }
 
 impl Measure {
@@ -118,11 +133,14 @@ pub enum Gate {
     /// constant and order measured on the case itself (the origin says where), for dynamics
     /// where no a-priori bound is within 10× of what it measures.
     Measured {
+        /// The constant c of `c·s^p`.
         c: f64,
+        /// The order p of `c·s^p`.
         p: i32,
+        /// Where c and p were measured.
         origin: &'static str,
     },
-    /// A stated bound with its origin.
+    /// A stated bound (in the measure's unit) with its origin.
     Fixed(f64, &'static str),
     /// [`OBSERVED_MARGIN`] × the difference measured on this very row (the value given, at
     /// least the rounding floor [`OBSERVED_FLOOR`]): where neither an a-priori bound nor a
@@ -149,11 +167,13 @@ pub const MAX_LOOSENESS: f64 = 10.0;
 /// One solver at one accuracy setting, with its gate.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Setting {
+    /// The solver.
     pub kind: SolverKind,
     /// Tolerance of the adaptive solvers.
     pub tol: f64,
     /// Step of Moreau–Jean.
     pub h: f64,
+    /// How its agreement is gated.
     pub gate: Gate,
 }
 
@@ -213,14 +233,21 @@ impl Setting {
 /// A stress case: what it stresses, the model and scene, the measure, and the settings.
 #[derive(Debug, Clone, PartialEq)]
 pub struct StressCase {
+    /// The case's name in the table (and the `stress_cases` test's messages).
     pub name: &'static str,
     /// One line for the table: what is stressed.
     pub what: String,
+    /// Its parameter set (Table 1 or a variant of it that stresses something).
     pub params: Params,
+    /// Motor input voltage u \[V\].
     pub u: f64,
+    /// Initial state `[α, ω_u, ω_l]` (rad, rad/s, rad/s).
     pub x0: State,
+    /// Horizon \[s\].
     pub t_end: f64,
+    /// How the settings' answers are compared.
     pub measure: Measure,
+    /// The solvers and accuracy settings run on it, each with its gate.
     pub settings: Vec<Setting>,
 }
 
@@ -280,11 +307,15 @@ impl std::fmt::Display for Outcome {
 /// The result of one setting of one case.
 #[derive(Debug, Clone, PartialEq)]
 pub struct StressRow {
+    /// The case's name ([`StressCase::name`]).
     pub case: &'static str,
+    /// What the case stresses ([`StressCase::what`]).
     pub what: String,
+    /// The solver run.
     pub solver: SolverKind,
     /// `tol 1e-10` or `h 1e-3`.
     pub setting: String,
+    /// How the run ended.
     pub outcome: Outcome,
     /// Work counters of the run (Moreau's `inexact_steps` flags steps that fell back to a
     /// fixed-point iterate).
@@ -296,6 +327,7 @@ pub struct StressRow {
     pub agreement: Option<f64>,
     /// The gate's value for this run (`None` for the reference) and its kind.
     pub gate: Option<f64>,
+    /// The gate's kind.
     pub gate_kind: Gate,
     /// Events per period seen in a [`Measure::Drift`] run: (min, max).
     pub events_per_period: Option<(usize, usize)>,

@@ -24,6 +24,7 @@ pub struct Dop853 {
     pub safety: f64,
     /// Bounds of the step ratio: `fac_min ≤ h_new/h ≤ fac_max` (0.333 and 6 in `dop853`).
     pub fac_min: f64,
+    /// Upper bound of the step ratio `h_new/h` (6 in `dop853`); `fac_min` is the lower.
     pub fac_max: f64,
     /// Lund stabilisation exponent β (0 in `dop853`).
     pub beta: f64,
@@ -34,9 +35,13 @@ pub struct Dop853 {
 /// A trial step: the new state, its scaled error, and the stages needed for dense output.
 #[derive(Debug, Clone, Copy)]
 pub struct Trial<const N: usize> {
+    /// Start time of the step.
     pub t: f64,
+    /// Step size; the step ends at `t + h`.
     pub h: f64,
+    /// State at `t`.
     pub y0: SVector<f64, N>,
+    /// The 8th-order solution at `t + h`.
     pub y1: SVector<f64, N>,
     /// Scaled error norm (≤ 1: acceptable).
     pub err: f64,
@@ -47,7 +52,9 @@ pub struct Trial<const N: usize> {
 /// The 7th-order continuous extension of one accepted step.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Dense<const N: usize> {
+    /// Start time of the step it interpolates.
     pub t0: f64,
+    /// Length of that step; the interpolant covers `[t0, t0 + h]`.
     pub h: f64,
     c: [SVector<f64, N>; 8],
 }
@@ -380,9 +387,14 @@ impl Dop853 {
 /// Counters of one integration.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
 pub struct Counts {
+    /// Evaluations of f (`nfcn` in `dop853`), the initial-step guess's included.
     pub fcn: u64,
+    /// Trial steps, accepted or rejected (`nstep`).
     pub steps: u64,
+    /// Accepted steps (`naccpt`).
     pub accepted: u64,
+    /// Rejected steps after the first accepted one (`nrejct`: `dop853` does not count
+    /// rejections before it).
     pub rejected: u64,
 }
 

@@ -46,6 +46,8 @@ pub struct EventOptions {
     /// Zeno guard: this many mode switches within `zeno_window` (relative to max(1, t)) is
     /// an error.
     pub zeno_count: u32,
+    /// Zeno guard's window \[s\] at t ≤ 1 s; it widens in proportion to t beyond (the
+    /// window is `zeno_window·max(1, t)`).
     pub zeno_window: f64,
     /// Sample intervals per step for guard detection (at most 64).
     pub guard_samples: usize,

@@ -18,13 +18,18 @@ pub enum StopAt {
 /// Where and how a flow ended.
 #[derive(Debug, Clone, PartialEq)]
 pub struct FlowEnd {
+    /// Time at the end \[s\], counted from the flow's start at t = 0 (so the return time
+    /// when the stop condition was met).
     pub t: f64,
+    /// The state `[α, ω_u, ω_l]` there.
     pub x: State,
+    /// The friction modes there (after the stop event, for [`StopAt::LowerStickExit`]).
     pub mode: Mode,
     /// Whether the stop condition was met before `t_max`.
     pub reached: bool,
     /// Mode-switch events on the way (stick onsets and exits, reversals).
     pub events: Vec<Event>,
+    /// Work counters of the flow (steps, evaluations, events).
     pub stats: Stats,
 }
 

@@ -4,6 +4,8 @@
 //! on a 7th-order dense output and refined, DOP853 between events. The project's accuracy
 //! reference.
 
+#![warn(missing_docs)]
+
 pub mod dop853;
 mod filippov;
 pub mod flow;

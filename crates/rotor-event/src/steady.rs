@@ -48,7 +48,10 @@ pub enum Method {
 /// A refined steady state.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Steady {
+    /// The steady state's metrics (an equilibrium's state, or a cycle's period, extrema and
+    /// stick time).
     pub state: SteadyState,
+    /// How it was obtained.
     pub method: Method,
     /// A state on the cycle (at the fixed point of the return map, or the settled run's
     /// final state); `None` for an equilibrium.

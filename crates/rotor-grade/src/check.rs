@@ -145,6 +145,8 @@ impl Serialize for Level {
 /// One graded quantity.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Graded {
+    /// The quantity (`alpha`, `omega_l`, `events`, `stick_lower`, `period`, `orbit`, ...; see
+    /// the module docs).
     pub name: String,
     /// The difference from the reference, in the quantity's unit (∞ when it cannot be
     /// measured: a missing event, another kind of steady state).
@@ -153,6 +155,7 @@ pub struct Graded {
     pub scale: f64,
     /// The largest difference the level allows: `scale·10^−digits`.
     pub tolerance: f64,
+    /// Whether `difference ≤ tolerance`.
     pub passed: bool,
     /// Significant correct digits, `−log10(difference/scale)` (0 … 16, one decimal).
     pub digits: f64,
@@ -167,9 +170,11 @@ pub struct Graded {
 /// The verdict on one trace (the JSON of `rotor check --json`).
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct CheckReport {
+    /// The scenario's name.
     pub scenario: String,
     /// The benchmark's version ([`BENCHMARK`]).
     pub benchmark: &'static str,
+    /// Whether every graded quantity passed.
     pub passed: bool,
     /// The level's name: `strict`, `loose` or `digits=N`.
     pub gate: Level,
@@ -179,6 +184,8 @@ pub struct CheckReport {
     pub not_graded: Vec<String>,
     /// Significant digits the trace file is written with (17 for arrays).
     pub file_digits: u32,
+    /// Every graded quantity, in a fixed order: the trace's variables, the events, the stick
+    /// intervals, the steady state.
     pub quantities: Vec<Graded>,
 }
 
@@ -245,38 +252,63 @@ impl CheckReport {
 /// or the missing time.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum CheckError {
+    /// The trace or events file could not be read as one.
     #[error(transparent)]
     Trace(#[from] crate::trace::TraceError),
+    /// A row's time is not the reference's grid time at that row.
     #[error("{}: t = {found} is not the grid time {expected} (the scenario's grid: every {dt} s from 0 to {t_end} s, times within 1e-9 s)", At(.path, *.line))]
     OffGrid {
+        /// The trace file (or [`crate::trace::ARRAYS`]).
         path: PathBuf,
+        /// The row's line (its index for arrays).
         line: u64,
+        /// The row's time \[s\].
         found: f64,
+        /// The grid time expected there \[s\].
         expected: f64,
+        /// The scenario's grid step \[s\].
         dt: f64,
+        /// The scenario's horizon \[s\].
         t_end: f64,
     },
+    /// The trace stops before `t_end`.
     #[error("{}: the trace ends here (t = {last}); the grid time {missing} s and later are missing", At(.path, *.line))]
     Missing {
+        /// The trace file (or [`crate::trace::ARRAYS`]).
         path: PathBuf,
+        /// The last row's line.
         line: u64,
+        /// The last row's time \[s\].
         last: f64,
+        /// The first grid time without a row \[s\].
         missing: f64,
     },
+    /// The trace has rows past the grid's last time.
     #[error("{}: t = {found} is past the grid's last time {t_end} s", At(.path, *.line))]
     Extra {
+        /// The trace file (or [`crate::trace::ARRAYS`]).
         path: PathBuf,
+        /// The first extra row's line.
         line: u64,
+        /// Its time \[s\].
         found: f64,
+        /// The scenario's horizon \[s\].
         t_end: f64,
     },
+    /// An event lies outside the run or out of time order.
     #[error("{}: event time {t} is outside [0, {t_end}] s or before the previous event", At(.path, *.line))]
     EventTime {
+        /// The events file (or [`crate::trace::ARRAYS`]).
         path: PathBuf,
+        /// The event's line.
         line: u64,
+        /// Its time \[s\].
         t: f64,
+        /// The scenario's horizon \[s\].
         t_end: f64,
     },
+    /// The trace is written with too few digits to show the level ([`check`] refuses it rather
+    /// than fail the solver).
     #[error(
         "{}: the trace is written with {digits} significant digits (printf's %g writes 6); \
          grading at {level} ({needed_digits} digits) needs at least {needed}: write every value \
@@ -284,21 +316,32 @@ pub enum CheckError {
         .path.display(), needed_digits = .needed - 1
     )]
     Precision {
+        /// The trace file.
         path: PathBuf,
+        /// Significant digits the file is written with ([`Trace::digits`]).
         digits: u32,
+        /// The level asked ([`Level::name`]).
         level: String,
+        /// Written digits the level needs: its digits + 1.
         needed: u32,
     },
+    /// The level asks more digits of a quantity than the reference is verified to, less one.
     #[error(
         "{level} asks {asked} digits of {quantity}, but the reference of {scenario} is verified \
          to {verified:.1} digits there: it cannot grade more than {most} (one digit below its own)"
     )]
     BeyondReference {
+        /// The scenario's name.
         scenario: String,
+        /// The level asked ([`Level::name`]).
         level: String,
+        /// The digits it asks of every quantity.
         asked: u32,
+        /// The first quantity whose reference is not verified far enough.
         quantity: String,
+        /// Digits to which the reference is verified there, `−log10(error/scale)`.
         verified: f64,
+        /// The most digits that can be graded there: `verified − 1`, rounded down.
         most: u32,
     },
 }
@@ -863,16 +906,49 @@ pub fn check(
 /// trace (or events) is unusable.
 #[derive(Debug, thiserror::Error)]
 pub enum GradeError {
+    /// The scenario file is not a valid scenario.
     #[error(transparent)]
     Scenario(#[from] rotor_scenario::ScenarioError),
+    /// Its reference data cannot be read.
     #[error(transparent)]
     Reference(#[from] crate::reference::ReferenceError),
+    /// The trace (or events) cannot be graded.
     #[error(transparent)]
     Check(#[from] CheckError),
 }
 
 /// `rotor check`'s grading: the scenario file, its reference from `fixtures/reference` beside
 /// it ([`crate::reference::dir_for`]), and [`check`].
+///
+/// # Example
+///
+/// Grading a solver's run as an external trace: Moreau–Jean at h = 1e-3 on the named
+/// scenario `t1-u1.5-rest` (Table 1, 1.5 V from rest, 200 s), with its events. A
+/// second-order time-stepper at that step reaches the loose level (3 digits) on every
+/// quantity, but not the strict one (7 digits).
+///
+/// ```
+/// use rotor_grade::check::{Level, grade};
+/// use rotor_grade::trace::{EventsFile, Trace};
+/// use rotor_solvers::{SolverKind, load_scenario, run::scene_for};
+///
+/// let fixtures = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../fixtures");
+/// let path = fixtures.join("scenarios/t1-u1.5-rest.toml");
+/// let sc = load_scenario(&path)?;
+/// // The scenario's comparison scene: its grid (0.01 s), events and steady window.
+/// let kind = SolverKind::MOREAU;
+/// let run = kind.solver().simulate(&sc.model, &scene_for(kind, &sc))?;
+/// let trace = Trace::of_run("moreau.csv", run.samples);
+/// let events = EventsFile::of_run("moreau.events.csv", &run.events);
+///
+/// let loose = grade(&path, &trace, Some(&events), Level::Loose)?;
+/// println!("{}", loose.table());
+/// assert!(loose.passed, "{}", loose.verdict());
+/// assert!(loose.not_graded.is_empty(), "the events were graded too");
+/// let strict = grade(&path, &trace, Some(&events), Level::Strict)?;
+/// assert!(!strict.passed && !strict.failing().is_empty());
+/// # Ok::<(), Box<dyn std::error::Error>>(())
+/// ```
 pub fn grade(
     scenario: &std::path::Path,
     trace: &Trace,

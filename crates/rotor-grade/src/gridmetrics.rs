@@ -45,15 +45,21 @@ pub const STUCK: f64 = 1e-9;
 /// Why a trace has no steady metrics.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum GridMetricsError {
+    /// The trace ends before the steady-state window starts.
     #[error("no sample at or after t = {from} s")]
-    Empty { from: f64 },
+    Empty {
+        /// Start of the window \[s\].
+        from: f64,
+    },
 }
 
 /// The model and input a trace was computed for: the stick interval of the lower disc, for
 /// the end of a stick phase.
 #[derive(Debug, Clone, Copy)]
 pub struct StickExit<'a> {
+    /// The rotor model (its lower friction law gives the stick interval).
     pub model: &'a Model,
+    /// The motor input voltage \[V\].
     pub u: f64,
 }
 

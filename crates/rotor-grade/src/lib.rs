@@ -2,6 +2,8 @@
 //! events files, the reference solution, the metrics read off a sample grid, the steady
 //! orbit, and the grade in significant digits.
 
+#![warn(missing_docs)]
+
 pub mod check;
 pub mod gridmetrics;
 pub mod orbit;

@@ -54,6 +54,7 @@ const FLOOR_REL: f64 = 1e-14;
 /// The `<name>.json` of a reference.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct ReferenceJson {
+    /// The scenario's name (the file's stem).
     pub scenario: String,
     /// The steady state as `rotor steady` prints it (`kind` and its metrics), over the
     /// scenario's `[steady_from, t_end]`; absent when the scenario compares no steady state.
@@ -61,10 +62,15 @@ pub struct ReferenceJson {
     pub steady: Option<SteadyState>,
     /// How the reference was computed.
     pub solver: String,
+    /// The solver's tolerance ([`REFERENCE_TOL`] for the stored reference).
     pub tol: f64,
+    /// Grid step of the trace \[s\] (the scenario's `compare.dt`).
     pub dt: f64,
+    /// Horizon of the run \[s\].
     pub t_end: f64,
+    /// Start of the steady-state window \[s\], if the scenario compares a steady state.
     pub steady_from: Option<f64>,
+    /// The scenario's transient window `[t0, t1]` \[s\], if it has one.
     pub transient: Option<[f64; 2]>,
     /// Significant digits of the values in the trace file.
     pub trace_digits: u32,
@@ -72,6 +78,7 @@ pub struct ReferenceJson {
     /// `omega_l` (the trace, largest over the run), `event_time` (largest over the events),
     /// and each steady metric by its name.
     pub error: BTreeMap<String, f64>,
+    /// How `error` was estimated, in words (the rule, its floor and its verification).
     pub error_method: String,
     /// Differences of the switch model and Moreau–Jean (at the scenario's settings) from the
     /// reference, per quantity as in `error`: the same answer from two independent methods.
@@ -85,30 +92,45 @@ pub struct ReferenceJson {
 pub struct CrossCheck {
     /// `tol 1e-10` or `h 1e-3`.
     pub setting: String,
+    /// Its largest difference from the reference per quantity (names and units as in
+    /// [`ReferenceJson::error`]); `None` where not comparable.
     pub differences: BTreeMap<String, Option<f64>>,
 }
 
 /// A reference: what the three files hold.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Reference {
+    /// The trace: the state on the scenario's grid over `[0, t_end]`.
     pub samples: Vec<Sample>,
+    /// The mode-switch events (stick onsets and exits, reversals; no extrema), in time order.
     pub events: Vec<Event>,
+    /// The steady state, the stated errors and how they were obtained.
     pub json: ReferenceJson,
 }
 
 /// Why a reference cannot be computed or read.
 #[derive(Debug, thiserror::Error)]
 pub enum ReferenceError {
+    /// A reference run of the scenario failed.
     #[error("scenario {scenario}: {source}")]
     Solve {
+        /// The scenario's name.
         scenario: String,
+        /// Why the run failed.
         #[source]
         source: SolveError,
     },
+    /// A stored trace or events file is not one.
     #[error(transparent)]
     Trace(#[from] TraceError),
+    /// A stored file is missing, unreadable, or not a reference JSON.
     #[error("{}: {message}", .path.display())]
-    File { path: PathBuf, message: String },
+    File {
+        /// The file.
+        path: PathBuf,
+        /// What is wrong, and how to make it (`rotor reference`).
+        message: String,
+    },
 }
 
 impl Reference {

@@ -99,82 +99,140 @@ impl std::fmt::Display for At<'_> {
 /// A trace file could not be read, or is not a trace.
 #[derive(Debug, Error, Clone, PartialEq)]
 pub enum TraceError {
+    /// The file could not be opened or read (or a line ran past the length cap).
     #[error("{}: cannot read: {message}", .path.display())]
-    Io { path: PathBuf, message: String },
-    #[error("{}: the file is empty (expected the header t,alpha,omega_u,omega_l)", .path.display())]
-    Empty { path: PathBuf },
-    #[error("{}: line {line}: the header is {found:?}, expected {expected:?}", .path.display())]
-    Header {
+    Io {
+        /// The file.
         path: PathBuf,
-        line: u64,
-        found: String,
-        expected: &'static str,
-    },
-    #[error("{}: line {line}, column {column} ({name}): {value:?} is not a finite number", .path.display())]
-    Value {
-        path: PathBuf,
-        line: u64,
-        column: usize,
-        name: &'static str,
-        value: String,
-    },
-    #[error("{}: line {line}, column {column} ({name}): {value:?} is not one of {expected}", .path.display())]
-    Word {
-        path: PathBuf,
-        line: u64,
-        column: usize,
-        name: &'static str,
-        value: String,
-        expected: &'static str,
-    },
-    #[error("{}: line {line}: {found} fields, expected {expected}", .path.display())]
-    Fields {
-        path: PathBuf,
-        line: u64,
-        found: usize,
-        expected: &'static str,
-    },
-    #[error("{}: line {line}: {message}", .path.display())]
-    Csv {
-        path: PathBuf,
-        line: u64,
+        /// The operating system's (or the reader's) reason.
         message: String,
     },
+    /// The file holds nothing, not even a header.
+    #[error("{}: the file is empty (expected the header t,alpha,omega_u,omega_l)", .path.display())]
+    Empty {
+        /// The file.
+        path: PathBuf,
+    },
+    /// The first line is not the expected header.
+    #[error("{}: line {line}: the header is {found:?}, expected {expected:?}", .path.display())]
+    Header {
+        /// The file.
+        path: PathBuf,
+        /// The header's line.
+        line: u64,
+        /// The header as found, its fields joined by commas.
+        found: String,
+        /// The header expected (`t,alpha,omega_u,omega_l` or `t,disc,kind`).
+        expected: &'static str,
+    },
+    /// A field that must be a number is not a finite one.
+    #[error("{}: line {line}, column {column} ({name}): {value:?} is not a finite number", .path.display())]
+    Value {
+        /// The file.
+        path: PathBuf,
+        /// The row's line (1-based; the header is line 1).
+        line: u64,
+        /// The field's column (1-based).
+        column: usize,
+        /// The column's name in the header (`t`, `alpha`, ...).
+        name: &'static str,
+        /// The field as written.
+        value: String,
+    },
+    /// An events file's `disc` or `kind` field is not one of its words.
+    #[error("{}: line {line}, column {column} ({name}): {value:?} is not one of {expected}", .path.display())]
+    Word {
+        /// The file.
+        path: PathBuf,
+        /// The row's line (1-based; the header is line 1).
+        line: u64,
+        /// The field's column (1-based).
+        column: usize,
+        /// The column's name, `disc` or `kind`.
+        name: &'static str,
+        /// The field as written.
+        value: String,
+        /// The words allowed (`upper, lower`; `stick_start, stick_end, reversal`).
+        expected: &'static str,
+    },
+    /// A row has the wrong number of fields.
+    #[error("{}: line {line}: {found} fields, expected {expected}", .path.display())]
+    Fields {
+        /// The file.
+        path: PathBuf,
+        /// The row's line (1-based; the header is line 1).
+        line: u64,
+        /// The number of fields in the row.
+        found: usize,
+        /// The number expected, with the header (`4 (t,alpha,omega_u,omega_l)`).
+        expected: &'static str,
+    },
+    /// The CSV reader refused the file (an unterminated quote, invalid UTF-8, ...).
+    #[error("{}: line {line}: {message}", .path.display())]
+    Csv {
+        /// The file.
+        path: PathBuf,
+        /// The line where the reader stopped (0 if it did not say).
+        line: u64,
+        /// The reader's message.
+        message: String,
+    },
+    /// The file has a header and no data row.
     #[error("{}: no data rows after the header", .path.display())]
-    NoRows { path: PathBuf },
+    NoRows {
+        /// The file.
+        path: PathBuf,
+    },
+    /// An events file holds more than [`MAX_EVENTS`] events; reading stopped there.
     #[error(
         "{}: line {line}: more than {limit} events, more than any run of this benchmark holds",
         .path.display()
     )]
     TooMany {
+        /// The file.
         path: PathBuf,
+        /// The line of the first event past the limit.
         line: u64,
+        /// The limit, [`MAX_EVENTS`] for a file.
         limit: usize,
     },
     /// A trace given as arrays: one value is not finite.
     #[error("{name}[{index}] = {value}: not a finite number")]
     Column {
+        /// The array's name (`t`, `alpha`, `omega_u`, `omega_l`).
         name: &'static str,
+        /// The value's index (0-based).
         index: usize,
+        /// The value (NaN or ±∞).
         value: f64,
     },
-    /// Events given as a list: an entry's disc or kind is not one of its words.
+    /// Events given as a list: an entry's time is not finite, or its disc or kind is not one
+    /// of its words.
     #[error("events[{index}][{name:?}] = {value:?}: not one of {expected}")]
     Entry {
+        /// The entry's index in the list (0-based).
         index: usize,
+        /// The entry's field (`t`, `disc` or `kind`).
         name: &'static str,
+        /// The field's value as given.
         value: String,
+        /// What it must be: the words allowed, or `the finite numbers` for `t`.
         expected: &'static str,
     },
     /// A trace given as arrays: the arrays are empty or of different lengths.
     #[error("{message}")]
-    Arrays { message: String },
+    Arrays {
+        /// What is wrong with the lengths.
+        message: String,
+    },
 }
 
 /// A trace as read: the samples with the line each came from.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Trace {
+    /// The file it was read from ([`ARRAYS`] for a trace given as arrays).
     pub path: PathBuf,
+    /// Its rows: time \[s\] and state `[α, ω_u, ω_l]` (rad, rad/s, rad/s).
     pub samples: Vec<Sample>,
     /// The file line of each sample (1-based; the header is line 1).
     pub lines: Vec<u64>,
@@ -411,6 +469,7 @@ pub struct LineCap<R> {
 }
 
 impl<R: Read> LineCap<R> {
+    /// `inner`, failing once a line runs past `limit` bytes.
     pub fn new(inner: R, limit: usize) -> LineCap<R> {
         LineCap {
             inner,
@@ -579,7 +638,9 @@ pub fn write_events(events: &[Event]) -> Vec<u8> {
 /// An events file as read: the events with the line each came from.
 #[derive(Debug, Clone, PartialEq)]
 pub struct EventsFile {
+    /// The file it was read from.
     pub path: PathBuf,
+    /// Its events, in file order; each carries no state (the file has none: `x` is zero).
     pub events: Vec<Event>,
     /// The file line of each event (1-based; the header is line 1).
     pub lines: Vec<u64>,

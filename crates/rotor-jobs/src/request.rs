@@ -23,6 +23,7 @@ pub struct Ignored {
     pub solver: &'static str,
     /// What sets its accuracy instead.
     pub instead: &'static str,
+    /// Whether the solver takes fixed steps (Moreau–Jean) rather than adaptive ones.
     pub fixed_step: bool,
 }
 
@@ -69,10 +70,16 @@ pub fn inexact_warning(stats: &Stats, h: &str) -> Option<String> {
 /// takes [`Scene::default`]'s).
 #[derive(Debug, Clone, PartialEq)]
 pub struct Request<'a> {
+    /// The solver's name as typed (`event`, `switch`, `moreau`); checked by
+    /// [`Request::solver_kind`].
     pub solver: &'a str,
+    /// Motor input voltage u \[V\].
     pub u: f64,
+    /// Initial state `[α, ω_u, ω_l]` (rad, rad/s, rad/s).
     pub x0: [f64; 3],
+    /// Tolerance of the adaptive solvers (relative = absolute), if given.
     pub tol: Option<f64>,
+    /// Step of Moreau–Jean \[s\], if given.
     pub h: Option<f64>,
 }
 

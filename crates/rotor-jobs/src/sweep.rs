@@ -30,21 +30,34 @@ pub const MAX_POINTS: usize = 10_000_000;
 /// Why a sweep or a merge cannot run.
 #[derive(Debug, thiserror::Error)]
 pub enum SweepError {
+    /// An option's value is refused before any run.
     #[error("{flag} {value:?}: {reason}")]
     Arg {
+        /// The option (`--u`, `--param`, `--shard`, ...).
         flag: &'static str,
+        /// Its value as given.
         value: String,
+        /// Why it is refused.
         reason: String,
     },
+    /// An output, shard record or input file cannot be read, or is not what it should be.
     #[error("{}: {message}", .path.display())]
-    File { path: PathBuf, message: String },
+    File {
+        /// The file.
+        path: PathBuf,
+        /// What went wrong.
+        message: String,
+    },
     /// Writing the rows failed: a full disk, or a reader of standard output that has gone.
     #[error("{}: cannot write: {source}", .path.display())]
     Write {
+        /// The output file (or `-` for standard output).
         path: PathBuf,
+        /// The operating system's error.
         #[source]
         source: std::io::Error,
     },
+    /// The shards given to [`merge`] do not make one grid; the text says why.
     #[error("the shards do not fit together: {0}")]
     Merge(String),
 }
@@ -60,8 +73,11 @@ fn arg(flag: &'static str, value: &str, reason: impl Into<String>) -> SweepError
 /// One axis `A:B:N`: N values from A to B, both included.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Axis {
+    /// The first value, A.
     pub a: f64,
+    /// The last value, B.
     pub b: f64,
+    /// The number of values, N ≥ 1 (A = B when N = 1).
     pub n: usize,
 }
 
@@ -107,13 +123,17 @@ impl Axis {
 /// `I/N`: the I-th of N shards (I from 1).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct Shard {
+    /// Which shard, I in 1..=N.
     pub i: usize,
+    /// How many shards, N ≥ 1.
     pub n: usize,
 }
 
 impl Shard {
+    /// `1/1`: the whole grid.
     pub const ALL: Shard = Shard { i: 1, n: 1 };
 
+    /// Parses `I/N` (`--shard`), with I in 1..=N.
     pub fn parse(s: &str) -> Result<Shard, SweepError> {
         let bad = |why: &str| arg("--shard", s, why);
         let (i, n) = s
@@ -166,11 +186,18 @@ pub enum SweepStart {
 /// A sweep: the grid, the parameter, the start and the solver.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Sweep {
+    /// The parameter set whose field `param` is varied.
     pub base: Params,
+    /// The input voltages u \[V\] (inner axis).
     pub u: Axis,
+    /// The varied parameter's dotted path (`k_theta`, `lower.t_s`; see
+    /// [`Params::field_names`]).
     pub param: String,
+    /// Its values, in its unit (outer axis).
     pub p: Axis,
+    /// Where each point's run starts.
     pub start: SweepStart,
+    /// The solver, at its default setting.
     pub solver: SolverKind,
     /// Horizon of each run \[s\]; the metrics are read over its second half.
     pub t_end: f64,
@@ -182,6 +209,7 @@ impl Sweep {
         self.u.n.saturating_mul(self.p.n)
     }
 
+    /// Whether the grid has no point.
     pub fn is_empty(&self) -> bool {
         self.len() == 0
     }
@@ -285,14 +313,21 @@ impl Sweep {
 /// What `OUT.shard.json` records.
 #[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct ShardInfo {
+    /// The u axis as `A:B:N`.
     pub u: String,
+    /// The parameter and its axis, `name=A:B:N`.
     pub param: String,
+    /// The start: `A,WU,WL`, or `eq` for the perturbed equilibrium.
     pub x0: String,
+    /// The solver's name.
     pub solver: String,
+    /// Horizon of each run \[s\].
     pub t_end: f64,
     /// The parameter set, as a fingerprint of its fields.
     pub params: String,
+    /// This shard, I (from 1).
     pub shard: usize,
+    /// The number of shards, N.
     pub shards: usize,
 }
 
@@ -505,6 +540,7 @@ impl Merged {
         self.lines.len()
     }
 
+    /// Whether there is no row.
     pub fn is_empty(&self) -> bool {
         self.lines.is_empty()
     }

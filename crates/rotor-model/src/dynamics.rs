@@ -33,7 +33,9 @@ pub const OMEGA_L: usize = 2;
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, serde::Serialize)]
 #[serde(rename_all = "lowercase")]
 pub enum Disc {
+    /// The motor-driven disc (J_u, ω_u, friction T_fu, eq. (4)).
     Upper,
+    /// The disc at the end of the string, loaded by the brake (J_l, ω_l, friction T_fl).
     Lower,
 }
 
@@ -85,7 +87,9 @@ impl DiscMode {
 /// Friction modes of both discs.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, serde::Serialize)]
 pub struct Mode {
+    /// Mode of the upper disc.
     pub upper: DiscMode,
+    /// Mode of the lower disc.
     pub lower: DiscMode,
 }
 
@@ -110,6 +114,7 @@ impl Mode {
 /// The rotor model: a validated parameter set with the vector fields built on it.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Model {
+    /// The parameter set the friction laws were built from.
     pub params: Params,
     upper: Friction,
     lower: Friction,

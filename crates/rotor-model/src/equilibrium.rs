@@ -18,8 +18,12 @@ use crate::dynamics::{DiscMode, Mode, Model, State};
 /// A slipping equilibrium (both discs at the same velocity ω ≠ 0).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct SlipEquilibrium {
+    /// u \[V\]: the input voltage at which this is an equilibrium,
+    /// `u = (T_fl(ω) + T_fu(ω))/k_m`.
     pub u: f64,
+    /// ω [rad/s]: the common velocity of both discs, ω_u = ω_l = ω ≠ 0.
     pub omega: f64,
+    /// α \[rad\]: the spring's twist, `α = T_fl(ω)/k_θ`.
     pub alpha: f64,
 }
 
@@ -33,7 +37,10 @@ impl SlipEquilibrium {
 /// The set of stuck equilibria `α ∈ [alpha_min, alpha_max]`, `ω_u = ω_l = 0`.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct StuckSet {
+    /// Smallest stuck twist \[rad\]: `max(T_l⁻/k_θ, (k_m u − T_u⁺)/k_θ)`, with `[T⁻, T⁺]` a
+    /// disc's stick interval.
     pub alpha_min: f64,
+    /// Largest stuck twist \[rad\]: `min(T_l⁺/k_θ, (k_m u − T_u⁻)/k_θ)`.
     pub alpha_max: f64,
 }
 

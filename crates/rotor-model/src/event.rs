@@ -25,7 +25,10 @@ pub enum EventKind {
 /// An event with its time and the state there.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct Event {
+    /// Time of the event \[s\], as the reporting solver located it.
     pub t: f64,
+    /// The state `[α, ω_u, ω_l]` at `t` (rad, rad/s, rad/s).
     pub x: State,
+    /// What happened, and to which disc.
     pub kind: EventKind,
 }

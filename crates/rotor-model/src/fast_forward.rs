@@ -70,7 +70,10 @@ pub enum Verdict {
     /// Go on.
     Continue,
     /// Stop at this event and continue from its state `dt` later (whole periods).
-    Jump { dt: f64 },
+    Jump {
+        /// The time skipped \[s\]: a whole number of periods of the detected cycle.
+        dt: f64,
+    },
     /// The return after the jump does not confirm it: go back to the state at the jump and
     /// integrate from there, without skipping again.
     Undo,

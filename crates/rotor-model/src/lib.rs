@@ -5,6 +5,8 @@
 //!
 //! This crate is shared by all solvers and holds no integration code.
 
+#![warn(missing_docs)]
+
 pub mod dynamics;
 pub mod equilibrium;
 pub mod event;

@@ -33,23 +33,41 @@ use thiserror::Error;
 pub enum ParamsError {
     /// The file could not be read.
     #[error("{}: cannot read parameter file: {message}", shown(.path))]
-    Io { path: PathBuf, message: String },
+    Io {
+        /// The file that was asked for.
+        path: PathBuf,
+        /// The operating system's reason (not found, permission denied, too large, ...).
+        message: String,
+    },
     /// The file is not valid TOML, or a key is unknown, missing or of the wrong type.
     #[error("{}: {message}", shown(.path))]
-    Parse { path: PathBuf, message: String },
+    Parse {
+        /// The file, or the origin a table was named by ([`Params::from_table`]).
+        path: PathBuf,
+        /// The parser's message on one line (see [`one_line`]), naming the key.
+        message: String,
+    },
     /// A value set by name (not read from a file) is unknown or out of its range.
     #[error("{field} = {value}: {reason}")]
     Value {
+        /// The dotted path of the field (`k_theta`, `lower.t_s`), or `param` for an
+        /// unknown name.
         field: String,
+        /// The value as given (the name itself, quoted, when the name is unknown).
         value: String,
+        /// Why it is refused (the admissible range, or the valid names).
         reason: String,
     },
     /// A value is out of its admissible range.
     #[error("{}: {field} = {value}: {reason}", shown(.path))]
     Invalid {
+        /// The file the value was read from.
         path: PathBuf,
+        /// The dotted path of the field (`j_l`, `lower.w_1`, `lower.family`).
         field: String,
+        /// The value read, as printed by [`crate::Num`].
         value: String,
+        /// Why it is refused (the admissible range).
         reason: String,
     },
 }
@@ -83,19 +101,34 @@ pub enum LowerFriction {
     /// after Mihajlović's thesis (TU Eindhoven 2005) and Mihajlović et al., J. Dyn. Sys. Meas.
     /// Control 126 (2004) 709–720, see docs/model.md §2.4).
     Exponential {
+        /// T_sl [N m]: static level, the law's value at ω = 0 (half-width of the stick
+        /// interval).
         t_s: f64,
+        /// T_1 [N m]: amplitude of the fast tanh term (Table 1: positive, the level rises).
         t_1: f64,
+        /// T_2 [N m]: amplitude of the slow tanh term (Table 1: negative, the falling branch
+        /// that drives the limit cycles).
         t_2: f64,
+        /// w_1 [s/rad]: rate of the fast term; it saturates over |ω| ≈ 2/w_1.
         w_1: f64,
+        /// w_2 [s/rad]: rate of the slow term; it saturates over |ω| ≈ 2/w_2.
         w_2: f64,
+        /// b_l [N m s/rad]: viscous coefficient.
         b: f64,
     },
     /// `T_cl(ω) = T_cl + (T_sl − T_cl)·exp(−|ω/ω_sl|^δ_sl) + b_l|ω|` (eq. 5 of the source).
     Stribeck {
+        /// T_sl [N m]: static level, the law's value at ω = 0 (half-width of the stick
+        /// interval).
         t_s: f64,
+        /// T_cl [N m]: Coulomb level, the level the law falls to at large |ω| (before the
+        /// viscous term).
         t_c: f64,
+        /// ω_sl [rad/s]: Stribeck velocity, the width of the fall from T_sl to T_cl.
         omega_s: f64,
+        /// δ_sl [–]: Stribeck exponent, the shape of that fall.
         delta: f64,
+        /// b_l [N m s/rad]: viscous coefficient.
         b: f64,
     },
 }

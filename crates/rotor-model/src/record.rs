@@ -157,6 +157,83 @@ impl Recorder {
     /// continues whole periods later (the metrics move with it), and after a jump that the
     /// next return does not confirm, or that the run's end leaves unconfirmed, it goes back to
     /// the checkpoint and integrates the skipped periods after all.
+    ///
+    /// # Example
+    ///
+    /// A toy "solver" that steps 1 s at a time along a known periodic solution, a triangle
+    /// wave of period 4 s in ω_l with its maxima and minima as events. With
+    /// [`Output::Metrics`] the recorder sees the cycle repeat, has the integration skip whole
+    /// periods ([`Integration::shift`]), and still reports the cycle's metrics.
+    ///
+    /// ```
+    /// use rotor_model::{
+    ///     Disc, DiscMode, Event, EventKind, Integration, Mode, Output, Recorder, Scene,
+    ///     SolveError, State, Stats, SteadyState,
+    /// };
+    ///
+    /// /// ω_l = 2 + tri(t), tri of period 4 between −1 and 1: maxima at t = 1 + 4k.
+    /// fn x(t: f64) -> State {
+    ///     let s = t.rem_euclid(4.0);
+    ///     let tri = if s < 1.0 { s } else if s < 3.0 { 2.0 - s } else { s - 4.0 };
+    ///     State::new(0.0, 1.0, 2.0 + tri)
+    /// }
+    ///
+    /// struct Toy {
+    ///     t: f64,
+    ///     t_end: f64,
+    /// }
+    ///
+    /// impl Integration for Toy {
+    ///     type Checkpoint = f64;
+    ///     fn advance(&mut self, rec: &mut Recorder) -> Result<(), SolveError> {
+    ///         while self.t < self.t_end {
+    ///             let (t0, t1) = (self.t, self.t + 1.0);
+    ///             rec.step(t0, t1, &x(t1), x); // the exact solution is the interpolant
+    ///             self.t = t1;
+    ///             let kind = match t1.rem_euclid(4.0) {
+    ///                 1.0 => EventKind::Max(Disc::Lower),
+    ///                 3.0 => EventKind::Min(Disc::Lower),
+    ///                 _ => continue,
+    ///             };
+    ///             rec.event(Event { t: t1, x: x(t1), kind });
+    ///             if rec.halted() {
+    ///                 return Ok(()); // the recorder decided a jump (or an undo) here
+    ///             }
+    ///         }
+    ///         Ok(())
+    ///     }
+    ///     fn checkpoint(&self, _anchor: &Event) -> f64 {
+    ///         self.t
+    ///     }
+    ///     fn restore(&mut self, t: f64) {
+    ///         self.t = t;
+    ///     }
+    ///     fn shift(&mut self, _anchor: &Event, dt: f64) {
+    ///         self.t += dt;
+    ///     }
+    /// }
+    ///
+    /// let scene = Scene {
+    ///     x0: x(0.0),
+    ///     t_end: 100.0,
+    ///     output: Output::Metrics,
+    ///     ..Scene::default()
+    /// };
+    /// let mut rec = Recorder::new(&scene, scene.x0, 1e-10, 3.0);
+    /// let mut toy = Toy { t: 0.0, t_end: scene.t_end };
+    /// rec.drive(&mut toy)?;
+    /// let slip = Mode { upper: DiscMode::SlipPos, lower: DiscMode::SlipPos };
+    /// let tr = rec.finish(toy.t, x(toy.t), slip, Stats::default());
+    ///
+    /// assert_eq!(tr.t_final, 100.0);
+    /// assert!(tr.stats.skipped_periods > 0, "whole periods were skipped, not integrated");
+    /// let Some(SteadyState::LimitCycle { period, omega_l_max, omega_l_min, .. }) = tr.metrics
+    /// else {
+    ///     panic!("a cycle: {:?}", tr.metrics)
+    /// };
+    /// assert_eq!((period, omega_l_max, omega_l_min), (4.0, 3.0, 1.0));
+    /// # Ok::<(), SolveError>(())
+    /// ```
     pub fn drive<I: Integration>(&mut self, integ: &mut I) -> Result<(), SolveError> {
         let mut saved: Option<(I::Checkpoint, Option<MetricsAccumulator>)> = None;
         loop {

@@ -22,7 +22,10 @@ pub enum Output {
     /// asked), no samples.
     Events,
     /// Samples at `t = k·dt` for `k = 0, 1, …` and at `t_end`, plus events.
-    Grid { dt: f64 },
+    Grid {
+        /// Sample spacing \[s\]; at most [`MAX_GRID_ROWS`] rows over the horizon.
+        dt: f64,
+    },
     /// The state after every step, plus events.
     Steps,
 }
@@ -249,7 +252,9 @@ impl OutputGrid {
 /// One output sample.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct Sample {
+    /// Time \[s\].
     pub t: f64,
+    /// The state `[α, ω_u, ω_l]` at `t` (rad, rad/s, rad/s).
     pub x: State,
 }
 
@@ -350,35 +355,80 @@ pub enum SolveError {
     /// The scene is not admissible.
     #[error("invalid scene: {field} = {}: {reason}", crate::Num(*.value))]
     InvalidScene {
+        /// The scene field at fault (`u`, `x0[omega_l]`, `t_end`, `tol`, `h`, `dt`,
+        /// `metrics_from`).
         field: &'static str,
+        /// Its value.
         value: f64,
+        /// The range it must lie in.
         reason: &'static str,
     },
     /// The step size fell below what floating point resolves.
     #[error("step size underflow at t = {t}: h = {h:e} (state {x:?})")]
-    StepSizeUnderflow { t: f64, h: f64, x: [f64; 3] },
+    StepSizeUnderflow {
+        /// Time reached \[s\].
+        t: f64,
+        /// The step size that fell below a few roundoffs of `t` \[s\].
+        h: f64,
+        /// The state `[α, ω_u, ω_l]` at `t`.
+        x: [f64; 3],
+    },
     /// The state became NaN or infinite.
     #[error("non-finite state at t = {t}: {x:?}")]
-    NonFinite { t: f64, x: [f64; 3] },
+    NonFinite {
+        /// Time at which the state was found non-finite \[s\].
+        t: f64,
+        /// That state `[α, ω_u, ω_l]`.
+        x: [f64; 3],
+    },
     /// The one-step complementarity problem had no admissible solution.
     #[error("complementarity failure at t = {t}: {detail}")]
-    Complementarity { t: f64, detail: String },
+    Complementarity {
+        /// Time of the step \[s\].
+        t: f64,
+        /// What the complementarity solver reported.
+        detail: String,
+    },
     /// Events accumulate (Zeno-like): too many in too short a time.
     #[error("Zeno-like event accumulation at t = {t}: {count} events within {window:e} s")]
-    Zeno { t: f64, count: u32, window: f64 },
+    Zeno {
+        /// Time of the last switch \[s\].
+        t: f64,
+        /// Number of switches that fell within `window`.
+        count: u32,
+        /// Length of the time window \[s\] they fell in.
+        window: f64,
+    },
     /// The run needed more steps than allowed.
     #[error("step limit {max_steps} reached at t = {t}")]
-    TooManySteps { t: f64, max_steps: u64 },
+    TooManySteps {
+        /// Time reached \[s\].
+        t: f64,
+        /// The solver's step limit.
+        max_steps: u64,
+    },
     /// A steady-state computation (shooting, Newton) did not converge.
     #[error("no convergence: {detail}")]
-    NoConvergence { detail: String },
+    NoConvergence {
+        /// What did not converge, and why (a residual, a section never reached).
+        detail: String,
+    },
     /// The solver does not support what was asked.
     #[error("unsupported: {detail}")]
-    Unsupported { detail: String },
+    Unsupported {
+        /// What was asked that the solver does not do.
+        detail: String,
+    },
     /// The solver finished, but its output holds a NaN or ∞ (a solver bug, caught by
     /// [`Trajectory::check_finite`] before anything is written).
     #[error("non-finite output ({what}) at t = {t}: a solver bug")]
-    NonFiniteOutput { t: f64, what: &'static str },
+    NonFiniteOutput {
+        /// Time of the first non-finite output \[s\] (`t_final` for the final state and the
+        /// metrics).
+        t: f64,
+        /// Which output: `sample`, `event`, `final state` or `steady-state metrics`.
+        what: &'static str,
+    },
 }
 
 impl SolveError {
@@ -407,10 +457,20 @@ impl SolveError {
 }
 
 /// A solver: takes a model and a scene and returns a trajectory.
+///
+/// The implementations live in crates of their own, which this one does not depend on:
+/// `rotor_event::EventSolver` (the accuracy reference), `rotor_switch::SwitchSolver` and
+/// `rotor_moreau::MoreauSolver`; `rotor_solvers::SOLVERS` lists them, with a constructor for
+/// each. For a runnable example of [`Solver::simulate`] on a Table 1 scene see the docs of
+/// `rotor_event::EventSolver`, and those of `rotor_solvers::SolverKind::solver` for all
+/// three solvers in turn.
 pub trait Solver: Sync {
     /// Short name (`"event"`, `"switch"`, `"moreau"`).
     fn name(&self) -> &'static str;
-    /// Runs the scene.
+    /// Runs the scene: integrates from `scene.x0` at input `scene.u` over `[0, t_end]`, at
+    /// the solver's accuracy knob (`tol` or `h`), keeping what `scene.output` and
+    /// `scene.metrics_from` ask. An inadmissible scene is refused before any step
+    /// ([`SolveError::InvalidScene`]).
     fn simulate(&self, model: &Model, scene: &Scene) -> Result<Trajectory, SolveError>;
 
     /// Runs the scene, and refuses a finished run whose output holds a NaN or ∞

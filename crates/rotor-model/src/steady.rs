@@ -15,19 +15,30 @@ use crate::event::{Event, EventKind};
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(tag = "kind", rename_all = "snake_case")]
 pub enum SteadyState {
-    /// An equilibrium (rad, rad/s).
+    /// An equilibrium (rad, rad/s): a run's final state when read off a run
+    /// ([`MetricsAccumulator::finish`]), or the solved equilibrium.
     Equilibrium {
+        /// ω_u [rad/s] (equal to ω_l at an equilibrium, up to how the run approached it).
         omega_u: f64,
+        /// ω_l [rad/s]; exactly 0 when the lower disc is stuck.
         omega_l: f64,
+        /// α \[rad\]: the spring's twist.
         alpha: f64,
     },
     /// A periodic orbit: period \[s\], extremes [rad/s], time per period with ω_l = 0 \[s\].
     LimitCycle {
+        /// Period \[s\]: time between the last two anchors (lower-disc stick exits when the
+        /// orbit sticks, ω_l maxima otherwise).
         period: f64,
+        /// Largest ω_l over the last cycle [rad/s].
         omega_l_max: f64,
+        /// Smallest ω_l over the last cycle [rad/s] (0 on a stick-slip cycle).
         omega_l_min: f64,
+        /// Largest ω_u over the last cycle [rad/s].
         omega_u_max: f64,
+        /// Smallest ω_u over the last cycle [rad/s].
         omega_u_min: f64,
+        /// Time the lower disc spends stuck per period \[s\] (0 on a slipping cycle).
         stick_time: f64,
     },
 }
@@ -97,7 +108,9 @@ impl SteadyState {
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize)]
 #[serde(rename_all = "snake_case")]
 pub enum SteadyKind {
+    /// A rest point: [`SteadyState::Equilibrium`].
     Equilibrium,
+    /// A periodic orbit: [`SteadyState::LimitCycle`].
     LimitCycle,
 }
 

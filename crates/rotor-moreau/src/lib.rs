@@ -127,6 +127,8 @@
 //!
 //! Events are fed in time order to a [`rotor_model::MetricsAccumulator`] when metrics are asked.
 
+#![warn(missing_docs)]
+
 pub mod onestep;
 mod run;
 pub mod stepper;
@@ -190,6 +192,7 @@ impl Default for MoreauOptions {
 /// The Moreau–Jean solver; step size `scene.h`.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct MoreauSolver {
+    /// θ, the friction level, Newton's limits and the step limit.
     pub options: MoreauOptions,
 }
 

@@ -49,16 +49,23 @@ pub const DISC_MODES: [DiscMode; 3] = [DiscMode::Stick, DiscMode::SlipPos, DiscM
 /// `r = −s·(pc + pd·ω)`, i.e. `P(ω) = pc + pd·ω` is the cone bound `μ r_N`.
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
 pub struct Branch {
+    /// Constant part of the total friction impulse `c + d·ω` \[N m s\].
     pub c: f64,
+    /// Its slope in ω, in the units of `A` (kg m²): in a mode where the disc slips on this
+    /// branch, its diagonal entry of `A` becomes `A_ii − d` and its right-hand side `b_i + c`.
     pub d: f64,
+    /// Constant part of the cone bound `P(ω) = pc + pd·ω` \[N m s\].
     pub pc: f64,
+    /// Slope of the cone bound in ω (kg m²).
     pub pd: f64,
 }
 
 /// A stuck disc (ω⁺ = 0): smooth friction impulse `e` and cone bound `p ≥ 0`.
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
 pub struct StickData {
+    /// The smooth friction impulse `e_i` of the stuck disc \[N m s\].
     pub e: f64,
+    /// The cone bound `P_i ≥ 0` \[N m s\]: stick holds while `|r_i| ≤ P_i`.
     pub p: f64,
 }
 
@@ -94,7 +101,10 @@ pub enum EnumError {
     /// No mode satisfies all complementarity conditions.
     NoneAdmissible,
     /// Several modes are admissible with different solutions.
-    Several { count: usize },
+    Several {
+        /// How many of the nine modes were admissible (at the slack of the failing test).
+        count: usize,
+    },
 }
 
 fn branch_index(m: DiscMode) -> usize {

@@ -148,8 +148,12 @@ impl BranchCtx<'_> {
 /// The data of one step size: `h`, the iteration matrix `M̂` and `W = M̂⁻¹`.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct StepSize {
+    /// Step size \[s\].
     pub h: f64,
+    /// The iteration matrix `M̂ = M + θhC + θ²h²K` on the velocities `[ω_u, ω_l]`
+    /// ([`Stepper::iteration_matrix`]).
     pub a: Matrix2<f64>,
+    /// Its inverse `W = M̂⁻¹` (the Delassus matrix of the two contacts).
     pub w_inv: Matrix2<f64>,
 }
 

@@ -1,6 +1,8 @@
 //! A small, dependency-free SVG line-plot writer (pure Rust, no fonts needed: text is left to
 //! the viewer's sans-serif).
 
+#![warn(missing_docs)]
+
 use std::fmt::Write;
 
 pub mod overlay;
@@ -9,6 +11,7 @@ pub mod overlay;
 pub struct Series<'a> {
     /// Legend text; an empty label keeps the series out of the legend.
     pub label: &'a str,
+    /// SVG colour of the line and markers, e.g. `"#e66101"`.
     pub color: &'a str,
     /// SVG `stroke-dasharray`, e.g. `"6 4"`; `None` draws a solid line.
     pub dash: Option<&'a str>,
@@ -16,6 +19,7 @@ pub struct Series<'a> {
     pub width: f64,
     /// Draws a filled circle of this radius at every point.
     pub marker: Option<f64>,
+    /// The points `(x, y)` in data coordinates, in drawing order.
     pub points: Vec<(f64, f64)>,
 }
 
@@ -35,8 +39,11 @@ impl<'a> Series<'a> {
 
 /// A text label placed at a data point, drawn with a small cross.
 pub struct Label {
+    /// Abscissa of the point, in data coordinates.
     pub x: f64,
+    /// Ordinate of the point, in data coordinates.
     pub y: f64,
+    /// The label (escaped for SVG when written).
     pub text: String,
 }
 
@@ -47,25 +54,38 @@ pub struct Label {
 /// where the band is narrower than a line of text; left out where every band is thinner than
 /// a pixel (it cannot be seen).
 pub struct Band {
+    /// The region's name.
     pub text: String,
+    /// Candidate places `(x, y_lo, y_hi)` in data coordinates, best first: a vertical band at
+    /// `x` from `y_lo` to `y_hi`.
     pub places: Vec<(f64, f64, f64)>,
 }
 
 /// A curve's name at one of its ends, in the curve's colour: in the right margin, joined to
 /// the end by a thin line, if `margin` (the curve reaches the right edge), else beside it.
 pub struct EndLabel {
+    /// Abscissa of the curve's end, in data coordinates.
     pub x: f64,
+    /// Ordinate of the curve's end, in data coordinates.
     pub y: f64,
+    /// The curve's name.
     pub text: String,
+    /// SVG colour, the curve's.
     pub color: String,
+    /// Whether the name goes to the right margin (the curve reaches the right edge) rather
+    /// than beside the end.
     pub margin: bool,
 }
 
 /// A panel: title, axis labels, series, and how each axis is scaled.
 pub struct Panel<'a> {
+    /// Title above the panel.
     pub title: String,
+    /// Label of the x axis, below it (with its unit, as the caller writes it).
     pub x_label: &'a str,
+    /// Label of the y axis, left of it and turned upright.
     pub y_label: &'a str,
+    /// The curves, drawn in order (the last on top), with a legend row for the labelled ones.
     pub series: Vec<Series<'a>>,
     /// Labelled points (special points of a diagram, say).
     pub labels: Vec<Label>,
@@ -77,6 +97,7 @@ pub struct Panel<'a> {
     pub clear_x: Vec<f64>,
     /// Logarithmic axes: points with a non-positive coordinate are skipped.
     pub x_log: bool,
+    /// Logarithmic y axis (see `x_log`).
     pub y_log: bool,
 }
 

@@ -8,11 +8,13 @@ use crate::{Label, Panel, Series, render};
 pub struct Layer<'a> {
     /// Legend text.
     pub label: &'a str,
+    /// SVG colour of the markers and line.
     pub color: &'a str,
     /// Marker radius \[px\]; 0 for none.
     pub marker: f64,
     /// Line width; 0 for no line (a NaN point lifts the pen).
     pub width: f64,
+    /// The points `(x, y)` in data coordinates.
     pub points: Vec<(f64, f64)>,
 }
 

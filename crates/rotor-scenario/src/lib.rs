@@ -5,6 +5,8 @@
 //! See docs/design.md, "Fixtures", and [`scenario`] for the format; [`tolerance`] holds the
 //! `[tolerance.<pair>]` tables.
 
+#![warn(missing_docs)]
+
 pub mod scenario;
 pub mod tolerance;
 

@@ -40,22 +40,42 @@ use crate::tolerance::{PairTolerance, RawPairTolerance, check_pair};
 pub enum ScenarioError {
     /// The file could not be read.
     #[error("{}: cannot read scenario file: {message}", shown(.path))]
-    Io { path: PathBuf, message: String },
+    Io {
+        /// The scenario file.
+        path: PathBuf,
+        /// The operating system's reason (not found, permission denied, too large, ...).
+        message: String,
+    },
     /// Not valid TOML, or a key is unknown, missing or of the wrong type.
     #[error("{}: {message}", shown(.path))]
-    Parse { path: PathBuf, message: String },
+    Parse {
+        /// The scenario file.
+        path: PathBuf,
+        /// The parser's message on one line, naming the key.
+        message: String,
+    },
     /// A value is out of range.
     #[error("{}: {field} = {value}: {reason}", shown(.path))]
     Invalid {
+        /// The scenario file.
         path: PathBuf,
+        /// The key at fault (`u`, `compare.dt`, `x0[2]`, `tolerance.event-switch.period_rel`,
+        /// ...).
         field: String,
+        /// Its value as written back.
         value: String,
+        /// Why it is refused.
         reason: String,
     },
     /// The parameter file it names is bad. (Not a `#[source]`: the message already holds
     /// it, and a reporter that prints the chain would print it twice.)
     #[error("{}: params: {error}", shown(.path))]
-    Params { path: PathBuf, error: ParamsError },
+    Params {
+        /// The scenario file that names the parameter file.
+        path: PathBuf,
+        /// What is wrong with the parameter file (it names that file).
+        error: ParamsError,
+    },
 }
 
 /// What the comparison harness compares for this scene.
@@ -113,18 +133,29 @@ struct RawScenario {
 /// A loaded, validated scenario.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Scenario {
+    /// Its name: the report's file names (`<name>.csv`, `<name>.svg`); 1 to 100 characters
+    /// of `A-Z a-z 0-9 . _ + -`, not starting with `.`.
     pub name: String,
+    /// One line on what the scene shows (empty if the file gives none).
     pub description: String,
+    /// The scenario file it was read from.
     pub path: PathBuf,
+    /// The parameter file, resolved relative to the scenario file.
     pub params_path: PathBuf,
+    /// The rotor model of that parameter file.
     pub model: Model,
+    /// Motor input voltage u \[V\].
     pub u: f64,
+    /// Initial state `[α, ω_u, ω_l]` (rad, rad/s, rad/s): `x0`, or the slipping equilibrium
+    /// at `u` plus `x0_from_equilibrium`, or rest.
     pub x0: State,
+    /// Horizon \[s\]; runs cover `[0, t_end]`.
     pub t_end: f64,
     /// Tolerance for the adaptive solvers, if the file sets one.
     pub tol: Option<f64>,
     /// Step for the time-stepping solver, if the file sets one.
     pub h: Option<f64>,
+    /// The `[compare]` table: transient window, grid step and steady-state window.
     pub compare: CompareSpec,
     /// Keyed by pair name, e.g. `"event-switch"`.
     pub tolerance: BTreeMap<String, PairTolerance>,

@@ -173,8 +173,12 @@ pub const STEADY_QUANTITIES: [SteadyQuantity; 9] = [
 /// One steady-state tolerance: its key in the file and the metric it gates.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct SteadyQuantity {
+    /// The key in a `[tolerance.<pair>]` table (`period_rel`, `stick_time`, ...).
     pub key: &'static str,
+    /// The [`rotor_model::SteadyState`] metric it gates (`period`, `stick_time`, ...).
     pub metric: &'static str,
+    /// Whether the tolerance is relative to the metric (with `steady_abs` as its floor);
+    /// otherwise it is absolute, in the metric's unit.
     pub relative: bool,
 }
 

@@ -35,6 +35,8 @@
 //! # Ok(()) }
 //! ```
 
+#![warn(missing_docs)]
+
 use rotor_model::{
     Disc, EventKind, Model, OMEGA_L, OMEGA_U, Output, Scene, SolveError, Solver, State,
 };
@@ -49,6 +51,8 @@ pub enum Section {
 }
 
 impl Section {
+    /// What the section is, for messages (`"stick exit of the lower disc"`,
+    /// `"maximum of omega_l"`).
     pub fn as_str(self) -> &'static str {
         match self {
             Section::StickExit => "stick exit of the lower disc",
@@ -157,6 +161,7 @@ impl Default for ShootOptions {
 /// A periodic orbit found by [`shoot`].
 #[derive(Debug, Clone, PartialEq)]
 pub struct Orbit {
+    /// The section the orbit was cut at; `z` is in its coordinates.
     pub section: Section,
     /// The fixed point's section coordinates.
     pub z: Vec<f64>,
@@ -168,6 +173,7 @@ pub struct Orbit {
     pub multipliers: Vec<[f64; 2]>,
     /// `|P(z) − z|∞` at the fixed point.
     pub residual: f64,
+    /// Newton iterations taken.
     pub iterations: usize,
     /// Runs of the solver it took.
     pub runs: usize,
@@ -183,28 +189,46 @@ impl Orbit {
 /// Why no orbit was found.
 #[derive(Debug, thiserror::Error)]
 pub enum ShootError {
+    /// A run of the solver failed.
     #[error(transparent)]
     Solve(#[from] SolveError),
+    /// A run from a point on the section did not come back to it within the horizon.
     #[error("no {what} within {horizon} s of the start at z = {z:?}: the orbit left the section")]
     NoReturn {
+        /// The section ([`Section::as_str`]).
         what: &'static str,
+        /// [`ShootOptions::horizon`] \[s\].
         horizon: f64,
+        /// The section coordinates the run started from.
         z: Vec<f64>,
     },
+    /// Newton ran out of iterations.
     #[error(
         "Newton did not converge in {iterations} iterations: residual {residual:e} at z = {z:?}"
     )]
     NoConvergence {
+        /// [`ShootOptions::max_iter`].
         iterations: usize,
+        /// `|P(z) − z|∞` at the last iterate.
         residual: f64,
+        /// The last iterate's section coordinates.
         z: Vec<f64>,
     },
+    /// Newton's matrix is singular: `DP − I` for [`shoot`], `[∂P/∂z' − I', ∂P/∂u]` for
+    /// [`shoot_with_u`].
     #[error("DP − I is singular at z = {z:?} (a multiplier at 1: a fold or a Hopf point)")]
-    Singular { z: Vec<f64> },
+    Singular {
+        /// The iterate's section coordinates.
+        z: Vec<f64>,
+    },
+    /// [`Section::of_run`] found no crossing of either section in the run's second half.
     #[error(
         "the run settles to no cycle by t = {t_end} s (no stick exit and no maximum of omega_l in its second half)"
     )]
-    NotACycle { t_end: f64 },
+    NotACycle {
+        /// The run's horizon \[s\].
+        t_end: f64,
+    },
 }
 
 /// The first run's horizon before any return is known \[s\]: two of the longest periods

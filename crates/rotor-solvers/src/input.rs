@@ -11,8 +11,12 @@ use crate::solvers::{SOLVERS, SolverKind};
 #[derive(Debug, Clone, PartialEq, Error)]
 #[error("{name} = {value}: {reason}")]
 pub struct BadInput {
+    /// The input's name as the Python argument (`t_end`, `x0`); the command line's flag is
+    /// the same with `-` for `_` ([`BadInput::as_flag`]).
     pub name: &'static str,
+    /// The value as typed, or as [`Num`] prints a number.
     pub value: String,
+    /// Why it is refused (the admissible range, or the valid names).
     pub reason: String,
 }
 

@@ -2,6 +2,8 @@
 //! scenario files loaded for them, one scenario run through each, and input refused before
 //! any run.
 
+#![warn(missing_docs)]
+
 pub mod fixtures;
 mod input;
 pub mod run;

@@ -30,7 +30,10 @@ pub fn solver_settings(kind: SolverKind, sc: &Scenario) -> (f64, f64) {
 /// One solver's run of one scenario.
 #[derive(Debug, Clone)]
 pub struct RunResult {
+    /// The solver that ran.
     pub kind: SolverKind,
+    /// Its trajectory on the scenario's comparison scene ([`scene_for`]), or why it failed
+    /// (a finished run with a NaN or ∞ in its output counts as failed).
     pub result: Result<Trajectory, SolveError>,
     /// Wall-clock run time \[s\] (for the report; never asserted).
     pub seconds: f64,
@@ -39,7 +42,9 @@ pub struct RunResult {
 /// All solvers' runs of one scenario.
 #[derive(Debug, Clone)]
 pub struct ScenarioResult {
+    /// The scenario that was run.
     pub scenario: Scenario,
+    /// One run per solver, in the order asked (the reference first).
     pub runs: Vec<RunResult>,
 }
 

@@ -33,9 +33,11 @@ impl Knob {
 /// How a solver's curves are drawn.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Style {
+    /// SVG colour, e.g. `"#e66101"`.
     pub color: &'static str,
     /// SVG dash pattern; `None` for a solid line.
     pub dash: Option<&'static str>,
+    /// Stroke width (SVG user units, pixels at the reports' scale).
     pub width: f64,
 }
 
@@ -46,6 +48,7 @@ pub struct SolverInfo {
     pub name: &'static str,
     /// For plots and tables (`"event-driven"`).
     pub label: &'static str,
+    /// What its accuracy setting is: a tolerance (`tol`) or a step size (`h`).
     pub knob: Knob,
     /// The setting the comparison runs it at (the reference's is tighter than what a user
     /// asks by default; a scenario file may override a non-reference solver's `tol` or `h`).
@@ -54,6 +57,7 @@ pub struct SolverInfo {
     pub default: f64,
     /// The benchmark's ladder of settings, loosest first.
     pub ladder: &'static [f64],
+    /// How its curves are drawn in the reports.
     pub style: Style,
     /// A solver with its default options.
     pub make: fn() -> Box<dyn Solver>,
@@ -121,8 +125,11 @@ pub struct SolverKind(pub &'static SolverInfo);
 pub static SOLVERS: [SolverKind; 3] = [SolverKind::EVENT, SolverKind::SWITCH, SolverKind::MOREAU];
 
 impl SolverKind {
+    /// The event-driven solver, [`EVENT`]: the accuracy reference.
     pub const EVENT: SolverKind = SolverKind(&EVENT);
+    /// The switch model, [`SWITCH`].
     pub const SWITCH: SolverKind = SolverKind(&SWITCH);
+    /// Moreau–Jean time-stepping, [`MOREAU`].
     pub const MOREAU: SolverKind = SolverKind(&MOREAU);
 
     /// Its entry.

@@ -20,7 +20,9 @@ use crate::solver_points;
 /// A diagram and the solver that computed it (the JSON of `rotor bifurcation --solver`).
 #[derive(Debug, Clone, Serialize)]
 pub struct SolverDiagram {
+    /// The solver's name (`event`, `switch`, `moreau`).
     pub solver: &'static str,
+    /// Its diagram: branches, periodic rows and special points.
     #[serde(flatten)]
     pub diagram: Diagram,
     /// Kinds of special points this solver's diagram does not locate (empty: every solver
@@ -37,7 +39,9 @@ pub struct SolverDiagram {
 /// A row or special point the solver's shooting did not reproduce, and why.
 #[derive(Debug, Clone, Serialize)]
 pub struct NotFound {
+    /// The row's or point's input u \[V\].
     pub u: f64,
+    /// Why the solver did not reproduce it (its error, or what it did not locate).
     pub reason: String,
 }
 

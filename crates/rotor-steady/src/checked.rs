@@ -106,7 +106,9 @@ pub enum Reached {
 /// An answer of [`checked_shot`], with its check.
 #[derive(Debug, Clone)]
 pub struct Checked {
+    /// The steady state.
     pub answer: SteadyAnswer,
+    /// How the run from the start confirmed it.
     pub reached: Reached,
     /// Simulated time from the start when the check passed \[s\].
     pub t: f64,

@@ -102,7 +102,10 @@ pub fn matching<'a>(points: &'a [SpecialPoint], p: &SpecialPoint) -> Option<&'a 
 /// A report section (the CLI turns it into its report's section type).
 #[derive(Debug, Clone, Default)]
 pub struct ReportSection {
+    /// The section's text (headings, figure links, tables).
     pub markdown: String,
+    /// Files the text links to, `(file name, bytes)`: one `figure3-<set>.svg` per parameter
+    /// set.
     pub files: Vec<(String, Vec<u8>)>,
     /// Gates that failed, one line each.
     pub failures: Vec<String>,

@@ -2,6 +2,8 @@
 //! by simulating until the metrics stop changing (every solver), and the probes next to the
 //! bifurcation diagram's special points.
 
+#![warn(missing_docs)]
+
 pub mod by_solver;
 pub mod checked;
 pub mod figure3;

@@ -38,6 +38,7 @@ pub enum Start {
 }
 
 impl Start {
+    /// The start's name in tables: `rest` or `eq+1e-3`.
     pub fn as_str(self) -> &'static str {
         match self {
             Start::Rest => "rest",
@@ -58,7 +59,9 @@ impl Start {
 /// coincide) and input.
 #[derive(Debug, Clone, PartialEq)]
 pub struct ProbePoint {
+    /// The kinds of special point here, joined by `/` (`hopf`, `grazing/fold`).
     pub label: String,
+    /// Its input u \[V\].
     pub u: f64,
 }
 
@@ -91,15 +94,30 @@ pub fn probe_points(d: &Diagram) -> Vec<ProbePoint> {
 #[derive(Debug, Clone, PartialEq)]
 pub enum Attractor {
     /// A stable slipping equilibrium.
-    Equilibrium { omega: f64, alpha: f64 },
+    Equilibrium {
+        /// The common velocity ω_u = ω_l \[rad/s\].
+        omega: f64,
+        /// The twist α \[rad\].
+        alpha: f64,
+    },
     /// Both discs at rest with α in the stuck set.
-    Stuck { alpha_min: f64, alpha_max: f64 },
+    Stuck {
+        /// Smallest stuck twist \[rad\].
+        alpha_min: f64,
+        /// Largest stuck twist \[rad\].
+        alpha_max: f64,
+    },
     /// A stable periodic orbit (its nontrivial multipliers' largest modulus in `mu`).
     Cycle {
+        /// Period \[s\].
         period: f64,
+        /// Largest ω_l over the cycle [rad/s].
         omega_l_max: f64,
+        /// Smallest ω_l over the cycle [rad/s] (0 with a stick phase).
         omega_l_min: f64,
+        /// Time per period with the lower disc stuck \[s\].
         stick_time: f64,
+        /// Largest modulus of the nontrivial Floquet multipliers (< 1).
         mu: f64,
     },
 }
@@ -259,15 +277,33 @@ pub fn agreement(kind: SolverKind) -> f64 {
 pub enum Verdict {
     /// The answer is the attractor named, within the solver's agreement (its largest
     /// relative difference in `diff`).
-    Agrees { attractor: String, diff: f64 },
+    Agrees {
+        /// The attractor, as printed.
+        attractor: String,
+        /// The largest relative difference of period, ω_l extremes (or equilibrium state).
+        diff: f64,
+    },
     /// No answer, and the error names the cause (a transient too slow to settle, a stick
     /// phase below the step, no cycle next to a weakly unstable equilibrium, a stability the
     /// tolerance cannot decide).
-    Refused { cause: String, short: &'static str },
+    Refused {
+        /// The error's message.
+        cause: String,
+        /// The cause in a few words, for a table cell (`slow transient`, ...).
+        short: &'static str,
+    },
     /// No answer, and the error is a failure of the solver rather than a named limit.
-    Failed { error: String },
+    Failed {
+        /// The error's message.
+        error: String,
+    },
     /// An answer that is none of the stable attractors.
-    Wrong { answer: String, expected: String },
+    Wrong {
+        /// The answer's steady state, as printed.
+        answer: String,
+        /// The attractors expected at its input, as printed, joined by `; `.
+        expected: String,
+    },
 }
 
 impl Verdict {
@@ -409,13 +445,18 @@ pub fn judge(
 /// One probe: a solver's steady state at `point.u + offset` from `start`.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Probe {
+    /// The special point probed around.
     pub point: ProbePoint,
+    /// The offset from its input \[V\] (one of [`OFFSETS`]).
     pub offset: f64,
+    /// Where the run starts.
     pub start: Start,
+    /// The solver asked.
     pub kind: SolverKind,
 }
 
 impl Probe {
+    /// The probe's input: `point.u + offset` \[V\].
     pub fn u(&self) -> f64 {
         self.point.u + self.offset
     }
@@ -468,7 +509,9 @@ pub fn run_probe(
 pub struct ProbeRow {
     /// The parameter set's name.
     pub set: String,
+    /// What was probed.
     pub probe: Probe,
+    /// The answer, judged.
     pub verdict: Verdict,
     /// How the answer was obtained, if there is one.
     pub method: Option<crate::steady::SteadyMethod>,

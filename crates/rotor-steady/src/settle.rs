@@ -61,10 +61,16 @@ pub enum SettleError {
          chunk to the next; {cause}"
     )]
     NotSettled {
+        /// Simulated time reached \[s\].
         t: f64,
+        /// Length of a chunk \[s\] ([`SettleOptions::chunk`]).
         chunk: f64,
+        /// The metric that changed most between the last two chunks (`the period`,
+        /// `the omega_l amplitude`, ...).
         what: String,
+        /// Its relative change between them.
         change: f64,
+        /// Why it still changes, as far as the chunks tell.
         cause: Unsettled,
     },
 }
@@ -78,22 +84,33 @@ pub enum Unsettled {
     /// A change that falls geometrically, by `per_chunk` per chunk, too slowly to settle
     /// before `max_time`: it would at about `needs` seconds.
     SlowDecay {
+        /// The ratio of the last change to the one before it (< 1).
         per_chunk: f64,
+        /// Simulated time \[s\] at which the change would fall within the agreement.
         needs: f64,
+        /// The limit it exceeds, [`SettleOptions::max_time`] \[s\].
         max_time: f64,
     },
     /// An oscillation growing geometrically, by `per_chunk` per chunk, from a weakly
     /// unstable equilibrium: it would leave the equilibrium's neighbourhood (1 % of the mean
     /// velocity) only at about `needs` seconds.
     SlowGrowth {
+        /// The ratio of the last ω_l amplitude to the one before it (> 1).
         per_chunk: f64,
+        /// Simulated time \[s\] at which the amplitude would reach 1 % of the mean velocity.
         needs: f64,
+        /// The limit it exceeds, [`SettleOptions::max_time`] \[s\].
         max_time: f64,
     },
     /// A fixed-step solver on a cycle that grazes ω_l = 0: its stick phase (`stick_time` per
     /// period, 0 if it only touches) is shorter than 10 steps of `h`, so whether and how long
     /// the disc sticks changes from period to period with where the steps fall.
-    GrazingBelowStep { stick_time: f64, h: f64 },
+    GrazingBelowStep {
+        /// The last chunk's stick time per period \[s\].
+        stick_time: f64,
+        /// The solver's step \[s\].
+        h: f64,
+    },
 }
 
 impl std::fmt::Display for Unsettled {
@@ -211,7 +228,9 @@ fn change(a: &SteadyState, b: &SteadyState, abs: f64) -> (String, f64) {
 /// A settled steady state and the summed counters of its chunks.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Settled {
+    /// The metrics of the last chunk's last complete cycle (or its final state, at rest).
     pub state: SteadyState,
+    /// The work counters of all chunks, summed.
     pub stats: Stats,
 }
 

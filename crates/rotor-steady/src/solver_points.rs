@@ -45,7 +45,9 @@ pub const FOLD_CONDITION: &str = "u extremal along the solver's branch (shooting
 /// The points one solver located, and those it did not.
 #[derive(Debug, Clone, Default)]
 pub struct Located {
+    /// The special points the solver located, with their conditions and residuals.
     pub points: Vec<SpecialPoint>,
+    /// The continuation's points it did not locate, each with the reason.
     pub not_found: Vec<NotFound>,
 }
 

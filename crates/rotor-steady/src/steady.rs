@@ -52,8 +52,10 @@ pub struct SteadyOptions {
 /// refined cycle, its Floquet multipliers.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct SteadyAnswer {
+    /// The metrics: an equilibrium's state, or a cycle's period, extremes and stick time.
     #[serde(flatten)]
     pub state: SteadyState,
+    /// How they were obtained.
     pub method: SteadyMethod,
     /// Floquet multipliers `[re, im]` of a refined cycle, the trivial one (≈ 1) first, then by
     /// decreasing modulus: `[1, λ, 0]` with a stick phase, `[1, λ1, λ2]` without; `None` for an
@@ -64,6 +66,8 @@ pub struct SteadyAnswer {
     /// inside the unit circle); absent otherwise.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub stable: Option<bool>,
+    /// Work counters of the run behind the answer where one is kept (a simulated answer, or
+    /// a shot orbit's metrics run); zero otherwise.
     #[serde(skip)]
     pub stats: Stats,
 }
@@ -81,13 +85,17 @@ fn complex_list<S: serde::Serializer>(
 /// Why there is no steady state to report.
 #[derive(Debug, thiserror::Error)]
 pub enum SteadyError {
+    /// A run failed, the scene is inadmissible, or the event-driven refinement found no
+    /// steady state.
     #[error(transparent)]
     Solve(#[from] SolveError),
+    /// Shooting found no periodic orbit (or the run settles to an equilibrium).
     #[error(
         "shooting found no periodic orbit (if the run settles to an equilibrium, --method \
          simulate answers it)"
     )]
     Shoot(#[from] rotor_shoot::ShootError),
+    /// A simulating solver's metrics did not settle ([`crate::settle`]).
     #[error(transparent)]
     Settle(#[from] SettleError),
     /// The refined cycle's saltation multipliers put it outside the unit circle although the
@@ -98,7 +106,9 @@ pub enum SteadyError {
          the input is too close to a bifurcation of the cycle for this tolerance"
     )]
     Undecided {
+        /// The monodromy matrix's multipliers, as printed.
         multipliers: String,
+        /// The return map's difference estimate, as printed.
         estimate: String,
     },
     /// Shooting found a periodic orbit near where a run from the start went, but a multiplier
@@ -107,7 +117,12 @@ pub enum SteadyError {
         "the periodic orbit shooting found (period {period:.6} s) is unstable: its Floquet \
          multipliers are {multipliers}; it is not the steady state"
     )]
-    Unstable { multipliers: String, period: f64 },
+    Unstable {
+        /// The orbit's Floquet multipliers, as printed.
+        multipliers: String,
+        /// Its period \[s\].
+        period: f64,
+    },
     /// Shooting found a periodic orbit whose largest multiplier is too close to the unit
     /// circle for its differences to decide its stability, and the run from the start went
     /// to no attractor within the check's time.
@@ -116,7 +131,12 @@ pub enum SteadyError {
          1e-3 of the unit circle ({multipliers}), closer than the return map's differences \
          resolve: its stability is undecided (the input is next to a bifurcation)"
     )]
-    Neutral { multipliers: String, period: f64 },
+    Neutral {
+        /// The orbit's Floquet multipliers, as printed.
+        multipliers: String,
+        /// Its period \[s\].
+        period: f64,
+    },
     /// The orbit shooting found is stable, but a run from the start had not come to it (at
     /// the rate its multipliers predict, or within the solver's reproducibility) by `t`.
     #[error(
@@ -125,27 +145,57 @@ pub enum SteadyError {
          approaching at the multipliers' rate (a slow transient next to a special point)"
     )]
     NotReached {
+        /// Simulated time from the start \[s\].
         t: f64,
+        /// `|z − z*|∞` of the run's last return to the section from the orbit's fixed point
+        /// (section coordinates, rad/s).
         distance: f64,
+        /// The orbit's Floquet multipliers, as printed.
         multipliers: String,
     },
     /// A value of the answer is not finite.
     #[error("the steady state has a non-finite {name}: {value}")]
-    NonFinite { name: &'static str, value: f64 },
+    NonFinite {
+        /// The metric ([`SteadyState::values`]'s name).
+        name: &'static str,
+        /// Its value.
+        value: f64,
+    },
 }
 
 /// The steady state that `kind` reaches from `scene.x0` at `scene.u` (the scene's `tol` or
 /// `h` is the solver's setting; its `t_end`, `output` and `metrics_from` are not used).
 /// For the event-driven solver the integration tolerance is `opts.event.tol`.
 ///
+/// # Example
+///
+/// Table 1 at 1.5 V from rest. The event-driven solver refines the stick-slip cycle as a
+/// stable fixed point of its return map and gives its Floquet multipliers `[1, λ, 0]` (the
+/// stick phase collapses one direction); Moreau–Jean (h = 1e-3) simulates until its metrics
+/// settle and finds the same cycle to O(h²).
+///
 /// ```
-/// use rotor_model::{Model, Scene, SteadyState};
+/// use rotor_model::{Model, Scene, State, SteadyState};
 /// use rotor_solvers::SolverKind;
-/// let scene = Scene { u: 1.5, ..Scene::default() };
-/// let a = rotor_steady::steady(SolverKind::EVENT, &Model::table1(), &scene, &Default::default())
-///     .unwrap();
-/// let SteadyState::LimitCycle { period, .. } = a.state else { panic!("{a:?}") };
+/// use rotor_steady::{SteadyMethod, steady};
+///
+/// let model = Model::table1();
+/// let scene = Scene { u: 1.5, x0: State::zeros(), ..Scene::default() };
+/// let a = steady(SolverKind::EVENT, &model, &scene, &Default::default())?;
+/// let SteadyState::LimitCycle { period, stick_time, .. } = a.state else { panic!("{a:?}") };
 /// assert!((period - 4.5777579).abs() < 1e-6); // the 1.5 V stick-slip cycle
+/// assert!(stick_time > 0.0);
+/// assert_eq!(a.method, SteadyMethod::Refined);
+/// let mu = a.multipliers.expect("a refined cycle has its multipliers");
+/// assert!((mu[0].re - 1.0).abs() < 1e-6, "the trivial multiplier, along the flow");
+/// assert!(mu[1].norm() < 1.0, "stable: {mu:?}");
+/// assert!(mu[2].norm() < 1e-12, "0 up to rounding: the stick phase");
+///
+/// let m = steady(SolverKind::MOREAU, &model, &scene, &Default::default())?;
+/// assert_eq!(m.method, SteadyMethod::Simulated);
+/// let SteadyState::LimitCycle { period: pm, .. } = m.state else { panic!("{m:?}") };
+/// assert!((pm - period).abs() < 1e-5, "Moreau-Jean's period {pm} s");
+/// # Ok::<(), rotor_steady::SteadyError>(())
 /// ```
 pub fn steady(
     kind: SolverKind,

@@ -21,6 +21,8 @@
 //! directory named by the version (written to a temporary directory and renamed into place,
 //! so an interrupted or concurrent extraction never leaves a partial suite).
 
+#![warn(missing_docs)]
+
 use std::path::{Path, PathBuf};
 
 include!(concat!(env!("OUT_DIR"), "/suite.rs"));
@@ -34,16 +36,21 @@ pub const VERSION: &str = concat!("rotorbench-1.0+", env!("ROTORBENCH_CHECKSUM12
 /// Why the suite's directory cannot be given.
 #[derive(Debug, thiserror::Error)]
 pub enum SuiteError {
+    /// `$ROTORBENCH_FIXTURES` names this path, which is not a directory.
     #[error("ROTORBENCH_FIXTURES = {0}: not a directory")]
     NotADirectory(PathBuf),
+    /// `$ROTORBENCH_SUITE` is set to this, not to `embedded`.
     #[error("ROTORBENCH_SUITE = {0:?}: expected embedded (or unset)")]
     Choice(String),
+    /// The embedded suite could not be written to the cache.
     #[error(
         "{path}: cannot write the embedded suite there ({source}); set ROTORBENCH_CACHE to a \
          writable directory, or ROTORBENCH_FIXTURES to a copy of the suite's fixtures/"
     )]
     Extract {
+        /// The file or directory that could not be created, written or renamed into place.
         path: PathBuf,
+        /// The operating system's error.
         source: std::io::Error,
     },
 }
@@ -60,6 +67,8 @@ pub enum Source {
 }
 
 impl Source {
+    /// Where, in words for messages (`"ROTORBENCH_FIXTURES"`, `"the source checkout"`,
+    /// `"embedded in this build"`).
     pub fn as_str(self) -> &'static str {
         match self {
             Source::Environment => "ROTORBENCH_FIXTURES",
@@ -73,7 +82,9 @@ impl Source {
 /// from.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct Located {
+    /// The directory holding `params/`, `scenarios/` and `reference/`.
     pub dir: PathBuf,
+    /// Where it came from.
     pub source: Source,
 }
 

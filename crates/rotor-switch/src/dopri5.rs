@@ -135,9 +135,19 @@ pub struct Counters {
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Dopri5Error {
     /// `0.1|h| ≤ |t|·uround`, or `h` is not a positive finite number.
-    StepSizeUnderflow { t: f64, h: f64 },
+    StepSizeUnderflow {
+        /// Time reached.
+        t: f64,
+        /// The step size asked for.
+        h: f64,
+    },
     /// More than `max_steps` step attempts.
-    TooManySteps { t: f64, max_steps: u64 },
+    TooManySteps {
+        /// Time reached.
+        t: f64,
+        /// The limit on step attempts ([`Dopri5Options`]).
+        max_steps: u64,
+    },
 }
 
 /// Dormand–Prince 5(4) stepper, forward in time, with the dense output of its last step.

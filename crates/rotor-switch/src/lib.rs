@@ -48,6 +48,8 @@
 //! points, then Illinois to `1e-14·max(1, t)` in time), the step is ended there, and the
 //! integration is restarted in the new region.
 
+#![warn(missing_docs)]
+
 pub mod dopri5;
 mod switch;
 

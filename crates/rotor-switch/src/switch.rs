@@ -62,6 +62,7 @@ impl Default for SwitchOptions {
 /// The switch-model solver (name `"switch"`).
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
 pub struct SwitchSolver {
+    /// The band η, step and Zeno limits, guard sampling and the fast-forward's check.
     pub options: SwitchOptions,
 }
 

@@ -12,6 +12,8 @@
 //!
 //! Dev-dependency only; nothing here is part of the published crates.
 
+#![warn(missing_docs)]
+
 pub mod arenstorf;
 #[cfg(feature = "mutate")]
 pub mod mutate;

@@ -37,8 +37,11 @@ pub fn toml_value() -> impl Strategy<Value = String> {
 /// One edit of a file's lines or bytes.
 #[derive(Debug, Clone)]
 pub enum Mutation {
+    /// Delete the line at this index (modulo the line count).
     DeleteLine(usize),
+    /// Insert a copy of the line at this index before it.
     DuplicateLine(usize),
+    /// Swap two lines.
     SwapLines(usize, usize),
     /// Swap the values of two `key = value` lines.
     SwapValues(usize, usize),
@@ -46,10 +49,14 @@ pub enum Mutation {
     SetValue(usize, String),
     /// Insert a `key = value` line with a random key.
     InsertKey(usize, String, String),
+    /// Insert these bytes at this byte offset (modulo the length + 1).
     InsertBytes(usize, Vec<u8>),
+    /// Keep only the bytes before this offset (modulo the length + 1).
     Truncate(usize),
 }
 
+/// Any [`Mutation`], uniformly over its kinds, with indices below 2¹⁶ that [`apply`] wraps
+/// to the file.
 pub fn mutation() -> impl Strategy<Value = Mutation> {
     let i = || any::<prop::sample::Index>();
     prop_oneof![

@@ -12,10 +12,10 @@ pub struct Args {
     /// source's Table 1).
     #[arg(long)]
     pub params: Option<PathBuf>,
-    /// Lower end of the input range [V] (>= 0; for a law odd in omega, u < 0 is the mirror).
+    /// Lower end of the input range, in V (>= 0; for a law odd in omega, u < 0 is the mirror).
     #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
     pub u_min: f64,
-    /// Upper end of the input range [V] (at most 1000).
+    /// Upper end of the input range, in V (at most 1000).
     #[arg(long, default_value_t = 7.0, allow_hyphen_values = true)]
     pub u_max: f64,
     /// Output JSON file (equilibria, periodic, points; `-`: standard output).

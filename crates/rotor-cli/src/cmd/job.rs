@@ -19,7 +19,7 @@ pub struct Args {
         conflicts_with = "h"
     )]
     pub tol: Option<f64>,
-    /// The step of a fixed-step client [s] (the job's `tol` is null).
+    /// The step of a fixed-step client, in s (the job's `tol` is null).
     #[arg(long, value_name = "H", allow_hyphen_values = true)]
     pub h: Option<f64>,
     /// The path the client writes its trace to.

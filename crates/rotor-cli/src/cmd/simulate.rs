@@ -10,10 +10,10 @@ use crate::common::{Common, load_model, request, warn_inexact};
 pub struct Args {
     #[command(flatten)]
     pub common: Common,
-    /// Horizon [s].
+    /// Horizon, in s.
     #[arg(long, default_value_t = 100.0, allow_hyphen_values = true)]
     pub t_end: f64,
-    /// Output interval [s] (rows at 0, dt, 2dt, ..., t_end).
+    /// Output interval, in s (rows at 0, dt, 2dt, ..., t_end).
     #[arg(long, default_value_t = 0.01, allow_hyphen_values = true)]
     pub dt: f64,
     /// Output CSV file (`-`: standard output).

@@ -10,7 +10,7 @@ use crate::common::{
 
 #[derive(clap::Args, Debug)]
 pub struct Args {
-    /// The u axis, A:B:N (N values from A to B) [V].
+    /// The u axis, A:B:N (N values from A to B), in V.
     #[arg(long)]
     pub u: String,
     /// The parameter axis, NAME=A:B:N (NAME a field of the parameter file).
@@ -37,7 +37,7 @@ pub struct Args {
     /// available to the process).
     #[arg(long, value_name = "N", value_parser = threads_arg)]
     pub threads: Option<usize>,
-    /// Horizon of each run [s] (metrics over its second half).
+    /// Horizon of each run, in s (metrics over its second half).
     #[arg(long, default_value_t = 600.0, allow_hyphen_values = true)]
     pub t_end: f64,
     /// Output CSV (`-`: standard output).
