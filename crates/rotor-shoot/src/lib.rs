@@ -306,6 +306,29 @@ impl Map<'_> {
             .map(|e| (self.section.project(&e.x), e.t)))
     }
 
+    /// The orbit through the fixed point `z` (`P(z)` in `pz`, residual `r` after `iterations`
+    /// Newton steps), its multipliers from `DP` by central differences.
+    fn orbit(
+        &mut self,
+        z: Vec<f64>,
+        pz: &[f64],
+        period: f64,
+        r: f64,
+        iterations: usize,
+    ) -> Result<Orbit, ShootError> {
+        let j = self.jacobian(&z, pz, true)?;
+        Ok(Orbit {
+            section: self.section,
+            x: self.section.lift(self.model, &z),
+            z,
+            period,
+            multipliers: eigenvalues(&j),
+            residual: r,
+            iterations,
+            runs: self.runs,
+        })
+    }
+
     /// `DP(z)` by forward (`central = false`) or central differences, given `P(z)`.
     fn jacobian(
         &mut self,
@@ -405,17 +428,7 @@ pub fn shoot(
     let mut r = resid(&z, &pz);
     for it in 0..=opts.max_iter {
         if r <= opts.tol * (1.0 + norm(&z)) {
-            let j = map.jacobian(&z, &pz, true)?;
-            return Ok(Orbit {
-                section,
-                x: section.lift(model, &z),
-                z,
-                period,
-                multipliers: eigenvalues(&j),
-                residual: r,
-                iterations: it,
-                runs: map.runs,
-            });
+            return map.orbit(z, &pz, period, r, it);
         }
         if it == opts.max_iter {
             break;
@@ -519,20 +532,8 @@ pub fn shoot_with_u(
     for it in 0..=opts.max_iter {
         if r <= opts.tol * (1.0 + norm(&z)) {
             map.scene.u = u;
-            let j = map.jacobian(&z, &pz, true)?;
-            return Ok(OrbitAtU {
-                u,
-                orbit: Orbit {
-                    section,
-                    x: section.lift(model, &z),
-                    z,
-                    period,
-                    multipliers: eigenvalues(&j),
-                    residual: r,
-                    iterations: it,
-                    runs: map.runs,
-                },
-            });
+            let orbit = map.orbit(z, &pz, period, r, it)?;
+            return Ok(OrbitAtU { u, orbit });
         }
         if it == opts.max_iter {
             break;
