@@ -142,6 +142,35 @@ fn steady_refuses_what_the_solver_cannot_resolve() {
     assert!((a - b).abs() <= 3e-6, "{a} vs {b}");
 }
 
+/// 1e-4 V above Table 1's first Hopf point (multiplier 0.9974), Moreau–Jean's default
+/// confirms the small stable cycle from rest by shooting: the run's returns jitter by more
+/// than the two-step rate test resolves, and come close enough for the fitted rate only after
+/// ~2000 s, within the default's 3000 s check (it used to fall back to simulating ~12 000 s).
+/// Its period is `--method shoot`'s: the same map's fixed point to the same Newton tolerance
+/// from another start, 4.4e-11 apart relative (measured); the gate is 5× that. The speed is
+/// the bench's (`benches/steady.rs`).
+#[test]
+fn steady_default_confirms_the_slow_cycle_next_to_h1() {
+    let h1 = rotor_bifurcation::equilibria::hopf_points(&rotor_model::Model::table1(), 20.0)[0]
+        .equilibrium
+        .u;
+    let u = format!("{}", h1 + 1e-4);
+    let json = |args: &[&str]| -> serde_json::Value {
+        let o = rotor(args);
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        serde_json::from_slice(&o.stdout).unwrap()
+    };
+    let default = json(&["steady", "--solver", "moreau", "--u", &u]);
+    let shot = json(&[
+        "steady", "--solver", "moreau", "--u", &u, "--method", "shoot",
+    ]);
+    assert_eq!(default["method"], "shoot", "{default}");
+    assert_eq!(default["stable"], true, "{default}");
+    let period = |v: &serde_json::Value| v["period"].as_f64().unwrap();
+    let (a, b) = (period(&default), period(&shot));
+    assert!((a - b).abs() <= 2.2e-10 * b, "{a} vs {b}");
+}
+
 #[test]
 fn bifurcation_writes_the_contract_json_and_a_figure() {
     let dir = std::env::temp_dir().join(format!("rotor-cli-bif-{}", std::process::id()));

@@ -336,7 +336,7 @@ fn refusal(e: &SteadyError) -> Option<&'static str> {
         SteadyError::Undecided { .. } => Some("stability undecided"),
         SteadyError::Unstable { .. } => Some("unstable orbit"),
         SteadyError::Neutral { .. } => Some("stability undecided"),
-        SteadyError::NotReached { .. } => Some("slow transient"),
+        SteadyError::NotReached { .. } | SteadyError::Unconfirmed { .. } => Some("slow transient"),
         SteadyError::Shoot(_) => Some("no orbit by shooting"),
         SteadyError::Solve(rotor_model::SolveError::NoConvergence { detail }) => {
             Some(if detail.contains("no cycle near the orbit") {

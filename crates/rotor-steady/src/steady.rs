@@ -153,6 +153,20 @@ pub enum SteadyError {
         /// The orbit's Floquet multipliers, as printed.
         multipliers: String,
     },
+    /// The default method's two answers both failed: shooting found a stable orbit that a
+    /// run from the start had not reached by the check's end ([`SteadyError::NotReached`]),
+    /// and the simulation did not settle either.
+    #[error(
+        "no steady state confirmed from this start: {check}; and simulating on: {simulate}. \
+         `--method shoot` answers the orbit shooting finds, without the check that the start \
+         goes to it"
+    )]
+    Unconfirmed {
+        /// The check's refusal.
+        check: Box<SteadyError>,
+        /// The simulation's.
+        simulate: Box<SteadyError>,
+    },
     /// A value of the answer is not finite.
     #[error("the steady state has a non-finite {name}: {value}")]
     NonFinite {
