@@ -3,7 +3,7 @@
 //! bands of one name in neighbouring columns are joined into one [`Region`].
 
 use rotor_bifurcation::BifError;
-use rotor_model::{Model, Output, Params, Scene, Solver, State, SteadyState};
+use rotor_model::{Attractor, Model, Output, Params, Scene, Solver, State};
 use serde::Serialize;
 
 use crate::curves::Curve;
@@ -24,10 +24,10 @@ pub struct Region {
     pub bands: Vec<[f64; 3]>,
 }
 
-/// What the orbit from a start reaches: `stuck`, `equilibrium`, `stick-slip cycle` or
-/// `slipping cycle` (event-driven solver, metrics only, 1500 s, metrics over the last 500 s:
-/// long enough for the slow transients a few tenths of a volt from a Hopf point).
-pub fn classify(model: &Model, u: f64, x0: State) -> &'static str {
+/// What the orbit from a start reaches (event-driven solver, metrics only, 1500 s, metrics
+/// over the last 500 s: long enough for the slow transients a few tenths of a volt from a
+/// Hopf point); `None` if the run gives no steady state.
+pub fn classify(model: &Model, u: f64, x0: State) -> Option<Attractor> {
     let scene = Scene {
         u,
         x0,
@@ -37,27 +37,25 @@ pub fn classify(model: &Model, u: f64, x0: State) -> &'static str {
         metrics_from: Some(1000.0),
         ..Scene::default()
     };
-    match rotor_event::EventSolver::default()
+    let metrics = rotor_event::EventSolver::default()
         .simulate(model, &scene)
-        .map(|t| t.metrics)
-    {
-        Ok(Some(m)) if m.is_stuck() => "stuck",
-        Ok(Some(SteadyState::Equilibrium { .. })) => "equilibrium",
-        Ok(Some(SteadyState::LimitCycle { stick_time, .. })) if stick_time > 0.0 => {
-            "stick-slip cycle"
-        }
-        Ok(Some(SteadyState::LimitCycle { .. })) => "slipping cycle",
-        _ => "unresolved",
-    }
+        .map(|t| t.metrics);
+    metrics.ok().flatten().as_ref().map(Attractor::of)
 }
 
-/// The region's name from what rest and the perturbed equilibrium reach.
-pub fn region_name(from_rest: &str, from_eq: &str) -> String {
+/// The word of what a start reaches in a region's name: the attractor's, or `unresolved`.
+fn word(a: Option<Attractor>) -> &'static str {
+    a.map_or("unresolved", Attractor::as_str)
+}
+
+/// The region's name from what rest and the perturbed equilibrium reach: `both discs stuck`,
+/// `<attractor> only`, or `bistable: <a> and <b>` (the two words in alphabetical order).
+pub fn region_name(from_rest: Option<Attractor>, from_eq: Option<Attractor>) -> String {
     match (from_rest, from_eq) {
-        ("stuck", "stuck") => "both discs stuck".into(),
-        (a, b) if a == b => format!("{a} only"),
+        (Some(Attractor::Stuck), Some(Attractor::Stuck)) => "both discs stuck".into(),
+        (a, b) if a == b => format!("{} only", word(a)),
         (a, b) => {
-            let mut v = [a, b];
+            let mut v = [word(a), word(b)];
             v.sort_unstable();
             format!("bistable: {} and {}", v[0], v[1])
         }
@@ -212,4 +210,47 @@ pub(crate) fn named(
         .collect();
     out.sort_by(|a, b| a.u.total_cmp(&b.u).then(a.p.total_cmp(&b.p)));
     Ok(out)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The names the report and the JSON carry, a run without a steady state included.
+    #[test]
+    fn regions_are_named_by_what_both_starts_reach() {
+        use Attractor::*;
+        for (rest, eq, name) in [
+            (Some(Stuck), Some(Stuck), "both discs stuck"),
+            (Some(Equilibrium), Some(Equilibrium), "equilibrium only"),
+            (
+                Some(SlippingCycle),
+                Some(SlippingCycle),
+                "slipping cycle only",
+            ),
+            (
+                Some(StickSlipCycle),
+                Some(Equilibrium),
+                "bistable: equilibrium and stick-slip cycle",
+            ),
+            (
+                Some(Equilibrium),
+                Some(SlippingCycle),
+                "bistable: equilibrium and slipping cycle",
+            ),
+            (
+                Some(Stuck),
+                Some(Equilibrium),
+                "bistable: equilibrium and stuck",
+            ),
+            (None, None, "unresolved only"),
+            (
+                None,
+                Some(StickSlipCycle),
+                "bistable: stick-slip cycle and unresolved",
+            ),
+        ] {
+            assert_eq!(region_name(rest, eq), name);
+        }
+    }
 }
