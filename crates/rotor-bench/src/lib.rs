@@ -33,6 +33,7 @@
 #![warn(missing_docs)]
 
 mod clients;
+mod colors;
 mod ladder;
 mod levels;
 mod measure;
