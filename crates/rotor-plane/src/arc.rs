@@ -20,9 +20,13 @@ use rotor_bifurcation::BifError;
 /// Continuation settings (in scaled coordinates).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ArcOptions {
+    /// The first step.
     pub h0: f64,
+    /// The largest step.
     pub h_max: f64,
+    /// The smallest step: a correction that fails below it ends the curve.
     pub h_min: f64,
+    /// Most points, the start included.
     pub max_points: usize,
     /// Newton stops at `|H|∞ ≤ tol` and a scaled update below `1e3·tol`.
     pub tol: f64,

@@ -63,11 +63,15 @@ impl Codim2Kind {
 /// A codimension-two point.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Codim2 {
+    /// What happens there.
     pub kind: Codim2Kind,
+    /// The parameter's value.
     pub p: f64,
+    /// The input \[V\].
     pub u: f64,
     /// The curves involved.
     pub curves: Vec<String>,
+    /// What was seen there, in words (the report's table).
     pub detail: String,
 }
 

@@ -19,17 +19,24 @@ use crate::options::{PlaneOptions, params_at};
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
 #[serde(rename_all = "snake_case")]
 pub enum CurveKind {
+    /// Hopf points of the slipping equilibrium.
     Hopf,
+    /// Grazing orbits that persist (Feigin's persistence).
     Grazing,
+    /// Smooth folds of cycles (a multiplier 1).
     Fold,
+    /// Grazing orbits where the branch turns back (Feigin's non-smooth fold).
     DiscontinuousFold,
+    /// Where the slipping branch meets the stuck set.
     StuckBoundary,
 }
 
 /// One point of a curve.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct CurvePoint {
+    /// The parameter's value.
     pub p: f64,
+    /// The input \[V\].
     pub u: f64,
     /// The defining condition's value at the point (its largest component).
     pub residual: f64,
@@ -66,9 +73,11 @@ pub struct CurvePoint {
 /// A codimension-one curve.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Curve {
+    /// What the curve's points are.
     pub kind: CurveKind,
     /// `H1`, `G2`, `E`, `S`, … (as in the u-diagram: numbered by u at the start).
     pub label: String,
+    /// Its points in order along the curve.
     pub points: Vec<CurvePoint>,
     /// Why each end of the curve ended (first end, last end).
     #[serde(skip_serializing_if = "Vec::is_empty")]

@@ -40,6 +40,8 @@
 //! module, [`curves`] uses those two, [`codim2`] and [`regions`] use the curves, [`picture`]
 //! uses all of these, and [`figure`] draws the picture.
 
+#![warn(missing_docs)]
+
 pub mod arc;
 pub mod codim2;
 pub mod curves;

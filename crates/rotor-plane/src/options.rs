@@ -9,9 +9,13 @@ use rotor_model::Params;
 pub struct PlaneOptions {
     /// The parameter: a field of the parameter file as a dotted path.
     pub param: String,
+    /// The parameter's range: `[p_min, p_max]`.
     pub p_min: f64,
+    /// See `p_min`.
     pub p_max: f64,
+    /// The input's range \[V\]: `[u_min, u_max]` (that of the one-parameter diagram).
     pub u_min: f64,
+    /// See `u_min`.
     pub u_max: f64,
     /// Integration tolerance of the flows.
     pub tol: f64,

@@ -14,14 +14,19 @@ use crate::regions::{self, Region};
 /// The two-parameter picture (the JSON of `rotor bifurcation2`).
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Plane {
+    /// The parameter, as a dotted path of the parameter file.
     pub param: String,
     /// The parameter's value in the file.
     pub p_file: f64,
     /// The window computed: `[p_min, p_max]` and `[u_min, u_max]`.
     pub p_range: [f64; 2],
+    /// See `p_range`.
     pub u_range: [f64; 2],
+    /// The codimension-one curves (a grazing curve as its pieces of one type).
     pub curves: Vec<Curve>,
+    /// The codimension-two points, in increasing p.
     pub points: Vec<Codim2>,
+    /// The named regions, in increasing u.
     pub regions: Vec<Region>,
 }
 

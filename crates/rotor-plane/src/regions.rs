@@ -13,10 +13,15 @@ use crate::options::{PlaneOptions, params_at};
 /// tallest band, `[u_lo, u_hi]` at `p`.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Region {
+    /// What rest and the perturbed equilibrium reach ([`region_name`]).
     pub name: String,
+    /// The parameter's value at the tallest band.
     pub p: f64,
+    /// The middle of the tallest band \[V\].
     pub u: f64,
+    /// The tallest band's lower end \[V\].
     pub u_lo: f64,
+    /// The tallest band's upper end \[V\].
     pub u_hi: f64,
     /// Every band of the region, `[p, u_lo, u_hi]`, this one first, then the others in
     /// order of height (where the figure may write the name instead).
