@@ -28,7 +28,7 @@
 //! curve changing between grazing and discontinuous fold (`grazing_fold`: a multiplier of one
 //! side at grazing crosses 1, so Feigin's fold indicator `det(I − A)·det(I − B)` changes sign
 //! and a fold curve meets the grazing curve), a curve ending at the stuck boundary
-//! (`stuck_end`), and two curves meeting (`curves_meet`). Where the theory of such a nonsmooth
+//! (`stuck_end`), and two curves meeting (`curves_cross`). Where the theory of such a nonsmooth
 //! point is not settled the point only records where the curves meet and what was seen; no
 //! normal form is claimed.
 //!
