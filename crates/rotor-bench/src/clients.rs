@@ -1,5 +1,5 @@
 //! External solvers (and the repository's peers) through the job-file protocol
-//! ([`crate::protocol`]): each over its ladder on each scene, graded as `rotor check` grades a
+//! ([`rotor_protocol`]): each over its ladder on each scene, graded as `rotor check` grades a
 //! trace, placed beside the three solvers, with the ratios at equal error.
 
 use std::path::{Path, PathBuf};
@@ -8,12 +8,12 @@ use std::time::Instant;
 use rotor_grade::check::{CheckError, Level, check};
 use rotor_grade::gridmetrics::{StickExit, grid_metrics};
 use rotor_grade::trace::{read_events, read_trace};
+use rotor_protocol::{ClientSays, ClientSpec, Ended, Job, RunOutput, run_client, tail};
 use serde::{Deserialize, Serialize};
 
 use crate::ladder::{LadderPoint, Loaded};
 use crate::measure::{Errors, SteadyRef, Timing, run_point, scene_at, time_at_error};
-use crate::options::{BenchOptions, SolverKind};
-use crate::protocol::{ClientSays, ClientSpec, Ended, Job, RunOutput, run_client, tail};
+use crate::options::{BenchOptions, SceneSpec, SolverKind};
 
 /// Why a run gave no usable point.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
@@ -255,6 +255,22 @@ fn job_for(l: &Loaded, spec: &ClientSpec, setting: f64, dir: &Path) -> Job {
         dir.join("trace.csv"),
         dir.join("events.csv"),
     )
+}
+
+/// The job `rotor bench --scenario PATH` hands a client of that knob on that scene (the
+/// scenario's own horizon and grid): what `rotor job` prints.
+pub fn job_for_scenario(
+    path: &Path,
+    fixed_step: bool,
+    setting: f64,
+    trace: PathBuf,
+    events: PathBuf,
+) -> Result<Job, crate::BenchError> {
+    let spec = SceneSpec::from_scenario(path)?;
+    let sc = rotor_solvers::load_scenario(path)?;
+    Ok(Job::new(
+        &sc, spec.t_end, spec.dt, fixed_step, setting, trace, events,
+    ))
 }
 
 /// Runs once: writes the job, starts the client. `Err` is the failure of the run.

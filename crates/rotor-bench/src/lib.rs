@@ -16,7 +16,7 @@
 //! * **Output levels**: per solver, metrics-only (`Output::Metrics`, which skips the periods
 //!   of a converged cycle), final-only (`Output::Final`) and the full trace
 //!   (`Output::Grid { dt: 0.01 }`), all with metrics, timed in turn.
-//! * **Clients**: external solvers through the job-file protocol ([`protocol`]; BENCHMARK.md),
+//! * **Clients**: external solvers through the job-file protocol ([`rotor_protocol`]; BENCHMARK.md),
 //!   each run in its own process with a timeout, over its ladder on every scene, graded as
 //!   `rotor check` grades a trace, placed beside the three solvers, with time ratios at equal
 //!   error (in-process and whole-process) and, for a fixed-step client that reports its
@@ -33,6 +33,7 @@
 #![warn(missing_docs)]
 
 mod clients;
+mod colors;
 mod ladder;
 mod levels;
 mod measure;
@@ -40,7 +41,6 @@ pub mod merge;
 mod options;
 mod peers;
 pub mod profile;
-pub mod protocol;
 mod report;
 mod results;
 mod word;
@@ -50,6 +50,7 @@ use rotor_scenario::ScenarioError;
 use serde::{Deserialize, Serialize};
 use thiserror::Error;
 
+pub use clients::job_for_scenario;
 pub use clients::{
     ClientPoint, ClientReport, ClientScene, ClientStatus, Failure, FailureKind, Overhead, PerStep,
     Ratio,
@@ -65,7 +66,7 @@ pub use options::{
 pub use peers::available as peer_available;
 pub use peers::octave_available;
 pub use profile::Profile;
-pub use protocol::ClientSpec;
+pub use rotor_protocol::ClientSpec;
 
 use ladder::{Loaded, ladders, load};
 use levels::output_levels;

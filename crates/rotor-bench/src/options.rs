@@ -220,7 +220,7 @@ pub struct BenchOptions {
     /// Peers.
     pub peers: PeerOptions,
     /// External solvers (`rotor bench --external NAME=COMMAND`).
-    pub clients: Vec<crate::protocol::ClientSpec>,
+    pub clients: Vec<rotor_protocol::ClientSpec>,
     /// A client's run past this many seconds is killed, its process group with it.
     pub timeout: f64,
     /// The ladder of an external client with a tolerance (1e-3 … 1e-12).
@@ -235,7 +235,7 @@ pub struct BenchOptions {
     pub keep: Option<std::path::PathBuf>,
     /// External clients (peers included) run side by side, each over its whole ladder; at
     /// least 1. Each client's runs stay one after the other, each process single-threaded
-    /// ([`crate::protocol::SINGLE_THREAD_ENV`]); the Rust solvers are timed before any client
+    /// ([`rotor_protocol::SINGLE_THREAD_ENV`]); the Rust solvers are timed before any client
     /// starts, alone.
     pub jobs: usize,
 }

@@ -9,7 +9,7 @@ use std::process::Command;
 
 use crate::clients::{ClientReport, ClientStatus};
 use crate::options::BenchOptions;
-use crate::protocol::ClientSpec;
+use rotor_protocol::ClientSpec;
 
 /// Whether `python -c "import <module>"` works; the error says why not.
 pub fn available(python: &str, module: &str) -> Result<(), String> {

@@ -79,7 +79,7 @@ impl Profile {
                 pts.push((tau_max, Profile::rho(e, tau_max)));
                 Series {
                     marker: None,
-                    ..Series::line(&e.name, crate::report::color(&e.name), pts)
+                    ..Series::line(&e.name, crate::colors::color(&e.name), pts)
                 }
             })
             .collect();

@@ -6,8 +6,8 @@ use std::fmt::Write;
 use rotor_plot::{Panel, Series, render};
 
 use crate::clients::{ClientReport, FailureKind};
+use crate::colors::color;
 use crate::measure::Errors;
-use crate::options::SolverKind;
 use crate::{BenchError, BenchReport, OutputLevel, Profile, SceneReport};
 
 fn e(v: Option<f64>) -> String {
@@ -72,21 +72,6 @@ impl<'a> CsvRow<'a> {
             newton_iters: c[5],
             failure: failure.unwrap_or(""),
         }
-    }
-}
-
-/// A solver's colour from its entry; the peers' own.
-pub(crate) fn color(name: &str) -> &'static str {
-    const OTHERS: [&str; 7] = [
-        "#2ca02c", "#9467bd", "#8c564b", "#e377c2", "#7f7f7f", "#bcbd22", "#17becf",
-    ];
-    match (SolverKind::by_name(name), name) {
-        (Some(k), _) => k.info().style.color,
-        (None, "scipy") => "#d62728",
-        (None, "siconos") => "#2ca02c",
-        (None, "octave") => "#1f77b4",
-        // Any other client: a colour fixed by its name (a sum of its bytes).
-        (None, _) => OTHERS[name.bytes().map(usize::from).sum::<usize>() % OTHERS.len()],
     }
 }
 

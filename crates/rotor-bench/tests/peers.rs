@@ -266,7 +266,7 @@ fn the_first_order_client_converges_and_passes_loose_at_h_1e_5() {
     let digits: Vec<(f64, bool)> = [1e-3, 1e-4, 1e-5]
         .into_iter()
         .map(|h| {
-            let job = rotor_bench::protocol::Job::new(
+            let job = rotor_protocol::Job::new(
                 &sc,
                 sc.t_end,
                 sc.compare.dt,
@@ -399,7 +399,7 @@ fn octave_peer_passes_loose_on_both_scenes() {
             rotor_solvers::load_scenario(&root.join(format!("fixtures/scenarios/{name}.toml")))
                 .unwrap();
         let r = rotor_grade::reference::read(&root.join("fixtures/reference"), &sc.name).unwrap();
-        let job = rotor_bench::protocol::Job::new(
+        let job = rotor_protocol::Job::new(
             &sc,
             sc.t_end,
             sc.compare.dt,
@@ -416,8 +416,7 @@ fn octave_peer_passes_loose_on_both_scenes() {
             .unwrap();
         let stderr = String::from_utf8_lossy(&out.stderr);
         assert!(out.status.success(), "{name}: {stderr}");
-        let says =
-            rotor_bench::protocol::ClientSays::from_stdout(&String::from_utf8_lossy(&out.stdout));
+        let says = rotor_protocol::ClientSays::from_stdout(&String::from_utf8_lossy(&out.stdout));
         assert!(says.solve_seconds.is_some(), "{name}: no solve_seconds");
         let t = rotor_grade::trace::read_trace(&job.trace, usize::MAX).unwrap();
         let e = rotor_grade::trace::read_events(&job.events).unwrap();
@@ -475,7 +474,7 @@ fn octave_peer_refuses_a_bad_job_by_name() {
     let sc =
         rotor_solvers::load_scenario(&root.join("fixtures/scenarios/t1-u1.5-rest.toml")).unwrap();
     let job = |fixed_step: bool| {
-        let j = rotor_bench::protocol::Job::new(
+        let j = rotor_protocol::Job::new(
             &sc,
             1.0,
             0.01,

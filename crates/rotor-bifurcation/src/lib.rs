@@ -26,7 +26,6 @@
 //! Its cost is benchmarked by `cargo bench -p rotor-bifurcation` (`benches/diagram.rs`);
 //! the measurements are in `reports/measurements.md`.
 
-pub mod arc;
 mod branch;
 pub mod continuation;
 mod diagram;
@@ -36,7 +35,6 @@ pub mod grazing;
 pub mod monodromy;
 mod output;
 pub mod periodic;
-pub mod plane;
 mod points;
 mod svg;
 

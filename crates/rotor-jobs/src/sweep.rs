@@ -17,7 +17,7 @@ use std::io::{BufRead, Read, Write};
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
 
-use rotor_model::{Model, Output, Params, Scene, State, SteadyState};
+use rotor_model::{Attractor, Model, Output, Params, Scene, State, SteadyState};
 
 use rotor_solvers::solvers::SolverKind;
 
@@ -285,28 +285,41 @@ impl Sweep {
             ..Scene::default()
         };
         let f = |v: f64| zmij::Buffer::new().format(v).to_owned();
-        match self.solver.solver().simulate_finite(&model, &scene) {
-            Ok(tr) => match tr.metrics {
-                Some(m) if m.is_stuck() => s.push_str(",stuck,,,,"),
-                Some(SteadyState::Equilibrium { .. }) => s.push_str(",equilibrium,,,,"),
-                Some(SteadyState::LimitCycle {
-                    period,
-                    omega_l_max,
-                    omega_l_min,
-                    stick_time,
-                    ..
-                }) => s.push_str(&format!(
-                    ",limit_cycle,{},{},{},{}",
-                    f(period),
-                    f(omega_l_max),
-                    f(omega_l_min),
-                    f(stick_time)
-                )),
-                None => s.push_str(",failed,,,,"),
-            },
-            Err(_) => s.push_str(",failed,,,,"),
+        let metrics = self.solver.solver().simulate_finite(&model, &scene);
+        match metrics.ok().and_then(|tr| tr.metrics) {
+            Some(m) => {
+                s.push(',');
+                s.push_str(kind_word(Attractor::of(&m)));
+                match m {
+                    SteadyState::LimitCycle {
+                        period,
+                        omega_l_max,
+                        omega_l_min,
+                        stick_time,
+                        ..
+                    } => s.push_str(&format!(
+                        ",{},{},{},{}",
+                        f(period),
+                        f(omega_l_max),
+                        f(omega_l_min),
+                        f(stick_time)
+                    )),
+                    SteadyState::Equilibrium { .. } => s.push_str(",,,,"),
+                }
+            }
+            None => s.push_str(",failed,,,,"),
         }
         s
+    }
+}
+
+/// The `kind` column of a row: `stuck`, `equilibrium`, or `limit_cycle` for a cycle with or
+/// without stick (its `stick_time` column tells them apart); a run without a steady state is
+/// `failed`.
+fn kind_word(a: Attractor) -> &'static str {
+    match a {
+        Attractor::Stuck | Attractor::Equilibrium => a.as_str(),
+        Attractor::StickSlipCycle | Attractor::SlippingCycle => a.steady_kind().as_str(),
     }
 }
 

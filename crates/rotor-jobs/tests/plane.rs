@@ -3,9 +3,9 @@
 //! it lies in, except within one grid cell of a curve.
 
 use rayon::prelude::*;
-use rotor_bifurcation::plane::{CurveKind, PlaneOptions, plane, solve_u};
 use rotor_jobs::sweep::{Axis, Sweep, SweepStart};
 use rotor_model::{Params, State};
+use rotor_plane::{CurveKind, PlaneOptions, plane, solve_u};
 use rotor_solvers::SolverKind;
 
 #[test]

@@ -7,6 +7,7 @@
 
 #![warn(missing_docs)]
 
+pub mod attractor;
 pub mod dynamics;
 pub mod equilibrium;
 pub mod event;
@@ -19,6 +20,7 @@ pub mod record;
 pub mod scene;
 pub mod steady;
 
+pub use attractor::Attractor;
 pub use dynamics::{ALPHA, Disc, DiscMode, Mode, Model, OMEGA_L, OMEGA_U, State};
 pub use equilibrium::{SlipEquilibrium, StuckSet};
 pub use event::{Event, EventKind};

@@ -43,11 +43,8 @@ pub fn plane_section(
         .par_iter()
         .map(|(_, _, p, param, a, b, d)| {
             let t0 = std::time::Instant::now();
-            let pl = rotor_bifurcation::plane::plane_with(
-                p,
-                &rotor_bifurcation::plane::PlaneOptions::new(param, *a, *b),
-                Some(d),
-            );
+            let pl =
+                rotor_plane::plane_with(p, &rotor_plane::PlaneOptions::new(param, *a, *b), Some(d));
             (pl, t0.elapsed().as_secs_f64())
         })
         .collect::<Vec<_>>();

@@ -18,7 +18,7 @@
 use rotor_bifurcation::continuation::{ContOptions, Continuer};
 use rotor_bifurcation::periodic::Shooter;
 use rotor_bifurcation::{Diagram, PointKind};
-use rotor_model::{Model, Scene, State, SteadyState};
+use rotor_model::{Attractor, Model, Scene, State, SteadyState};
 
 use crate::checked::{CheckOptions, checked_shot};
 use crate::steady::{SteadyAnswer, SteadyError, SteadyOptions, steady};
@@ -90,9 +90,11 @@ pub fn probe_points(d: &Diagram) -> Vec<ProbePoint> {
     out
 }
 
-/// An attractor the continuation says is stable at a given input.
+/// An attractor the continuation says is stable at a given input, with what the answer is
+/// compared with: its kind is an [`Attractor`] ([`Expected::attractor`]), the data beside it
+/// each kind's own.
 #[derive(Debug, Clone, PartialEq)]
-pub enum Attractor {
+pub enum Expected {
     /// A stable slipping equilibrium.
     Equilibrium {
         /// The common velocity ω_u = ω_l \[rad/s\].
@@ -122,17 +124,29 @@ pub enum Attractor {
     },
 }
 
-impl std::fmt::Display for Attractor {
+impl Expected {
+    /// Which attractor it is, as the plane and the sweep name what a run reaches.
+    pub fn attractor(&self) -> Attractor {
+        match *self {
+            Expected::Equilibrium { .. } => Attractor::Equilibrium,
+            Expected::Stuck { .. } => Attractor::Stuck,
+            Expected::Cycle { stick_time, .. } if stick_time > 0.0 => Attractor::StickSlipCycle,
+            Expected::Cycle { .. } => Attractor::SlippingCycle,
+        }
+    }
+}
+
+impl std::fmt::Display for Expected {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         match *self {
-            Attractor::Equilibrium { omega, alpha } => {
+            Expected::Equilibrium { omega, alpha } => {
                 write!(f, "equilibrium (omega {omega:.6}, alpha {alpha:.6})")
             }
-            Attractor::Stuck {
+            Expected::Stuck {
                 alpha_min,
                 alpha_max,
             } => write!(f, "stuck (alpha in [{alpha_min:.6}, {alpha_max:.6}])"),
-            Attractor::Cycle {
+            Expected::Cycle {
                 period,
                 omega_l_max,
                 omega_l_min,
@@ -150,18 +164,18 @@ impl std::fmt::Display for Attractor {
 /// eigenvalues), the stuck set, and the stable cycles, each found by Newton's method at `u`
 /// from the diagram's neighbouring branch points (and the point between them) and kept if its
 /// saltation multipliers lie inside the unit circle.
-pub fn expected(model: &Model, d: &Diagram, u: f64) -> Vec<Attractor> {
+pub fn expected(model: &Model, d: &Diagram, u: f64) -> Vec<Expected> {
     let mut out = Vec::new();
     for e in model.slip_equilibria(u) {
         if model.equilibrium_is_stable(&e) {
-            out.push(Attractor::Equilibrium {
+            out.push(Expected::Equilibrium {
                 omega: e.omega,
                 alpha: e.alpha,
             });
         }
     }
     if let Some(s) = model.stuck_equilibria(u) {
-        out.push(Attractor::Stuck {
+        out.push(Expected::Stuck {
             alpha_min: s.alpha_min,
             alpha_max: s.alpha_max,
         });
@@ -220,7 +234,7 @@ pub fn expected(model: &Model, d: &Diagram, u: f64) -> Vec<Attractor> {
             continue;
         };
         if info.stable {
-            out.push(Attractor::Cycle {
+            out.push(Expected::Cycle {
                 period: info.period,
                 omega_l_max: info.omega_l_max,
                 omega_l_min: info.omega_l_min,
@@ -351,7 +365,7 @@ fn refusal(e: &SteadyError) -> Option<&'static str> {
 
 /// The largest relative difference between an answer and an attractor (∞ if the kinds
 /// differ); `floor` bounds the scale from below (rad/s, s).
-fn distance(st: &SteadyState, a: &Attractor, floor: f64) -> f64 {
+fn distance(st: &SteadyState, a: &Expected, floor: f64) -> f64 {
     let rel = |x: f64, y: f64| (x - y).abs() / x.abs().max(y.abs()).max(floor);
     match (*st, a) {
         (
@@ -360,7 +374,7 @@ fn distance(st: &SteadyState, a: &Attractor, floor: f64) -> f64 {
                 omega_l,
                 alpha,
             },
-            Attractor::Equilibrium { omega, alpha: a0 },
+            Expected::Equilibrium { omega, alpha: a0 },
         ) => rel(omega_u, *omega)
             .max(rel(omega_l, *omega))
             .max(rel(alpha, *a0)),
@@ -370,7 +384,7 @@ fn distance(st: &SteadyState, a: &Attractor, floor: f64) -> f64 {
                 omega_l,
                 alpha,
             },
-            Attractor::Stuck {
+            Expected::Stuck {
                 alpha_min,
                 alpha_max,
             },
@@ -387,7 +401,7 @@ fn distance(st: &SteadyState, a: &Attractor, floor: f64) -> f64 {
                 omega_l_min,
                 ..
             },
-            Attractor::Cycle {
+            Expected::Cycle {
                 period: p0,
                 omega_l_max: max0,
                 omega_l_min: min0,
@@ -404,7 +418,7 @@ fn distance(st: &SteadyState, a: &Attractor, floor: f64) -> f64 {
 pub fn judge(
     kind: SolverKind,
     answer: &Result<SteadyAnswer, SteadyError>,
-    expected: &[Attractor],
+    expected: &[Expected],
 ) -> Verdict {
     let st = match answer {
         Ok(a) => a.state,
@@ -487,7 +501,7 @@ pub fn probes(d: &Diagram, solvers: &[SolverKind]) -> Vec<Probe> {
 pub fn run_probe(
     model: &Model,
     probe: &Probe,
-    expected: &[Attractor],
+    expected: &[Expected],
 ) -> (Result<SteadyAnswer, SteadyError>, Verdict) {
     let u = probe.u();
     let scene = Scene {
@@ -531,7 +545,7 @@ where
     inputs.dedup();
     // Computed by the first probe at each input that needs them (so in parallel across
     // inputs when `map` is parallel), once.
-    let expect: Vec<(f64, std::sync::OnceLock<Vec<Attractor>>)> = inputs
+    let expect: Vec<(f64, std::sync::OnceLock<Vec<Expected>>)> = inputs
         .iter()
         .map(|&u| (u, std::sync::OnceLock::new()))
         .collect();

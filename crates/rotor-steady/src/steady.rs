@@ -393,8 +393,8 @@ fn list(m: &[Complex<f64>]) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::probes::{Attractor, expected};
-    use rotor_model::SteadyKind;
+    use crate::probes::{Expected, expected};
+    use rotor_model::{Attractor, SteadyKind};
 
     fn scene(u: f64) -> Scene {
         Scene {
@@ -501,10 +501,18 @@ mod tests {
             rotor_bifurcation::diagram(&m, &rotor_bifurcation::DiagramOptions::default()).unwrap();
         let above = uh + 1e-4;
         let ev = answer(SolverKind::EVENT, &m, above);
-        let cycles: Vec<[f64; 3]> = expected(&m, &d, above)
+        let stable = expected(&m, &d, above);
+        // The small cycle born at the supercritical Hopf point slips: no stick phase yet.
+        let cycle_kinds: Vec<Attractor> = stable
+            .iter()
+            .map(Expected::attractor)
+            .filter(|a| a.steady_kind() == SteadyKind::LimitCycle)
+            .collect();
+        assert_eq!(cycle_kinds, [Attractor::SlippingCycle]);
+        let cycles: Vec<[f64; 3]> = stable
             .into_iter()
             .filter_map(|a| match a {
-                Attractor::Cycle {
+                Expected::Cycle {
                     period,
                     omega_l_max,
                     omega_l_min,

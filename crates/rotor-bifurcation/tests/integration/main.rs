@@ -4,7 +4,7 @@
 mod common;
 mod diagram;
 mod floquet;
+mod lyapunov;
 mod output;
-mod plane;
 mod points;
 mod variational;

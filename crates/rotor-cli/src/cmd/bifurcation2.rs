@@ -53,12 +53,12 @@ pub(crate) fn bifurcation2(
 ) -> Result<()> {
     use rotor_compare::report::write_output;
     let base = load_model(params)?.params;
-    let opts = rotor_bifurcation::plane::PlaneOptions {
+    let opts = rotor_plane::PlaneOptions {
         u_min,
         u_max,
-        ..rotor_bifurcation::plane::PlaneOptions::new(param, p_min, p_max)
+        ..rotor_plane::PlaneOptions::new(param, p_min, p_max)
     };
-    rotor_bifurcation::plane::validate(&base, &opts).map_err(|e| {
+    rotor_plane::validate(&base, &opts).map_err(|e| {
         anyhow!(
             "{}",
             e.to_string()
@@ -69,7 +69,7 @@ pub(crate) fn bifurcation2(
         )
     })?;
     let t0 = std::time::Instant::now();
-    let plane = rotor_bifurcation::plane::plane(&base, &opts)?;
+    let plane = rotor_plane::plane(&base, &opts)?;
     let secs = t0.elapsed().as_secs_f64();
     write_output(json, plane.to_json()?.as_bytes())
         .with_context(|| format!("{}: cannot write", json.display()))?;

@@ -1,14 +1,18 @@
-//! The two-parameter curves: through the one-parameter points, with the criticality and the
-//! grazing type the one-parameter diagram finds independently, and the codimension-two
-//! points of the Stribeck set over its lower static level.
+//! The two-parameter curves: through the one-parameter points, with the grazing type the
+//! one-parameter diagram finds independently, and the codimension-two points of the Stribeck
+//! set over its lower static level.
 
-use rotor_bifurcation::PointKind;
 use rotor_bifurcation::feigin::GrazingType;
-use rotor_bifurcation::plane::{
-    Codim2Kind, Curve, CurveKind, PlaneOptions, first_lyapunov, plane, solve_u,
-};
+use rotor_bifurcation::{DiagramOptions, PointKind, diagram};
+use rotor_model::{Model, Params};
+use rotor_plane::{Codim2Kind, Curve, CurveKind, PlaneOptions, first_lyapunov, plane, solve_u};
 
-use crate::common::{model, st_diagram, t1_diagram};
+/// The model of `fixtures/params/{name}.toml`.
+fn model(name: &str) -> Model {
+    let p = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join(format!("../../fixtures/params/{name}.toml"));
+    Model::new(Params::from_file(&p).unwrap())
+}
 
 /// Started away from the file's value (at k_θ = 0.06 and lower.t_s = 0.25, from those
 /// parameters' own one-parameter diagrams), the curves pass through the points of the
@@ -16,10 +20,11 @@ use crate::common::{model, st_diagram, t1_diagram};
 /// Table 1, and the Hopf and grazing points of the Stribeck set.
 #[test]
 fn curves_started_elsewhere_pass_through_the_one_parameter_points() {
-    for (name, d, param, range, start) in [
-        ("table1", t1_diagram(), "k_theta", (0.05, 0.11), 0.06),
-        ("stribeck", st_diagram(), "lower.t_s", (0.2, 0.35), 0.25),
+    for (name, param, range, start) in [
+        ("table1", "k_theta", (0.05, 0.11), 0.06),
+        ("stribeck", "lower.t_s", (0.2, 0.35), 0.25),
     ] {
+        let d = diagram(&model(name), &DiagramOptions::default()).unwrap();
         let base = model(name).params;
         let p_file = base.get(param).unwrap();
         let opts = PlaneOptions {
@@ -52,42 +57,6 @@ fn curves_started_elsewhere_pass_through_the_one_parameter_points() {
         }
         assert!(matched >= 4, "{name}: {matched}");
     }
-}
-
-/// The u-diagram's Hopf points carry their first Lyapunov coefficient, and its sign (their
-/// criticality) agrees with the direction of the small cycles the diagram finds by shooting:
-/// Table 1's H1 supercritical (l1 < 0), H2 and both Hopf points of the Stribeck set
-/// subcritical (l1 > 0). Table 1's H2 has l1 ≈ 1.7e-3 (issue 33, from independent code).
-#[test]
-fn the_lyapunov_coefficient_agrees_with_the_cycles_direction() {
-    for (name, d) in [("table1", t1_diagram()), ("stribeck", st_diagram())] {
-        let m = model(name);
-        for sp in d.points.iter().filter(|p| p.kind == PointKind::Hopf) {
-            let l1 = first_lyapunov(&m, sp.omega.unwrap()).unwrap();
-            assert_eq!(sp.l1, Some(l1), "{name} {sp:?}");
-            let sup = sp.detail.starts_with("supercritical");
-            assert!(
-                sup == (l1 < 0.0)
-                    && sp
-                        .detail
-                        .starts_with(if sup { "super" } else { "subcritical" }),
-                "{name} at {}: l1 = {l1}, {}",
-                sp.u,
-                sp.detail
-            );
-            // The witness from shooting, in the same detail: stable small cycles ⇔ l1 < 0.
-            let stable = sp.detail.contains("are stable)");
-            assert!(
-                stable || sp.detail.contains("are unstable)"),
-                "{}",
-                sp.detail
-            );
-            assert_eq!(stable, l1 < 0.0, "{name} at {}: {}", sp.u, sp.detail);
-        }
-    }
-    let h2 = crate::common::points(t1_diagram(), "hopf")[1].l1.unwrap();
-    // Two significant digits, as the issue quotes it.
-    assert!((h2 - 1.7e-3).abs() < 0.05e-3, "{h2}");
 }
 
 /// Over the Stribeck set's lower static level T_sl ∈ [0.1, 0.45] the curves meet in a
@@ -201,8 +170,8 @@ fn the_stribeck_set_has_its_codimension_two_points_where_the_curves_say() {
     assert_eq!(g2_at(0.128), CurveKind::Grazing);
 }
 
-fn model_at(base: &rotor_model::Params, p: f64) -> rotor_model::Model {
-    rotor_model::Model::new(base.with("lower.t_s", p).unwrap())
+fn model_at(base: &Params, p: f64) -> Model {
+    Model::new(base.with("lower.t_s", p).unwrap())
 }
 
 /// Bad input is refused before any computation, naming the value.

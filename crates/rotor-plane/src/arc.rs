@@ -1,5 +1,5 @@
 //! Pseudo-arclength continuation of a curve `H(y) = 0`, `H: Rⁿ → Rⁿ⁻¹`, with finite-difference
-//! Jacobians: the workhorse of the two-parameter curves ([`crate::plane`]).
+//! Jacobians: the workhorse of the two-parameter curves ([`crate::curves`]).
 //!
 //! From a point `y_k` with unit tangent `t_k` (the null vector of `DH(y_k)`, oriented along
 //! the previous one), predict `y_p = y_k + h t_k` and correct with Newton's method (chord: the
@@ -15,14 +15,18 @@
 
 use nalgebra::{DMatrix, DVector};
 
-use crate::BifError;
+use rotor_bifurcation::BifError;
 
 /// Continuation settings (in scaled coordinates).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ArcOptions {
+    /// The first step.
     pub h0: f64,
+    /// The largest step.
     pub h_max: f64,
+    /// The smallest step: a correction that fails below it ends the curve.
     pub h_min: f64,
+    /// Most points, the start included.
     pub max_points: usize,
     /// Newton stops at `|H|∞ ≤ tol` and a scaled update below `1e3·tol`.
     pub tol: f64,

@@ -6,6 +6,8 @@
 //! Each run is its own process group, killed as a whole (SIGKILL) when it runs past the
 //! timeout; its wall time is measured from the spawn to its exit.
 
+#![warn(missing_docs)]
+
 use std::io::Read;
 use std::path::{Path, PathBuf};
 use std::process::{Command, ExitStatus, Stdio};
@@ -199,22 +201,6 @@ impl Job {
             trace,
             events,
         }
-    }
-
-    /// The job `rotor bench --scenario PATH` hands a client of that knob on that scene (the
-    /// scenario's own horizon and grid): what `rotor job` prints.
-    pub fn for_scenario(
-        path: &Path,
-        fixed_step: bool,
-        setting: f64,
-        trace: PathBuf,
-        events: PathBuf,
-    ) -> Result<Job, crate::BenchError> {
-        let spec = crate::SceneSpec::from_scenario(path)?;
-        let sc = rotor_solvers::load_scenario(path)?;
-        Ok(Job::new(
-            &sc, spec.t_end, spec.dt, fixed_step, setting, trace, events,
-        ))
     }
 
     /// The job file's text (numbers as the shortest decimal that reads back to the same
