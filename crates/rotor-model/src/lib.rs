@@ -23,7 +23,7 @@ pub use event::{Event, EventKind};
 pub use fast_forward::{FastForward, Verdict};
 pub use friction::Friction;
 pub use lagrangian::{Coords, Lagrangian};
-pub use num::Num;
+pub use num::{Num, Rounding, round_sig};
 pub use params::{LowerFriction, Params, ParamsError, UpperFriction};
 pub use record::{Integration, Recorder};
 pub use scene::{
