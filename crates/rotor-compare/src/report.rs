@@ -471,8 +471,7 @@ mod tests {
 
     #[test]
     fn atomic_writes_replace_whole_files_and_stale_temporaries_go() {
-        let dir = std::env::temp_dir().join(format!("rotor-report-{}", std::process::id()));
-        std::fs::create_dir_all(&dir).unwrap();
+        let dir = rotor_testkit::tmp_dir("rotor-report");
         let file = dir.join("a.csv");
         write_atomic(&file, b"old\n").unwrap();
         write_atomic(&file, b"new\n").unwrap();

@@ -772,6 +772,7 @@ fn check_records(paths: &[PathBuf]) -> Result<(), SweepError> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use rotor_testkit::tmp_dir;
 
     #[test]
     fn axes_and_shards_parse_or_name_the_problem() {
@@ -835,13 +836,6 @@ mod tests {
                 }
             }
         }
-    }
-
-    /// A fresh directory for one test (tests run in parallel).
-    fn tmp_dir(tag: &str) -> PathBuf {
-        let dir = std::env::temp_dir().join(format!("{tag}-{}", std::process::id()));
-        std::fs::create_dir_all(&dir).unwrap();
-        dir
     }
 
     fn sweep() -> Sweep {
