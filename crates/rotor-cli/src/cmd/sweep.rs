@@ -75,7 +75,7 @@ pub(crate) fn sweep(
     let (name, range) = param
         .split_once('=')
         .ok_or_else(|| anyhow!("--param {param:?}: expected NAME=A:B:N"))?;
-    check("t-end", t_end, t_end > 0.0, "must be positive and finite")?;
+    check("t_end", t_end, t_end > 0.0, "must be positive and finite")?;
     let start = match x0 {
         Some("eq") => SweepStart::PerturbedEquilibrium,
         other => SweepStart::State(parse_x0(other)?),
