@@ -81,7 +81,7 @@ fn solve_error(py: Python<'_>, message: String, t: Option<f64>, state: Option<[f
 
 fn from_solve(py: Python<'_>, e: rotor_model::SolveError) -> PyErr {
     match e {
-        rotor_model::SolveError::InvalidScene { .. } => value_error(e),
+        rotor_model::SolveError::InvalidScene(_) => value_error(e),
         _ => solve_error(py, e.to_string(), e.time(), e.state()),
     }
 }
