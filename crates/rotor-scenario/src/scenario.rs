@@ -31,7 +31,7 @@ use thiserror::Error;
 
 use rotor_model::params::{Params, ParamsError, one_line, read_small, shown, text_of};
 use rotor_model::scene::{MAX_GRID_ROWS, MIN_TOL, Output, Scene};
-use rotor_model::{Model, Num, State};
+use rotor_model::{FieldError, Model, Num, State};
 
 use crate::tolerance::{PairTolerance, RawPairTolerance, check_pair};
 
@@ -45,13 +45,8 @@ pub enum ScenarioError {
     #[error("{}: {message}", shown(.path))]
     Parse { path: PathBuf, message: String },
     /// A value is out of range.
-    #[error("{}: {field} = {value}: {reason}", shown(.path))]
-    Invalid {
-        path: PathBuf,
-        field: String,
-        value: String,
-        reason: String,
-    },
+    #[error("{}: {error}", shown(.path))]
+    Invalid { path: PathBuf, error: FieldError },
     /// The parameter file it names is bad. (Not a `#[source]`: the message already holds
     /// it, and a reporter that prints the chain would print it twice.)
     #[error("{}: params: {error}", shown(.path))]
@@ -211,15 +206,17 @@ impl Scenario {
             None => Ok(()),
             Some(pair) => Err(ScenarioError::Invalid {
                 path: self.path.clone(),
-                field: "tolerance".into(),
-                value: format!("{pair:?}"),
-                reason: format!(
-                    "unknown solver pair (expected one of {})",
-                    known
-                        .iter()
-                        .map(|k| format!("{k:?}"))
-                        .collect::<Vec<_>>()
-                        .join(", ")
+                error: FieldError::new(
+                    "tolerance",
+                    format!("{pair:?}"),
+                    format!(
+                        "unknown solver pair (expected one of {})",
+                        known
+                            .iter()
+                            .map(|k| format!("{k:?}"))
+                            .collect::<Vec<_>>()
+                            .join(", ")
+                    ),
                 ),
             }),
         }
@@ -245,9 +242,7 @@ impl Bad<'_> {
     pub(crate) fn at(self, field: &str, value: String, reason: &str) -> ScenarioError {
         ScenarioError::Invalid {
             path: self.0.to_owned(),
-            field: field.to_owned(),
-            value,
-            reason: reason.to_owned(),
+            error: FieldError::new(field, value, reason),
         }
     }
 }
