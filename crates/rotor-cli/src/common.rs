@@ -137,6 +137,15 @@ pub(crate) fn flagged(e: rotor_model::FieldError) -> anyhow::Error {
     anyhow!(e.as_flag())
 }
 
+/// A sweep's error as the command line spells it: a refused argument names its flag
+/// ([`flagged`]); the others keep their sources.
+pub(crate) fn sweep_flagged(e: rotor_jobs::sweep::SweepError) -> anyhow::Error {
+    match e {
+        rotor_jobs::sweep::SweepError::Arg(f) => flagged(f),
+        e => e.into(),
+    }
+}
+
 /// The checked request of `simulate` and `steady` (the same checks and words as the Python
 /// package's), with a warning for a setting the solver ignores.
 pub(crate) fn request(common: &Common) -> Result<rotor_jobs::request::Request<'_>> {

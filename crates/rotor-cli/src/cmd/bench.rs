@@ -123,8 +123,10 @@ pub(crate) fn bench(
     )?;
     opts.timeout = clients.timeout;
     for e in clients.external {
-        opts.clients
-            .push(rotor_bench::ClientSpec::parse(e, clients.fixed_step).map_err(|m| anyhow!(m))?);
+        opts.clients.push(
+            rotor_bench::ClientSpec::parse(e, clients.fixed_step)
+                .map_err(crate::common::flagged)?,
+        );
     }
     for name in clients.fixed_step {
         if !opts.clients.iter().any(|c| &c.name == name) {
@@ -149,7 +151,8 @@ pub(crate) fn bench(
     opts.shard = clients
         .shard
         .map(rotor_jobs::sweep::Shard::parse)
-        .transpose()?;
+        .transpose()
+        .map_err(crate::common::sweep_flagged)?;
     opts.keep = clients.keep.map(Path::to_path_buf);
     let report = rotor_bench::run(&opts, |m| eprintln!("{m}"))?;
     write_bench(&report, [json, svg, csv])?;
