@@ -243,8 +243,7 @@ fn the_regularised_client_fails_the_gates_with_the_quantities_named() {
 fn the_first_order_client_converges_and_passes_loose_at_h_1e_5() {
     use rotor_grade::check::{Level, check};
     let root = rotor_bench::workspace_root();
-    let dir = std::env::temp_dir().join(format!("rotor-first-order-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = rotor_testkit::tmp_dir("rotor-first-order");
     let exe = dir.join("first_order");
     let built = std::process::Command::new("cc")
         .args(["-O2", "-o"])
@@ -392,8 +391,7 @@ fn octave_peer_passes_loose_on_both_scenes() {
         return;
     }
     let root = rotor_bench::workspace_root();
-    let dir = std::env::temp_dir().join(format!("rotor-octave-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = rotor_testkit::tmp_dir("rotor-octave");
     for name in ["t1-u1.5-rest", "st-u1.5-rest"] {
         let sc =
             rotor_solvers::load_scenario(&root.join(format!("fixtures/scenarios/{name}.toml")))
@@ -469,8 +467,7 @@ fn octave_peer_refuses_a_bad_job_by_name() {
         return;
     }
     let root = rotor_bench::workspace_root();
-    let dir = std::env::temp_dir().join(format!("rotor-octave-bad-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = rotor_testkit::tmp_dir("rotor-octave-bad");
     let sc =
         rotor_solvers::load_scenario(&root.join("fixtures/scenarios/t1-u1.5-rest.toml")).unwrap();
     let job = |fixed_step: bool| {

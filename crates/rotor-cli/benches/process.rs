@@ -43,8 +43,7 @@ fn time(n: usize, mut f: impl FnMut()) -> f64 {
 
 fn main() {
     let n = 41;
-    let dir = std::env::temp_dir().join(format!("rotor-process-bench-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = rotor_testkit::tmp_dir("rotor-process-bench");
     let csv = dir.join("x.csv");
     let model = Model::table1();
     let scene = Scene {

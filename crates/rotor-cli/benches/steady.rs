@@ -68,8 +68,7 @@ fn children_cpu() -> Option<f64> {
 
 fn main() {
     let bin = Path::new(env!("CARGO_BIN_EXE_rotor"));
-    let dir = std::env::temp_dir().join(format!("rotor-steady-bench-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).expect("a temporary directory");
+    let dir = rotor_testkit::tmp_dir("rotor-steady-bench");
     let h1 = rotor_bifurcation::equilibria::hopf_points(&Model::table1(), 20.0)[0]
         .equilibrium
         .u;

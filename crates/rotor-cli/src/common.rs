@@ -33,7 +33,7 @@ pub(crate) struct Common {
 }
 
 pub(crate) fn kind_by_name(name: &str) -> Result<SolverKind> {
-    rotor_jobs::request::solver_kind(name).map_err(|e| anyhow!(e.as_flag()))
+    rotor_jobs::request::solver_kind(name).map_err(flagged)
 }
 
 /// Prints a command's summary: on standard output, unless one of its outputs goes there
@@ -126,12 +126,24 @@ pub(crate) fn thread_pool(explicit: Option<usize>) -> Result<String> {
     })
 }
 
-/// Checks a numeric option: finite and in range, naming the flag and the value.
-pub(crate) fn check(flag: &str, v: f64, ok: bool, what: &str) -> Result<()> {
-    if !v.is_finite() || !ok {
-        bail!("--{flag} {}: {what}", rotor_model::Num(v));
+/// Checks a numeric option: finite and in range, else the refusal naming its flag
+/// ([`flagged`]) and the value.
+pub(crate) fn check(field: &str, v: f64, ok: bool, what: &str) -> Result<()> {
+    rotor_jobs::request::check_number(field, v, ok, what).map_err(flagged)
+}
+
+/// A bad input as the command line spells it: the field as its flag (`t_end` is `--t-end`).
+pub(crate) fn flagged(e: rotor_model::FieldError) -> anyhow::Error {
+    anyhow!(e.as_flag())
+}
+
+/// A sweep's error as the command line spells it: a refused argument names its flag
+/// ([`flagged`]); the others keep their sources.
+pub(crate) fn sweep_flagged(e: rotor_jobs::sweep::SweepError) -> anyhow::Error {
+    match e {
+        rotor_jobs::sweep::SweepError::Arg(f) => flagged(f),
+        e => e.into(),
     }
-    Ok(())
 }
 
 /// The checked request of `simulate` and `steady` (the same checks and words as the Python

@@ -13,7 +13,7 @@ use std::process::{Command, Output};
 
 use rotor_testkit::{
     SCENARIO, TABLE1, bad_pair_cases, bad_params_cases, bad_scenario_cases, edit, local_scenario,
-    write_scenario,
+    tmp_dir, write_scenario,
 };
 
 fn fixtures() -> PathBuf {
@@ -25,11 +25,6 @@ fn rotor(args: &[&str]) -> Output {
         .args(args)
         .output()
         .unwrap()
-}
-
-/// A fresh directory per call (tests run in parallel).
-fn tmp_dir() -> PathBuf {
-    rotor_testkit::tmp_dir("rotor-cli-bad-input")
 }
 
 /// An error exit: a code that is neither success, nor a panic (101), nor a signal; stderr's
@@ -56,7 +51,7 @@ fn assert_clean_error(o: &Output, what: &str, needles: &[&str]) {
 
 #[test]
 fn bad_parameter_files_are_named_with_field_and_value() {
-    let dir = tmp_dir();
+    let dir = tmp_dir("rotor-cli-bad-input");
     let cases = bad_params_cases();
     assert!(!cases.is_empty());
     for (i, c) in cases.iter().enumerate() {
@@ -101,7 +96,7 @@ fn bad_parameter_files_are_named_with_field_and_value() {
 
 #[test]
 fn bad_flags_name_the_flag_and_value() {
-    let dir = tmp_dir();
+    let dir = tmp_dir("rotor-cli-bad-input");
     let csv = dir.join("out.csv");
     let csv_s = csv.to_str().unwrap();
     let cases: [(&[&str], &[&str]); 15] = [
@@ -190,7 +185,7 @@ fn bad_flags_name_the_flag_and_value() {
 /// its last write, and no earlier output of the same command is left behind.
 #[test]
 fn unwritable_outputs_are_refused_before_any_work() {
-    let dir = tmp_dir();
+    let dir = tmp_dir("rotor-cli-bad-input");
     let json = dir.join("b.json");
     let (json_s, dir_s) = (json.to_str().unwrap(), dir.to_str().unwrap());
     let missing = dir.join("no-such-dir").join("x");
@@ -324,7 +319,7 @@ fn compare_with_a_bad_scenario_writes_no_report() {
     assert!(!cases.is_empty());
     for c in &cases {
         let what = c.name.as_str();
-        let dir = tmp_dir();
+        let dir = tmp_dir("rotor-cli-bad-input");
         let f = write_scenario(&dir, &c.contents);
         // A good scenario first: it must not be reported either when a later one is bad.
         let good = dir.join("good.toml");
@@ -344,7 +339,7 @@ fn compare_with_a_bad_scenario_writes_no_report() {
         assert!(files_of(&report).is_empty(), "{what}: report written");
     }
     // A bad parameter file named by a scenario: both files named.
-    let dir = tmp_dir();
+    let dir = tmp_dir("rotor-cli-bad-input");
     let f = write_scenario(&dir, edit(&s, "\"table1.toml\"", "\"bad.toml\"").as_bytes());
     std::fs::write(
         dir.join("bad.toml"),
@@ -371,7 +366,7 @@ fn compare_with_a_bad_scenario_writes_no_report() {
         vec![("README.md".to_string(), b"old report\n".to_vec())]
     );
     // Two scenarios of one name would overwrite each other's report files.
-    let dir = tmp_dir();
+    let dir = tmp_dir("rotor-cli-bad-input");
     let f = write_scenario(&dir, s.as_bytes());
     let twin = dir.join("twin.toml");
     std::fs::write(&twin, &s).unwrap();
@@ -420,7 +415,7 @@ fn a_killed_compare_leaves_every_report_file_whole() {
     use std::os::unix::process::ExitStatusExt;
     use std::time::Instant;
 
-    let dir = tmp_dir();
+    let dir = tmp_dir("rotor-cli-bad-input");
     let params = fixtures().join("params/table1.toml");
     // Large files (1e5 CSV rows, ~11 MB) so that writing them takes a while.
     let big = edit(

@@ -12,8 +12,7 @@ fn rotor(args: &[&str]) -> std::process::Output {
 
 #[test]
 fn simulate_writes_the_contract_csv() {
-    let dir = std::env::temp_dir().join(format!("rotor-cli-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = rotor_testkit::tmp_dir("rotor-cli");
     let csv = dir.join("out.csv");
     for solver in ["event", "switch", "moreau"] {
         let o = rotor(&[
@@ -59,8 +58,7 @@ fn simulate_writes_the_contract_csv() {
 /// A flag the solver does not use is a warning on stderr, and the run goes on.
 #[test]
 fn flags_a_solver_ignores_are_warned_about() {
-    let dir = std::env::temp_dir().join(format!("rotor-cli-warn-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = rotor_testkit::tmp_dir("rotor-cli-warn");
     let csv = dir.join("out.csv");
     let csv = csv.to_str().unwrap();
     for (solver, flag, value, needle) in [
@@ -173,8 +171,7 @@ fn steady_default_confirms_the_slow_cycle_next_to_h1() {
 
 #[test]
 fn bifurcation_writes_the_contract_json_and_a_figure() {
-    let dir = std::env::temp_dir().join(format!("rotor-cli-bif-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = rotor_testkit::tmp_dir("rotor-cli-bif");
     let (json, svg) = (dir.join("d.json"), dir.join("d.svg"));
     let o = rotor(&[
         "bifurcation",
@@ -244,8 +241,7 @@ fn bifurcation_writes_the_contract_json_and_a_figure() {
 
 #[test]
 fn bench_quick_prints_the_table_and_writes_the_plot() {
-    let dir = std::env::temp_dir().join(format!("rotor-cli-bench-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = rotor_testkit::tmp_dir("rotor-cli-bench");
     let (json, svg) = (dir.join("b.json"), dir.join("b.svg"));
     let o = rotor(&[
         "bench",
@@ -273,7 +269,7 @@ fn bench_quick_prints_the_table_and_writes_the_plot() {
 fn a_report_written_twice_is_the_same_bytes() {
     let fixtures =
         std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../fixtures/scenarios");
-    let base = std::env::temp_dir().join(format!("rotor-cli-report-twice-{}", std::process::id()));
+    let base = rotor_testkit::tmp_dir("rotor-cli-report-twice");
     let read = |dir: &std::path::Path| {
         let mut v: Vec<(String, Vec<u8>)> = std::fs::read_dir(dir)
             .unwrap()
@@ -349,8 +345,7 @@ fn check_case() -> (PathBuf, PathBuf, Vec<String>) {
 #[test]
 fn check_grades_with_exit_codes_0_1_2() {
     let (scenario, good, mut lines) = check_case();
-    let dir = std::env::temp_dir().join(format!("rotor-cli-check-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = rotor_testkit::tmp_dir("rotor-cli-check");
     let run = |trace: &std::path::Path, extra: &[&str]| {
         let mut args = vec![
             "check",
@@ -459,8 +454,7 @@ fn the_minimal_client_of_benchmark_md_passes_check() {
         eprintln!("minimal client not run: python3 cannot import scipy");
         return;
     }
-    let dir = std::env::temp_dir().join(format!("rotor-cli-minimal-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = rotor_testkit::tmp_dir("rotor-cli-minimal");
     let client = dir.join("client.py");
     std::fs::write(&client, block).unwrap();
     let params = rotor_model::Params::from_file(&root.join("fixtures/params/table1.toml")).unwrap();
@@ -514,8 +508,7 @@ fn sweep_shards_merge_to_the_single_run_and_resume() {
         .nth(1)
         .and_then(|r| r.split("```\n<!-- parallel end -->").next())
         .expect("the README's parallel block");
-    let dir = std::env::temp_dir().join(format!("rotor-cli-sweep-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = rotor_testkit::tmp_dir("rotor-cli-sweep");
     let grid = ["--u", "0.02:6:24", "--param", "k_theta=0.05:0.11:10"];
     assert!(block.contains("--u 0.02:6:24 --param k_theta=0.05:0.11:10"));
     let whole = dir.join("whole.csv");
@@ -639,8 +632,7 @@ fn sweep_refuses_bad_shards_parameters_and_huge_grids() {
 #[test]
 fn a_closed_standard_output_ends_quietly() {
     let (scenario, good, lines) = check_case();
-    let dir = std::env::temp_dir().join(format!("rotor-cli-pipe-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = rotor_testkit::tmp_dir("rotor-cli-pipe");
     let bad = dir.join("bad.csv");
     std::fs::write(&bad, lines.join("\n") + "\n").unwrap();
     let (sc, good, bad) = (
@@ -794,8 +786,7 @@ fn threads_follow_the_flag_then_slurm_then_the_cores() {
 /// naming the file.
 #[test]
 fn bench_shards_merge_to_one_run_timings_aside() {
-    let dir = std::env::temp_dir().join(format!("rotor-cli-bench-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = rotor_testkit::tmp_dir("rotor-cli-bench");
     let p = |f: &str| dir.join(f).to_str().unwrap().to_owned();
     let suite = [
         "bench",
@@ -1015,9 +1006,7 @@ fn job_prints_the_job_file_with_x0_at_full_precision() {
 /// no scene makes `bench` exit 1, naming it, with its report still written.
 #[test]
 fn bench_keeps_runs_and_names_an_unsolved_client() {
-    let dir = std::env::temp_dir().join(format!("rotor-cli-keep-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = rotor_testkit::tmp_dir("rotor-cli-keep");
     let keep = dir.join("runs");
     let json = dir.join("b.json");
     // A client that writes one line on standard error and exits 2.
@@ -1057,9 +1046,7 @@ fn bench_keeps_runs_and_names_an_unsolved_client() {
 /// the scenario's name, with the version on its verdict.
 #[test]
 fn an_installed_rotor_grades_by_name_from_an_empty_directory() {
-    let dir = std::env::temp_dir().join(format!("rotor-cli-installed-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = rotor_testkit::tmp_dir("rotor-cli-installed");
     let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
     std::fs::copy(
         root.join("fixtures/reference/t1-u1.5-rest.csv"),
@@ -1184,8 +1171,7 @@ fn steady_shoot_finds_the_cycle_with_every_solver() {
 /// periods within the solver's error; the JSON names the solver and what it does not locate.
 #[test]
 fn bifurcation_by_each_solver_reproduces_the_branch() {
-    let dir = std::env::temp_dir().join(format!("rotor-cli-bif-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = rotor_testkit::tmp_dir("rotor-cli-bif");
     let run = |solver: &str| -> serde_json::Value {
         let path = dir.join(format!("{solver}.json"));
         let o = rotor(&[

@@ -4,11 +4,10 @@ use std::fmt::Write as _;
 use std::io::Write as _;
 use std::path::Path;
 
-use rotor_model::{Disc, Friction, Model, Params, SteadyState};
+use rotor_model::{Disc, Friction, Model, Params, Rounding, SteadyState, round_sig};
 use rotor_scenario::Scenario;
 
 use crate::gate::{Failure, GateResult, gate_scenario};
-use crate::snapshot::round_sig;
 use rotor_plot::{Panel, Series, render};
 use rotor_solvers::run::{ScenarioResult, solver_settings};
 use rotor_solvers::solvers::SolverKind;
@@ -141,8 +140,8 @@ pub fn scenario_csv(r: &ScenarioResult) -> String {
         row.push(rotor_grade::trace::round_to(t, digits));
         for k in &kinds {
             let x = r.traj(*k).map(|tr| tr.samples[i].x).unwrap_or_default();
-            row.push(round_sig(x[1], 12, 0.0));
-            row.push(round_sig(x[2], 12, 0.0));
+            row.push(round_sig(x[1], 12, Rounding::Decimal { floor: 0.0 }));
+            row.push(round_sig(x[2], 12, Rounding::Decimal { floor: 0.0 }));
         }
         w.serialize(&row).expect("in memory");
     }
@@ -472,8 +471,7 @@ mod tests {
 
     #[test]
     fn atomic_writes_replace_whole_files_and_stale_temporaries_go() {
-        let dir = std::env::temp_dir().join(format!("rotor-report-{}", std::process::id()));
-        std::fs::create_dir_all(&dir).unwrap();
+        let dir = rotor_testkit::tmp_dir("rotor-report");
         let file = dir.join("a.csv");
         write_atomic(&file, b"old\n").unwrap();
         write_atomic(&file, b"new\n").unwrap();

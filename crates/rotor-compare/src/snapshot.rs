@@ -24,7 +24,7 @@
 
 use std::collections::BTreeMap;
 
-use rotor_model::{Stats, SteadyState};
+use rotor_model::{Rounding, Stats, SteadyState, round_sig};
 use serde::Serialize;
 
 use rotor_solvers::run::ScenarioResult;
@@ -108,19 +108,6 @@ pub const MAX_DIGITS: u32 = 12;
 /// O(1) values, measured up to 5e-15 between two solvers on the same equilibrium).
 pub const ROUNDING: f64 = 1e-13;
 
-/// Rounds `v` to `digits` significant digits; `|v| < floor` gives 0 (never −0).
-pub fn round_sig(v: f64, digits: u32, floor: f64) -> f64 {
-    if !v.is_finite() || v.abs() < floor || v == 0.0 {
-        return if v.is_finite() { 0.0 } else { v };
-    }
-    let e = v.abs().log10().floor() as i32;
-    let scale = 10f64.powi(digits as i32 - 1 - e);
-    let r = (v * scale).round() / scale;
-    // Re-parse the shortest decimal so the value prints as written (no 4.5778000000000001).
-    let s = format!("{:.*e}", digits.saturating_sub(1) as usize, r);
-    s.parse().unwrap_or(r)
-}
-
 /// A difference to one significant digit, as `4e-11`; `0` below [`ROUNDING`].
 pub fn one_digit(d: f64) -> String {
     if d.is_finite() && d < ROUNDING {
@@ -185,7 +172,7 @@ pub fn snapshot(r: &ScenarioResult) -> ScenarioSnapshot {
                             .is_none_or(|(q, _)| q.relative);
                         let d = digits_for(tightest);
                         let rounded = if relative {
-                            round_sig(v, d, floor)
+                            round_sig(v, d, Rounding::Decimal { floor })
                         } else {
                             round_decimals(v, d)
                         };
@@ -238,17 +225,6 @@ pub fn snapshot(r: &ScenarioResult) -> ScenarioSnapshot {
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn rounding_keeps_significant_digits_and_floors_small_values() {
-        assert_eq!(round_sig(4.577757971, 5, 1e-9), 4.5778);
-        assert_eq!(round_sig(-0.000123456789, 3, 1e-9), -0.000123);
-        assert_eq!(round_sig(6.3361e-10, 5, 1e-9), 0.0);
-        assert_eq!(round_sig(-3e-12, 5, 1e-9), 0.0);
-        assert!(round_sig(-3e-12, 5, 1e-9).is_sign_positive());
-        assert_eq!(round_sig(99999.7, 5, 1e-9), 100000.0);
-        assert_eq!(format!("{}", round_sig(0.1 + 0.2, 5, 0.0)), "0.3");
-    }
 
     #[test]
     fn differences_keep_one_digit_and_drop_rounding() {

@@ -266,7 +266,7 @@ impl Outcome {
         match self {
             Outcome::Finished => "ok",
             Outcome::Failed(e) => match e {
-                SolveError::InvalidScene { .. } => "invalid scene",
+                SolveError::InvalidScene(_) => "invalid scene",
                 SolveError::StepSizeUnderflow { .. } => "step size underflow",
                 SolveError::NonFinite { .. } => "non-finite state",
                 SolveError::Complementarity { .. } => "complementarity failure",

@@ -201,8 +201,7 @@ steady_abs = 1e-12        # rounding floor of the relative gates: |difference| <
 fn a_fourth_solver_needs_its_crate_one_entry_and_its_tolerances() {
     let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../fixtures");
     let text = std::fs::read_to_string(root.join("scenarios/t1-u1.5-rest.toml")).unwrap();
-    let dir = std::env::temp_dir().join(format!("rotor-fourth-solver-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = rotor_testkit::tmp_dir("rotor-fourth-solver");
     std::fs::copy(root.join("params/table1.toml"), dir.join("table1.toml")).unwrap();
     let file = dir.join("t1-u1.5-rest.toml");
     let text = text.replace("\"../params/table1.toml\"", "\"table1.toml\"");

@@ -540,7 +540,7 @@ fn stress_overflowing_input_is_refused_by_every_solver() {
         };
         for kind in SOLVERS {
             match kind.solver().simulate(&m, &scene) {
-                Err(rotor_model::SolveError::InvalidScene { field: "u", .. }) => {}
+                Err(rotor_model::SolveError::InvalidScene(e)) if e.field == "u" => {}
                 other => panic!("{kind:?} at u = {u:e}: {other:?}"),
             }
         }

@@ -51,7 +51,7 @@ use crate::gridmetrics::{STUCK, StickExit, grid_metrics};
 use crate::orbit::Orbit;
 use crate::reference::Reference;
 use crate::trace::{At, EventsFile, Trace, disc_name, event_row};
-use rotor_solvers::BadInput;
+use rotor_model::FieldError;
 
 /// The benchmark's version: named in every verdict.
 pub const BENCHMARK: &str = rotor_suite::VERSION;
@@ -104,34 +104,37 @@ impl Level {
     }
 
     /// The level of a name (`strict`, `loose`, or `digits=N` with N in 1..=15), or a
-    /// [`BadInput`] naming `gate` and the value.
-    pub fn parse(s: &str) -> Result<Level, BadInput> {
+    /// [`FieldError`] naming `gate` and the value.
+    pub fn parse(s: &str) -> Result<Level, FieldError> {
         match s {
             "strict" => Ok(Level::Strict),
             "loose" => Ok(Level::Loose),
             _ => match s.strip_prefix("digits=") {
-                Some(n) => Level::with_digits(n).map_err(|e| BadInput { name: "gate", ..e }),
-                None => Err(BadInput {
-                    name: "gate",
-                    value: format!("{s:?}"),
-                    reason: format!(
+                Some(n) => Level::with_digits(n).map_err(|e| FieldError {
+                    field: "gate".into(),
+                    ..e
+                }),
+                None => Err(FieldError::new(
+                    "gate",
+                    format!("{s:?}"),
+                    format!(
                         "expected strict ({STRICT_DIGITS} significant digits), loose \
                          ({LOOSE_DIGITS}) or digits=N"
                     ),
-                }),
+                )),
             },
         }
     }
 
-    /// `--digits N`: N in 1..=15 (a double holds 15 to 17), or a [`BadInput`] naming `digits`.
-    pub fn with_digits(n: &str) -> Result<Level, BadInput> {
+    /// `--digits N`: N in 1..=15 (a double holds 15 to 17), or a [`FieldError`] naming `digits`.
+    pub fn with_digits(n: &str) -> Result<Level, FieldError> {
         match n.trim().parse::<u32>() {
             Ok(d) if (1..=15).contains(&d) => Ok(Level::Digits(d)),
-            _ => Err(BadInput {
-                name: "digits",
-                value: format!("{n:?}"),
-                reason: "expected a whole number of significant digits from 1 to 15".into(),
-            }),
+            _ => Err(FieldError::new(
+                "digits",
+                format!("{n:?}"),
+                "expected a whole number of significant digits from 1 to 15",
+            )),
         }
     }
 }

@@ -27,7 +27,7 @@
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
-use rotor_model::{Event, Output, Sample, Scene, SolveError, SteadyState};
+use rotor_model::{Event, Output, Rounding, Sample, Scene, SolveError, SteadyState, round_sig};
 use rotor_scenario::Scenario;
 use serde::{Deserialize, Serialize};
 
@@ -252,29 +252,6 @@ fn differences(
     out
 }
 
-/// `x` rounded to `digits` significant digits.
-pub fn round_sig(x: f64, digits: u32) -> f64 {
-    if x == 0.0 || !x.is_finite() {
-        return x;
-    }
-    let e = x.abs().log10().floor() as i32;
-    let scale = 10f64.powi(digits as i32 - 1 - e);
-    let r = (x * scale).round() / scale;
-    if r.is_finite() { r } else { x }
-}
-
-/// `x ≥ 0` rounded up to `digits` significant digits (a stated error never shrinks): the
-/// decimal `⌈x·10^k⌉/10^k`, nudged up by an ulp if its nearest double lies below `x`.
-fn round_up_sig(x: f64, digits: u32) -> f64 {
-    if x == 0.0 || !x.is_finite() {
-        return x;
-    }
-    let e = x.abs().log10().floor() as i32;
-    let scale = 10f64.powi(digits as i32 - 1 - e);
-    let r = (x * scale).ceil() / scale;
-    if r >= x { r } else { r.next_up() }
-}
-
 /// Computes the reference of a scenario (three event-driven runs: the reference, the tighter
 /// one, and the cross-check runs of the other two solvers).
 pub fn compute(sc: &Scenario) -> Result<Reference, ReferenceError> {
@@ -335,7 +312,7 @@ pub fn compute(sc: &Scenario) -> Result<Reference, ReferenceError> {
         .iter()
         .map(|s| Sample {
             t: s.t,
-            x: s.x.map(|v| round_sig(v, trace_digits)),
+            x: s.x.map(|v| round_sig(v, trace_digits, Rounding::Scaled)),
         })
         .collect();
     let mut cross_check = BTreeMap::new();
@@ -370,17 +347,17 @@ pub fn compute(sc: &Scenario) -> Result<Reference, ReferenceError> {
             } else {
                 ((v.abs() / (0.1 * e)).log10().ceil() as u32 + 1).clamp(2, 17)
             };
-            round_sig(v, d)
+            round_sig(v, d, Rounding::Scaled)
         };
         m.map(rounded)
     });
     let error = error
         .into_iter()
-        .map(|(n, e)| (n, round_up_sig(e, 2)))
+        .map(|(n, e)| (n, round_sig(e, 2, Rounding::Up)))
         .collect();
     for c in cross_check.values_mut() {
         for d in c.differences.values_mut() {
-            *d = d.map(|x| round_sig(x, 2));
+            *d = d.map(|x| round_sig(x, 2, Rounding::Scaled));
         }
     }
     let json = ReferenceJson {

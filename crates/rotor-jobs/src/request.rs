@@ -2,15 +2,15 @@
 //!
 //! `rotor simulate`/`rotor steady` and the Python package's `simulate`/`steady`/`sweep` take
 //! the same inputs (a solver name, u, x0, a horizon, tol or h). A [`Request`] turns them into
-//! a solver and a validated [`Scene`], and refuses bad input with a [`BadInput`] that names
+//! a solver and a validated [`Scene`], and refuses bad input with a [`FieldError`] that names
 //! the input and the value. The reason is worded once, here and in [`rotor_solvers`]
 //! ([`check_number`], [`solver_kind`]); each front end only spells the name its own way
-//! ([`BadInput::as_flag`] for the command line, `name = value` for Python).
+//! ([`FieldError::as_flag`] for the command line, `name = value` for Python).
 
-use rotor_model::{Num, Output, Scene, State, Stats};
+use rotor_model::{FieldError, Num, Output, Scene, State, Stats};
 
 use rotor_solvers::SolverKind;
-pub use rotor_solvers::{BadInput, check_number, solver_kind};
+pub use rotor_solvers::{check_number, solver_kind};
 use rotor_steady::SteadyOptions;
 
 /// A setting the chosen solver has no use for (the adaptive solvers take no step size,
@@ -85,7 +85,7 @@ pub struct Request<'a> {
 
 impl Request<'_> {
     /// The solver asked for.
-    pub fn solver_kind(&self) -> Result<SolverKind, BadInput> {
+    pub fn solver_kind(&self) -> Result<SolverKind, FieldError> {
         solver_kind(self.solver)
     }
 
@@ -109,19 +109,19 @@ impl Request<'_> {
     /// The scene of a run over `[0, t_end]` keeping `output`: u finite, x0 finite, tol in
     /// (0, 1), h in (0, t_end] (the default step shrinks to a horizon shorter than itself; an
     /// explicit h does not).
-    pub fn scene(&self, t_end: f64, output: Output) -> Result<Scene, BadInput> {
+    pub fn scene(&self, t_end: f64, output: Output) -> Result<Scene, FieldError> {
         check_number("u", self.u, true, "must be a finite number")?;
         for (k, v) in self.x0.iter().enumerate() {
             if !v.is_finite() {
-                return Err(BadInput {
-                    name: "x0",
-                    value: format!("{:?}", self.x0.map(|x| Num(x).to_string())),
-                    reason: format!(
+                return Err(FieldError::new(
+                    "x0",
+                    format!("{:?}", self.x0.map(|x| Num(x).to_string())),
+                    format!(
                         "component {} ({}) is not finite",
                         k + 1,
                         ["alpha", "omega_u", "omega_l"][k]
                     ),
-                });
+                ));
             }
         }
         let d = Scene::default();
@@ -147,7 +147,7 @@ impl Request<'_> {
     }
 
     /// A simulation over `[0, t_end]` sampled every `dt`: the solver and the scene.
-    pub fn simulation(&self, t_end: f64, dt: f64) -> Result<(SolverKind, Scene), BadInput> {
+    pub fn simulation(&self, t_end: f64, dt: f64) -> Result<(SolverKind, Scene), FieldError> {
         check_number("t_end", t_end, t_end > 0.0, "must be positive and finite")?;
         check_number("dt", dt, dt > 0.0, "must be positive and finite")?;
         let kind = self.solver_kind()?;
@@ -156,7 +156,7 @@ impl Request<'_> {
 
     /// A steady-state computation ([`rotor_steady::steady`]): the solver, the scene and the options
     /// (the event-driven solver's refinement runs at `tol`).
-    pub fn steady(&self) -> Result<(SolverKind, Scene, SteadyOptions), BadInput> {
+    pub fn steady(&self) -> Result<(SolverKind, Scene, SteadyOptions), FieldError> {
         let mut opts = SteadyOptions::default();
         if let Some(tol) = self.tol {
             check_number("tol", tol, tol > 0.0 && tol < 1.0, "must lie in (0, 1)")?;
@@ -223,7 +223,7 @@ mod tests {
         }
         .simulation(10.0, 0.01)
         .unwrap_err();
-        assert_eq!(e.name, "x0");
+        assert_eq!(e.field, "x0");
         assert!(e.reason.contains("omega_u"), "{e}");
     }
 

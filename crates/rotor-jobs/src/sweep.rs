@@ -17,7 +17,7 @@ use std::io::{BufRead, Read, Write};
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
 
-use rotor_model::{Attractor, Model, Output, Params, Scene, State, SteadyState};
+use rotor_model::{Attractor, FieldError, Model, Output, Params, Scene, State, SteadyState};
 
 use rotor_solvers::solvers::SolverKind;
 
@@ -30,16 +30,11 @@ pub const MAX_POINTS: usize = 10_000_000;
 /// Why a sweep or a merge cannot run.
 #[derive(Debug, thiserror::Error)]
 pub enum SweepError {
-    /// An option's value is refused before any run.
-    #[error("{flag} {value:?}: {reason}")]
-    Arg {
-        /// The option (`--u`, `--param`, `--shard`, ...).
-        flag: &'static str,
-        /// Its value as given.
-        value: String,
-        /// Why it is refused.
-        reason: String,
-    },
+    /// An argument is refused: the field as `rotor sweep` names it (`u`, `param`, `shard`;
+    /// `u/param` for the size of the grid), its value quoted as given. The command line
+    /// spells the field as its flag ([`FieldError::as_flag`]: `--shard "0/3": ...`).
+    #[error(transparent)]
+    Arg(FieldError),
     /// An output, shard record or input file cannot be read, or is not what it should be.
     #[error("{}: {message}", .path.display())]
     File {
@@ -62,12 +57,8 @@ pub enum SweepError {
     Merge(String),
 }
 
-fn arg(flag: &'static str, value: &str, reason: impl Into<String>) -> SweepError {
-    SweepError::Arg {
-        flag,
-        value: value.to_owned(),
-        reason: reason.into(),
-    }
+fn arg(field: &str, value: &str, reason: impl Into<String>) -> SweepError {
+    SweepError::Arg(FieldError::new(field, format!("{value:?}"), reason))
 }
 
 /// One axis `A:B:N`: N values from A to B, both included.
@@ -82,28 +73,28 @@ pub struct Axis {
 }
 
 impl Axis {
-    /// Parses `A:B:N`; `flag` names the option in the error.
-    pub fn parse(flag: &'static str, s: &str) -> Result<Axis, SweepError> {
+    /// Parses `A:B:N`; `field` names the axis in the error (`u`, `param`).
+    pub fn parse(field: &str, s: &str) -> Result<Axis, SweepError> {
         let parts: Vec<&str> = s.split(':').collect();
         let [a, b, n] = parts[..] else {
-            return Err(arg(flag, s, "expected A:B:N (from A to B in N values)"));
+            return Err(arg(field, s, "expected A:B:N (from A to B in N values)"));
         };
         let num = |t: &str| {
             t.trim()
                 .parse::<f64>()
                 .ok()
                 .filter(|v| v.is_finite())
-                .ok_or_else(|| arg(flag, s, format!("{t:?} is not a finite number")))
+                .ok_or_else(|| arg(field, s, format!("{t:?} is not a finite number")))
         };
         let n = n
             .trim()
             .parse::<usize>()
             .ok()
             .filter(|&n| n >= 1)
-            .ok_or_else(|| arg(flag, s, format!("N = {n:?} must be a whole number >= 1")))?;
+            .ok_or_else(|| arg(field, s, format!("N = {n:?} must be a whole number >= 1")))?;
         let (a, b) = (num(a)?, num(b)?);
         if n == 1 && a != b {
-            return Err(arg(flag, s, "N = 1 needs A = B"));
+            return Err(arg(field, s, "N = 1 needs A = B"));
         }
         Ok(Axis { a, b, n })
     }
@@ -135,7 +126,7 @@ impl Shard {
 
     /// Parses `I/N` (`--shard`), with I in 1..=N.
     pub fn parse(s: &str) -> Result<Shard, SweepError> {
-        let bad = |why: &str| arg("--shard", s, why);
+        let bad = |why: &str| arg("shard", s, why);
         let (i, n) = s
             .split_once('/')
             .ok_or_else(|| bad("expected I/N, e.g. 3/8"))?;
@@ -226,18 +217,18 @@ impl Sweep {
     pub fn validate(&self, shard: Shard) -> Result<(), SweepError> {
         self.base
             .get(&self.param)
-            .map_err(|e| arg("--param", &self.param, e.to_string()))?;
+            .map_err(|e| arg("param", &self.param, e.to_string()))?;
         let points = format!("{} x {} points", self.u.n, self.p.n);
         if self.u.n.checked_mul(self.p.n).is_none() {
             return Err(arg(
-                "--u/--param",
+                "u/param",
                 &points,
                 format!("more points than this machine can count ({})", usize::MAX),
             ));
         }
         if shard.count(self.len()) > MAX_POINTS {
             return Err(arg(
-                "--u/--param",
+                "u/param",
                 &points,
                 format!(
                     "more than {MAX_POINTS} points for one process: split the grid with \
@@ -256,7 +247,7 @@ impl Sweep {
             let p = self.p.value(i);
             self.base
                 .with(&self.param, p)
-                .map_err(|e| arg("--param", &format!("{}={p}", self.param), e.to_string()))?;
+                .map_err(|e| arg("param", &format!("{}={p}", self.param), e.to_string()))?;
         }
         Ok(())
     }
@@ -821,23 +812,32 @@ fn check_records(paths: &[PathBuf]) -> Result<(), SweepError> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use rotor_testkit::tmp_dir;
+
+    /// A refused argument as the command line spells it.
+    fn flag(e: SweepError) -> String {
+        match e {
+            SweepError::Arg(f) => f.as_flag(),
+            e => panic!("not a refused argument: {e}"),
+        }
+    }
 
     #[test]
     fn axes_and_shards_parse_or_name_the_problem() {
-        let a = Axis::parse("--u", "0:2:5").unwrap();
+        let a = Axis::parse("u", "0:2:5").unwrap();
         assert_eq!((a.value(0), a.value(2), a.value(4)), (0.0, 1.0, 2.0));
-        assert_eq!(Axis::parse("--u", "3:1:3").unwrap().value(1), 2.0);
+        assert_eq!(Axis::parse("u", "3:1:3").unwrap().value(1), 2.0);
         // Both ends are the numbers given, bit for bit (7 + (0.3 − 7)·1 is not 0.3).
-        let a = Axis::parse("--u", "7:0.3:4").unwrap();
+        let a = Axis::parse("u", "7:0.3:4").unwrap();
         assert_eq!((a.value(0), a.value(3)), (7.0, 0.3));
         assert!(a.value(2) > a.value(3));
         for bad in ["0:1", "a:1:3", "0:1:0", "0:1:x", "0:inf:3", "0:1:1"] {
-            let e = Axis::parse("--u", bad).unwrap_err().to_string();
+            let e = flag(Axis::parse("u", bad).unwrap_err());
             assert!(e.starts_with(&format!("--u {bad:?}")), "{e}");
         }
         assert_eq!(Shard::parse("2/3").unwrap(), Shard { i: 2, n: 3 });
         for bad in ["0/3", "4/3", "a/b", "3", "1/0"] {
-            let e = Shard::parse(bad).unwrap_err().to_string();
+            let e = flag(Shard::parse(bad).unwrap_err());
             assert!(e.starts_with(&format!("--shard {bad:?}")), "{e}");
         }
         let s = Shard { i: 2, n: 3 };
@@ -873,7 +873,7 @@ mod tests {
             for solver in rotor_solvers::solvers::SOLVERS {
                 let sw = Sweep {
                     base,
-                    u: Axis::parse("--u", &format!("{u}:{}:2", 0.5 * u)).unwrap(),
+                    u: Axis::parse("u", &format!("{u}:{}:2", 0.5 * u)).unwrap(),
                     solver,
                     ..sweep()
                 };
@@ -886,19 +886,12 @@ mod tests {
         }
     }
 
-    /// A fresh directory for one test (tests run in parallel).
-    fn tmp_dir(tag: &str) -> PathBuf {
-        let dir = std::env::temp_dir().join(format!("{tag}-{}", std::process::id()));
-        std::fs::create_dir_all(&dir).unwrap();
-        dir
-    }
-
     fn sweep() -> Sweep {
         Sweep {
             base: Params::table1(),
-            u: Axis::parse("--u", "0.5:6:4").unwrap(),
+            u: Axis::parse("u", "0.5:6:4").unwrap(),
             param: "k_theta".into(),
-            p: Axis::parse("--param", "0.06:0.09:3").unwrap(),
+            p: Axis::parse("param", "0.06:0.09:3").unwrap(),
             start: SweepStart::State(State::zeros()),
             solver: SolverKind::EVENT,
             t_end: 300.0,
@@ -940,7 +933,7 @@ mod tests {
         let e = s.validate(one).unwrap_err().to_string();
         assert!(e.contains("k_theta = -0.01: must be positive"), "{e}");
         let mut s = sweep();
-        s.p = Axis::parse("--param", "-0.01:0.09:3").unwrap();
+        s.p = Axis::parse("param", "-0.01:0.09:3").unwrap();
         let e = s.validate(Shard::ALL).unwrap_err().to_string();
         assert!(e.contains("k_theta = -0.01: must be positive"), "{e}");
         let mut s = sweep();
@@ -1022,7 +1015,7 @@ mod tests {
             bytes
         );
         let other = Sweep {
-            u: Axis::parse("--u", "0.5:6:5").unwrap(),
+            u: Axis::parse("u", "0.5:6:5").unwrap(),
             ..sweep()
         };
         let o = dir.join("other.csv");
@@ -1054,8 +1047,8 @@ mod tests {
     fn downward_axes_merge_in_their_direction() {
         let dir = tmp_dir("rotor-sweep-down");
         let s = Sweep {
-            u: Axis::parse("--u", "6:0.5:4").unwrap(),
-            p: Axis::parse("--param", "0.09:0.06:3").unwrap(),
+            u: Axis::parse("u", "6:0.5:4").unwrap(),
+            p: Axis::parse("param", "0.09:0.06:3").unwrap(),
             ..sweep()
         };
         let whole = dir.join("whole.csv");

@@ -27,9 +27,9 @@ fn a_sweep_classifies_every_point_as_the_curves_region() {
         .unwrap();
     let sweep = |start| Sweep {
         base,
-        u: Axis::parse("--u", "0.02:6:13").unwrap(),
+        u: Axis::parse("u", "0.02:6:13").unwrap(),
         param: "k_theta".into(),
-        p: Axis::parse("--param", "0.05:0.11:9").unwrap(),
+        p: Axis::parse("param", "0.05:0.11:9").unwrap(),
         start,
         solver: SolverKind::EVENT,
         t_end: 1500.0,

@@ -28,6 +28,8 @@ use std::path::{Path, PathBuf};
 use serde::{Deserialize, Serialize};
 use thiserror::Error;
 
+use crate::FieldError;
+
 /// A parameter file could not be read or is not an admissible parameter set.
 #[derive(Debug, Error, Clone, PartialEq)]
 pub enum ParamsError {
@@ -48,27 +50,15 @@ pub enum ParamsError {
         message: String,
     },
     /// A value set by name (not read from a file) is unknown or out of its range.
-    #[error("{field} = {value}: {reason}")]
-    Value {
-        /// The dotted path of the field (`k_theta`, `lower.t_s`), or `param` for an
-        /// unknown name.
-        field: String,
-        /// The value as given (the name itself, quoted, when the name is unknown).
-        value: String,
-        /// Why it is refused (the admissible range, or the valid names).
-        reason: String,
-    },
+    #[error(transparent)]
+    Value(FieldError),
     /// A value is out of its admissible range.
-    #[error("{}: {field} = {value}: {reason}", shown(.path))]
+    #[error("{}: {error}", shown(.path))]
     Invalid {
         /// The file the value was read from.
         path: PathBuf,
-        /// The dotted path of the field (`j_l`, `lower.w_1`, `lower.family`).
-        field: String,
-        /// The value read, as printed by [`crate::Num`].
-        value: String,
-        /// Why it is refused (the admissible range).
-        reason: String,
+        /// The field, its value as printed by [`crate::Num`], and why it is refused.
+        error: FieldError,
     },
 }
 
@@ -282,12 +272,12 @@ impl Params {
     }
 
     fn from_raw(raw: RawParams, path: &Path) -> Result<Params, ParamsError> {
-        let bad = |field: &str, value: f64, reason: &str| ParamsError::Invalid {
+        let invalid = |error| ParamsError::Invalid {
             path: path.to_owned(),
-            field: field.to_owned(),
-            value: crate::Num(value).to_string(),
-            reason: reason.to_owned(),
+            error,
         };
+        let bad =
+            |field: &str, value: f64, reason: &str| invalid(FieldError::num(field, value, reason));
         let lower = match raw.lower.family.as_str() {
             "exponential" => {
                 let l = &raw.lower;
@@ -348,13 +338,11 @@ impl Params {
                 }
             }
             other => {
-                return Err(ParamsError::Invalid {
-                    path: path.to_owned(),
-                    field: "lower.family".into(),
-                    value: format!("{other:?}"),
-                    reason: "unknown friction family (expected \"exponential\" or \"stribeck\")"
-                        .into(),
-                });
+                return Err(invalid(FieldError::new(
+                    "lower.family",
+                    format!("{other:?}"),
+                    "unknown friction family (expected \"exponential\" or \"stribeck\")",
+                )));
             }
         };
         let p = Params {
@@ -365,8 +353,7 @@ impl Params {
             upper: raw.upper,
             lower,
         };
-        p.validate()
-            .map_err(|(field, value, reason)| bad(&field, value, &reason))?;
+        p.validate().map_err(invalid)?;
         Ok(p)
     }
 
@@ -444,30 +431,32 @@ impl Params {
     pub fn with(&self, name: &str, value: f64) -> Result<Params, ParamsError> {
         let mut copy = *self;
         *copy.field_mut(name).ok_or_else(|| self.unknown(name))? = value;
-        copy.validate()
-            .map_err(|(field, v, reason)| ParamsError::Value {
-                field,
-                value: v.to_string(),
-                reason,
-            })?;
+        copy.validate().map_err(|e| {
+            // A value set by name has always been written as Rust writes an f64 (`0.00001`,
+            // not `1e-5` as a file's value is): kept so, so that no message changes.
+            let value = copy
+                .get(&e.field)
+                .map_or(e.value.clone(), |v| v.to_string());
+            ParamsError::Value(FieldError { value, ..e })
+        })?;
         Ok(copy)
     }
 
     fn unknown(&self, name: &str) -> ParamsError {
-        ParamsError::Value {
-            field: "param".into(),
-            value: format!("{name:?}"),
-            reason: format!(
+        ParamsError::Value(FieldError::new(
+            "param",
+            format!("{name:?}"),
+            format!(
                 "not a parameter of this {} set (valid: {})",
                 self.lower.family(),
                 self.field_names().join(", ")
             ),
-        }
+        ))
     }
 
-    /// Checks that every value is finite and in its admissible range.
-    /// Returns `(field, value, reason)` for the first violation.
-    pub fn validate(&self) -> Result<(), (String, f64, String)> {
+    /// Checks that every value is finite and in its admissible range; the error names the
+    /// first violation (its field as a dotted path, `lower.t_s`).
+    pub fn validate(&self) -> Result<(), FieldError> {
         let mut fields: Vec<(&str, f64)> = vec![
             ("j_u", self.j_u),
             ("k_m", self.k_m),
@@ -508,7 +497,7 @@ impl Params {
                 ("lower.b", b),
             ]),
         }
-        let err = |f: &str, v: f64, r: &str| Err((f.to_owned(), v, r.to_owned()));
+        let err = |f: &str, v: f64, r: &str| Err(FieldError::num(f, v, r));
         for (f, v) in &fields {
             if !v.is_finite() {
                 return err(f, *v, "must be a finite number");

@@ -5,6 +5,7 @@ use thiserror::Error;
 
 use crate::dynamics::{Mode, Model, State};
 use crate::event::Event;
+use crate::field::FieldError;
 use crate::steady::SteadyState;
 
 /// What a solver keeps while it runs. Every level keeps the final state and the counters.
@@ -79,12 +80,8 @@ impl Default for Scene {
 impl Scene {
     /// Checks the scene; the error names the field and the bad value.
     pub fn validate(&self) -> Result<(), SolveError> {
-        let bad = |field: &'static str, value: f64, reason: &'static str| {
-            Err(SolveError::InvalidScene {
-                field,
-                value,
-                reason,
-            })
+        let bad = |field: &str, value: f64, reason: &str| {
+            Err(FieldError::num(field, value, reason).into())
         };
         if !self.u.is_finite() {
             return bad("u", self.u, "must be finite");
@@ -139,18 +136,15 @@ impl Scene {
     pub fn validate_for(&self, model: &crate::Model) -> Result<(), SolveError> {
         self.validate()?;
         if !(model.params.k_m * self.u).is_finite() {
-            return Err(SolveError::InvalidScene {
-                field: "u",
-                value: self.u,
-                reason: "the motor torque k_m u overflows",
-            });
+            return Err(FieldError::num("u", self.u, "the motor torque k_m u overflows").into());
         }
         if !(model.params.k_theta * self.x0[0]).is_finite() {
-            return Err(SolveError::InvalidScene {
-                field: "x0[alpha]",
-                value: self.x0[0],
-                reason: "the spring torque k_theta alpha overflows",
-            });
+            return Err(FieldError::num(
+                "x0[alpha]",
+                self.x0[0],
+                "the spring torque k_theta alpha overflows",
+            )
+            .into());
         }
         Ok(())
     }
@@ -352,17 +346,10 @@ impl Trajectory {
 /// Why a solver could not finish.
 #[derive(Debug, Error, Clone, PartialEq)]
 pub enum SolveError {
-    /// The scene is not admissible.
-    #[error("invalid scene: {field} = {}: {reason}", crate::Num(*.value))]
-    InvalidScene {
-        /// The scene field at fault (`u`, `x0[omega_l]`, `t_end`, `tol`, `h`, `dt`,
-        /// `metrics_from`).
-        field: &'static str,
-        /// Its value.
-        value: f64,
-        /// The range it must lie in.
-        reason: &'static str,
-    },
+    /// The scene (or a solver's option) is not admissible. (Boxed: the other variants are
+    /// half its size, and a solver's inner loops return this type.)
+    #[error("invalid scene: {0}")]
+    InvalidScene(Box<FieldError>),
     /// The step size fell below what floating point resolves.
     #[error("step size underflow at t = {t}: h = {h:e} (state {x:?})")]
     StepSizeUnderflow {
@@ -431,6 +418,12 @@ pub enum SolveError {
     },
 }
 
+impl From<FieldError> for SolveError {
+    fn from(e: FieldError) -> SolveError {
+        SolveError::InvalidScene(Box::new(e))
+    }
+}
+
 impl SolveError {
     /// The time at which the run failed, where the failure has one.
     pub fn time(&self) -> Option<f64> {
@@ -441,7 +434,7 @@ impl SolveError {
             | SolveError::Zeno { t, .. }
             | SolveError::TooManySteps { t, .. }
             | SolveError::NonFiniteOutput { t, .. } => Some(t),
-            SolveError::InvalidScene { .. }
+            SolveError::InvalidScene(_)
             | SolveError::NoConvergence { .. }
             | SolveError::Unsupported { .. } => None,
         }

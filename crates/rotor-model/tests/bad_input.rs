@@ -7,16 +7,11 @@
 //! cases that the `rotor` binary is held to as well are in `rotor-testkit`
 //! ([`bad_params_cases`]); the ones here are the library's own.
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 use rotor_model::scene::MAX_GRID_ROWS;
 use rotor_model::{Output, Params, Scene};
-use rotor_testkit::{STRIBECK, TABLE1, bad_params_cases, edit};
-
-/// A fresh directory per call (tests run in parallel).
-fn tmp_dir() -> PathBuf {
-    rotor_testkit::tmp_dir("rotor-model-bad-input")
-}
+use rotor_testkit::{STRIBECK, TABLE1, bad_params_cases, edit, tmp_dir};
 
 /// The message must be one line, start with the file's path and contain every needle.
 fn check_message(what: &str, msg: &str, path: &Path, needles: &[&str]) {
@@ -36,7 +31,7 @@ fn check_message(what: &str, msg: &str, path: &Path, needles: &[&str]) {
 
 /// Writes a parameter file and expects an error.
 fn params_err(what: &str, text: &[u8], needles: &[&str]) {
-    let path = tmp_dir().join("p.toml");
+    let path = tmp_dir("rotor-model-bad-input").join("p.toml");
     std::fs::write(&path, text).unwrap();
     match Params::from_file(&path) {
         Ok(p) => panic!(
@@ -50,7 +45,7 @@ fn params_err(what: &str, text: &[u8], needles: &[&str]) {
 #[test]
 fn the_unmutated_files_load() {
     // Guards every case: each one differs from a file that loads only by its mutation.
-    let dir = tmp_dir();
+    let dir = tmp_dir("rotor-model-bad-input");
     std::fs::write(dir.join("table1.toml"), TABLE1).unwrap();
     std::fs::write(dir.join("st.toml"), STRIBECK).unwrap();
     Params::from_file(&dir.join("table1.toml")).unwrap();
@@ -68,7 +63,7 @@ fn bad_parameter_files() {
 
 #[test]
 fn a_missing_key_is_not_quoted_from_a_comment() {
-    let path = tmp_dir().join("p.toml");
+    let path = tmp_dir("rotor-model-bad-input").join("p.toml");
     std::fs::write(&path, edit(TABLE1, "j_u = 0.4765", "")).unwrap();
     let e = Params::from_file(&path).unwrap_err().to_string();
     assert!(!e.contains("(in `#"), "{e}");
@@ -76,10 +71,10 @@ fn a_missing_key_is_not_quoted_from_a_comment() {
 
 #[test]
 fn params_paths_that_cannot_be_read() {
-    let missing = tmp_dir().join("nothere.toml");
+    let missing = tmp_dir("rotor-model-bad-input").join("nothere.toml");
     let e = Params::from_file(&missing).unwrap_err().to_string();
     check_message("missing file", &e, &missing, &["cannot read"]);
-    let dir = tmp_dir();
+    let dir = tmp_dir("rotor-model-bad-input");
     let e = Params::from_file(&dir).unwrap_err().to_string();
     check_message("a directory", &e, &dir, &["cannot read"]);
 }
@@ -87,7 +82,7 @@ fn params_paths_that_cannot_be_read() {
 #[test]
 fn control_characters_in_params_paths_are_escaped() {
     // (A newline in a scenario's params path is a shared scenario case.)
-    let odd = tmp_dir().join("a\rb.toml");
+    let odd = tmp_dir("rotor-model-bad-input").join("a\rb.toml");
     let e = Params::from_file(&odd).unwrap_err().to_string();
     assert!(!e.contains('\r') && e.contains("a\\rb.toml"), "{e}");
 }

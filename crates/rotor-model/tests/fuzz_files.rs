@@ -38,11 +38,7 @@ fn fixtures() -> &'static Vec<(String, String)> {
 /// A scratch directory for the mutants.
 fn scratch() -> &'static PathBuf {
     static D: OnceLock<PathBuf> = OnceLock::new();
-    D.get_or_init(|| {
-        let d = std::env::temp_dir().join(format!("rotor-model-fuzz-{}", std::process::id()));
-        std::fs::create_dir_all(&d).unwrap();
-        d
-    })
+    D.get_or_init(|| rotor_testkit::tmp_dir("rotor-model-fuzz"))
 }
 
 /// Reads a mutant of fixture `which` through `from_file` and checks the contract.

@@ -3,8 +3,8 @@
 //! [`Recorder`], which keeps what the scene asks for and drives the metrics-only skip.
 
 use rotor_model::{
-    Disc, DiscMode, Event, EventKind, Integration, Mode, Model, Recorder, Scene, SolveError,
-    Solver, State, Stats, Trajectory, check_finite,
+    Disc, DiscMode, Event, EventKind, FieldError, Integration, Mode, Model, Recorder, Scene,
+    SolveError, Solver, State, Stats, Trajectory, check_finite,
 };
 
 use crate::stepper::{StepSize, Stepper};
@@ -437,18 +437,10 @@ impl MoreauOptions {
     /// Checks the options; the error names the field and the bad value.
     fn validate(&self) -> Result<(), SolveError> {
         if !(self.theta >= 0.5 && self.theta <= 1.0) {
-            return Err(SolveError::InvalidScene {
-                field: "theta",
-                value: self.theta,
-                reason: "must lie in [1/2, 1]",
-            });
+            return Err(FieldError::num("theta", self.theta, "must lie in [1/2, 1]").into());
         }
         if self.max_newton == 0 {
-            return Err(SolveError::InvalidScene {
-                field: "max_newton",
-                value: 0.0,
-                reason: "must be at least 1",
-            });
+            return Err(FieldError::num("max_newton", 0.0, "must be at least 1").into());
         }
         Ok(())
     }

@@ -14,6 +14,7 @@ use std::process::{Command, ExitStatus, Stdio};
 use std::sync::mpsc;
 use std::time::{Duration, Instant};
 
+use rotor_model::FieldError;
 use serde::Serialize;
 
 /// An external solver: its name, the command (split into words), and whether its accuracy
@@ -32,22 +33,23 @@ pub struct ClientSpec {
 }
 
 impl ClientSpec {
-    /// `NAME=COMMAND` as given to `--external`. The client is fixed-step when `fixed` names
-    /// it, or when its name says so (it contains `fixed`, `moreau`, `siconos` or ends in
-    /// `:h`, which is removed).
-    pub fn parse(arg: &str, fixed: &[String]) -> Result<ClientSpec, String> {
+    /// `NAME=COMMAND` as given to `--external`; a refusal names the field `external`. The
+    /// client is fixed-step when `fixed` names it, or when its name says so (it contains
+    /// `fixed`, `moreau`, `siconos` or ends in `:h`, which is removed).
+    pub fn parse(arg: &str, fixed: &[String]) -> Result<ClientSpec, FieldError> {
+        let bad = |reason: String| FieldError::new("external", format!("{arg:?}"), reason);
         let (name, command) = arg
             .split_once('=')
-            .ok_or_else(|| format!("--external {arg:?}: expected NAME=COMMAND"))?;
+            .ok_or_else(|| bad("expected NAME=COMMAND".into()))?;
         let name = name.trim();
         if name.is_empty() || name.contains(['/', '\\', ' ']) {
-            return Err(format!(
-                "--external {arg:?}: the name {name:?} must be non-empty, without spaces or slashes"
-            ));
+            return Err(bad(format!(
+                "the name {name:?} must be non-empty, without spaces or slashes"
+            )));
         }
-        let argv = split_words(command).map_err(|e| format!("--external {arg:?}: {e}"))?;
+        let argv = split_words(command).map_err(bad)?;
         if argv.is_empty() {
-            return Err(format!("--external {arg:?}: the command is empty"));
+            return Err(bad("the command is empty".into()));
         }
         let (name, by_suffix) = match name.strip_suffix(":h") {
             Some(n) => (n, true),
@@ -416,7 +418,7 @@ mod tests {
             ("x=", "empty"),
             ("x='oops", "unterminated"),
         ] {
-            let e = ClientSpec::parse(bad, &[]).unwrap_err();
+            let e = ClientSpec::parse(bad, &[]).unwrap_err().as_flag();
             assert!(e.contains(needle), "{bad}: {e}");
         }
     }

@@ -24,8 +24,8 @@ use rayon::prelude::*;
 use rotor_bifurcation::{BifError, DiagramOptions};
 use rotor_grade::check::{GradeError, Level};
 use rotor_grade::trace::{EventsFile, Trace, disc_name, event_row, round_to, time_digits};
-use rotor_jobs::request::{BadInput, Request};
-use rotor_model::{Model, Params, Stats};
+use rotor_jobs::request::Request;
+use rotor_model::{FieldError, Model, Params, Stats};
 use rotor_steady::{SettleError, SteadyAnswer, SteadyError};
 
 pyo3::create_exception!(
@@ -64,7 +64,7 @@ fn value_error(e: impl std::fmt::Display) -> PyErr {
     PyValueError::new_err(e.to_string())
 }
 
-fn bad(e: BadInput) -> PyErr {
+fn bad(e: FieldError) -> PyErr {
     value_error(e)
 }
 
@@ -81,7 +81,7 @@ fn solve_error(py: Python<'_>, message: String, t: Option<f64>, state: Option<[f
 
 fn from_solve(py: Python<'_>, e: rotor_model::SolveError) -> PyErr {
     match e {
-        rotor_model::SolveError::InvalidScene { .. } => value_error(e),
+        rotor_model::SolveError::InvalidScene(_) => value_error(e),
         _ => solve_error(py, e.to_string(), e.time(), e.state()),
     }
 }
@@ -456,7 +456,7 @@ fn sweep<'py>(
             tol,
             h,
         };
-        jobs.push(req.steady().map_err(|e| match e.name {
+        jobs.push(req.steady().map_err(|e| match e.field.as_str() {
             "u" => PyValueError::new_err(format!("u[{i}] = {}: {}", e.value, e.reason)),
             _ => bad(e),
         })?);

@@ -31,7 +31,7 @@ use thiserror::Error;
 
 use rotor_model::params::{Params, ParamsError, one_line, read_small, shown, text_of};
 use rotor_model::scene::{MAX_GRID_ROWS, MIN_TOL, Output, Scene};
-use rotor_model::{Model, Num, State};
+use rotor_model::{FieldError, Model, Num, State};
 
 use crate::tolerance::{PairTolerance, RawPairTolerance, check_pair};
 
@@ -55,17 +55,12 @@ pub enum ScenarioError {
         message: String,
     },
     /// A value is out of range.
-    #[error("{}: {field} = {value}: {reason}", shown(.path))]
+    #[error("{}: {error}", shown(.path))]
     Invalid {
         /// The scenario file.
         path: PathBuf,
-        /// The key at fault (`u`, `compare.dt`, `x0[2]`, `tolerance.event-switch.period_rel`,
-        /// ...).
-        field: String,
-        /// Its value as written back.
-        value: String,
-        /// Why it is refused.
-        reason: String,
+        /// The key at fault (`u`, `compare.dt`, `x0[2]`, ...), its value and why.
+        error: FieldError,
     },
     /// The parameter file it names is bad. (Not a `#[source]`: the message already holds
     /// it, and a reporter that prints the chain would print it twice.)
@@ -242,15 +237,17 @@ impl Scenario {
             None => Ok(()),
             Some(pair) => Err(ScenarioError::Invalid {
                 path: self.path.clone(),
-                field: "tolerance".into(),
-                value: format!("{pair:?}"),
-                reason: format!(
-                    "unknown solver pair (expected one of {})",
-                    known
-                        .iter()
-                        .map(|k| format!("{k:?}"))
-                        .collect::<Vec<_>>()
-                        .join(", ")
+                error: FieldError::new(
+                    "tolerance",
+                    format!("{pair:?}"),
+                    format!(
+                        "unknown solver pair (expected one of {})",
+                        known
+                            .iter()
+                            .map(|k| format!("{k:?}"))
+                            .collect::<Vec<_>>()
+                            .join(", ")
+                    ),
                 ),
             }),
         }
@@ -276,9 +273,7 @@ impl Bad<'_> {
     pub(crate) fn at(self, field: &str, value: String, reason: &str) -> ScenarioError {
         ScenarioError::Invalid {
             path: self.0.to_owned(),
-            field: field.to_owned(),
-            value,
-            reason: reason.to_owned(),
+            error: FieldError::new(field, value, reason),
         }
     }
 }

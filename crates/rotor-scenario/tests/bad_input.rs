@@ -6,17 +6,13 @@
 //! cases that the `rotor` binary is held to as well are in `rotor-testkit`
 //! ([`bad_scenario_cases`]); the ones here are the library's own.
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 use rotor_scenario::Scenario;
 use rotor_testkit::{
-    TABLE1, bad_scenario_cases, edit, local_scenario, short_horizon_scenario, write_scenario,
+    TABLE1, bad_scenario_cases, edit, local_scenario, short_horizon_scenario, tmp_dir,
+    write_scenario,
 };
-
-/// A fresh directory per call (tests run in parallel).
-fn tmp_dir() -> PathBuf {
-    rotor_testkit::tmp_dir("rotor-scenario-bad-input")
-}
 
 /// The message must be one line, start with the file's path and contain every needle.
 fn check_message(what: &str, msg: &str, path: &Path, needles: &[&str]) {
@@ -36,7 +32,7 @@ fn check_message(what: &str, msg: &str, path: &Path, needles: &[&str]) {
 
 /// Writes a scenario (and a good Table 1 parameter file next to it) and expects an error.
 fn scenario_err(what: &str, text: &[u8], needles: &[&str]) -> String {
-    let path = write_scenario(&tmp_dir(), text);
+    let path = write_scenario(&tmp_dir("rotor-scenario-bad-input"), text);
     match Scenario::from_file(&path) {
         Ok(s) => panic!(
             "{what}: accepted {}: {}",
@@ -54,7 +50,11 @@ fn scenario_err(what: &str, text: &[u8], needles: &[&str]) -> String {
 #[test]
 fn the_unmutated_file_loads() {
     // Guards every case: each one differs from a file that loads only by its mutation.
-    Scenario::from_file(&write_scenario(&tmp_dir(), local_scenario().as_bytes())).unwrap();
+    Scenario::from_file(&write_scenario(
+        &tmp_dir("rotor-scenario-bad-input"),
+        local_scenario().as_bytes(),
+    ))
+    .unwrap();
 }
 
 #[test]
@@ -70,7 +70,7 @@ fn bad_scenario_files() {
 fn a_short_horizon_loads_once_h_is_set() {
     // The shared case refuses `short_horizon_scenario()` for the missing h alone.
     let path = write_scenario(
-        &tmp_dir(),
+        &tmp_dir("rotor-scenario-bad-input"),
         edit(
             &short_horizon_scenario(),
             "t_end = 5e-4",
@@ -93,7 +93,7 @@ fn scenario_params_path_and_bad_params_file() {
     );
     assert_eq!(e.matches("nothere.toml").count(), 1, "{e}");
     // A parameter file with a bad value: named through the scenario.
-    let dir = tmp_dir();
+    let dir = tmp_dir("rotor-scenario-bad-input");
     std::fs::write(
         dir.join("bad.toml"),
         edit(TABLE1, "j_l = 0.0326", "j_l = 0.0"),
@@ -111,7 +111,7 @@ fn scenario_params_path_and_bad_params_file() {
 
 #[test]
 fn a_missing_scenario_file() {
-    let missing = tmp_dir().join("nothere.toml");
+    let missing = tmp_dir("rotor-scenario-bad-input").join("nothere.toml");
     let e = Scenario::from_file(&missing).unwrap_err().to_string();
     check_message("missing file", &e, &missing, &["cannot read scenario file"]);
 }

@@ -42,7 +42,7 @@ fn fixtures() -> &'static Vec<(String, String)> {
 fn scratch() -> &'static PathBuf {
     static D: OnceLock<PathBuf> = OnceLock::new();
     D.get_or_init(|| {
-        let d = std::env::temp_dir().join(format!("rotor-scenario-fuzz-{}", std::process::id()));
+        let d = rotor_testkit::tmp_dir("rotor-scenario-fuzz");
         std::fs::create_dir_all(d.join("params")).unwrap();
         std::fs::create_dir_all(d.join("scenarios")).unwrap();
         let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../fixtures/params");

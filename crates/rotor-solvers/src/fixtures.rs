@@ -44,8 +44,7 @@ mod tests {
 
     #[test]
     fn names_resolve_to_fixture_files_and_files_win() {
-        let dir = std::env::temp_dir().join(format!("rotor-fixtures-{}", std::process::id()));
-        std::fs::create_dir_all(&dir).unwrap();
+        let dir = rotor_testkit::tmp_dir("rotor-fixtures");
         for f in ["t1-u1.5-rest.toml", "b.toml", "notes.txt"] {
             std::fs::write(dir.join(f), "").unwrap();
         }

@@ -1,8 +1,8 @@
 //! The switch-model field, its guards, and the event-located integration loop.
 
 use rotor_model::{
-    Disc, DiscMode, Event, EventKind, Integration, Mode, Model, OMEGA_L, OMEGA_U, Recorder, Scene,
-    SolveError, Solver, State, Stats, Trajectory, check_finite,
+    Disc, DiscMode, Event, EventKind, FieldError, Integration, Mode, Model, OMEGA_L, OMEGA_U,
+    Recorder, Scene, SolveError, Solver, State, Stats, Trajectory, check_finite,
 };
 
 use crate::dopri5::{Dopri5, Dopri5Error, Dopri5Options};
@@ -680,12 +680,8 @@ impl Integration for Run<'_> {
 impl SwitchOptions {
     /// Checks the options; the error names the field and the bad value.
     fn validate(&self) -> Result<(), SolveError> {
-        let bad = |field: &'static str, value: f64, reason: &'static str| {
-            Err(SolveError::InvalidScene {
-                field,
-                value,
-                reason,
-            })
+        let bad = |field: &str, value: f64, reason: &str| {
+            Err(FieldError::num(field, value, reason).into())
         };
         if !(self.eta >= 0.0 && self.eta.is_finite()) {
             return bad("eta", self.eta, "must be finite and >= 0");

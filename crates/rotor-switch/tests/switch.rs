@@ -379,9 +379,9 @@ fn bad_input_gives_typed_errors() {
             },
         )
         .unwrap_err();
-    assert!(matches!(e, SolveError::InvalidScene { field: "tol", .. }));
+    assert!(matches!(&e, SolveError::InvalidScene(f) if f.field == "tol"));
     let e = solver(-1.0).simulate(&model, &base).unwrap_err();
-    assert!(matches!(e, SolveError::InvalidScene { field: "eta", .. }));
+    assert!(matches!(&e, SolveError::InvalidScene(f) if f.field == "eta"));
     // k_m·u overflows to ∞: refused before the run, naming u.
     let e = s
         .simulate(
@@ -393,7 +393,7 @@ fn bad_input_gives_typed_errors() {
         )
         .unwrap_err();
     assert!(
-        matches!(e, SolveError::InvalidScene { field: "u", .. }),
+        matches!(&e, SolveError::InvalidScene(f) if f.field == "u"),
         "{e}"
     );
     let tiny = SwitchSolver {

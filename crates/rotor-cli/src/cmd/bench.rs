@@ -130,8 +130,10 @@ pub(crate) fn bench(
     )?;
     opts.timeout = clients.timeout;
     for e in clients.external {
-        opts.clients
-            .push(rotor_bench::ClientSpec::parse(e, clients.fixed_step).map_err(|m| anyhow!(m))?);
+        opts.clients.push(
+            rotor_bench::ClientSpec::parse(e, clients.fixed_step)
+                .map_err(crate::common::flagged)?,
+        );
     }
     for name in clients.fixed_step {
         if !opts.clients.iter().any(|c| &c.name == name) {
@@ -156,7 +158,8 @@ pub(crate) fn bench(
     opts.shard = clients
         .shard
         .map(rotor_jobs::sweep::Shard::parse)
-        .transpose()?;
+        .transpose()
+        .map_err(crate::common::sweep_flagged)?;
     opts.keep = clients.keep.map(Path::to_path_buf);
     opts.jobs = match clients.jobs {
         Some(0) => bail!("--jobs 0: at least one client must run at a time"),

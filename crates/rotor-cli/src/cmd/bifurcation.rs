@@ -73,7 +73,7 @@ pub(crate) fn bifurcation(
                 .replace("u_max", "--u-max")
         )
     })?;
-    let kind = rotor_jobs::request::solver_kind(solver).map_err(|e| anyhow!(e.as_flag()))?;
+    let kind = rotor_jobs::request::solver_kind(solver).map_err(crate::common::flagged)?;
     let event = rotor_bifurcation::diagram(&model, &opts)?;
     let by = rotor_steady::by_solver::by_solver(kind, &model, &event);
     let d = &by.diagram;

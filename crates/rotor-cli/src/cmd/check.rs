@@ -74,7 +74,7 @@ fn verdict(
         Some(n) => Level::with_digits(n),
         None => Level::parse(gate),
     }
-    .map_err(|e| anyhow::anyhow!(e.as_flag()))?;
+    .map_err(crate::common::flagged)?;
     // The scenario and its reference first: the trace is read up to one row past their grid.
     let scenario = crate::common::fixture_path("scenario", scenario, "scenarios")?;
     let sc = rotor_solvers::load_scenario(&scenario)?;

@@ -2,7 +2,7 @@
 
 use std::path::{Path, PathBuf};
 
-use anyhow::{Context, Result, anyhow};
+use anyhow::{Context, Result};
 
 use crate::common::{Common, load_model, request, warn_inexact};
 
@@ -28,7 +28,7 @@ pub fn run(a: &Args) -> Result<()> {
 pub(crate) fn simulate(common: &Common, t_end: f64, dt: f64, csv_path: &Path) -> Result<()> {
     let (kind, scene) = request(common)?
         .simulation(t_end, dt)
-        .map_err(|e| anyhow!(e.as_flag()))?;
+        .map_err(crate::common::flagged)?;
     let model = load_model(common.params.as_deref())?;
     let solver = kind.solver();
     let traj = solver

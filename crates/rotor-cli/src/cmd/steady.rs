@@ -1,6 +1,6 @@
 //! `rotor steady`: the steady state as one JSON object.
 
-use anyhow::{Context, Result, anyhow, bail};
+use anyhow::{Context, Result, bail};
 
 use crate::common::{Common, load_model, request, warn_inexact};
 use crate::out;
@@ -39,9 +39,7 @@ pub(crate) fn steady(common: &Common, method: Option<&str>) -> Result<()> {
         Some("shoot") => How::Shoot,
         Some(other) => bail!("--method {other:?}: expected shoot or simulate"),
     };
-    let (kind, scene, opts) = request(common)?
-        .steady()
-        .map_err(|e| anyhow!(e.as_flag()))?;
+    let (kind, scene, opts) = request(common)?.steady().map_err(crate::common::flagged)?;
     let model = load_model(common.params.as_deref())?;
     let answer = match how {
         How::Shoot => rotor_steady::shot(kind, &model, &scene),

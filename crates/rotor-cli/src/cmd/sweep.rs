@@ -5,7 +5,8 @@ use std::path::{Path, PathBuf};
 use anyhow::{Result, anyhow, bail};
 
 use crate::common::{
-    check, kind_by_name, load_model, parse_x0, progress_bar, thread_pool, threads_arg,
+    check, kind_by_name, load_model, parse_x0, progress_bar, sweep_flagged, thread_pool,
+    threads_arg,
 };
 
 #[derive(clap::Args, Debug)]
@@ -75,21 +76,25 @@ pub(crate) fn sweep(
     let (name, range) = param
         .split_once('=')
         .ok_or_else(|| anyhow!("--param {param:?}: expected NAME=A:B:N"))?;
-    check("t-end", t_end, t_end > 0.0, "must be positive and finite")?;
+    check("t_end", t_end, t_end > 0.0, "must be positive and finite")?;
     let start = match x0 {
         Some("eq") => SweepStart::PerturbedEquilibrium,
         other => SweepStart::State(parse_x0(other)?),
     };
     let s = Sweep {
         base,
-        u: Axis::parse("--u", u)?,
+        u: Axis::parse("u", u).map_err(sweep_flagged)?,
         param: name.to_owned(),
-        p: Axis::parse("--param", range)?,
+        p: Axis::parse("param", range).map_err(sweep_flagged)?,
         start,
         solver: kind_by_name(solver)?,
         t_end,
     };
-    let shard = shard.map(Shard::parse).transpose()?.unwrap_or(Shard::ALL);
+    let shard = shard
+        .map(Shard::parse)
+        .transpose()
+        .map_err(sweep_flagged)?
+        .unwrap_or(Shard::ALL);
     if resume && csv.as_os_str() == "-" {
         bail!("--resume needs an output file, not standard output");
     }
@@ -110,7 +115,8 @@ pub(crate) fn sweep(
                 sink(i, row);
             }
         });
-    })?;
+    })
+    .map_err(sweep_flagged)?;
     bar.finish_and_clear();
     let secs = t0.elapsed().as_secs_f64();
     eprintln!(

@@ -231,7 +231,7 @@ fn typed_errors() {
     let s = MoreauSolver::default();
     assert!(matches!(
         s.simulate(&m, &Scene { h: 0.0, ..base() }),
-        Err(SolveError::InvalidScene { field: "h", .. })
+        Err(SolveError::InvalidScene(e)) if e.field == "h"
     ));
     assert!(matches!(
         s.simulate(
@@ -241,7 +241,7 @@ fn typed_errors() {
                 ..base()
             }
         ),
-        Err(SolveError::InvalidScene { .. })
+        Err(SolveError::InvalidScene(_))
     ));
     let bad = MoreauSolver::new(MoreauOptions {
         theta: 0.3,
@@ -249,7 +249,7 @@ fn typed_errors() {
     });
     assert!(matches!(
         bad.simulate(&m, &base()),
-        Err(SolveError::InvalidScene { field: "theta", .. })
+        Err(SolveError::InvalidScene(e)) if e.field == "theta"
     ));
     let few = MoreauSolver::new(MoreauOptions {
         max_steps: 10,
