@@ -7,10 +7,14 @@
 
 #![warn(missing_docs)]
 
+pub mod compare;
+pub mod error;
 pub mod scenario;
 pub mod tolerance;
 
-pub use scenario::{CompareSpec, Scenario, ScenarioError};
+pub use compare::CompareSpec;
+pub use error::ScenarioError;
+pub use scenario::Scenario;
 pub use tolerance::{
     CYCLE_KEYS, EQUILIBRIUM_KEYS, PairTolerance, RETIRED_KEYS, STEADY_QUANTITIES, SteadyQuantity,
     TOLERANCE_KEYS,

@@ -27,80 +27,14 @@ use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
 use serde::Deserialize;
-use thiserror::Error;
 
-use rotor_model::params::{Params, ParamsError, one_line, read_small, shown, text_of};
-use rotor_model::scene::{MAX_GRID_ROWS, MIN_TOL, Output, Scene};
+use rotor_model::params::{Params, one_line, read_small, text_of};
+use rotor_model::scene::{MIN_TOL, Output, Scene};
 use rotor_model::{FieldError, Model, Num, State};
 
+use crate::compare::CompareSpec;
+use crate::error::{Bad, ScenarioError};
 use crate::tolerance::{PairTolerance, RawPairTolerance, check_pair};
-
-/// A scenario file could not be read or is not admissible.
-#[derive(Debug, Error, Clone, PartialEq)]
-pub enum ScenarioError {
-    /// The file could not be read.
-    #[error("{}: cannot read scenario file: {message}", shown(.path))]
-    Io {
-        /// The scenario file.
-        path: PathBuf,
-        /// The operating system's reason (not found, permission denied, too large, ...).
-        message: String,
-    },
-    /// Not valid TOML, or a key is unknown, missing or of the wrong type.
-    #[error("{}: {message}", shown(.path))]
-    Parse {
-        /// The scenario file.
-        path: PathBuf,
-        /// The parser's message on one line, naming the key.
-        message: String,
-    },
-    /// A value is out of range.
-    #[error("{}: {error}", shown(.path))]
-    Invalid {
-        /// The scenario file.
-        path: PathBuf,
-        /// The key at fault (`u`, `compare.dt`, `x0[2]`, ...), its value and why.
-        error: FieldError,
-    },
-    /// The parameter file it names is bad. (Not a `#[source]`: the message already holds
-    /// it, and a reporter that prints the chain would print it twice.)
-    #[error("{}: params: {error}", shown(.path))]
-    Params {
-        /// The scenario file that names the parameter file.
-        path: PathBuf,
-        /// What is wrong with the parameter file (it names that file).
-        error: ParamsError,
-    },
-}
-
-/// What the comparison harness compares for this scene.
-#[derive(Debug, Clone, PartialEq, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct CompareSpec {
-    /// Window `[t0, t1]` compared sample by sample on a common grid.
-    #[serde(default)]
-    pub transient: Option<[f64; 2]>,
-    /// Grid step of the transient comparison and of the report's CSVs \[s\].
-    #[serde(default = "default_dt")]
-    pub dt: f64,
-    /// Steady-state metrics over `[steady_from, t_end]`; `None`: no steady comparison.
-    #[serde(default)]
-    pub steady_from: Option<f64>,
-}
-
-fn default_dt() -> f64 {
-    0.01
-}
-
-impl Default for CompareSpec {
-    fn default() -> Self {
-        CompareSpec {
-            transient: None,
-            dt: default_dt(),
-            steady_from: None,
-        }
-    }
-}
 
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -264,20 +198,6 @@ impl Scenario {
     }
 }
 
-/// Builds the [`ScenarioError::Invalid`] of the file at its path: the field, the value as
-/// written back, and the reason.
-#[derive(Clone, Copy)]
-pub(crate) struct Bad<'a>(&'a Path);
-
-impl Bad<'_> {
-    pub(crate) fn at(self, field: &str, value: String, reason: &str) -> ScenarioError {
-        ScenarioError::Invalid {
-            path: self.0.to_owned(),
-            error: FieldError::new(field, value, reason),
-        }
-    }
-}
-
 /// `name`: it becomes the report's file names (`<name>.csv`, `<name>.svg`), so a path
 /// separator or a leading dot would write outside the report or hide the file.
 fn check_name(name: &str, bad: Bad) -> Result<(), ScenarioError> {
@@ -389,53 +309,6 @@ fn from_equilibrium(d: [f64; 3], u: f64, model: &Model, bad: Bad) -> Result<Stat
             format!("{d:?}"),
             "several slipping equilibria exist at this u; give x0",
         )),
-    }
-}
-
-impl CompareSpec {
-    /// `[compare]` for a horizon `t_end`: `dt` positive and at most 1e7 rows, the transient
-    /// window `0 <= t0 < t1 <= t_end` and at least `dt` long, `steady_from` in `[0, t_end)`.
-    fn check(&self, t_end: f64, bad: Bad) -> Result<(), ScenarioError> {
-        if !(self.dt > 0.0 && self.dt.is_finite()) {
-            return Err(bad.at("compare.dt", Num(self.dt).to_string(), "must be positive"));
-        }
-        if t_end / self.dt > MAX_GRID_ROWS {
-            return Err(bad.at(
-                "compare.dt",
-                Num(self.dt).to_string(),
-                "asks more than 1e7 output rows (t_end/dt): choose a larger dt",
-            ));
-        }
-        if let Some([a, b]) = self.transient
-            && !(0.0 <= a && a < b && b <= t_end)
-        {
-            return Err(bad.at(
-                "compare.transient",
-                format!("[{a}, {b}]"),
-                "must satisfy 0 <= t0 < t1 <= t_end",
-            ));
-        }
-        // A window shorter than the grid step may hold no sample: its gate would measure
-        // nothing.
-        if let Some([a, b]) = self.transient
-            && b - a < self.dt
-        {
-            return Err(bad.at(
-                "compare.transient",
-                format!("[{a}, {b}]"),
-                "is shorter than compare.dt: it may hold no grid sample to compare",
-            ));
-        }
-        if let Some(t) = self.steady_from
-            && !(t >= 0.0 && t < t_end)
-        {
-            return Err(bad.at(
-                "compare.steady_from",
-                Num(t).to_string(),
-                "must lie in [0, t_end)",
-            ));
-        }
-        Ok(())
     }
 }
 

@@ -4,7 +4,8 @@
 use rotor_model::Num;
 use serde::Deserialize;
 
-use crate::scenario::{Bad, CompareSpec, ScenarioError};
+use crate::compare::CompareSpec;
+use crate::error::{Bad, ScenarioError};
 
 /// Agreement tolerances for one solver pair: one key per quantity, each with its origin in a
 /// comment in the file. The steady-state ones are relative (with `steady_abs` as the floor for

@@ -7,6 +7,7 @@
 pub mod by_solver;
 pub mod checked;
 pub mod figure3;
+mod orbit_rows;
 pub mod probes;
 mod settle;
 pub mod solver_points;

@@ -35,7 +35,7 @@ use rotor_bifurcation::{Diagram, PeriodicRow, PointKind, SpecialPoint};
 use rotor_model::{Model, Solver};
 use rotor_shoot::{Orbit, Section, shoot, shoot_with_u};
 
-use crate::by_solver::{BySolverOptions, NotFound, first_crossing, row_of, shoot_opts};
+use crate::orbit_rows::{BySolverOptions, NotFound, first_crossing, row_of, shoot_opts};
 
 /// The condition of a grazing point located by a solver.
 pub const GRAZING_CONDITION: &str = "min omega_l = 0 of the solver's slipping cycle, root of the quadratic through its last three shots; residual: change of the root from the previous fit [V]";
