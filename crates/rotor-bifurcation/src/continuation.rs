@@ -51,8 +51,11 @@ pub enum Multipliers {
 /// What the diagram reports about one periodic orbit.
 #[derive(Debug, Clone, PartialEq)]
 pub struct CycleInfo {
+    /// Period \[s\]: the return time to the section `ω_l = c(u)`.
     pub period: f64,
+    /// Largest lower-disc velocity over the cycle \[rad/s\].
     pub omega_l_max: f64,
+    /// Smallest lower-disc velocity over the cycle \[rad/s\]: 0 with a stick phase.
     pub omega_l_min: f64,
     /// Smallest upper-disc velocity over the cycle \[rad/s\] (the upper disc grazes ω_u = 0
     /// where it reaches 0).
@@ -92,6 +95,7 @@ pub struct Node {
     pub tangent: [f64; 3],
     /// Arclength step that produced this point from the previous one.
     pub step: f64,
+    /// Period, extrema of ω_l, stick time and Floquet multipliers of the cycle.
     pub info: CycleInfo,
 }
 
@@ -111,7 +115,11 @@ pub enum End {
 /// Continuation settings.
 #[derive(Debug, Clone, Copy)]
 pub struct ContOptions {
+    /// Lower end of the input range \[V\]: a point below it ends the direction
+    /// ([`End::Range`]).
     pub u_min: f64,
+    /// Upper end of the input range \[V\]: a point above it ends the direction
+    /// ([`End::Range`]).
     pub u_max: f64,
     /// Largest arclength step.
     pub h_max: f64,
@@ -160,8 +168,12 @@ pub struct Linearized {
     pub derivs: SectionDerivs,
 }
 
+/// Pseudo-arclength continuation of the periodic orbits (see the module docs): the shooting
+/// setup and the settings.
 pub struct Continuer<'a> {
+    /// The model and the integration tolerance of every return map.
     pub sh: Shooter<'a>,
+    /// Steps, limits and how the multipliers are computed.
     pub opts: ContOptions,
 }
 

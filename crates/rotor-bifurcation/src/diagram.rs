@@ -133,11 +133,18 @@ impl EquilibriumKind {
 /// One equilibrium of the table.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct EquilibriumRow {
+    /// Input \[V\]: one of the table's `n` values.
     pub u: f64,
+    /// Common velocity of both discs `ω_u = ω_l` \[rad/s\]: > 0 slipping, 0 stuck.
     pub omega: f64,
+    /// Spring twist \[rad\]: `T_fl(ω)/k_θ` slipping, the stuck set's lower end stuck.
     pub alpha: f64,
+    /// Slipping: all eigenvalues of the Jacobian in the open left half-plane. The stuck set
+    /// is always reported stable.
     pub stable: bool,
+    /// Slipping equilibrium or stuck set.
     pub kind: EquilibriumKind,
+    /// Stuck set only: its upper end \[rad\]; left out of the JSON for a slipping equilibrium.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub alpha_max: Option<f64>,
 }
@@ -148,18 +155,26 @@ pub struct PeriodicRow {
     /// Index of the branch (0: the one started from a steady orbit; then one per Hopf point
     /// the first does not reach, started from the Hopf eigenvector).
     pub branch: usize,
+    /// Input \[V\].
     pub u: f64,
+    /// Period \[s\]: the return time to the section.
     pub period: f64,
+    /// Largest lower-disc velocity over the cycle \[rad/s\].
     pub omega_l_max: f64,
+    /// Smallest lower-disc velocity over the cycle \[rad/s\]: 0 with a stick phase.
     pub omega_l_min: f64,
     /// Smallest ω_u over the cycle \[rad/s\]: the upper disc would graze ω_u = 0 (where the
     /// Stribeck set has static friction) if it reached 0.
     pub omega_u_min: f64,
+    /// Both nontrivial multipliers (eigenvalues of the section map's `∂P/∂z`) inside the unit
+    /// circle.
     pub stable: bool,
     /// Floquet multipliers `[re, im]`, eigenvalues of the saltation monodromy matrix: the
     /// trivial one (≈ 1) first, then by decreasing modulus (`[≈1, λ, 0]` with a stick phase).
     pub multipliers: Vec<[f64; 2]>,
+    /// Whether the lower disc sticks on the cycle.
     pub stick_slip: bool,
+    /// Time per period with the lower disc stuck \[s\].
     pub stick_time: f64,
     /// The orbit's state `[α, ω_u, ω_l]` on the section `ω_l = ω*(u)` (a restart point).
     pub section_state: [f64; 3],
@@ -168,8 +183,13 @@ pub struct PeriodicRow {
 /// The bifurcation diagram (the JSON of `rotor bifurcation`, docs/design.md).
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Diagram {
+    /// The equilibrium table: at each of the `n` values of u, the stuck set (if any) and the
+    /// slipping equilibria with ω > 0.
     pub equilibria: Vec<EquilibriumRow>,
+    /// The periodic orbits, branch after branch, each branch in its order along the arclength.
     pub periodic: Vec<PeriodicRow>,
+    /// The special points: stick limit and Hopf points of the equilibria, then those of the
+    /// periodic branches (grazing orbits, folds, stability changes, branch ends).
     pub points: Vec<SpecialPoint>,
 }
 

@@ -28,6 +28,7 @@ pub fn complex_pair(model: &Model, omega: f64) -> Option<Complex<f64>> {
 /// A located Hopf point of the slipping branch.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct HopfPoint {
+    /// The slipping equilibrium at the located ω: u \[V\], ω \[rad/s\], α \[rad\].
     pub equilibrium: SlipEquilibrium,
     /// Crossing frequency `|Im λ|` \[rad/s\]; the cycles born here have period ≈ 2π/frequency.
     pub frequency: f64,

@@ -38,7 +38,9 @@ use serde::Serialize;
 /// The nontrivial multipliers of one side: the roots of `λ² − trace·λ + det`.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct Side {
+    /// `s = λ₁ + λ₂`, the trace of the side's 2×2 Jacobian.
     pub trace: f64,
+    /// `p = λ₁ λ₂`, its determinant (0 on the stick-slip side).
     pub det: f64,
 }
 
@@ -115,6 +117,7 @@ pub enum GrazingType {
 }
 
 impl GrazingType {
+    /// The JSON and CSV name (`"nonsmooth_fold"`).
     pub fn as_str(self) -> &'static str {
         match self {
             GrazingType::Persistence => "persistence",
@@ -126,6 +129,7 @@ impl GrazingType {
 /// Feigin's classification at one grazing orbit.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct Feigin {
+    /// Persistence (`σ⁺_A + σ⁺_B` even) or non-smooth fold (odd).
     pub kind: GrazingType,
     /// σ⁻ odd: a period-two orbit is born at the grazing orbit as well.
     pub period_doubling: bool,

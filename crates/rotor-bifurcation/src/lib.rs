@@ -26,6 +26,8 @@
 //! Its cost is benchmarked by `cargo bench -p rotor-bifurcation` (`benches/diagram.rs`);
 //! the measurements are in `reports/measurements.md`.
 
+#![warn(missing_docs)]
+
 mod branch;
 pub mod continuation;
 mod diagram;
@@ -50,28 +52,68 @@ pub use points::{PointKind, SpecialPoint, grazing_near};
 /// What can go wrong while computing the diagram.
 #[derive(Debug, Error, Clone, PartialEq)]
 pub enum BifError {
+    /// The Filippov flow failed (`rotor_event::flow`, or the event solver measuring a cycle's
+    /// extrema and stick time).
     #[error("the flow failed: {0}")]
     Solve(#[from] SolveError),
     /// A monodromy or shooting step that has no solution (a singular matrix, a degenerate
     /// crossing).
     #[error("{0}")]
     Degenerate(String),
+    /// No slipping equilibrium with ω > 0 at `u`, so the section level `c(u) = ω*(u)` is
+    /// undefined.
     #[error("no slipping equilibrium at u = {u} (needed as the section level)")]
-    NoEquilibrium { u: f64 },
+    NoEquilibrium {
+        /// The input \[V\].
+        u: f64,
+    },
+    /// The trajectory does not reach its target (the upward crossing of the section, the
+    /// lower disc's stick exit, a grazing orbit's minimum of ω_l) within the time or step
+    /// limit.
     #[error("the orbit does not return to the section / stick exit at u = {u}")]
-    NoReturn { u: f64 },
+    NoReturn {
+        /// The input \[V\].
+        u: f64,
+    },
+    /// An iteration (Newton, secant, bisection, the continuation corrector) did not converge
+    /// or met a singular matrix.
     #[error("no convergence at u = {u}: {detail}")]
-    NoConvergence { u: f64, detail: String },
+    NoConvergence {
+        /// The input where it stopped \[V\] (for the corrector, its last iterate's u).
+        u: f64,
+        /// Which solve failed and how (`corrector: 12 iterations`).
+        detail: String,
+    },
+    /// An option outside its admissible range ([`DiagramOptions::validate`], and the options
+    /// of callers built on this crate).
     #[error("invalid option {field} = {}: {reason}", rotor_model::Num(*.value))]
     InvalidOption {
+        /// The option's name (`u_max`).
         field: &'static str,
+        /// Its value (a count as f64).
         value: f64,
+        /// The admissible range in words (`must be at least 2`).
         reason: &'static str,
     },
+    /// The trajectory meets a switching surface tangentially (`nᵀf⁻ = 0`, or it reaches the
+    /// section with `ω̇_l ≤ 0`): there is no saltation matrix.
     #[error("the trajectory meets a switching surface tangentially at u = {u}, state {state:?}")]
-    Grazing { u: f64, state: [f64; 3] },
+    Grazing {
+        /// The input \[V\].
+        u: f64,
+        /// The state `[α, ω_u, ω_l]` at the tangency (rad, rad/s, rad/s).
+        state: [f64; 3],
+    },
+    /// A NaN or infinity in a result: a number of the diagram (checked before it is written),
+    /// or a grazing orbit's monodromy matrix.
     #[error("non-finite value in the diagram: {what} = {value}")]
-    NonFinite { what: String, value: f64 },
+    NonFinite {
+        /// Which number: its path in the diagram (`periodic[3].period`) or a description.
+        what: String,
+        /// The value (NaN when a whole matrix is meant).
+        value: f64,
+    },
+    /// Serializing the diagram as JSON or writing its CSV failed; the underlying message.
     #[error("write failed: {0}")]
     Io(String),
 }

@@ -55,9 +55,13 @@ const MAX_STEPS: usize = 1_000_000;
 /// One switching event on the way, with its saltation matrix.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Switch {
+    /// Time of the event from the start `x₀` of the piece \[s\].
     pub t: f64,
+    /// The surface crossed, and by which disc ([`surface`]).
     pub kind: EventKind,
+    /// Mode before the event (its field is `f⁻`).
     pub before: Mode,
+    /// Mode after the event ([`mode_after`]; its field is `f⁺`).
     pub after: Mode,
     /// `S = I + (f⁺ − f⁻) nᵀ / (nᵀ f⁻)`.
     pub saltation: Matrix3<f64>,

@@ -29,6 +29,7 @@ use crate::monodromy::{self, Variational};
 /// ([`Shooter::section_derivatives`]).
 #[derive(Debug, Clone, PartialEq)]
 pub struct SectionDerivs {
+    /// The return itself: `P_c(z)`, the return time, whether the lower disc stuck.
     pub ret: Return,
     /// Variational data over the return time (the monodromy matrix at a fixed point).
     pub var: Variational,
@@ -44,6 +45,7 @@ pub const T_RETURN: f64 = 2000.0;
 /// The shooting setup at one input u.
 #[derive(Debug, Clone, Copy)]
 pub struct Shooter<'a> {
+    /// The rotor: parameters and friction laws.
     pub model: &'a Model,
     /// Integration tolerance of the flow.
     pub tol: f64,

@@ -53,7 +53,9 @@ impl std::fmt::Display for PointKind {
 /// A special point.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct SpecialPoint {
+    /// What the point is; the fields that apply depend on it.
     pub kind: PointKind,
+    /// Input at the located point \[V\].
     pub u: f64,
     /// Folds only: `true` for a discontinuous fold (the branch turns at a grazing orbit,
     /// where a stable and an unstable branch meet), `false` for a smooth one.
@@ -68,8 +70,11 @@ pub struct SpecialPoint {
     /// Period of the orbit (Hopf: 2π/frequency) \[s\].
     #[serde(skip_serializing_if = "Option::is_none")]
     pub period: Option<f64>,
+    /// Points of the periodic branches: the cycle's largest lower-disc velocity \[rad/s\].
     #[serde(skip_serializing_if = "Option::is_none")]
     pub omega_l_max: Option<f64>,
+    /// Points of the periodic branches: the cycle's smallest lower-disc velocity \[rad/s\] (0
+    /// at a grazing orbit).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub omega_l_min: Option<f64>,
     /// The value of the defining condition at the located point (see `condition`).
@@ -112,6 +117,8 @@ pub struct SpecialPoint {
     /// limit of its saltation monodromy; one of them is 0).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub stick_slip_multipliers: Option<[[f64; 2]; 2]>,
+    /// A sentence for the reader: the point's character (Feigin's type and counts, a Hopf
+    /// point's criticality), or why it was not located or classified.
     pub detail: String,
 }
 
