@@ -38,7 +38,7 @@ pub mod periodic;
 mod points;
 mod svg;
 
-use rotor_model::SolveError;
+use rotor_model::{FieldError, SolveError};
 use thiserror::Error;
 
 pub use diagram::{
@@ -62,12 +62,8 @@ pub enum BifError {
     NoReturn { u: f64 },
     #[error("no convergence at u = {u}: {detail}")]
     NoConvergence { u: f64, detail: String },
-    #[error("invalid option {field} = {}: {reason}", rotor_model::Num(*.value))]
-    InvalidOption {
-        field: &'static str,
-        value: f64,
-        reason: &'static str,
-    },
+    #[error("invalid option {0}")]
+    InvalidOption(FieldError),
     #[error("the trajectory meets a switching surface tangentially at u = {u}, state {state:?}")]
     Grazing { u: f64, state: [f64; 3] },
     #[error("non-finite value in the diagram: {what} = {value}")]
