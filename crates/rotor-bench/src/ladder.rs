@@ -4,7 +4,7 @@
 use rotor_grade::check::{Level, check};
 use rotor_grade::gridmetrics::{StickExit, grid_metrics};
 use rotor_grade::reference::Reference;
-use rotor_model::{Output, Scene, Stats};
+use rotor_model::{Accuracy, Output, Scene, Stats};
 use rotor_scenario::Scenario;
 use serde::{Deserialize, Serialize};
 
@@ -128,8 +128,7 @@ pub(crate) fn load(
         u: scenario.u,
         x0: scenario.x0,
         t_end: spec.t_end,
-        tol: opts.reference_tol,
-        h: Scene::default().h,
+        accuracy: Accuracy::Tol(opts.reference_tol),
         output: Output::Grid { dt: spec.dt },
         metrics_from: Some(spec.metrics_from),
     };
@@ -157,7 +156,7 @@ pub(crate) fn load(
         scenario.name, opts.reference_check_tol
     ));
     let check_scene = Scene {
-        tol: opts.reference_check_tol,
+        accuracy: Accuracy::Tol(opts.reference_check_tol),
         ..base.clone()
     };
     let (check, check_failure) = match ev.simulate(&scenario.model, &check_scene) {

@@ -67,16 +67,11 @@ pub fn solver(kind: SolverKind) -> Box<dyn Solver> {
 
 /// The scene for one solver at one accuracy setting (its tolerance or its step).
 pub fn scene_at(base: &Scene, kind: SolverKind, setting: f64, output: Output) -> Scene {
-    let mut s = Scene {
+    Scene {
+        accuracy: kind.accuracy(setting),
         output,
         ..base.clone()
-    };
-    if kind.is_fixed_step() {
-        s.h = setting;
-    } else {
-        s.tol = setting;
     }
-    s
 }
 
 /// A steady state as the errors read it: a cycle's period and max ω_l, or an equilibrium's

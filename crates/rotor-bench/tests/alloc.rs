@@ -10,7 +10,7 @@
 use rotor_event::EventSolver;
 use std::path::Path;
 
-use rotor_model::{Model, Output, Params, Scene, Solver, State};
+use rotor_model::{Accuracy, Model, Output, Params, Scene, Solver, State};
 use rotor_moreau::MoreauSolver;
 use rotor_switch::SwitchSolver;
 
@@ -22,8 +22,8 @@ fn scene(t_end: f64, metrics: bool) -> Scene {
         u: 1.5,
         x0: State::zeros(),
         t_end,
-        tol: 1e-10,
-        h: 1e-3,
+        // Moreau–Jean takes the default step, 1e-3.
+        accuracy: Accuracy::Tol(1e-10),
         output: Output::Final,
         metrics_from: metrics.then_some(0.5 * t_end),
     }

@@ -348,10 +348,9 @@ impl Continuer<'_> {
             u,
             x0,
             t_end: 2.05 * period,
-            tol: self.sh.tol,
             output: Output::Final,
             metrics_from: Some(0.0),
-            ..Scene::default()
+            ..Scene::with_tol(self.sh.tol)
         };
         let traj = rotor_event::EventSolver::default()
             .simulate(self.sh.model, &scene)

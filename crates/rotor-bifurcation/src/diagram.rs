@@ -2,7 +2,7 @@
 //! rest and from each Hopf point, and their special points.
 
 use rotor_event::{StopAt, flow};
-use rotor_model::{Model, State};
+use rotor_model::{FieldError, Model, State};
 use serde::Serialize;
 
 use crate::branch::Branch;
@@ -58,12 +58,10 @@ impl Default for DiagramOptions {
 impl DiagramOptions {
     /// Checks every field; the error names the first bad one and its value.
     pub fn validate(&self) -> Result<(), BifError> {
-        let bad = |field, value, reason| {
-            Err(BifError::InvalidOption {
-                field,
-                value,
-                reason,
-            })
+        let bad = |field: &str, value: f64, reason: &str| {
+            Err(BifError::InvalidOption(FieldError::num(
+                field, value, reason,
+            )))
         };
         if !self.u_min.is_finite() {
             return bad("u_min", self.u_min, "must be finite");

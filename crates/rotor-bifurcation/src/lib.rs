@@ -40,7 +40,7 @@ pub mod periodic;
 mod points;
 mod svg;
 
-use rotor_model::SolveError;
+use rotor_model::{FieldError, SolveError};
 use thiserror::Error;
 
 pub use diagram::{
@@ -85,16 +85,10 @@ pub enum BifError {
         detail: String,
     },
     /// An option outside its admissible range ([`DiagramOptions::validate`], and the options
-    /// of callers built on this crate).
-    #[error("invalid option {field} = {}: {reason}", rotor_model::Num(*.value))]
-    InvalidOption {
-        /// The option's name (`u_max`).
-        field: &'static str,
-        /// Its value (a count as f64).
-        value: f64,
-        /// The admissible range in words (`must be at least 2`).
-        reason: &'static str,
-    },
+    /// of callers built on this crate): the option's name (`u_max`), its value and the
+    /// admissible range in words.
+    #[error("invalid option {0}")]
+    InvalidOption(FieldError),
     /// The trajectory meets a switching surface tangentially (`nᵀf⁻ = 0`, or it reaches the
     /// section with `ω̇_l ≤ 0`): there is no saltation matrix.
     #[error("the trajectory meets a switching surface tangentially at u = {u}, state {state:?}")]

@@ -49,9 +49,8 @@ fn main() {
     let scene = Scene {
         u: 1.5,
         t_end: 100.0,
-        tol: 1e-12,
         output: Output::Grid { dt: 0.01 },
-        ..Scene::default()
+        ..Scene::with_tol(1e-12)
     };
     let solver = rotor_event::EventSolver::default();
     let solve = time(n, || {

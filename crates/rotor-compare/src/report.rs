@@ -9,7 +9,7 @@ use rotor_scenario::Scenario;
 
 use crate::gate::{Failure, GateResult, gate_scenario};
 use rotor_plot::{Panel, Series, render};
-use rotor_solvers::run::{ScenarioResult, solver_settings};
+use rotor_solvers::run::{ScenarioResult, solver_setting};
 use rotor_solvers::solvers::SolverKind;
 
 /// One row of the report's gate table. A quantity that could not be measured (steady
@@ -105,8 +105,7 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
 }
 
 fn label(kind: SolverKind, sc: &Scenario) -> String {
-    let (tol, h) = solver_settings(kind, sc);
-    kind.label_at(if kind.is_fixed_step() { h } else { tol })
+    kind.label_at(solver_setting(kind, sc))
 }
 
 /// Per-scenario CSV: `t` and ω_u, ω_l of each solver on the comparison grid, each value to

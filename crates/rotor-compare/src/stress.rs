@@ -28,8 +28,8 @@ use std::time::Instant;
 
 use nalgebra::{Matrix4, Vector4};
 use rotor_model::{
-    Disc, Event, EventKind, LowerFriction, Model, OMEGA_L, Output, Params, Scene, SolveError,
-    State, Stats, SteadyState, Trajectory, UpperFriction,
+    Accuracy, Disc, Event, EventKind, LowerFriction, Model, OMEGA_L, Output, Params, Scene,
+    SolveError, State, Stats, SteadyState, Trajectory, UpperFriction,
 };
 
 use rotor_solvers::solvers::{SOLVERS, SolverKind};
@@ -169,10 +169,8 @@ pub const MAX_LOOSENESS: f64 = 10.0;
 pub struct Setting {
     /// The solver.
     pub kind: SolverKind,
-    /// Tolerance of the adaptive solvers.
-    pub tol: f64,
-    /// Step of Moreau–Jean.
-    pub h: f64,
+    /// The solver's tolerance (adaptive) or step (Moreau–Jean).
+    pub accuracy: Accuracy,
     /// How its agreement is gated.
     pub gate: Gate,
 }
@@ -182,8 +180,7 @@ impl Setting {
     pub fn reference() -> Setting {
         Setting {
             kind: SolverKind::EVENT,
-            tol: REFERENCE_TOL,
-            h: 1e-3,
+            accuracy: Accuracy::Tol(REFERENCE_TOL),
             gate: Gate::Reference,
         }
     }
@@ -192,8 +189,7 @@ impl Setting {
     pub fn adaptive(kind: SolverKind, tol: f64) -> Setting {
         Setting {
             kind,
-            tol,
-            h: 1e-3,
+            accuracy: Accuracy::Tol(tol),
             gate: Gate::Adaptive,
         }
     }
@@ -204,8 +200,7 @@ impl Setting {
             .iter()
             .map(|&kind| Setting {
                 kind,
-                tol: 1e-10,
-                h: 1e-3,
+                accuracy: kind.accuracy(kind.info().default),
                 gate,
             })
             .collect()
@@ -215,18 +210,13 @@ impl Setting {
     pub fn moreau(h: f64, gate: Gate) -> Setting {
         Setting {
             kind: SolverKind::MOREAU,
-            tol: 1e-10,
-            h,
+            accuracy: Accuracy::Step(h),
             gate,
         }
     }
 
     fn label(&self) -> String {
-        self.kind.setting_label(if self.kind.is_fixed_step() {
-            self.h
-        } else {
-            self.tol
-        })
+        self.kind.setting_label(self.accuracy.value())
     }
 }
 
@@ -474,8 +464,11 @@ fn scene_of(case: &StressCase, s: &Setting, u: f64, x0: State) -> Scene {
         u,
         x0,
         t_end: case.t_end,
-        tol: s.tol,
-        h: s.h.min(case.t_end),
+        // A step longer than the horizon is cut to it.
+        accuracy: match s.accuracy {
+            Accuracy::Step(h) => Accuracy::Step(h.min(case.t_end)),
+            tol => tol,
+        },
         output,
         metrics_from,
     }
@@ -509,10 +502,7 @@ fn gate_value(
     match s.gate {
         Gate::Reference | Gate::Unresolved(_) => None,
         Gate::Exact => Some(0.0),
-        Gate::Measured { c, p, .. } => {
-            let knob = if s.kind.is_fixed_step() { s.h } else { s.tol };
-            Some(c * knob.powi(p))
-        }
+        Gate::Measured { c, p, .. } => Some(c * s.accuracy.value().powi(p)),
         Gate::Fixed(v, _) => Some(v),
         Gate::Observed(e) => Some((OBSERVED_MARGIN * e).max(OBSERVED_FLOOR)),
         Gate::Adaptive => {
@@ -530,13 +520,14 @@ fn gate_value(
             } else {
                 0.0
             };
-            Some(4.0 * phase.max(1.0) * (s.tol + tol_ref) + eta)
+            Some(4.0 * phase.max(1.0) * (s.accuracy.tol() + tol_ref) + eta)
         }
         Gate::Trapezoid => {
             let w = omega_fast(p);
-            let trapezoid = w.powi(3) * s.h * s.h * case.t_end / 12.0;
+            let h = s.accuracy.step();
+            let trapezoid = w.powi(3) * h * h * case.t_end / 12.0;
             let base = reference.unwrap_or(run);
-            Some(trapezoid + reversal_term(p, &base.events, &samples(base), s.h))
+            Some(trapezoid + reversal_term(p, &base.events, &samples(base), h))
         }
         Gate::MoreauPeriod => {
             let t_ref = reference.and_then(|r| {
@@ -545,7 +536,8 @@ fn gate_value(
                     ps.first().map(|p| p.0)
                 })
             })?;
-            Some(2.0 * MOREAU_PERIOD_C * s.h * s.h / t_ref + 1e-10)
+            let h = s.accuracy.step();
+            Some(2.0 * MOREAU_PERIOD_C * h * h / t_ref + 1e-10)
         }
     }
 }
@@ -932,10 +924,9 @@ pub fn cases(full: bool) -> Vec<StressCase> {
         ("mirror-rest", rest),
         ("mirror-moving", State::new(0.3, 1.0, -0.5)),
     ] {
-        let exact = |kind, tol, h| Setting {
+        let exact = |kind, accuracy| Setting {
             kind,
-            tol,
-            h,
+            accuracy,
             gate: Gate::Exact,
         };
         v.push(StressCase {
@@ -950,9 +941,9 @@ pub fn cases(full: bool) -> Vec<StressCase> {
             t_end: pick(20.0, 100.0),
             measure: Measure::Mirror { dt: 0.01 },
             settings: vec![
-                exact(SolverKind::EVENT, REFERENCE_TOL, 1e-3),
-                exact(SolverKind::SWITCH, 1e-10, 1e-3),
-                exact(SolverKind::MOREAU, 1e-10, 1e-3),
+                exact(SolverKind::EVENT, Accuracy::Tol(REFERENCE_TOL)),
+                exact(SolverKind::SWITCH, Accuracy::Tol(1e-10)),
+                exact(SolverKind::MOREAU, Accuracy::Step(1e-3)),
             ],
         });
     }

@@ -9,7 +9,7 @@
 //! Moreau–Jean extrema are sign changes of the discrete acceleration, whose rounding noise
 //! must not produce them either.
 
-use rotor_model::{Disc, EventKind, Model, Output, Scene, State};
+use rotor_model::{Accuracy, Disc, EventKind, Model, Output, Scene, State};
 use rotor_solvers::{SOLVERS, SolverKind};
 
 #[test]
@@ -31,18 +31,17 @@ fn no_solver_reports_turns_below_its_resolution() {
     );
     for kind in SOLVERS {
         // The comparison's settings: event tol 1e-12, switch tol 1e-10, Moreau h = 1e-3.
-        let (tol, h) = match kind.name() {
-            "event" => (1e-12, 1e-3),
-            "switch" => (1e-10, 1e-3),
-            "moreau" => (1e-10, 1e-3),
+        let accuracy = match kind.name() {
+            "event" => Accuracy::Tol(1e-12),
+            "switch" => Accuracy::Tol(1e-10),
+            "moreau" => Accuracy::Step(1e-3),
             other => panic!("no setting for {other}"),
         };
         let s = Scene {
             u,
             x0: State::zeros(),
             t_end: 200.0,
-            tol,
-            h,
+            accuracy,
             output: Output::Events,
             metrics_from: Some(100.0),
         };
@@ -69,7 +68,7 @@ fn no_solver_reports_turns_below_its_resolution() {
             let w: Vec<f64> = ext.iter().filter(|e| e.1 == d).map(|e| e.2).collect();
             for p in w.windows(2) {
                 assert!(
-                    (p[1] - p[0]).abs() > 10.0 * tol * (1.0 + p[1].abs()),
+                    (p[1] - p[0]).abs() > 10.0 * s.tol() * (1.0 + p[1].abs()),
                     "{kind:?}, {d:?}: a turn of {:e} rad/s reported",
                     (p[1] - p[0]).abs()
                 );

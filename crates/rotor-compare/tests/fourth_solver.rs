@@ -138,10 +138,11 @@ mod euler {
 
         fn simulate(&self, model: &Model, scene: &Scene) -> Result<Trajectory, SolveError> {
             scene.validate_for(model)?;
+            let h = scene.checked_step()?;
             let mut run = Run {
                 model,
                 u: scene.u,
-                h: scene.h,
+                h,
                 t_end: scene.t_end,
                 t: 0.0,
                 x: scene.x0,
@@ -152,7 +153,7 @@ mod euler {
             let mut x0 = scene.x0;
             run.mode = run.mode_at(&scene.x0, &mut x0);
             run.x = x0;
-            let mut rec = Recorder::new(scene, x0, scene.h, 3.0);
+            let mut rec = Recorder::new(scene, x0, h, 3.0);
             rec.drive(&mut run)?;
             let stats = Stats {
                 steps: run.steps,

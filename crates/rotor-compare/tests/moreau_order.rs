@@ -17,19 +17,18 @@
 //! tolerances at h = 1e-3 are derived from them (see the scenario files).
 
 use rotor_event::EventSolver;
-use rotor_model::{Disc, EventKind, Model, Output, Scene, Solver, State, SteadyState};
+use rotor_model::{Accuracy, Disc, EventKind, Model, Output, Scene, Solver, State, SteadyState};
 use rotor_moreau::{FrictionLevel, MoreauOptions, MoreauSolver};
 
 const HS: [f64; 5] = [1e-2, 3e-3, 1e-3, 3e-4, 1e-4];
 
 /// The scene: from rest, the cycle is reached within ~20 s; metrics over [30, 60] s.
-fn scene(h: f64, tol: f64) -> Scene {
+fn scene(accuracy: Accuracy) -> Scene {
     Scene {
         u: 1.5,
         x0: State::zeros(),
         t_end: 60.0,
-        tol,
-        h,
+        accuracy,
         output: Output::Final,
         metrics_from: Some(30.0),
     }
@@ -55,7 +54,7 @@ fn reference() -> ((f64, f64), f64) {
     let run = |tol| {
         cycle(
             &EventSolver::default()
-                .simulate(&model, &scene(1e-3, tol))
+                .simulate(&model, &scene(Accuracy::Tol(tol)))
                 .unwrap(),
             "event",
         )
@@ -88,7 +87,7 @@ fn orders(options: MoreauOptions, label: &str) -> [(f64, f64); 2] {
     let mut ew = Vec::new();
     let run = |h: f64| {
         let tr = MoreauSolver::new(options)
-            .simulate(&model, &scene(h, 1e-10))
+            .simulate(&model, &scene(Accuracy::Step(h)))
             .unwrap();
         assert_eq!(tr.stats.inexact_steps, 0, "{label} h={h}");
         cycle(&tr, label)
@@ -232,8 +231,7 @@ fn moreau_state_and_stick_onsets_converge_at_second_order() {
                     u: 1.5,
                     x0: State::zeros(),
                     t_end,
-                    tol,
-                    h: 1e-3,
+                    accuracy: Accuracy::Tol(tol),
                     output: Output::Grid { dt: REF_DT },
                     metrics_from: None,
                 },
@@ -266,8 +264,7 @@ fn moreau_state_and_stick_onsets_converge_at_second_order() {
                     u: 1.5,
                     x0: State::zeros(),
                     t_end,
-                    tol: 1e-10,
-                    h,
+                    accuracy: Accuracy::Step(h),
                     output: Output::Steps,
                     metrics_from: None,
                 },

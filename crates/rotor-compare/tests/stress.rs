@@ -19,7 +19,9 @@ use rotor_compare::stress::{
     Gate, MAX_LOOSENESS, Measure, Outcome, Setting, StressCase, StressRow, cases, full_from_env,
     linear_exact, run_case, stress_table_markdown,
 };
-use rotor_model::{Event, LowerFriction, Model, Output, Params, Scene, State, UpperFriction};
+use rotor_model::{
+    Accuracy, Event, LowerFriction, Model, Output, Params, Scene, State, UpperFriction,
+};
 use rotor_solvers::{SOLVERS, SolverKind};
 
 #[test]
@@ -339,8 +341,7 @@ fn energy_run(
         u,
         x0,
         t_end: 10.0,
-        tol,
-        h: 1e-4,
+        accuracy: kind.accuracy(if fixed { 1e-4 } else { tol }),
         output: if fixed {
             Output::Steps
         } else {
@@ -454,7 +455,7 @@ proptest! {
         let u = 1.5 * fu;
         for kind in SOLVERS {
             // No panic, no NaN.
-            let scene = Scene { u, x0, t_end: 10.0, tol: 1e-10, h: 1e-3,
+            let scene = Scene { u, x0, t_end: 10.0, accuracy: Accuracy::Tol(1e-10),
                 output: Output::Grid { dt: 0.01 }, metrics_from: Some(5.0) };
             let tr = match kind.solver().simulate(&m, &scene) {
                 Ok(tr) => tr,
@@ -676,7 +677,7 @@ fn stress_random_parameters_metrics_only_matches_the_full_run() {
         |(p, x0, fu)| {
             let m = Model::new(p);
             let u = 1.5 * fu;
-            let scene = Scene { u, x0, t_end: 100.0, tol: 1e-10, h: 1e-3,
+            let scene = Scene { u, x0, t_end: 100.0, accuracy: Accuracy::Tol(1e-10),
                 output: Output::Events, metrics_from: Some(50.0) };
             // Whether a disc reverses in the metrics window (the event solver's full run).
             let events = SolverKind::EVENT.solver().simulate(&m, &scene)
@@ -698,14 +699,14 @@ fn stress_random_parameters_metrics_only_matches_the_full_run() {
                 let merged = match (kind.name(), a) {
                     ("moreau", rotor_model::SteadyState::LimitCycle { period, .. }) => {
                         let evs = &events.events;
-                        moreau_unresolved_slip(&m, scene.h, evs, 50.0, scene.t_end, period)
+                        moreau_unresolved_slip(&m, scene.step(), evs, 50.0, scene.t_end, period)
                     }
                     _ => 0.0,
                 };
                 for ((name, va), (_, vb)) in a.values().into_iter().zip(b.values()) {
                     let extra = if name == "stick_time" { merged } else { 0.0 };
                     let scale = va.abs().max(vb.abs()).max(1.0);
-                    let allowed = metrics_only_allowed(kind, &m, scene.h, reversal, name, scale);
+                    let allowed = metrics_only_allowed(kind, &m, scene.step(), reversal, name, scale);
                     prop_assert!(
                         (va - vb).abs() <= allowed + extra,
                         "{} {name}: full {va} vs metrics-only {vb} (skipped {}, reversal {reversal})",
@@ -772,8 +773,8 @@ fn stress_moreau_reports_a_one_step_hold_between_opposite_slips_as_a_reversal() 
         u: 1.5 * 1.2706457676858947,
         x0: State::new(-0.614332526354382, 0.9150337225434341, 0.954027712696292),
         t_end: 100.0,
-        tol: 1e-10,
-        h: 1e-3,
+        // Moreau–Jean takes the default step, 1e-3.
+        accuracy: Accuracy::Tol(1e-10),
         output: Output::Events,
         metrics_from: Some(50.0),
     };
@@ -798,7 +799,7 @@ fn stress_moreau_reports_a_one_step_hold_between_opposite_slips_as_a_reversal() 
     // Moreau–Jean is first order across a reversal (crate docs): its period within h of the
     // reference's (measured 6.7e-5 s).
     assert!(
-        (period(&moreau) - period(&event)).abs() <= scene.h,
+        (period(&moreau) - period(&event)).abs() <= scene.step(),
         "{} vs {}",
         period(&moreau),
         period(&event)
@@ -870,8 +871,7 @@ fn stress_an_extremum_of_one_disc_keeps_the_other_discs_stick() {
             u: 1.5 * fu,
             x0: State::zeros(),
             t_end: 100.0,
-            tol: 1e-10,
-            h: 1e-3,
+            accuracy: Accuracy::Tol(1e-10),
             output: Output::Events,
             metrics_from: Some(50.0),
         };

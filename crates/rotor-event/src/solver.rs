@@ -105,8 +105,9 @@ impl Solver for EventSolver {
 
     fn simulate(&self, model: &Model, scene: &Scene) -> Result<Trajectory, SolveError> {
         scene.validate_for(model)?;
-        let mut rec = Recorder::new(scene, scene.x0, scene.tol, self.options.skip_verify);
-        let mut integ = Integrator::new(model, scene.u, scene.tol, self.options);
+        let tol = scene.tol();
+        let mut rec = Recorder::new(scene, scene.x0, tol, self.options.skip_verify);
+        let mut integ = Integrator::new(model, scene.u, tol, self.options);
         integ.extrema = rec.wants_extrema();
         let at = RunEnd {
             t: 0.0,

@@ -87,9 +87,8 @@ fn a_stick_exit_guard_dipping_inside_one_step_is_found() {
         u,
         x0: State::new(a_star, v, 0.0),
         t_end: 3.0,
-        tol,
         output: Output::Events,
-        ..Scene::default()
+        ..Scene::with_tol(tol)
     };
     for samples in [1, 4] {
         let solver = EventSolver {
@@ -167,9 +166,8 @@ fn a_disc_stuck_on_its_edge_after_a_switch_leaves_at_once() {
                 u,
                 x0: x,
                 t_end: 10.0,
-                tol,
                 output: Output::Events,
-                ..Scene::default()
+                ..Scene::with_tol(tol)
             },
         )
         .unwrap();
@@ -222,9 +220,8 @@ fn both_discs_sticking_at_one_instant_both_stick() {
                     u: 0.5,
                     x0: State::new(0.5, w0, w0),
                     t_end: 20.0,
-                    tol,
                     output: Output::Events,
-                    ..Scene::default()
+                    ..Scene::with_tol(tol)
                 },
             )
             .unwrap();

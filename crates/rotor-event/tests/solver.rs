@@ -51,9 +51,8 @@ fn frictionless_levels_match_matrix_exponential() {
             u,
             x0,
             t_end,
-            tol: 1e-12,
             output: Output::Final,
-            ..Scene::default()
+            ..Scene::with_tol(1e-12)
         };
         let tr = EventSolver::default().simulate(&m, &s).unwrap();
         let err = (tr.x_final - exact).amax();
@@ -67,9 +66,8 @@ fn t1_events(u: f64, t_end: f64, tol: f64) -> Vec<rotor_model::Event> {
     let s = Scene {
         u,
         t_end,
-        tol,
         output: Output::Events,
-        ..Scene::default()
+        ..Scene::with_tol(tol)
     };
     EventSolver::default()
         .simulate(&Model::table1(), &s)
@@ -129,10 +127,9 @@ fn extrema_are_roots_of_the_fields_acceleration() {
     let s = Scene {
         u,
         t_end: 100.0,
-        tol: 1e-10,
         output: Output::Events,
         metrics_from: Some(50.0),
-        ..Scene::default()
+        ..Scene::with_tol(1e-10)
     };
     let evs = EventSolver::default().simulate(&m, &s).unwrap().events;
     let mut n = 0;
@@ -205,10 +202,9 @@ fn cycle_extremes_are_as_accurate_as_the_steps() {
         let scene = Scene {
             u: 1.5 * 0.6466672309136015,
             t_end: 100.0,
-            tol,
             output: Output::Final,
             metrics_from: Some(50.0),
-            ..Scene::default()
+            ..Scene::with_tol(tol)
         };
         EventSolver::default()
             .simulate(&m, &scene)
@@ -299,10 +295,9 @@ fn steady_state_converges_in_tolerance_and_matches_long_run() {
     let s = Scene {
         u: 1.5,
         t_end: 600.0,
-        tol: 1e-12,
         output: Output::Final,
         metrics_from: Some(300.0),
-        ..Scene::default()
+        ..Scene::with_tol(1e-12)
     };
     let long = cycle(
         EventSolver::default()
@@ -590,9 +585,8 @@ fn a_reversal_whose_excursion_returns_within_one_sample_ends_in_stick() {
     let scene = Scene {
         u: 2.7914295546632484,
         t_end: 4.5,
-        tol: 1e-10,
         output: Output::Grid { dt: 1e-4 },
-        ..Scene::default()
+        ..Scene::with_tol(1e-10)
     };
     let tr = sampling(4).simulate(&model, &scene).unwrap();
     let lower = switches(&tr.events);
@@ -665,10 +659,9 @@ fn steady_state_accepts_only_a_stable_cycle_near_a_fold() {
             &Scene {
                 u,
                 t_end: 3000.0,
-                tol: 1e-12,
                 output: Output::Final,
                 metrics_from: Some(2900.0),
-                ..Scene::default()
+                ..Scene::with_tol(1e-12)
             },
         )
         .unwrap();
@@ -729,9 +722,8 @@ fn a_start_on_the_stick_edge_with_rising_torque_leaves_at_once() {
                     u: 4.63,
                     x0: State::new(alpha, 8.0, 0.0),
                     t_end: 10.0,
-                    tol: 1e-12,
                     output: Output::Events,
-                    ..Scene::default()
+                    ..Scene::with_tol(1e-12)
                 },
             )
             .unwrap()

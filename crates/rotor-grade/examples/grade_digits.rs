@@ -32,13 +32,10 @@ fn main() {
             .unwrap_or_else(|e| panic!("{e}"));
         println!("== {}", sc.name);
         for &(kind, setting) in &runs {
-            let mut scene = sc.scene(Output::Grid { dt: sc.compare.dt });
-            if kind.is_fixed_step() {
-                scene.h = setting;
-            } else {
-                scene.tol = setting;
-            }
-            let scene = Scene { ..scene };
+            let scene = Scene {
+                accuracy: kind.accuracy(setting),
+                ..sc.scene(Output::Grid { dt: sc.compare.dt })
+            };
             let tr = match kind.solver().simulate_finite(&sc.model, &scene) {
                 Ok(tr) => tr,
                 Err(e) => {

@@ -316,10 +316,9 @@ mod tests {
         let scene = Scene {
             u,
             t_end: 200.0,
-            tol: 1e-12,
             output: Output::Grid { dt: 0.01 },
             metrics_from: Some(100.0),
-            ..Scene::default()
+            ..Scene::with_tol(1e-12)
         };
         let tr = rotor_event::EventSolver::default()
             .simulate(&m, &scene)

@@ -72,10 +72,9 @@ impl Orbit {
             u: sc.u,
             x0: x_start,
             t_end: span,
-            tol,
             output: Output::Grid { dt: ORBIT_DT },
             metrics_from: None,
-            ..Scene::default()
+            ..Scene::with_tol(tol)
         };
         let tr = SolverKind::EVENT
             .solver()

@@ -27,7 +27,9 @@
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
-use rotor_model::{Event, Output, Rounding, Sample, Scene, SolveError, SteadyState, round_sig};
+use rotor_model::{
+    Accuracy, Event, Output, Rounding, Sample, Scene, SolveError, SteadyState, round_sig,
+};
 use rotor_scenario::Scenario;
 use serde::{Deserialize, Serialize};
 
@@ -172,7 +174,7 @@ impl Reference {
 /// The reference run of a scenario at tolerance `tol`: grid samples, events, metrics.
 fn event_run(sc: &Scenario, tol: f64) -> Result<rotor_model::Trajectory, ReferenceError> {
     let scene = Scene {
-        tol,
+        accuracy: Accuracy::Tol(tol),
         ..sc.scene(Output::Grid { dt: sc.compare.dt })
     };
     SolverKind::EVENT
@@ -325,11 +327,10 @@ pub fn compute(sc: &Scenario) -> Result<Reference, ReferenceError> {
                 scenario: format!("{} ({})", sc.name, kind.name()),
                 source,
             })?;
-        let (tol, h) = rotor_solvers::run::solver_settings(kind, sc);
         cross_check.insert(
             kind.name().to_owned(),
             CrossCheck {
-                setting: kind.setting_label(if kind.is_fixed_step() { h } else { tol }),
+                setting: kind.setting_label(rotor_solvers::run::solver_setting(kind, sc)),
                 differences: differences(&run, &r)
                     .into_iter()
                     .map(|(n, d)| (n, d.is_finite().then_some(d)))

@@ -8,7 +8,7 @@ use rayon::prelude::*;
 use rotor_grade::check::{CheckError, Level, check};
 use rotor_grade::reference::{self, Reference};
 use rotor_grade::trace::{EventsFile, Trace, parse_events, parse_trace, write_events, write_trace};
-use rotor_model::Trajectory;
+use rotor_model::{Accuracy, Trajectory};
 use rotor_scenario::Scenario;
 use rotor_solvers::{SolverKind, load_scenario, run::scene_for};
 
@@ -125,7 +125,7 @@ fn every_solver_passes_check_at_its_level() {
             let r = stored(sc);
             let mut out = Vec::new();
             let tight = rotor_model::Scene {
-                tol: 1e-11,
+                accuracy: Accuracy::Tol(1e-11),
                 ..scene_for(SolverKind::EVENT, sc)
             };
             for (kind, scene, level) in [

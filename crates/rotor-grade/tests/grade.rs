@@ -448,12 +448,10 @@ fn no_level_is_tighter_than_ten_times_the_reference_error() {
 fn digits_rise_as_a_method_converges() {
     let (sc, r) = scenario("t1-u1.5-rest");
     let digits = |kind: SolverKind, setting: f64| {
-        let mut scene: Scene = scene_for(kind, &sc);
-        if kind.is_fixed_step() {
-            scene.h = setting;
-        } else {
-            scene.tol = setting;
-        }
+        let scene = Scene {
+            accuracy: kind.accuracy(setting),
+            ..scene_for(kind, &sc)
+        };
         let tr = kind.solver().simulate(&sc.model, &scene).unwrap();
         let t = Trace::of_run("run", tr.samples);
         let e = EventsFile::of_run("run.events", &tr.events);

@@ -7,9 +7,10 @@
 //! ([`check_number`], [`solver_kind`]); each front end only spells the name its own way
 //! ([`FieldError::as_flag`] for the command line, `name = value` for Python).
 
-use rotor_model::{FieldError, Num, Output, Scene, State, Stats};
+use rotor_model::scene::{DEFAULT_STEP, DEFAULT_TOL};
+use rotor_model::{Accuracy, FieldError, Num, Output, Scene, State, Stats};
 
-use rotor_solvers::SolverKind;
+use rotor_solvers::{Knob, SolverKind};
 pub use rotor_solvers::{check_number, solver_kind};
 use rotor_steady::SteadyOptions;
 
@@ -106,10 +107,10 @@ impl Request<'_> {
         })
     }
 
-    /// The scene of a run over `[0, t_end]` keeping `output`: u finite, x0 finite, tol in
-    /// (0, 1), h in (0, t_end] (the default step shrinks to a horizon shorter than itself; an
-    /// explicit h does not).
-    pub fn scene(&self, t_end: f64, output: Output) -> Result<Scene, FieldError> {
+    /// The scene of a run by `kind` over `[0, t_end]` keeping `output`, at `kind`'s setting:
+    /// u finite, x0 finite, tol in (0, 1), h in (0, t_end] (the default step shrinks to a
+    /// horizon shorter than itself; an explicit h does not).
+    pub fn scene(&self, kind: SolverKind, t_end: f64, output: Output) -> Result<Scene, FieldError> {
         check_number("u", self.u, true, "must be a finite number")?;
         for (k, v) in self.x0.iter().enumerate() {
             if !v.is_finite() {
@@ -124,10 +125,9 @@ impl Request<'_> {
                 ));
             }
         }
-        let d = Scene::default();
-        let tol = self.tol.unwrap_or(d.tol);
+        let tol = self.tol.unwrap_or(DEFAULT_TOL);
         check_number("tol", tol, tol > 0.0 && tol < 1.0, "must lie in (0, 1)")?;
-        let h = self.h.unwrap_or(d.h.min(t_end));
+        let h = self.h.unwrap_or(DEFAULT_STEP.min(t_end));
         check_number(
             "h",
             h,
@@ -135,12 +135,17 @@ impl Request<'_> {
             &format!("must lie in (0, {}] s (the run's horizon)", Num(t_end)),
         )?;
         let [a, wu, wl] = self.x0;
+        // The solver's own setting; the other one was checked all the same, and is ignored
+        // (with the warning of [`Request::ignored`]).
+        let accuracy = match kind.info().knob {
+            Knob::Tolerance => Accuracy::Tol(tol),
+            Knob::Step => Accuracy::Step(h),
+        };
         Ok(Scene {
             u: self.u,
             x0: State::new(a, wu, wl),
             t_end,
-            tol,
-            h,
+            accuracy,
             output,
             metrics_from: None,
         })
@@ -151,7 +156,7 @@ impl Request<'_> {
         check_number("t_end", t_end, t_end > 0.0, "must be positive and finite")?;
         check_number("dt", dt, dt > 0.0, "must be positive and finite")?;
         let kind = self.solver_kind()?;
-        Ok((kind, self.scene(t_end, Output::Grid { dt })?))
+        Ok((kind, self.scene(kind, t_end, Output::Grid { dt })?))
     }
 
     /// A steady-state computation ([`rotor_steady::steady`]): the solver, the scene and the options
@@ -163,7 +168,11 @@ impl Request<'_> {
             opts.event.tol = tol;
         }
         let kind = self.solver_kind()?;
-        Ok((kind, self.scene(opts.settle.chunk, Output::Final)?, opts))
+        Ok((
+            kind,
+            self.scene(kind, opts.settle.chunk, Output::Final)?,
+            opts,
+        ))
     }
 }
 
@@ -262,6 +271,6 @@ mod tests {
         }
         .simulation(1e-4, 1e-5)
         .unwrap();
-        assert_eq!(sc.h, 1e-4);
+        assert_eq!(sc.accuracy, Accuracy::Step(1e-4));
     }
 }

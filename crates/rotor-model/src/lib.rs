@@ -33,6 +33,7 @@ pub use num::{Num, Rounding, round_sig};
 pub use params::{LowerFriction, Params, ParamsError, UpperFriction};
 pub use record::{Integration, Recorder};
 pub use scene::{
-    Output, OutputGrid, Sample, Scene, SolveError, Solver, Stats, Trajectory, check_finite,
+    Accuracy, Output, OutputGrid, Sample, Scene, SolveError, Solver, Stats, Trajectory,
+    check_finite,
 };
 pub use steady::{MetricsAccumulator, SteadyKind, SteadyState};

@@ -43,6 +43,47 @@ pub const MAX_GRID_ROWS: f64 = 1e7;
 /// underflows its step or silently delivers less than it was asked.
 pub const MIN_TOL: f64 = 10.0 * (f64::EPSILON / 2.0);
 
+/// The tolerance a scene that sets a step gives the adaptive solvers ([`Scene::tol`]).
+pub const DEFAULT_TOL: f64 = 1e-10;
+
+/// The step a scene that sets a tolerance gives the time-stepping solver ([`Scene::step`]) \[s\].
+pub const DEFAULT_STEP: f64 = 1e-3;
+
+/// How accurately a scene is run: the knob of one kind of solver. A solver of the other kind
+/// takes its own default ([`DEFAULT_TOL`], [`DEFAULT_STEP`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Accuracy {
+    /// Tolerance of the adaptive solvers (relative = absolute).
+    Tol(f64),
+    /// Step size of the time-stepping solver \[s\].
+    Step(f64),
+}
+
+impl Accuracy {
+    /// The adaptive solvers' tolerance: this one's, or [`DEFAULT_TOL`] for a step.
+    pub fn tol(self) -> f64 {
+        match self {
+            Accuracy::Tol(tol) => tol,
+            Accuracy::Step(_) => DEFAULT_TOL,
+        }
+    }
+
+    /// The time-stepping solver's step: this one's, or [`DEFAULT_STEP`] for a tolerance.
+    pub fn step(self) -> f64 {
+        match self {
+            Accuracy::Step(h) => h,
+            Accuracy::Tol(_) => DEFAULT_STEP,
+        }
+    }
+
+    /// The number itself, the tolerance or the step.
+    pub fn value(self) -> f64 {
+        match self {
+            Accuracy::Tol(v) | Accuracy::Step(v) => v,
+        }
+    }
+}
+
 /// One simulation request: input, initial state, horizon, accuracy, and what to keep.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Scene {
@@ -52,10 +93,8 @@ pub struct Scene {
     pub x0: State,
     /// Horizon \[s\]; the run covers `[0, t_end]`.
     pub t_end: f64,
-    /// Tolerance of the adaptive solvers (relative = absolute).
-    pub tol: f64,
-    /// Step size of the time-stepping solver \[s\].
-    pub h: f64,
+    /// The tolerance or the step ([`Scene::tol`], [`Scene::step`] read it for a solver).
+    pub accuracy: Accuracy,
     /// What to keep.
     pub output: Output,
     /// If set, steady-state metrics over `[metrics_from, t_end]` (extrema located between
@@ -69,8 +108,7 @@ impl Default for Scene {
             u: 1.5,
             x0: State::zeros(),
             t_end: 100.0,
-            tol: 1e-10,
-            h: 1e-3,
+            accuracy: Accuracy::Tol(DEFAULT_TOL),
             output: Output::Grid { dt: 0.01 },
             metrics_from: None,
         }
@@ -78,7 +116,46 @@ impl Default for Scene {
 }
 
 impl Scene {
-    /// Checks the scene; the error names the field and the bad value.
+    /// [`Scene::default`] at tolerance `tol` (for the adaptive solvers).
+    pub fn with_tol(tol: f64) -> Scene {
+        Scene {
+            accuracy: Accuracy::Tol(tol),
+            ..Scene::default()
+        }
+    }
+
+    /// [`Scene::default`] at step `h` (for the time-stepping solver).
+    pub fn with_step(h: f64) -> Scene {
+        Scene {
+            accuracy: Accuracy::Step(h),
+            ..Scene::default()
+        }
+    }
+
+    /// The adaptive solvers' tolerance: the scene's, or [`DEFAULT_TOL`] if it sets a step.
+    pub fn tol(&self) -> f64 {
+        self.accuracy.tol()
+    }
+
+    /// The time-stepping solver's step: the scene's, or [`DEFAULT_STEP`] if it sets a
+    /// tolerance.
+    pub fn step(&self) -> f64 {
+        self.accuracy.step()
+    }
+
+    /// [`Scene::step`], refused (as [`Scene::validate`] refuses a scene's own step) when it
+    /// does not fit in the horizon: the check of the time-stepping solver, which takes the
+    /// default step from a scene that sets a tolerance.
+    pub fn checked_step(&self) -> Result<f64, SolveError> {
+        let h = self.step();
+        if !(h > 0.0 && h <= self.t_end) {
+            return Err(FieldError::num("h", h, "must lie in (0, t_end]").into());
+        }
+        Ok(h)
+    }
+
+    /// Checks the scene, its own tolerance or step among the rest; the error names the field
+    /// and the bad value.
     pub fn validate(&self) -> Result<(), SolveError> {
         let bad = |field: &str, value: f64, reason: &str| {
             Err(FieldError::num(field, value, reason).into())
@@ -97,18 +174,21 @@ impl Scene {
         if !(self.t_end > 0.0 && self.t_end.is_finite()) {
             return bad("t_end", self.t_end, "must be positive and finite");
         }
-        if !(self.tol > 0.0 && self.tol < 1.0) {
-            return bad("tol", self.tol, "must lie in (0, 1)");
-        }
-        if self.tol < MIN_TOL {
-            return bad(
-                "tol",
-                self.tol,
-                "is below 1.1e-15 (10 unit roundoffs): double precision cannot deliver it",
-            );
-        }
-        if !(self.h > 0.0 && self.h <= self.t_end) {
-            return bad("h", self.h, "must lie in (0, t_end]");
+        match self.accuracy {
+            Accuracy::Tol(tol) if !(tol > 0.0 && tol < 1.0) => {
+                return bad("tol", tol, "must lie in (0, 1)");
+            }
+            Accuracy::Tol(tol) if tol < MIN_TOL => {
+                return bad(
+                    "tol",
+                    tol,
+                    "is below 1.1e-15 (10 unit roundoffs): double precision cannot deliver it",
+                );
+            }
+            Accuracy::Tol(_) => {}
+            Accuracy::Step(_) => {
+                self.checked_step()?;
+            }
         }
         if let Output::Grid { dt } = self.output {
             if !(dt > 0.0 && dt.is_finite()) {
@@ -593,15 +673,9 @@ mod tests {
 
     #[test]
     fn validation_names_field() {
-        let s = Scene {
-            tol: 0.0,
-            ..Scene::default()
-        };
+        let s = Scene::with_tol(0.0);
         assert!(s.validate().unwrap_err().to_string().contains("tol = 0"));
-        let s = Scene {
-            h: 1000.0,
-            ..Scene::default()
-        };
+        let s = Scene::with_step(1000.0);
         assert!(s.validate().unwrap_err().to_string().contains("h = 1000"));
         let s = Scene {
             x0: State::new(0.0, f64::NAN, 0.0),

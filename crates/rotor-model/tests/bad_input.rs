@@ -10,7 +10,7 @@
 use std::path::Path;
 
 use rotor_model::scene::MAX_GRID_ROWS;
-use rotor_model::{Output, Params, Scene};
+use rotor_model::{Accuracy, Output, Params, Scene};
 use rotor_testkit::{STRIBECK, TABLE1, bad_params_cases, edit, tmp_dir};
 
 /// The message must be one line, start with the file's path and contain every needle.
@@ -92,8 +92,7 @@ fn scene_tolerance_below_roundoff_is_refused() {
     use rotor_model::scene::MIN_TOL;
     let at = |tol| {
         Scene {
-            tol,
-            ..Scene::default()
+            ..Scene::with_tol(tol)
         }
         .validate()
     };
@@ -123,7 +122,7 @@ fn scene_grid_that_would_exhaust_memory_is_refused() {
     assert!(e.contains("dt = 1e-12") && e.contains("1e7"), "{e}");
     let e = Scene {
         t_end: 1e300,
-        h: 1.0,
+        accuracy: Accuracy::Step(1.0),
         output: Output::Grid { dt: 1.0 },
         ..ok
     }

@@ -189,7 +189,7 @@ impl Default for MoreauOptions {
     }
 }
 
-/// The Moreau–Jean solver; step size `scene.h`.
+/// The Moreau–Jean solver; step size [`Scene::step`](rotor_model::Scene::step).
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct MoreauSolver {
     /// θ, the friction level, Newton's limits and the step limit.

@@ -453,10 +453,12 @@ impl Solver for MoreauSolver {
 
     fn simulate(&self, model: &Model, scene: &Scene) -> Result<Trajectory, SolveError> {
         scene.validate_for(model)?;
+        // The scene's step, or the default one from a scene that sets a tolerance.
+        let h = scene.checked_step()?;
         check_finite(0.0, &scene.x0)?;
         let o = &self.options;
         o.validate()?;
-        let (u, h, t_end) = (scene.u, scene.h, scene.t_end);
+        let (u, t_end) = (scene.u, scene.t_end);
         let n = steps_to(t_end, 0.0, h);
         if n.is_nan() || n > o.max_steps as f64 {
             return Err(SolveError::TooManySteps {

@@ -2,7 +2,7 @@
 //! any work ([`validate`]), and the parameter set at a value of the parameter.
 
 use rotor_bifurcation::{BifError, DiagramOptions};
-use rotor_model::Params;
+use rotor_model::{FieldError, Params};
 
 /// What [`crate::plane`] computes.
 #[derive(Debug, Clone, PartialEq)]
@@ -54,12 +54,10 @@ pub(crate) fn params_at(base: &Params, name: &str, p: f64) -> Result<Params, Bif
 /// Checks the options and that every parameter value of the range is admissible (both ends
 /// and 64 values between).
 pub fn validate(base: &Params, opts: &PlaneOptions) -> Result<(), BifError> {
-    let bad = |field, value, reason| {
-        Err(BifError::InvalidOption {
-            field,
-            value,
-            reason,
-        })
+    let bad = |field: &str, value: f64, reason: &str| {
+        Err(BifError::InvalidOption(FieldError::num(
+            field, value, reason,
+        )))
     };
     base.get(&opts.param)
         .map_err(|e| BifError::Degenerate(e.to_string()))?;
@@ -132,8 +130,8 @@ mod tests {
             let mut o = ok.clone();
             spoil(&mut o);
             let e = validate(&base, &o).unwrap_err();
-            if let BifError::InvalidOption { field: f, .. } = e {
-                assert_eq!(f, field);
+            if let BifError::InvalidOption(f) = &e {
+                assert_eq!(f.field, field);
             }
             assert!(e.to_string().contains(field), "{field}: {e}");
         }

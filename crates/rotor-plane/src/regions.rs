@@ -37,10 +37,9 @@ pub fn classify(model: &Model, u: f64, x0: State) -> Option<Attractor> {
         u,
         x0,
         t_end: 1500.0,
-        tol: 1e-8,
         output: Output::Metrics,
         metrics_from: Some(1000.0),
-        ..Scene::default()
+        ..Scene::with_tol(1e-8)
     };
     let metrics = rotor_event::EventSolver::default()
         .simulate(model, &scene)

@@ -98,7 +98,7 @@ fn from_steady(py: Python<'_>, e: SteadyError) -> PyErr {
 
 fn from_bif(py: Python<'_>, e: BifError) -> PyErr {
     match e {
-        BifError::InvalidOption { .. } => value_error(e),
+        BifError::InvalidOption(_) => value_error(e),
         BifError::Solve(e) => from_solve(py, e),
         BifError::Grazing { state, .. } => solve_error(py, e.to_string(), None, Some(state)),
         _ => solve_error(py, e.to_string(), None, None),

@@ -29,7 +29,7 @@ use std::path::{Path, PathBuf};
 use serde::Deserialize;
 
 use rotor_model::params::{Params, one_line, read_small, text_of};
-use rotor_model::scene::{MIN_TOL, Output, Scene};
+use rotor_model::scene::{DEFAULT_STEP, MIN_TOL, Output, Scene};
 use rotor_model::{FieldError, Model, Num, State};
 
 use crate::compare::CompareSpec;
@@ -92,7 +92,7 @@ pub struct Scenario {
 
 impl Scenario {
     /// The scene of this scenario keeping `output`: its input, initial state, horizon and
-    /// steady-state window, at [`Scene::default`]'s accuracy (callers set `tol` or `h`).
+    /// steady-state window, at [`Scene::default`]'s accuracy (callers set their solver's).
     pub fn scene(&self, output: Output) -> Scene {
         Scene {
             u: self.u,
@@ -251,7 +251,7 @@ fn check_run(raw: &RawScenario, bad: Bad) -> Result<(), ScenarioError> {
     }
     // Without `h`, the time-stepping solver takes the default step, which must fit in
     // the horizon (Scene::validate), or every run of the scenario would fail.
-    let h_default = Scene::default().h;
+    let h_default = DEFAULT_STEP;
     if raw.h.is_none() && raw.t_end < h_default {
         return Err(bad.at(
             "t_end",

@@ -11,7 +11,7 @@ use std::path::{Path, PathBuf};
 use std::sync::OnceLock;
 
 use proptest::prelude::*;
-use rotor_model::{Output, Scene};
+use rotor_model::{Accuracy, Output, Scene};
 use rotor_scenario::Scenario;
 use rotor_testkit::mutate::{Mutation, apply, mutation};
 
@@ -71,16 +71,14 @@ fn check(which: usize, muts: &[Mutation]) -> Result<(), TestCaseError> {
     let message = match Scenario::from_file(&path) {
         Ok(sc) => {
             prop_assert!(sc.model.params.validate().is_ok());
-            // The settings rotor-solvers runs a scenario with (run.rs solver_settings).
-            let d = Scene::default();
-            for (tol, h) in [
-                (1e-12, d.h),
-                (sc.tol.unwrap_or(1e-10), d.h),
-                (d.tol, sc.h.unwrap_or(1e-3)),
+            // The settings rotor-solvers runs a scenario with (run.rs solver_setting).
+            for accuracy in [
+                Accuracy::Tol(1e-12),
+                Accuracy::Tol(sc.tol.unwrap_or(1e-10)),
+                Accuracy::Step(sc.h.unwrap_or(1e-3)),
             ] {
                 let scene = Scene {
-                    tol,
-                    h,
+                    accuracy,
                     ..sc.scene(Output::Grid { dt: sc.compare.dt })
                 };
                 prop_assert!(

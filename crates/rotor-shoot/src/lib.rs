@@ -28,7 +28,7 @@
 //! # fn f(solver: &dyn rotor_model::Solver) -> Result<(), rotor_shoot::ShootError> {
 //! use rotor_model::{Model, Scene, State};
 //! let model = Model::table1();
-//! let scene = Scene { u: 1.5, tol: 1e-10, ..Scene::default() };
+//! let scene = Scene { u: 1.5, ..Scene::with_tol(1e-10) };
 //! let (section, z) = rotor_shoot::Section::of_run(solver, &model, &scene, State::zeros(), 200.0)?;
 //! let orbit = rotor_shoot::shoot(solver, &model, &scene, section, &z, &Default::default())?;
 //! println!("T = {} s, stable: {}", orbit.period, orbit.is_stable());

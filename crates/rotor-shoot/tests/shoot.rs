@@ -32,12 +32,11 @@ fn period_gate(name: &str, case: usize) -> f64 {
     }
 }
 
+/// The scene at `u`: tol 1e-10, and Moreau–Jean's default step 1e-3.
 fn scene(u: f64) -> Scene {
     Scene {
         u,
-        tol: 1e-10,
-        h: 1e-3,
-        ..Scene::default()
+        ..Scene::with_tol(1e-10)
     }
 }
 

@@ -7,23 +7,18 @@ use rotor_scenario::Scenario;
 
 use crate::solvers::{Knob, SOLVERS, SolverKind};
 
-/// The accuracy setting `(tol, h)` of a solver in the comparison of a scenario: the
-/// reference (the first of [`SOLVERS`]) at its comparison setting; every other solver at its
-/// comparison setting unless the scenario file sets `tol` or `h`.
-pub fn solver_settings(kind: SolverKind, sc: &Scenario) -> (f64, f64) {
-    let d = Scene::default();
+/// The accuracy setting (its tolerance or its step) of a solver in the comparison of a
+/// scenario: the reference (the first of [`SOLVERS`]) at its comparison setting; every other
+/// solver at its comparison setting unless the scenario file sets `tol` or `h`.
+pub fn solver_setting(kind: SolverKind, sc: &Scenario) -> f64 {
     let info = kind.info();
-    let set = if kind == SOLVERS[0] {
+    if kind == SOLVERS[0] {
         info.comparison
     } else {
         match info.knob {
             Knob::Tolerance => sc.tol.unwrap_or(info.comparison),
             Knob::Step => sc.h.unwrap_or(info.comparison),
         }
-    };
-    match info.knob {
-        Knob::Tolerance => (set, d.h),
-        Knob::Step => (d.tol, set),
     }
 }
 
@@ -50,10 +45,8 @@ pub struct ScenarioResult {
 
 /// The scene of a scenario for one solver: the comparison grid, events, and metrics.
 pub fn scene_for(kind: SolverKind, sc: &Scenario) -> Scene {
-    let (tol, h) = solver_settings(kind, sc);
     Scene {
-        tol,
-        h,
+        accuracy: kind.accuracy(solver_setting(kind, sc)),
         ..sc.scene(Output::Grid { dt: sc.compare.dt })
     }
 }

@@ -7,25 +7,34 @@
 //! plot styles, ladders, the CLI's `--solver` names. Adding a solver is one crate, one entry
 //! here, and its tolerances in the fixtures (`CONTRIBUTING.md`; a test adds a fourth one).
 
-use rotor_model::Solver;
+use rotor_model::scene::{DEFAULT_STEP, DEFAULT_TOL};
+use rotor_model::{Accuracy, Solver};
 use rotor_scenario::{Scenario, ScenarioError};
 use serde::{Serialize, Serializer};
 
 /// What a solver's accuracy setting is.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Knob {
-    /// An error tolerance (relative = absolute): `Scene::tol`, the CLI's `--tol`.
+    /// An error tolerance (relative = absolute): [`Accuracy::Tol`], the CLI's `--tol`.
     Tolerance,
-    /// A fixed step size \[s\]: `Scene::h`, the CLI's `--h`.
+    /// A fixed step size \[s\]: [`Accuracy::Step`], the CLI's `--h`.
     Step,
 }
 
 impl Knob {
-    /// `"tol"` or `"h"`: the scene field and CLI flag.
+    /// `"tol"` or `"h"`: the setting's name and CLI flag.
     pub fn name(self) -> &'static str {
         match self {
             Knob::Tolerance => "tol",
             Knob::Step => "h",
+        }
+    }
+
+    /// A scene's accuracy with this knob at `setting`.
+    pub fn accuracy(self, setting: f64) -> Accuracy {
+        match self {
+            Knob::Tolerance => Accuracy::Tol(setting),
+            Knob::Step => Accuracy::Step(setting),
         }
     }
 }
@@ -73,7 +82,7 @@ pub static EVENT: SolverInfo = SolverInfo {
     label: "event-driven",
     knob: Knob::Tolerance,
     comparison: 1e-12,
-    default: 1e-10,
+    default: DEFAULT_TOL,
     ladder: &DECADES_3_12,
     style: Style {
         color: "#000000",
@@ -89,7 +98,7 @@ pub static SWITCH: SolverInfo = SolverInfo {
     label: "switch model",
     knob: Knob::Tolerance,
     comparison: 1e-10,
-    default: 1e-10,
+    default: DEFAULT_TOL,
     ladder: &DECADES_3_12,
     style: Style {
         color: "#e66101",
@@ -107,7 +116,7 @@ pub static MOREAU: SolverInfo = SolverInfo {
     label: "Moreau-Jean",
     knob: Knob::Step,
     comparison: 1e-3,
-    default: 1e-3,
+    default: DEFAULT_STEP,
     ladder: &[1e-2, 5e-3, 2e-3, 1e-3, 5e-4, 2e-4, 1e-4, 1e-5],
     style: Style {
         color: "#5e3c99",
@@ -155,6 +164,11 @@ impl SolverKind {
     /// Whether the accuracy knob is a fixed step h (else a tolerance).
     pub fn is_fixed_step(self) -> bool {
         self.0.knob == Knob::Step
+    }
+
+    /// A scene's accuracy at this solver's `setting` (its tolerance or its step).
+    pub fn accuracy(self, setting: f64) -> Accuracy {
+        self.0.knob.accuracy(setting)
     }
 
     /// The solver, with its default options. Every solver runs a [`rotor_model::Scene`]

@@ -38,7 +38,7 @@ fn main() {
             let mut line = format!("{name} {label} u = {:.10}:", p.u);
             let mut moreau = Vec::new();
             for (sname, kind, opts) in &runs {
-                let found = locate(&*kind.solver(), &model, &event, opts);
+                let found = locate(*kind, &model, &event, opts);
                 match matching(&found.points, p) {
                     Some(q) => {
                         let d = (q.u - p.u).abs();

@@ -74,10 +74,10 @@ pub fn by_solver_with(
         || {
             picked
                 .par_iter()
-                .map(|row| reshoot(&*kind.solver(), model, row, opts))
+                .map(|row| reshoot(kind, model, row, opts))
                 .collect::<Vec<_>>()
         },
-        || solver_points::locate(&*kind.solver(), model, event, opts),
+        || solver_points::locate(kind, model, event, opts),
     );
     let mut periodic = Vec::new();
     let mut not_found = Vec::new();
@@ -111,12 +111,13 @@ pub fn by_solver_with(
 
 /// One periodic row, found again by this solver from the row's restart state.
 fn reshoot(
-    solver: &dyn rotor_model::Solver,
+    kind: SolverKind,
     model: &Model,
     row: &PeriodicRow,
     opts: &BySolverOptions,
 ) -> Result<PeriodicRow, String> {
-    let scene = opts.scene(row.u);
+    let solver = &*kind.solver();
+    let scene = opts.scene(kind, row.u);
     // The continuation's section first; next to a grazing orbit a stick phase shorter than
     // Moreau–Jean's step is not seen, so the other one second.
     let first = section_of(row);

@@ -4,8 +4,9 @@
 //! shooting options for a period, the diagram row of a shot orbit).
 
 use rotor_bifurcation::PeriodicRow;
-use rotor_model::{Disc, EventKind, Model, OMEGA_L, OMEGA_U, Output, Scene, SteadyState};
+use rotor_model::{Accuracy, Disc, EventKind, Model, OMEGA_L, OMEGA_U, Output, Scene, SteadyState};
 use rotor_shoot::{Orbit, Section, ShootOptions};
+use rotor_solvers::{Knob, SolverKind};
 use serde::Serialize;
 
 /// A row or special point the solver's shooting did not reproduce, and why.
@@ -40,12 +41,15 @@ impl Default for BySolverOptions {
 }
 
 impl BySolverOptions {
-    /// The scene of one solve at input `u`.
-    pub fn scene(&self, u: f64) -> Scene {
+    /// The scene of one solve by `kind` at input `u`, at its tolerance or its step.
+    pub fn scene(&self, kind: SolverKind, u: f64) -> Scene {
+        let accuracy = match kind.info().knob {
+            Knob::Tolerance => Accuracy::Tol(self.tol),
+            Knob::Step => Accuracy::Step(self.h),
+        };
         Scene {
             u,
-            tol: self.tol,
-            h: self.h,
+            accuracy,
             ..Scene::default()
         }
     }

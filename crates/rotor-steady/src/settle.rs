@@ -244,7 +244,7 @@ pub fn settle(
 ) -> Result<Settled, SettleError> {
     let solver = kind.solver();
     let rel = if kind.is_fixed_step() {
-        opts.rel.max(opts.rel_per_h * base.h)
+        opts.rel.max(opts.rel_per_h * base.step())
     } else {
         opts.rel
     };
@@ -382,7 +382,7 @@ pub fn settle(
             // its steps fall: a change that has not halved over the last five chunks (ten
             // chunks into the run) will not fall below `rel` later either.
             changes.push(c);
-            let cause = unsettled(kind.is_fixed_step(), base.h, &st);
+            let cause = unsettled(kind.is_fixed_step(), base.step(), &st);
             let jitter = matches!(cause, Unsettled::GrazingBelowStep { .. })
                 && changes.len() >= 10
                 && c >= 0.5 * changes[changes.len() - 6];

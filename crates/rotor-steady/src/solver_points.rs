@@ -32,8 +32,9 @@
 use rayon::prelude::*;
 use rotor_bifurcation::feigin::GrazingType;
 use rotor_bifurcation::{Diagram, PeriodicRow, PointKind, SpecialPoint};
-use rotor_model::{Model, Solver};
+use rotor_model::Model;
 use rotor_shoot::{Orbit, Section, shoot, shoot_with_u};
+use rotor_solvers::SolverKind;
 
 use crate::orbit_rows::{BySolverOptions, NotFound, first_crossing, row_of, shoot_opts};
 
@@ -52,13 +53,8 @@ pub struct Located {
 }
 
 /// Every grazing orbit and smooth fold of the event-driven continuation, located again by
-/// `solver` (see the module docs); discontinuous folds come with their grazing orbit.
-pub fn locate(
-    solver: &dyn Solver,
-    model: &Model,
-    event: &Diagram,
-    opts: &BySolverOptions,
-) -> Located {
+/// `kind` (see the module docs); discontinuous folds come with their grazing orbit.
+pub fn locate(kind: SolverKind, model: &Model, event: &Diagram, opts: &BySolverOptions) -> Located {
     let jobs: Vec<&SpecialPoint> = event
         .points
         .iter()
@@ -71,9 +67,9 @@ pub fn locate(
         .par_iter()
         .map(|p| {
             if p.kind == PointKind::Grazing {
-                grazing(solver, model, event, p, opts)
+                grazing(kind, model, event, p, opts)
             } else {
-                smooth_fold(solver, model, p, opts)
+                smooth_fold(kind, model, p, opts)
             }
         })
         .collect();
@@ -203,12 +199,13 @@ fn beside(event: &Diagram, u: f64) -> (Vec<&PeriodicRow>, Vec<&PeriodicRow>) {
 }
 
 fn grazing(
-    solver: &dyn Solver,
+    kind: SolverKind,
     model: &Model,
     event: &Diagram,
     g: &SpecialPoint,
     opts: &BySolverOptions,
 ) -> Result<Vec<SpecialPoint>, String> {
+    let solver = &*kind.solver();
     let ug = g.u;
     let (slips, sticks) = beside(event, ug);
     if slips.is_empty() {
@@ -218,7 +215,7 @@ fn grazing(
     // The solver's slipping cycle at the u of each of three continuation rows, from that row's
     // state (one crossing on: an unstable cycle's start has not drifted), and its min ω_l.
     let shoot_row = |u: f64, z0: Option<&[f64]>, row: &PeriodicRow| {
-        let sc = opts.scene(u);
+        let sc = opts.scene(kind, u);
         let z = match z0 {
             Some(z) => z.to_vec(),
             None => first_crossing(
@@ -357,7 +354,7 @@ fn grazing(
     let mut found = None;
     let mut why = String::from("no stick-slip cycle of the continuation beside it");
     for row in sticks.iter().take(8) {
-        let sc = opts.scene(row.u);
+        let sc = opts.scene(kind, row.u);
         let sec = Section::StickExit;
         let r =
             first_crossing(solver, model, &sc, row.section_state, row.period, sec).and_then(|z2| {
@@ -437,18 +434,19 @@ fn grazing(
 }
 
 fn smooth_fold(
-    solver: &dyn Solver,
+    kind: SolverKind,
     model: &Model,
     f: &SpecialPoint,
     opts: &BySolverOptions,
 ) -> Result<Vec<SpecialPoint>, String> {
+    let solver = &*kind.solver();
     let x = f
         .section_state
         .ok_or("the continuation gives no state on the fold's cycle")?;
     let period = f
         .period
         .ok_or("the continuation gives no period of the fold's cycle")?;
-    let sc = opts.scene(f.u);
+    let sc = opts.scene(kind, f.u);
     let section = if f.omega_l_min.is_some_and(|m| m > 0.0) {
         Section::LowerMax
     } else {
@@ -461,7 +459,7 @@ fn smooth_fold(
     let mut u_of = |s: f64, u0: f64| -> Result<rotor_shoot::OrbitAtU, String> {
         let mut zs = z.clone();
         zs[fix] = s;
-        let r = shoot_with_u(solver, model, &opts.scene(u0), section, &zs, fix, &so)
+        let r = shoot_with_u(solver, model, &opts.scene(kind, u0), section, &zs, fix, &so)
             .map_err(|e| format!("at {} = {s}: {e}", section.as_str()))?;
         z = r.orbit.z.clone();
         Ok(r)
@@ -500,7 +498,7 @@ fn smooth_fold(
         })
         .copied()
         .unwrap_or([f64::NAN, 0.0]);
-    let row = row_of(solver, model, &opts.scene(at.u), &at.orbit, 0)?;
+    let row = row_of(solver, model, &opts.scene(kind, at.u), &at.orbit, 0)?;
     let mut p = SpecialPoint::new(
         PointKind::Fold,
         u_est,

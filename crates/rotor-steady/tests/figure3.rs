@@ -19,8 +19,8 @@ fn every_gated_point_is_located_by_both_solvers_within_its_gate() {
         let model = Model::new(params);
         let event = rotor_bifurcation::diagram(&model, &Default::default()).unwrap();
         let opts = BySolverOptions::default();
-        let sw = locate(&*SolverKind::SWITCH.solver(), &model, &event, &opts);
-        let mo = locate(&*SolverKind::MOREAU.solver(), &model, &event, &opts);
+        let sw = locate(SolverKind::SWITCH, &model, &event, &opts);
+        let mo = locate(SolverKind::MOREAU, &model, &event, &opts);
         let labels = label_points(&event.points);
         // H1, H2 are shared; Table 1: G1, G2, F1 (smooth); Stribeck: G1 = D1 and G2 = E
         // (discontinuous folds).

@@ -28,10 +28,9 @@ fn main() {
         let scene = Scene {
             u: *u,
             t_end: 200.0,
-            tol: 1e-10,
             output: Output::Final,
             metrics_from: Some(100.0),
-            ..Scene::default()
+            ..Scene::with_tol(1e-10)
         };
         let run = |eta: f64| {
             let s = SwitchSolver {

@@ -745,7 +745,7 @@ impl Solver for SwitchSolver {
         "switch"
     }
 
-    /// Integrates the switch model over `[0, t_end]` with DOPRI5 at `rtol = atol = scene.tol`,
+    /// Integrates the switch model over `[0, t_end]` with DOPRI5 at `rtol = atol = scene.tol()`,
     /// locating every region change (guards of the crate docs) and restarting there.
     fn simulate(&self, model: &Model, scene: &Scene) -> Result<Trajectory, SolveError> {
         scene.validate_for(model)?;
@@ -754,10 +754,11 @@ impl Solver for SwitchSolver {
         let mut field = Field::new(model, scene.u, o.eta);
         let x0 = field.start(&scene.x0);
         check_finite(0.0, &x0)?;
-        let mut rec = Recorder::new(scene, x0, scene.tol, o.skip_verify);
+        let tol = scene.tol();
+        let mut rec = Recorder::new(scene, x0, tol, o.skip_verify);
         let dopts = Dopri5Options {
-            rtol: scene.tol,
-            atol: scene.tol,
+            rtol: tol,
+            atol: tol,
             h0: None,
             h_max: o.h_max,
             max_steps: o.max_steps,
@@ -770,7 +771,7 @@ impl Solver for SwitchSolver {
             field,
             integ,
             t_end: scene.t_end,
-            tol: scene.tol,
+            tol,
             samples: o.guard_samples.clamp(1, 16),
             zeno: Zeno::new(o.zeno_count, o.zeno_window),
             last_extremum: [None; 2],

@@ -3,8 +3,8 @@
 use std::path::{Path, PathBuf};
 
 use rotor_model::{
-    Disc, EventKind, Model, OMEGA_L, OMEGA_U, Output, OutputGrid, Scene, SolveError, Solver,
-    SteadyState, Trajectory,
+    Accuracy, Disc, EventKind, Model, OMEGA_L, OMEGA_U, Output, OutputGrid, Scene, SolveError,
+    Solver, SteadyState, Trajectory,
 };
 use rotor_scenario::Scenario;
 use rotor_switch::{SwitchOptions, SwitchSolver};
@@ -41,10 +41,9 @@ fn steady_scene(u: f64) -> Scene {
     Scene {
         u,
         t_end: 200.0,
-        tol: 1e-10,
         output: Output::Final,
         metrics_from: Some(100.0),
-        ..Scene::default()
+        ..Scene::with_tol(1e-10)
     }
 }
 
@@ -136,7 +135,7 @@ fn fixtures() -> Vec<PathBuf> {
 
 fn scene_of(sc: &Scenario, output: Output) -> Scene {
     Scene {
-        tol: sc.tol.unwrap_or(1e-10),
+        accuracy: Accuracy::Tol(sc.tol.unwrap_or(1e-10)),
         ..sc.scene(output)
     }
 }
@@ -374,7 +373,7 @@ fn bad_input_gives_typed_errors() {
         .simulate(
             &model,
             &Scene {
-                tol: 2.0,
+                accuracy: Accuracy::Tol(2.0),
                 ..base.clone()
             },
         )
@@ -536,9 +535,8 @@ fn leaving_stick_from_just_below_zero_is_no_reversal() {
             // the lower disc's stick interval, so it sticks until the spring winds up.
             x0: rotor_model::State::new(0.0, 0.0, w),
             t_end: 3.0,
-            tol: 1e-10,
             output: Output::Events,
-            ..Scene::default()
+            ..Scene::with_tol(1e-10)
         };
         let t = run(eta, &Model::table1(), &scene);
         let lower: Vec<EventKind> = t

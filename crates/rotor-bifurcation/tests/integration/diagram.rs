@@ -292,10 +292,9 @@ fn hysteresis_of_a_brute_force_sweep_matches_the_bistable_window() {
             u,
             x0,
             t_end: 300.0,
-            tol: 1e-9,
             output: Output::Final,
             metrics_from: Some(200.0),
-            ..Scene::default()
+            ..Scene::with_tol(1e-9)
         };
         let t1 = solver.simulate(&m, &scene).unwrap();
         let t2 = solver

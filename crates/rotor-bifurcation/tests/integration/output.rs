@@ -316,9 +316,9 @@ fn options_are_validated_with_the_field_named() {
         ),
     ];
     for (opts, field) in cases {
-        match diagram(&m, &opts) {
-            Err(e @ BifError::InvalidOption { field: f, .. }) => {
-                assert_eq!(f, field);
+        match &diagram(&m, &opts) {
+            Err(e @ BifError::InvalidOption(f)) => {
+                assert_eq!(f.field, field);
                 assert!(e.to_string().contains(field), "{e}");
             }
             other => panic!("{field}: {other:?}"),

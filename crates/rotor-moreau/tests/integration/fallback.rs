@@ -2,7 +2,7 @@
 //! very large h): it converges to a solution of the step problem, or the step is flagged.
 
 use nalgebra::{Matrix2, Vector2};
-use rotor_model::{Disc, Model, Output, Scene, Solver};
+use rotor_model::{Accuracy, Disc, Model, Output, Scene, Solver};
 use rotor_moreau::{MoreauOptions, MoreauSolver, StepOutcome, Stepper};
 
 use crate::scenarios;
@@ -106,8 +106,7 @@ fn picard_fallback_converges_to_a_solution_or_is_flagged() {
                     u: sc.u,
                     x0: sc.x0,
                     t_end: n as f64 * h,
-                    tol: 1e-10,
-                    h,
+                    accuracy: Accuracy::Step(h),
                     output: Output::Final,
                     metrics_from: None,
                 },

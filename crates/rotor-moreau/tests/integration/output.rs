@@ -1,7 +1,7 @@
 //! The scene's output levels, events, metrics and errors.
 
 use rotor_model::{
-    Disc, EventKind, Model, OMEGA_U, Output, OutputGrid, Scene, SolveError, Solver, State,
+    Accuracy, Disc, EventKind, Model, OMEGA_U, Output, OutputGrid, Scene, SolveError, Solver, State,
 };
 use rotor_moreau::{MoreauOptions, MoreauSolver, Stepper};
 
@@ -10,10 +10,9 @@ fn base() -> Scene {
         u: 1.5,
         x0: State::zeros(),
         t_end: 1.0,
-        h: 0.003,
         output: Output::Final,
         metrics_from: None,
-        ..Scene::default()
+        ..Scene::with_step(0.003)
     }
 }
 
@@ -35,7 +34,11 @@ fn name_is_moreau_and_its_samples_are_the_steppers() {
     assert_eq!(tr.samples[0].x, x);
     for (k, s) in tr.samples.iter().enumerate().skip(1) {
         let t0 = tr.samples[k - 1].t;
-        let h = if k < 334 { scene.h } else { scene.t_end - t0 };
+        let h = if k < 334 {
+            scene.step()
+        } else {
+            scene.t_end - t0
+        };
         x = st.step(t0, &x, h).unwrap().x;
         assert_eq!(s.x, x, "step {k} at t = {}", s.t);
     }
@@ -135,7 +138,7 @@ fn grid_matches_output_grid() {
 fn events_are_ordered_and_stick_phases_alternate() {
     let scene = Scene {
         t_end: 40.0,
-        h: 1e-3,
+        accuracy: Accuracy::Step(1e-3),
         output: Output::Events,
         ..base()
     };
@@ -198,7 +201,7 @@ fn events_are_ordered_and_stick_phases_alternate() {
 fn skipping_changes_nothing() {
     let scene = Scene {
         t_end: 20.0,
-        h: 1e-3,
+        accuracy: Accuracy::Step(1e-3),
         output: Output::Steps,
         ..base()
     };
@@ -230,7 +233,7 @@ fn typed_errors() {
     let m = Model::table1();
     let s = MoreauSolver::default();
     assert!(matches!(
-        s.simulate(&m, &Scene { h: 0.0, ..base() }),
+        s.simulate(&m, &Scene { accuracy: Accuracy::Step(0.0), ..base() }),
         Err(SolveError::InvalidScene(e)) if e.field == "h"
     ));
     assert!(matches!(

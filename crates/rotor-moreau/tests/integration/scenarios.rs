@@ -1,13 +1,13 @@
 //! Every fixture runs; large steps stay bounded; stuck equilibria stay exactly stuck.
 
-use rotor_model::{Output, Scene, Solver, State};
+use rotor_model::{Accuracy, Output, Scene, Solver, State};
 use rotor_moreau::MoreauSolver;
 
 use crate::scenarios;
 
 fn scene(sc: &rotor_scenario::Scenario, h: f64, output: Output) -> Scene {
     Scene {
-        h,
+        accuracy: Accuracy::Step(h),
         ..sc.scene(output)
     }
 }
