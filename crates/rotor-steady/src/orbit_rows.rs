@@ -18,7 +18,7 @@ pub struct NotFound {
     pub reason: String,
 }
 
-/// Options of [`by_solver_with`].
+/// Options of [`by_solver_with`](crate::by_solver::by_solver_with).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct BySolverOptions {
     /// Re-shoot every `stride`-th periodic row of the continuation (1: every row). The
