@@ -18,14 +18,14 @@ use crate::filippov::{EventOptions, Integrator, RunEnd, Sink};
 ///
 /// ```
 /// use rotor_event::EventSolver;
-/// use rotor_model::{Model, Output, Scene, Solver, State, SteadyState};
+/// use rotor_model::{Accuracy, Model, Output, Scene, Solver, State, SteadyState};
 ///
 /// let model = Model::table1();
 /// let scene = Scene {
 ///     u: 1.5,                // V
 ///     x0: State::zeros(),    // [α, ω_u, ω_l]: at rest
 ///     t_end: 60.0,           // s
-///     tol: 1e-10,            // relative = absolute
+///     accuracy: Accuracy::Tol(1e-10), // relative = absolute
 ///     output: Output::Metrics,
 ///     metrics_from: Some(30.0),
 ///     ..Scene::default()
