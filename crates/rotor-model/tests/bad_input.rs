@@ -7,27 +7,9 @@
 //! cases that the `rotor` binary is held to as well are in `rotor-testkit`
 //! ([`bad_params_cases`]); the ones here are the library's own.
 
-use std::path::Path;
-
 use rotor_model::scene::MAX_GRID_ROWS;
 use rotor_model::{Accuracy, Output, Params, Scene};
-use rotor_testkit::{STRIBECK, TABLE1, bad_params_cases, edit, tmp_dir};
-
-/// The message must be one line, start with the file's path and contain every needle.
-fn check_message(what: &str, msg: &str, path: &Path, needles: &[&str]) {
-    assert!(
-        !msg.contains('\n') && !msg.contains('\r'),
-        "{what}: one line: {msg}"
-    );
-    let p = path.display().to_string();
-    assert!(
-        msg.starts_with(&p),
-        "{what}: starts with the file {p}: {msg}"
-    );
-    for n in needles {
-        assert!(msg.contains(n), "{what}: names {n:?}: {msg}");
-    }
-}
+use rotor_testkit::{STRIBECK, TABLE1, bad_params_cases, check_message, edit, tmp_dir};
 
 /// Writes a parameter file and expects an error.
 fn params_err(what: &str, text: &[u8], needles: &[&str]) {

@@ -6,29 +6,11 @@
 //! cases that the `rotor` binary is held to as well are in `rotor-testkit`
 //! ([`bad_scenario_cases`]); the ones here are the library's own.
 
-use std::path::Path;
-
 use rotor_scenario::Scenario;
 use rotor_testkit::{
-    TABLE1, bad_scenario_cases, edit, local_scenario, short_horizon_scenario, tmp_dir,
-    write_scenario,
+    TABLE1, bad_scenario_cases, check_message, edit, local_scenario, short_horizon_scenario,
+    tmp_dir, write_scenario,
 };
-
-/// The message must be one line, start with the file's path and contain every needle.
-fn check_message(what: &str, msg: &str, path: &Path, needles: &[&str]) {
-    assert!(
-        !msg.contains('\n') && !msg.contains('\r'),
-        "{what}: one line: {msg}"
-    );
-    let p = path.display().to_string();
-    assert!(
-        msg.starts_with(&p),
-        "{what}: starts with the file {p}: {msg}"
-    );
-    for n in needles {
-        assert!(msg.contains(n), "{what}: names {n:?}: {msg}");
-    }
-}
 
 /// Writes a scenario (and a good Table 1 parameter file next to it) and expects an error.
 fn scenario_err(what: &str, text: &[u8], needles: &[&str]) -> String {

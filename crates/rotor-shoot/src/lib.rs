@@ -254,7 +254,26 @@ struct Map<'a> {
     last_return: Option<f64>,
 }
 
-impl Map<'_> {
+impl<'a> Map<'a> {
+    /// The return map of `solver` on `section` at `scene` (its u and accuracy), before any run.
+    fn new(
+        solver: &'a dyn Solver,
+        model: &'a Model,
+        scene: &Scene,
+        section: Section,
+        opts: &ShootOptions,
+    ) -> Map<'a> {
+        Map {
+            solver,
+            model,
+            scene: scene.clone(),
+            section,
+            opts: *opts,
+            runs: 0,
+            last_return: None,
+        }
+    }
+
     /// `P(z)` and the return time. Once one return is known, a run covers 1.5× its time (a
     /// run to the full horizon would integrate ten periods to use one); before that, a run
     /// covers [`FIRST_WINDOW`], and a return found there at least [`END_MARGIN`] before its
@@ -412,15 +431,7 @@ pub fn shoot(
     z0: &[f64],
     opts: &ShootOptions,
 ) -> Result<Orbit, ShootError> {
-    let mut map = Map {
-        solver,
-        model,
-        scene: scene.clone(),
-        section,
-        opts: *opts,
-        runs: 0,
-        last_return: None,
-    };
+    let mut map = Map::new(solver, model, scene, section, opts);
     let mut z = z0.to_vec();
     let (mut pz, mut period) = map.at(&z)?;
     let resid =
@@ -510,15 +521,7 @@ pub fn shoot_with_u(
         fix < n,
         "fix = {fix} is not a coordinate of a {n}-dimensional section"
     );
-    let mut map = Map {
-        solver,
-        model,
-        scene: scene.clone(),
-        section,
-        opts: *opts,
-        runs: 0,
-        last_return: None,
-    };
+    let mut map = Map::new(solver, model, scene, section, opts);
     let free: Vec<usize> = (0..n).filter(|&c| c != fix).collect();
     let mut z = z0.to_vec();
     let mut u = scene.u;

@@ -29,6 +29,22 @@ pub const STRIBECK: &str = include_str!("../../../fixtures/params/stribeck.toml"
 /// `../params/table1.toml`, relative to the fixtures; see [`local_scenario`]).
 pub const SCENARIO: &str = include_str!("../../../fixtures/scenarios/t1-u1.5-rest.toml");
 
+/// A bad-input message (of a parameter or scenario file) must be one line, start with the file's path and contain every needle.
+pub fn check_message(what: &str, msg: &str, path: &std::path::Path, needles: &[&str]) {
+    assert!(
+        !msg.contains('\n') && !msg.contains('\r'),
+        "{what}: one line: {msg}"
+    );
+    let p = path.display().to_string();
+    assert!(
+        msg.starts_with(&p),
+        "{what}: starts with the file {p}: {msg}"
+    );
+    for n in needles {
+        assert!(msg.contains(n), "{what}: names {n:?}: {msg}");
+    }
+}
+
 /// A fresh, existing directory under the system's temporary directory, named
 /// `{prefix}-{pid}-{n}` with `n` counting the calls of this process, so that tests running in
 /// parallel (and test binaries running at the same time) never share one.
