@@ -253,13 +253,13 @@ pub fn workspace_root() -> PathBuf {
 impl Default for BenchOptions {
     /// The whole suite ([`suite`]: every scenario of `fixtures/scenarios`, its own horizon,
     /// windows and grid; both tiers), with short ladders for the peers and clients (the whole
-    /// run with every peer still takes about half an hour on two cores, BENCHMARK.md; most
-    /// of it Radau and BDF at 1e-10 and Siconos at 2e-3): event and switch at tol 1e-3 … 1e-12, Moreau–Jean at h = 1e-2 …
-    /// 1e-4 (1-2-5), reference = event at tol 1e-13, median of up to 15 runs within 0.3 s per
-    /// point (a run longer than that is timed once); the scipy peer at rtol = atol = 1e-4,
-    /// 1e-7, 1e-10 (DOP853) and 1e-6, 1e-10 (Radau, BDF, LSODA), Siconos at h = 1e-2 and
-    /// 2e-3, external clients at tol 1e-4, 1e-6, 1e-8, 1e-10 (four, so that a client ignoring
-    /// its tolerance is told) or h = 1e-2, 1e-3, 1e-4. The Rust tolerance ladders start at
+    /// run with every peer and two clients takes 8 min 39 s on two cores, BENCHMARK.md; most
+    /// of it Octave, Radau, BDF and Siconos): event and switch at tol 1e-3 … 1e-12,
+    /// Moreau–Jean at h = 1e-2 … 1e-4 (1-2-5), reference = event at tol 1e-13, median of up
+    /// to 15 runs within 0.3 s per point (a run longer than that is timed once); the scipy
+    /// peer at rtol = atol = 1e-4, 1e-7, 1e-10 (DOP853) and 1e-6, 1e-9 (Radau, BDF, LSODA),
+    /// Siconos at h = 1e-2 and 2e-3, external clients at tol 1e-4, 1e-6, 1e-8, 1e-10 (four,
+    /// so that a client ignoring its tolerance is told) or h = 1e-2, 1e-3, 1e-4. The Rust tolerance ladders start at
     /// 1e-3 so that the event solver has a point less accurate than scipy's loosest (tol
     /// 1e-4): the ratio there is then measured, not only bounded. (A scenario directory that
     /// cannot be read leaves the scene list empty: [`crate::run`] then says "no scene".)
@@ -291,7 +291,10 @@ impl Default for BenchOptions {
                 scipy: true,
                 python: "python3".into(),
                 scipy_tols: vec![1e-4, 1e-7, 1e-10],
-                scipy_method_tols: vec![1e-6, 1e-10],
+                // Radau and BDF at 1e-10 took a third of all client time in a full run (up
+                // to 60 s a run on one 200 s scene); 1e-9 costs about half and gives about a
+                // digit less (Radau at 1e-10: 7.7-10.6 digits on the suite).
+                scipy_method_tols: vec![1e-6, 1e-9],
                 siconos: true,
                 siconos_python: "/usr/bin/python3".into(),
                 // Each divides the 0.01 s grid; h = 1e-3 takes 7 s a run on a 200 s scene.
