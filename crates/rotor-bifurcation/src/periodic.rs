@@ -67,12 +67,13 @@ fn err(e: SolveError) -> BifError {
 }
 
 impl Shooter<'_> {
-    /// The section velocity `c(u) = ω*(u)`: the slipping equilibrium's velocity.
+    /// The section velocity `c(u) = ω*(u)`: the velocity of the slipping equilibrium nearest
+    /// rest.
     pub fn section_level(&self, u: f64) -> Result<f64, BifError> {
-        let eq = self.model.slip_equilibria(u);
-        eq.iter()
+        self.model
+            .slip_equilibrium_nearest_rest(u)
             .map(|e| e.omega)
-            .find(|w| *w > 0.0)
+            .filter(|w| *w > 0.0)
             .ok_or(BifError::NoEquilibrium { u })
     }
 

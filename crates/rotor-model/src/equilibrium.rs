@@ -68,13 +68,29 @@ impl Model {
     /// All slipping equilibria at input u, ordered by ω. The branch `u(ω)` can fold
     /// (falling friction), so several may exist; each is refined to machine precision.
     pub fn slip_equilibria(&self, u: f64) -> Vec<SlipEquilibrium> {
+        let mut out = self.scan_slip_equilibria(u, false);
+        out.sort_by(|a, b| a.omega.total_cmp(&b.omega));
+        out
+    }
+
+    /// The slipping equilibrium nearest rest at input u (smallest |ω|), if any: the first
+    /// of [`Model::slip_equilibria`]'s scan, found without the rest of it (the sections of
+    /// the continuation and the perturbed starts ask for this one only, thousands of times).
+    pub fn slip_equilibrium_nearest_rest(&self, u: f64) -> Option<SlipEquilibrium> {
+        self.scan_slip_equilibria(u, true).pop()
+    }
+
+    /// The roots of `u(sω) = u` (s = sign u) in scan order, |ω| increasing, on a grid in
+    /// |ω| dense near 0 (where the friction varies fastest) out to where the viscous growth
+    /// dominates every bounded friction term; each bracket bisected to adjacent doubles.
+    /// With `first`, the scan stops at the first root.
+    fn scan_slip_equilibria(&self, u: f64, first: bool) -> Vec<SlipEquilibrium> {
         if u == 0.0 {
             return Vec::new();
         }
         let s = u.signum();
         let bt = self.friction(crate::Disc::Lower).viscous()
             + self.friction(crate::Disc::Upper).viscous();
-        // Beyond ω_max the viscous growth dominates every bounded friction term.
         let bound = self.params.upper.t_s.abs()
             + self.params.upper.dt_s.abs()
             + self.friction(crate::Disc::Lower).level(0.0).abs()
@@ -88,7 +104,6 @@ impl Model {
             1e4
         };
         let g = |w: f64| self.slip_equilibrium_at(s * w).u - u;
-        // Grid dense near 0 (where the friction varies fastest), then linear.
         let n = 4000;
         let mut ws: Vec<f64> = (0..=n)
             .map(|i| {
@@ -107,9 +122,11 @@ impl Model {
                 let root = bisect(&g, prev.0, w, prev.1, gw);
                 out.push(self.slip_equilibrium_at(s * root));
             }
+            if first && !out.is_empty() {
+                break;
+            }
             prev = (w, gw);
         }
-        out.sort_by(|a, b| a.omega.total_cmp(&b.omega));
         out
     }
 
@@ -132,9 +149,7 @@ impl Model {
     /// or the middle of the stuck set (or rest) with it.
     pub fn perturbed_equilibrium(&self, u: f64) -> State {
         let base = self
-            .slip_equilibria(u)
-            .into_iter()
-            .min_by(|a, b| a.omega.abs().total_cmp(&b.omega.abs()))
+            .slip_equilibrium_nearest_rest(u)
             .map(|e| e.state())
             .or_else(|| {
                 self.stuck_equilibria(u)

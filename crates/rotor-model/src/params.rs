@@ -621,8 +621,10 @@ fn exponential_law_minimum(t_s: f64, t_1: f64, t_2: f64, w_1: f64, w_2: f64, b: 
     let w_max = 40.0 / w_1.min(w_2);
     let n = 9 * 64;
     let grid = |k: usize| w_max * 10f64.powf(-9.0 * (n - k) as f64 / n as f64);
+    // The law on the grid, each point once; the first of equal minima.
+    let values: Vec<f64> = (0..=n).map(|k| law(grid(k))).collect();
     let k = (0..=n)
-        .min_by(|&i, &j| law(grid(i)).total_cmp(&law(grid(j))))
+        .min_by(|&i, &j| values[i].total_cmp(&values[j]))
         .unwrap_or(n);
     let (mut a, mut c) = (grid(k.saturating_sub(1)), grid((k + 1).min(n)));
     if k == 0 {

@@ -556,6 +556,7 @@ pub trait Solver: Sync {
 }
 
 /// Checks a state for NaN/∞ and reports it as a [`SolveError::NonFinite`].
+#[inline]
 pub fn check_finite(t: f64, x: &State) -> Result<(), SolveError> {
     if x.iter().all(|v| v.is_finite()) {
         Ok(())
