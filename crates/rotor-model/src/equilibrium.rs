@@ -200,6 +200,36 @@ mod tests {
     use super::*;
     use approx::assert_relative_eq;
 
+    /// The equilibrium nearest rest is the one of smallest |ω| among all of them, bit for
+    /// bit (the same scan, stopped at its first root), on both parameter sets, for either
+    /// sign of u, and where the branch folds and several coexist; none where none exists.
+    #[test]
+    fn nearest_rest_is_the_smallest_of_all() {
+        let stribeck = crate::Params::from_file(
+            &std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+                .join("../../fixtures/params/stribeck.toml"),
+        )
+        .unwrap();
+        // Table 1 with a nearly frictionless upper disc: the lower law's falling part then
+        // makes u(ω) fold, with several equilibria over a band of u.
+        let folded = crate::Params::table1().with("upper.b", 1e-3).unwrap();
+        let mut several = 0;
+        for p in [crate::Params::table1(), stribeck, folded] {
+            let m = Model::new(p);
+            for i in -700..=700 {
+                let u = i as f64 * 0.01;
+                let all = m.slip_equilibria(u);
+                several += usize::from(all.len() > 1);
+                let smallest = all
+                    .iter()
+                    .copied()
+                    .min_by(|a, b| a.omega.abs().total_cmp(&b.omega.abs()));
+                assert_eq!(m.slip_equilibrium_nearest_rest(u), smallest, "u = {u}");
+            }
+        }
+        assert!(several > 0, "no input with several equilibria was tried");
+    }
+
     #[test]
     fn slip_equilibria_are_fixed_points() {
         let m = Model::table1();
