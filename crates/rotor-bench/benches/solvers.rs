@@ -12,7 +12,8 @@ use std::time::Duration;
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use rotor_bench::{SceneSpec, scene_of, solver, workspace_root};
-use rotor_model::{Model, Output, Scene};
+use rotor_model::Model;
+use rotor_seam::{Output, Scene};
 
 fn setup() -> (Model, Scene) {
     let spec = SceneSpec::table1_u15(&workspace_root(), 100.0);

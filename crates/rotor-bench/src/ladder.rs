@@ -4,8 +4,8 @@
 use rotor_grade::check::{Level, check};
 use rotor_grade::gridmetrics::{StickExit, grid_metrics};
 use rotor_grade::reference::Reference;
-use rotor_model::{Accuracy, Output, Scene, Stats};
 use rotor_scenario::Scenario;
+use rotor_seam::{Accuracy, Output, Scene, Stats};
 use serde::{Deserialize, Serialize};
 
 use crate::BenchError;
@@ -285,7 +285,7 @@ pub(crate) fn ladders(
 /// A run's trace and events graded as `rotor check` grades an external trace: whether they
 /// pass the loose and the strict level, and their digits (`None` where the grade cannot be
 /// made).
-fn graded(l: &Loaded, tr: &rotor_model::Trajectory) -> (Option<bool>, Option<bool>, Option<f64>) {
+fn graded(l: &Loaded, tr: &rotor_seam::Trajectory) -> (Option<bool>, Option<bool>, Option<f64>) {
     let (sc, r) = &l.view;
     let trace = rotor_grade::trace::Trace::of_run("run", tr.samples.clone());
     let events = rotor_grade::trace::EventsFile::of_run("run", &tr.events);

@@ -1,7 +1,7 @@
 //! Output levels: each solver's metrics-only, final-only and full-trace runs of the same
 //! scene, timed side by side.
 
-use rotor_model::{Output, SolveError};
+use rotor_seam::{Output, SolveError};
 use serde::{Deserialize, Serialize};
 
 use crate::BenchError;
@@ -138,7 +138,7 @@ pub(crate) fn output_levels(
 
 /// Largest `|m_a − m_b| / max(|m|, 1)` over the metrics of two runs; `None` if they differ in
 /// kind or one has none.
-fn metrics_difference(a: &rotor_model::Trajectory, b: &rotor_model::Trajectory) -> Option<f64> {
+fn metrics_difference(a: &rotor_seam::Trajectory, b: &rotor_seam::Trajectory) -> Option<f64> {
     match (a.metrics, b.metrics) {
         (Some(ma), Some(mb)) if ma.kind() == mb.kind() => Some(
             ma.values()

@@ -12,7 +12,7 @@
 //!   window on the common grid. The reference's own error is estimated by one run at a
 //!   tenfold tighter tolerance ([`ReferenceReport::check`]).
 //! * **Run time**: the median of repeated runs (`std::time::Instant`), after one untimed
-//!   warm-up; the work counters ([`rotor_model::Stats`]).
+//!   warm-up; the work counters ([`rotor_seam::Stats`]).
 //! * **Output levels**: per solver, metrics-only (`Output::Metrics`, which skips the periods
 //!   of a converged cycle), final-only (`Output::Final`) and the full trace
 //!   (`Output::Grid { dt: 0.01 }`), all with metrics, timed in turn.
@@ -45,8 +45,9 @@ mod report;
 mod results;
 mod word;
 
-use rotor_model::{Model, Output, Scene, SolveError};
+use rotor_model::Model;
 use rotor_scenario::ScenarioError;
+use rotor_seam::{Output, Scene, SolveError};
 use serde::{Deserialize, Serialize};
 use thiserror::Error;
 

@@ -2,7 +2,8 @@
 
 use std::time::Instant;
 
-use rotor_model::{OMEGA_L, Output, Scene, SolveError, Solver, SteadyState, Trajectory};
+use rotor_model::OMEGA_L;
+use rotor_seam::{Output, Scene, SolveError, Solver, SteadyState, Trajectory};
 use serde::{Deserialize, Serialize};
 
 use crate::options::SolverKind;

@@ -160,7 +160,7 @@ impl BenchReport {
     pub fn to_csv(&self) -> Result<String, BenchError> {
         self.check_finite()?;
         let mut w = csv::Writer::from_writer(Vec::new());
-        let counts = |st: &rotor_model::Stats| {
+        let counts = |st: &rotor_seam::Stats| {
             [
                 Some(st.steps),
                 Some(st.rejected),

@@ -10,8 +10,9 @@
 use rotor_event::EventSolver;
 use std::path::Path;
 
-use rotor_model::{Accuracy, Model, Output, Params, Scene, Solver, State};
+use rotor_model::{Model, Params, State};
 use rotor_moreau::MoreauSolver;
+use rotor_seam::{Accuracy, Output, Scene, Solver};
 use rotor_switch::SwitchSolver;
 
 // The crate replaces the global allocator; naming it here links it into this test binary.

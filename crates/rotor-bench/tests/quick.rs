@@ -96,7 +96,7 @@ fn the_reference_is_tight_enough() {
     )
     .unwrap()
     .state;
-    let rotor_model::SteadyState::LimitCycle {
+    let rotor_seam::SteadyState::LimitCycle {
         period,
         omega_l_max,
         ..

@@ -30,7 +30,8 @@
 //! selects the earlier central differences of the return maps instead (a check).
 
 use nalgebra::{Complex, Matrix3, Vector3};
-use rotor_model::{Output, Scene, Solver, State, SteadyState};
+use rotor_model::State;
+use rotor_seam::{Output, Scene, Solver, SteadyState};
 
 use crate::BifError;
 use crate::monodromy::order_multipliers;

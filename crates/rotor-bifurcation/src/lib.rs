@@ -40,7 +40,8 @@ pub mod periodic;
 mod points;
 mod svg;
 
-use rotor_model::{FieldError, SolveError};
+use rotor_model::FieldError;
+use rotor_seam::SolveError;
 use thiserror::Error;
 
 pub use diagram::{

@@ -41,7 +41,8 @@
 
 use nalgebra::{Complex, Matrix3, SVector, Vector3};
 use rotor_event::dop853::Dop853;
-use rotor_model::{Disc, DiscMode, Event, EventKind, Mode, Model, State};
+use rotor_model::{Disc, DiscMode, Mode, Model, State};
+use rotor_seam::{Event, EventKind};
 
 use crate::BifError;
 

@@ -20,7 +20,8 @@
 
 use nalgebra::{Complex, Matrix2, Matrix3, Vector2, Vector3};
 use rotor_event::{FlowEnd, StopAt, flow};
-use rotor_model::{Disc, DiscMode, Mode, Model, OMEGA_L, SolveError, State};
+use rotor_model::{Disc, DiscMode, Mode, Model, OMEGA_L, State};
+use rotor_seam::SolveError;
 
 use crate::BifError;
 use crate::monodromy::{self, Variational};
@@ -108,7 +109,7 @@ impl Shooter<'_> {
         let stuck = end
             .events
             .iter()
-            .any(|e| e.kind == rotor_model::EventKind::StickStart(Disc::Lower));
+            .any(|e| e.kind == rotor_seam::EventKind::StickStart(Disc::Lower));
         Ok((
             Return {
                 x: end.x,

@@ -21,7 +21,8 @@ use std::path::Path;
 use std::process::{Command, Stdio};
 use std::time::Instant;
 
-use rotor_model::{Model, Output, Scene, Solver};
+use rotor_model::Model;
+use rotor_seam::{Output, Scene, Solver};
 
 fn median(mut v: Vec<f64>) -> f64 {
     v.sort_by(f64::total_cmp);

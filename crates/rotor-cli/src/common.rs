@@ -94,7 +94,7 @@ pub(crate) fn parse_x0(s: Option<&str>) -> Result<State> {
 }
 
 /// Moreau–Jean steps whose step problem did not converge are answers to distrust: say so.
-pub(crate) fn warn_inexact(stats: &rotor_model::Stats) {
+pub(crate) fn warn_inexact(stats: &rotor_seam::Stats) {
     if let Some(w) = rotor_jobs::request::inexact_warning(stats, "--h") {
         eprintln!("warning: {w}");
     }

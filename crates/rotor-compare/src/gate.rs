@@ -8,8 +8,9 @@
 //! the transient window matched one to one within `event_time`.
 //! Every comparison is written `!(diff <= tol)` so that a NaN fails.
 
-use rotor_model::{Disc, EventKind, SteadyState, Trajectory};
+use rotor_model::Disc;
 use rotor_scenario::PairTolerance;
+use rotor_seam::{EventKind, SteadyState, Trajectory};
 
 use rotor_solvers::run::ScenarioResult;
 use rotor_solvers::solvers::{SolverKind, pair_name, pairs};
@@ -313,7 +314,8 @@ pub fn gate_scenario(r: &ScenarioResult) -> (Vec<GateResult>, Vec<Failure>) {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use rotor_model::{DiscMode, Mode, Sample, State, Stats};
+    use rotor_model::{DiscMode, Mode, State};
+    use rotor_seam::{Sample, Stats};
 
     /// A trajectory with samples every 0.01 s on [0, 1] and the given metrics.
     fn traj(metrics: Option<SteadyState>) -> Trajectory {
@@ -503,7 +505,7 @@ mod tests {
             ..PairTolerance::default()
         };
         let mut a = traj(None);
-        let ev = |t: f64, kind| rotor_model::Event {
+        let ev = |t: f64, kind| rotor_seam::Event {
             t,
             x: State::zeros(),
             kind,

@@ -4,8 +4,9 @@ use std::fmt::Write as _;
 use std::io::Write as _;
 use std::path::Path;
 
-use rotor_model::{Disc, Friction, Model, Params, Rounding, SteadyState, round_sig};
+use rotor_model::{Disc, Friction, Model, Params, Rounding, round_sig};
 use rotor_scenario::Scenario;
+use rotor_seam::SteadyState;
 
 use crate::gate::{Failure, GateResult, gate_scenario};
 use rotor_plot::{Panel, Series, render};

@@ -24,7 +24,8 @@
 
 use std::collections::BTreeMap;
 
-use rotor_model::{Rounding, Stats, SteadyState, round_sig};
+use rotor_model::{Rounding, round_sig};
+use rotor_seam::{Stats, SteadyState};
 use serde::Serialize;
 
 use rotor_solvers::run::ScenarioResult;

@@ -27,9 +27,9 @@ use std::fmt::Write as _;
 use std::time::Instant;
 
 use nalgebra::{Matrix4, Vector4};
-use rotor_model::{
-    Accuracy, Disc, Event, EventKind, LowerFriction, Model, OMEGA_L, Output, Params, Scene,
-    SolveError, State, Stats, SteadyState, Trajectory, UpperFriction,
+use rotor_model::{Disc, LowerFriction, Model, OMEGA_L, Params, State, UpperFriction};
+use rotor_seam::{
+    Accuracy, Event, EventKind, Output, Scene, SolveError, Stats, SteadyState, Trajectory,
 };
 
 use rotor_solvers::solvers::{SOLVERS, SolverKind};

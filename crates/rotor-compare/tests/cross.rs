@@ -1,9 +1,8 @@
 //! Cross-solver checks of single solver features against the event-driven reference (the
 //! solver crates test themselves; what needs a second solver lives here).
 
-use rotor_model::{
-    Accuracy, Disc, EventKind, Model, OMEGA_L, Output, Scene, Solver, State, Trajectory,
-};
+use rotor_model::{Disc, Model, OMEGA_L, State};
+use rotor_seam::{Accuracy, EventKind, Output, Scene, Solver, Trajectory};
 use rotor_solvers::SolverKind;
 
 /// `scene` run by `kind` at `setting`, its tolerance or its step.

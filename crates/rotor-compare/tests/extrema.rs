@@ -9,7 +9,8 @@
 //! Moreau–Jean extrema are sign changes of the discrete acceleration, whose rounding noise
 //! must not produce them either.
 
-use rotor_model::{Accuracy, Disc, EventKind, Model, Output, Scene, State};
+use rotor_model::{Disc, Model, State};
+use rotor_seam::{Accuracy, EventKind, Output, Scene};
 use rotor_solvers::{SOLVERS, SolverKind};
 
 #[test]

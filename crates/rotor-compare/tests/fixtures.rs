@@ -8,8 +8,9 @@ use std::sync::OnceLock;
 use rotor_compare::gate::gate_scenario;
 use rotor_compare::margins::{MAX_LOOSENESS, floor_violations, margins};
 use rotor_compare::snapshot::snapshot;
-use rotor_model::{Disc, Event, EventKind, State, SteadyState, Trajectory};
+use rotor_model::{Disc, State};
 use rotor_scenario::Scenario;
+use rotor_seam::{Event, EventKind, SteadyState, Trajectory};
 use rotor_solvers::{SOLVERS, ScenarioResult, SolverKind, pair_name, pairs, run_scenario};
 
 /// Every fixture through the three solvers, once per test binary (shared by the tests).
@@ -88,7 +89,7 @@ fn every_fixture_agrees_across_the_three_solvers_and_a_perturbation_is_caught() 
                     s.x[2] += 1e-5;
                 }
             }
-            if let Some(rotor_model::SteadyState::LimitCycle { period, .. }) = tr.metrics.as_mut() {
+            if let Some(rotor_seam::SteadyState::LimitCycle { period, .. }) = tr.metrics.as_mut() {
                 *period *= 1.0 + 1e-5;
             }
         }

@@ -15,9 +15,10 @@ use rotor_solvers::{Knob, SolverInfo, SolverKind, load_scenario_for, run_scenari
 
 /// The solver's "crate".
 mod euler {
-    use rotor_model::{
-        Disc, DiscMode, Event, EventKind, Integration, Mode, Model, Recorder, Scene, SolveError,
-        Solver, State, Stats, Trajectory, check_finite,
+    use rotor_model::{Disc, DiscMode, Mode, Model, State};
+    use rotor_seam::{
+        Event, EventKind, Integration, Recorder, Scene, SolveError, Solver, Stats, Trajectory,
+        check_finite,
     };
 
     /// Half-width of the stick band [rad/s].
@@ -249,7 +250,7 @@ fn a_fourth_solver_needs_its_crate_one_entry_and_its_tolerances() {
         .iter_mut()
         .find(|run| run.kind.name() == "euler")
         .unwrap();
-    if let Some(rotor_model::SteadyState::LimitCycle { period, .. }) =
+    if let Some(rotor_seam::SteadyState::LimitCycle { period, .. }) =
         run.result.as_mut().unwrap().metrics.as_mut()
     {
         *period *= 1.0 + 8e-4;

@@ -1,5 +1,5 @@
 //! `Output::Metrics`: a scene that asks for the steady state only skips whole periods once the
-//! orbit is on its cycle (`rotor_model::FastForward`). Its answer must be the solver's full-run
+//! orbit is on its cycle (`rotor_seam::FastForward`). Its answer must be the solver's full-run
 //! answer within what the skip may change (below); where nothing is skipped it must be the full
 //! run, bit for bit; and a skip that the return after it does not confirm must be undone. (The
 //! full runs pass the fixtures' agreement gates in `fixtures.rs`.)
@@ -8,9 +8,9 @@ use std::path::Path;
 use std::sync::OnceLock;
 
 use rotor_event::{EventOptions, EventSolver};
-use rotor_model::{Output, Scene, Solver, SteadyState, Trajectory};
 use rotor_moreau::{MoreauOptions, MoreauSolver};
 use rotor_scenario::Scenario;
+use rotor_seam::{Output, Scene, Solver, SteadyState, Trajectory};
 use rotor_solvers::run::scene_for;
 use rotor_solvers::{SOLVERS, SolverKind};
 use rotor_switch::{SwitchOptions, SwitchSolver};
@@ -226,7 +226,7 @@ fn a_skip_that_the_next_return_does_not_confirm_is_undone() {
         // Watching resumes after an undo: every attempt fails its check.
         assert_eq!(
             undone.stats.undone_skips,
-            u64::from(rotor_model::fast_forward::MAX_JUMPS),
+            u64::from(rotor_seam::fast_forward::MAX_JUMPS),
             "{name}"
         );
         assert!(matches!(

@@ -17,8 +17,9 @@
 //! tolerances at h = 1e-3 are derived from them (see the scenario files).
 
 use rotor_event::EventSolver;
-use rotor_model::{Accuracy, Disc, EventKind, Model, Output, Scene, Solver, State, SteadyState};
+use rotor_model::{Disc, Model, State};
 use rotor_moreau::{FrictionLevel, MoreauOptions, MoreauSolver};
+use rotor_seam::{Accuracy, EventKind, Output, Scene, Solver, SteadyState};
 
 const HS: [f64; 5] = [1e-2, 3e-3, 1e-3, 3e-4, 1e-4];
 
@@ -34,7 +35,7 @@ fn scene(accuracy: Accuracy) -> Scene {
     }
 }
 
-fn cycle(tr: &rotor_model::Trajectory, who: &str) -> (f64, f64) {
+fn cycle(tr: &rotor_seam::Trajectory, who: &str) -> (f64, f64) {
     match tr.metrics {
         Some(SteadyState::LimitCycle {
             period,
@@ -183,7 +184,7 @@ const WINDOW: (f64, f64) = (30.0, 34.6);
 const REF_DT: f64 = 1e-4;
 
 /// The lower disc's stick onsets in `[20, t_end]` (three cycles) of a run's events.
-fn onsets(tr: &rotor_model::Trajectory) -> Vec<f64> {
+fn onsets(tr: &rotor_seam::Trajectory) -> Vec<f64> {
     tr.events
         .iter()
         .filter(|e| e.kind == EventKind::StickStart(Disc::Lower) && e.t >= 20.0)
@@ -193,7 +194,7 @@ fn onsets(tr: &rotor_model::Trajectory) -> Vec<f64> {
 
 /// The scheme's own stick onsets: the first step end at which the scheme's one-step problem
 /// leaves the lower disc at rest (ω_l = 0 exactly) after a slipping step end, in `[20, t_end]`.
-fn step_onsets(tr: &rotor_model::Trajectory) -> Vec<f64> {
+fn step_onsets(tr: &rotor_seam::Trajectory) -> Vec<f64> {
     tr.samples
         .windows(2)
         .filter(|w| w[0].x[2] != 0.0 && w[1].x[2] == 0.0 && w[1].t >= 20.0)

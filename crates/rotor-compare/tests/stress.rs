@@ -19,9 +19,8 @@ use rotor_compare::stress::{
     Gate, MAX_LOOSENESS, Measure, Outcome, Setting, StressCase, StressRow, cases, full_from_env,
     linear_exact, run_case, stress_table_markdown,
 };
-use rotor_model::{
-    Accuracy, Event, LowerFriction, Model, Output, Params, Scene, State, UpperFriction,
-};
+use rotor_model::{LowerFriction, Model, Params, State, UpperFriction};
+use rotor_seam::{Accuracy, Event, Output, Scene};
 use rotor_solvers::{SOLVERS, SolverKind};
 
 #[test]
@@ -426,7 +425,7 @@ fn energy_check(
 }
 
 /// `max |x(−u, −x0) + x(u, x0)|` over two runs' samples (∞ if their grids differ).
-fn mirror_gap(a: &rotor_model::Trajectory, b: &rotor_model::Trajectory) -> f64 {
+fn mirror_gap(a: &rotor_seam::Trajectory, b: &rotor_seam::Trajectory) -> f64 {
     if a.samples.len() != b.samples.len() {
         return f64::INFINITY;
     }
@@ -541,7 +540,7 @@ fn stress_overflowing_input_is_refused_by_every_solver() {
         };
         for kind in SOLVERS {
             match kind.solver().simulate(&m, &scene) {
-                Err(rotor_model::SolveError::InvalidScene(e)) if e.field == "u" => {}
+                Err(rotor_seam::SolveError::InvalidScene(e)) if e.field == "u" => {}
                 other => panic!("{kind:?} at u = {u:e}: {other:?}"),
             }
         }
@@ -572,7 +571,7 @@ fn stress_rest_at_zero_input_stays_at_rest() {
 /// `|m_metrics − m_full|` allowed between a solver's metrics-only and full runs of metric
 /// `name` (100 s, metrics over [50, 100] s; tol 1e-10, h = 1e-3), where the two values are at
 /// most `scale = max(|m|, 1)`. The skip itself moves a metric by ≤ 2 tolerances
-/// (`rotor_model::fast_forward`); the rest is the difference of two integrations whose step
+/// (`rotor_seam::fast_forward`); the rest is the difference of two integrations whose step
 /// sequences differ, of the order of each run's own error. Measured over 1600 draws of this
 /// generator (two seeds, about 1000 of them skipping), relative to `scale`:
 /// * event ≤ 1.3e-8, switch ≤ 4.5e-10 (both tol 1e-10): gate 1e-7;
@@ -629,7 +628,8 @@ fn moreau_unresolved_slip(
     t_end: f64,
     period: f64,
 ) -> f64 {
-    use rotor_model::{Disc, EventKind, OMEGA_L};
+    use rotor_model::{Disc, OMEGA_L};
+    use rotor_seam::EventKind;
     let quantum = moreau_reversal_quantum(m, h);
     let mut total = 0.0;
     // The current slip phase: its start and its depth so far.
@@ -683,7 +683,7 @@ fn stress_random_parameters_metrics_only_matches_the_full_run() {
             let events = SolverKind::EVENT.solver().simulate(&m, &scene)
                 .map_err(|e| TestCaseError::fail(format!("event (events): {e}")))?;
             let reversal = events.events.iter()
-                .any(|e| e.t >= 50.0 && matches!(e.kind, rotor_model::EventKind::Reversal(_)));
+                .any(|e| e.t >= 50.0 && matches!(e.kind, rotor_seam::EventKind::Reversal(_)));
             let mut skipped = [false; 3];
             for (i, kind) in SOLVERS.into_iter().enumerate() {
                 let run = |output| kind.solver().simulate(&m, &Scene { output, ..scene })
@@ -697,7 +697,7 @@ fn stress_random_parameters_metrics_only_matches_the_full_run() {
                 }
                 // Moreau–Jean's stick time may also take in a slip below its resolution.
                 let merged = match (kind.name(), a) {
-                    ("moreau", rotor_model::SteadyState::LimitCycle { period, .. }) => {
+                    ("moreau", rotor_seam::SteadyState::LimitCycle { period, .. }) => {
                         let evs = &events.events;
                         moreau_unresolved_slip(&m, scene.step(), evs, 50.0, scene.t_end, period)
                     }
@@ -778,11 +778,11 @@ fn stress_moreau_reports_a_one_step_hold_between_opposite_slips_as_a_reversal() 
         output: Output::Events,
         metrics_from: Some(50.0),
     };
-    let reversals = |tr: &rotor_model::Trajectory| {
+    let reversals = |tr: &rotor_seam::Trajectory| {
         tr.events
             .iter()
             .filter(|e| {
-                e.t >= 50.0 && e.kind == rotor_model::EventKind::Reversal(rotor_model::Disc::Lower)
+                e.t >= 50.0 && e.kind == rotor_seam::EventKind::Reversal(rotor_model::Disc::Lower)
             })
             .count()
     };
@@ -792,8 +792,8 @@ fn stress_moreau_reports_a_one_step_hold_between_opposite_slips_as_a_reversal() 
     // something only if there are reversals to count).
     assert!(reversals(&event) >= 6, "{}", reversals(&event));
     assert_eq!(reversals(&moreau), reversals(&event));
-    let period = |tr: &rotor_model::Trajectory| match tr.metrics {
-        Some(rotor_model::SteadyState::LimitCycle { period, .. }) => period,
+    let period = |tr: &rotor_seam::Trajectory| match tr.metrics {
+        Some(rotor_seam::SteadyState::LimitCycle { period, .. }) => period,
         m => panic!("{m:?}"),
     };
     // Moreau–Jean is first order across a reversal (crate docs): its period within h of the
@@ -880,11 +880,11 @@ fn stress_an_extremum_of_one_disc_keeps_the_other_discs_stick() {
             assert!(
                 tr.events
                     .iter()
-                    .all(|e| e.kind != rotor_model::EventKind::Reversal(rotor_model::Disc::Lower)),
+                    .all(|e| e.kind != rotor_seam::EventKind::Reversal(rotor_model::Disc::Lower)),
                 "{}: the cycle does not reverse",
                 kind.name()
             );
-            let Some(rotor_model::SteadyState::LimitCycle {
+            let Some(rotor_seam::SteadyState::LimitCycle {
                 omega_l_min,
                 stick_time,
                 ..

@@ -28,9 +28,8 @@
 //! re-taken by an RK step to that time (the dense output's error is not controlled) and
 //! polished once more from there. A section crossing is refined as a terminal root.
 
-use rotor_model::{
-    Disc, DiscMode, Event, EventKind, Mode, Model, OMEGA_L, SolveError, State, Stats, check_finite,
-};
+use rotor_model::{Disc, DiscMode, Mode, Model, OMEGA_L, State};
+use rotor_seam::{Event, EventKind, SolveError, Stats, check_finite};
 use std::cell::Cell;
 
 use crate::dop853::{Dense, Dop853};
@@ -51,8 +50,8 @@ pub struct EventOptions {
     pub zeno_window: f64,
     /// Sample intervals per step for guard detection (at most 64).
     pub guard_samples: usize,
-    /// [`rotor_model::Output::Metrics`]: how close, in tolerances, the first return after
-    /// skipped periods must come to the return before them ([`rotor_model::FastForward`]);
+    /// [`rotor_seam::Output::Metrics`]: how close, in tolerances, the first return after
+    /// skipped periods must come to the return before them ([`rotor_seam::FastForward`]);
     /// 0 rejects every skip (a check of the undo).
     pub skip_verify: f64,
 }
@@ -65,7 +64,7 @@ impl Default for EventOptions {
             zeno_count: 64,
             zeno_window: 1e-9,
             guard_samples: 4,
-            skip_verify: rotor_model::fast_forward::VERIFY_TOLERANCES,
+            skip_verify: rotor_seam::fast_forward::VERIFY_TOLERANCES,
         }
     }
 }

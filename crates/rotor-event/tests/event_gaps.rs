@@ -5,10 +5,8 @@
 use std::path::Path;
 
 use rotor_event::{EventOptions, EventSolver, StopAt, flow};
-use rotor_model::{
-    Disc, DiscMode, EventKind, LowerFriction, Mode, Model, Output, Params, Scene, Solver, State,
-    UpperFriction,
-};
+use rotor_model::{Disc, DiscMode, LowerFriction, Mode, Model, Params, State, UpperFriction};
+use rotor_seam::{EventKind, Output, Scene, Solver};
 
 fn fixtures() -> std::path::PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../../fixtures")
@@ -19,7 +17,7 @@ fn stribeck() -> Model {
 }
 
 /// The mode switches among a run's events (extrema left out).
-fn switches(events: &[rotor_model::Event]) -> Vec<rotor_model::Event> {
+fn switches(events: &[rotor_seam::Event]) -> Vec<rotor_seam::Event> {
     events
         .iter()
         .filter(|e| !matches!(e.kind, EventKind::Max(_) | EventKind::Min(_)))

@@ -5,11 +5,9 @@ use std::path::Path;
 
 use nalgebra::{Matrix3, Vector3};
 use rotor_event::{EventOptions, EventSolver, SteadyOptions, steady_state};
-use rotor_model::{
-    Disc, EventKind, LowerFriction, Model, Output, Params, Scene, SolveError, Solver, State,
-    SteadyState,
-};
+use rotor_model::{Disc, LowerFriction, Model, Params, State};
 use rotor_scenario::Scenario;
+use rotor_seam::{EventKind, Output, Scene, SolveError, Solver, SteadyState};
 
 fn fixtures() -> std::path::PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../../fixtures")
@@ -62,7 +60,7 @@ fn frictionless_levels_match_matrix_exponential() {
     }
 }
 
-fn t1_events(u: f64, t_end: f64, tol: f64) -> Vec<rotor_model::Event> {
+fn t1_events(u: f64, t_end: f64, tol: f64) -> Vec<rotor_seam::Event> {
     let s = Scene {
         u,
         t_end,
@@ -511,7 +509,7 @@ fn sampling(n: usize) -> EventSolver {
 }
 
 /// The mode switches among a run's events (extrema left out).
-fn switches(events: &[rotor_model::Event]) -> Vec<rotor_model::Event> {
+fn switches(events: &[rotor_seam::Event]) -> Vec<rotor_seam::Event> {
     events
         .iter()
         .filter(|e| !matches!(e.kind, EventKind::Max(_) | EventKind::Min(_)))
@@ -734,7 +732,7 @@ fn a_start_on_the_stick_edge_with_rising_torque_leaves_at_once() {
         on.events
             .first()
             .is_some_and(|e| e.t == 0.0
-                && e.kind == rotor_model::EventKind::StickEnd(rotor_model::Disc::Lower)),
+                && e.kind == rotor_seam::EventKind::StickEnd(rotor_model::Disc::Lower)),
         "{:?}",
         on.events.first()
     );

@@ -11,8 +11,8 @@ use std::path::Path;
 
 use rotor_grade::check::{Level, check, reference_error};
 use rotor_grade::trace::{EventsFile, Trace};
-use rotor_model::{Output, Scene};
 use rotor_scenario::Scenario;
+use rotor_seam::{Output, Scene};
 use rotor_solvers::solvers::SolverKind;
 
 fn main() {

@@ -43,8 +43,9 @@
 
 use std::path::PathBuf;
 
-use rotor_model::{Disc, Event, EventKind, Sample, SteadyState};
+use rotor_model::Disc;
 use rotor_scenario::Scenario;
+use rotor_seam::{Event, EventKind, Sample, SteadyState};
 use serde::{Serialize, Serializer};
 
 use crate::gridmetrics::{STUCK, StickExit, grid_metrics};

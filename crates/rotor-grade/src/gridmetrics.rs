@@ -7,7 +7,7 @@
 //! is the difference between the two solutions.
 //!
 //! Over the samples in `[from, t_end]`, with the solvers' own definitions
-//! ([`rotor_model::MetricsAccumulator`]), each event located on the model's field from the
+//! ([`rotor_seam::MetricsAccumulator`]), each event located on the model's field from the
 //! sample before it (RK4, 200 steps per sample interval, within that interval):
 //!
 //! * the lower disc is stuck at a sample with |ω_l| ≤ [`STUCK`]. A stick phase starts where
@@ -19,7 +19,7 @@
 //!   cycle is reported: its period, its extremes of ω_l and ω_u (the extreme samples, moved
 //!   to the vertex of the parabola through their neighbours when they are strict local
 //!   extrema), and its stick time;
-//! * an ω_l range of at most [`rotor_model::steady::EQUILIBRIUM_AMPLITUDE`] (over the window,
+//! * an ω_l range of at most [`rotor_seam::steady::EQUILIBRIUM_AMPLITUDE`] (over the window,
 //!   over the last cycle, or over the last cycle's length at the end of the window, where a
 //!   focus has decayed), or fewer than two anchors, is an equilibrium: the last sample's
 //!   state.
@@ -34,8 +34,9 @@
 //! the solvers do matters too: a time-stepping solver's single periods jitter with where its
 //! steps fall, so another choice of anchor reads another period.
 
-use rotor_model::steady::EQUILIBRIUM_AMPLITUDE;
-use rotor_model::{Disc, DiscMode, Model, OMEGA_L, OMEGA_U, Sample, State, SteadyState};
+use rotor_model::{Disc, DiscMode, Model, OMEGA_L, OMEGA_U, State};
+use rotor_seam::steady::EQUILIBRIUM_AMPLITUDE;
+use rotor_seam::{Sample, SteadyState};
 
 /// |ω_l| at or below which a sample counts as stuck [rad/s]: an event-driven solver writes
 /// exactly 0, a time-stepping one its complementarity solver's rounding (≈ 1e-13 for
@@ -311,7 +312,7 @@ mod tests {
     /// The reconstruction on the event-driven solver's own 0.01 s trace against the metrics
     /// the solver located from its events: their largest difference per metric.
     fn reconstruction_error(u: f64) -> Vec<(&'static str, f64)> {
-        use rotor_model::{Output, Scene, Solver};
+        use rotor_seam::{Output, Scene, Solver};
         let m = Model::table1();
         let scene = Scene {
             u,

@@ -16,8 +16,9 @@
 //! The distance is measured in coordinates scaled by each variable's scale
 //! (`α/S_α, ω_u/S_u, ω_l/S_l`), so it is a relative error like the others.
 
-use rotor_model::{Output, Sample, Scene, SolveError, State};
+use rotor_model::State;
 use rotor_scenario::Scenario;
+use rotor_seam::{Output, Sample, Scene, SolveError};
 
 use rotor_solvers::solvers::SolverKind;
 

@@ -27,10 +27,9 @@
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
-use rotor_model::{
-    Accuracy, Event, Output, Rounding, Sample, Scene, SolveError, SteadyState, round_sig,
-};
+use rotor_model::{Rounding, round_sig};
 use rotor_scenario::Scenario;
+use rotor_seam::{Accuracy, Event, Output, Sample, Scene, SolveError, SteadyState};
 use serde::{Deserialize, Serialize};
 
 use crate::trace::{TraceError, parse_events, parse_trace, write_events};
@@ -139,7 +138,7 @@ impl Reference {
     /// A reference held in memory only (the benchmark's own reference run on its scene):
     /// the run's grid samples and mode-switch events, and the steady state it reached; no
     /// error is stated.
-    pub fn in_memory(sc: &Scenario, tr: &rotor_model::Trajectory, tol: f64) -> Reference {
+    pub fn in_memory(sc: &Scenario, tr: &rotor_seam::Trajectory, tol: f64) -> Reference {
         Reference {
             samples: tr.samples.clone(),
             events: switches(&tr.events),
@@ -172,7 +171,7 @@ impl Reference {
 }
 
 /// The reference run of a scenario at tolerance `tol`: grid samples, events, metrics.
-fn event_run(sc: &Scenario, tol: f64) -> Result<rotor_model::Trajectory, ReferenceError> {
+fn event_run(sc: &Scenario, tol: f64) -> Result<rotor_seam::Trajectory, ReferenceError> {
     let scene = Scene {
         accuracy: Accuracy::Tol(tol),
         ..sc.scene(Output::Grid { dt: sc.compare.dt })
@@ -223,8 +222,8 @@ fn event_difference(a: &[Event], b: &[Event]) -> f64 {
 
 /// The differences of a run from the reference, per quantity (∞ where not comparable).
 fn differences(
-    r: &rotor_model::Trajectory,
-    reference: &rotor_model::Trajectory,
+    r: &rotor_seam::Trajectory,
+    reference: &rotor_seam::Trajectory,
 ) -> BTreeMap<String, f64> {
     let d = trace_differences(&r.samples, &reference.samples);
     let mut out: BTreeMap<String, f64> = ["alpha", "omega_u", "omega_l"]

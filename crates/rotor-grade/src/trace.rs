@@ -12,7 +12,8 @@
 use std::io::Read;
 use std::path::{Path, PathBuf};
 
-use rotor_model::{Disc, Event, EventKind, Sample, State};
+use rotor_model::{Disc, State};
+use rotor_seam::{Event, EventKind, Sample};
 use thiserror::Error;
 
 /// The header of a trace file.

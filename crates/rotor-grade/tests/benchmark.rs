@@ -8,8 +8,8 @@ use rayon::prelude::*;
 use rotor_grade::check::{CheckError, Level, check};
 use rotor_grade::reference::{self, Reference};
 use rotor_grade::trace::{EventsFile, Trace, parse_events, parse_trace, write_events, write_trace};
-use rotor_model::{Accuracy, Trajectory};
 use rotor_scenario::Scenario;
+use rotor_seam::{Accuracy, Trajectory};
 use rotor_solvers::{SolverKind, load_scenario, run::scene_for};
 
 fn fixtures() -> PathBuf {
@@ -124,7 +124,7 @@ fn every_solver_passes_check_at_its_level() {
         .flat_map(|sc| {
             let r = stored(sc);
             let mut out = Vec::new();
-            let tight = rotor_model::Scene {
+            let tight = rotor_seam::Scene {
                 accuracy: Accuracy::Tol(1e-11),
                 ..scene_for(SolverKind::EVENT, sc)
             };

@@ -9,8 +9,8 @@ use rotor_grade::check::{
 };
 use rotor_grade::reference::{self, Reference};
 use rotor_grade::trace::{EventsFile, Trace, parse_trace};
-use rotor_model::{Event, Scene};
 use rotor_scenario::Scenario;
+use rotor_seam::{Event, Scene};
 use rotor_solvers::{SolverKind, load_scenario, run::scene_for};
 
 fn fixtures() -> PathBuf {
@@ -290,7 +290,7 @@ fn stick_intervals_are_graded_from_the_grid() {
     let ons: Vec<f64> = r
         .events
         .iter()
-        .filter(|e| e.kind == rotor_model::EventKind::StickStart(rotor_model::Disc::Lower))
+        .filter(|e| e.kind == rotor_seam::EventKind::StickStart(rotor_model::Disc::Lower))
         .map(|e| e.t)
         .collect();
     for level in LEVELS {
@@ -351,7 +351,7 @@ fn unsorted_out_of_range_and_unmatched_events() {
         .to_string();
     assert!(m.contains("outside [0, 200]"), "{m}");
     let mut e = ev.clone();
-    e.events[7].kind = rotor_model::EventKind::Reversal(rotor_model::Disc::Lower);
+    e.events[7].kind = rotor_seam::EventKind::Reversal(rotor_model::Disc::Lower);
     let rep = grade(&sc, &r, &t, Some(&e), Level::Loose);
     let q = rep.quantities.iter().find(|q| q.name == "events").unwrap();
     let note = q.note.as_deref().unwrap();

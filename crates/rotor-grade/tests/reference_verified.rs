@@ -25,8 +25,9 @@ use std::path::{Path, PathBuf};
 use independent::{Ev, Problem, Run, Tableau};
 use rayon::prelude::*;
 use rotor_grade::reference;
-use rotor_model::{Disc, EventKind, OMEGA_L, OMEGA_U, State, SteadyState};
+use rotor_model::{Disc, OMEGA_L, OMEGA_U, State};
 use rotor_scenario::Scenario;
+use rotor_seam::{EventKind, SteadyState};
 
 fn fixtures() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../../fixtures")
@@ -36,7 +37,7 @@ fn fixtures() -> PathBuf {
 const STAGES: usize = 5;
 
 /// The amplitude of ω_l under which an oscillation counts as an equilibrium (the metrics'
-/// definition, docs/design.md: rotor_model::steady::EQUILIBRIUM_AMPLITUDE).
+/// definition, docs/design.md: rotor_seam::steady::EQUILIBRIUM_AMPLITUDE).
 const EQUILIBRIUM_AMPLITUDE: f64 = 1e-6;
 
 /// The steady state of a run as the reference defines it: the last complete cycle in the

@@ -7,8 +7,9 @@
 //! ([`check_number`], [`solver_kind`]); each front end only spells the name its own way
 //! ([`FieldError::as_flag`] for the command line, `name = value` for Python).
 
-use rotor_model::scene::{DEFAULT_STEP, DEFAULT_TOL};
-use rotor_model::{Accuracy, FieldError, Num, Output, Scene, State, Stats};
+use rotor_model::{FieldError, Num, State};
+use rotor_seam::scene::{DEFAULT_STEP, DEFAULT_TOL};
+use rotor_seam::{Accuracy, Output, Scene, Stats};
 
 use rotor_solvers::{Knob, SolverKind};
 pub use rotor_solvers::{check_number, solver_kind};

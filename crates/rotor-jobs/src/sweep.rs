@@ -17,7 +17,8 @@ use std::io::{BufRead, Read, Write};
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
 
-use rotor_model::{Attractor, FieldError, Model, Output, Params, Scene, State, SteadyState};
+use rotor_model::{FieldError, Model, Params, State};
+use rotor_seam::{Attractor, Output, Scene, SteadyState};
 
 use rotor_solvers::solvers::SolverKind;
 

@@ -1,14 +1,13 @@
 //! Bad parameter files: every kind of bad input is an error, never a panic, and its message
 //! is one line that names the file, the field and the offending value. (Bad scenario files
-//! are rotor-scenario's tests/bad_input.rs.)
+//! are rotor-scenario's tests/bad_input.rs; bad scenes, rotor-seam's.)
 //!
 //! Each case is a mutation of a real fixture file, written to a temporary directory and read
 //! back through `from_file`, so that the path in the message is the path of the file. The
 //! cases that the `rotor` binary is held to as well are in `rotor-testkit`
 //! ([`bad_params_cases`]); the ones here are the library's own.
 
-use rotor_model::scene::MAX_GRID_ROWS;
-use rotor_model::{Accuracy, Output, Params, Scene};
+use rotor_model::Params;
 use rotor_testkit::{STRIBECK, TABLE1, bad_params_cases, check_message, edit, tmp_dir};
 
 /// Writes a parameter file and expects an error.
@@ -67,49 +66,4 @@ fn control_characters_in_params_paths_are_escaped() {
     let odd = tmp_dir("rotor-model-bad-input").join("a\rb.toml");
     let e = Params::from_file(&odd).unwrap_err().to_string();
     assert!(!e.contains('\r') && e.contains("a\\rb.toml"), "{e}");
-}
-
-#[test]
-fn scene_tolerance_below_roundoff_is_refused() {
-    use rotor_model::scene::MIN_TOL;
-    let at = |tol| {
-        Scene {
-            ..Scene::with_tol(tol)
-        }
-        .validate()
-    };
-    assert!(at(1e-13).is_ok());
-    assert!(at(MIN_TOL).is_ok());
-    let e = at(1e-20).unwrap_err().to_string();
-    assert!(e.contains("tol = 1e-20") && e.contains("roundoff"), "{e}");
-}
-
-#[test]
-fn scene_grid_that_would_exhaust_memory_is_refused() {
-    let ok = Scene {
-        t_end: 100.0,
-        output: Output::Grid {
-            dt: 100.0 / MAX_GRID_ROWS,
-        },
-        ..Scene::default()
-    };
-    ok.validate().unwrap();
-    let e = Scene {
-        output: Output::Grid { dt: 1e-12 },
-        ..ok.clone()
-    }
-    .validate()
-    .unwrap_err()
-    .to_string();
-    assert!(e.contains("dt = 1e-12") && e.contains("1e7"), "{e}");
-    let e = Scene {
-        t_end: 1e300,
-        accuracy: Accuracy::Step(1.0),
-        output: Output::Grid { dt: 1.0 },
-        ..ok
-    }
-    .validate()
-    .unwrap_err()
-    .to_string();
-    assert!(e.contains("dt = 1"), "{e}");
 }

@@ -2,9 +2,10 @@
 //! ends (stick onsets and exits, reversals, extrema), released in time order to the
 //! [`Recorder`], which keeps what the scene asks for and drives the metrics-only skip.
 
-use rotor_model::{
-    Disc, DiscMode, Event, EventKind, FieldError, Integration, Mode, Model, Recorder, Scene,
-    SolveError, Solver, State, Stats, Trajectory, check_finite,
+use rotor_model::{Disc, DiscMode, FieldError, Mode, Model, State};
+use rotor_seam::{
+    Event, EventKind, Integration, Recorder, Scene, SolveError, Solver, Stats, Trajectory,
+    check_finite,
 };
 
 use crate::stepper::{StepSize, Stepper};

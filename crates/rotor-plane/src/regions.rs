@@ -3,7 +3,8 @@
 //! bands of one name in neighbouring columns are joined into one [`Region`].
 
 use rotor_bifurcation::BifError;
-use rotor_model::{Attractor, Model, Output, Params, Scene, Solver, State};
+use rotor_model::{Model, Params, State};
+use rotor_seam::{Attractor, Output, Scene, Solver};
 use serde::Serialize;
 
 use crate::curves::Curve;

@@ -25,7 +25,8 @@ use rotor_bifurcation::{BifError, DiagramOptions};
 use rotor_grade::check::{GradeError, Level};
 use rotor_grade::trace::{EventsFile, Trace, disc_name, event_row, round_to, time_digits};
 use rotor_jobs::request::Request;
-use rotor_model::{FieldError, Model, Params, Stats};
+use rotor_model::{FieldError, Model, Params};
+use rotor_seam::Stats;
 use rotor_steady::{SettleError, SteadyAnswer, SteadyError};
 
 pyo3::create_exception!(
@@ -79,9 +80,9 @@ fn solve_error(py: Python<'_>, message: String, t: Option<f64>, state: Option<[f
     err
 }
 
-fn from_solve(py: Python<'_>, e: rotor_model::SolveError) -> PyErr {
+fn from_solve(py: Python<'_>, e: rotor_seam::SolveError) -> PyErr {
     match e {
-        rotor_model::SolveError::InvalidScene(_) => value_error(e),
+        rotor_seam::SolveError::InvalidScene(_) => value_error(e),
         _ => solve_error(py, e.to_string(), e.time(), e.state()),
     }
 }
@@ -277,7 +278,7 @@ struct Columns {
 impl Columns {
     /// The samples as `rotor simulate` writes them: times rounded to the grid's decimals
     /// ([`time_digits`]), states as computed; the mode switches as in an events file.
-    fn of(tr: rotor_model::Trajectory, dt: f64) -> Columns {
+    fn of(tr: rotor_seam::Trajectory, dt: f64) -> Columns {
         let digits = time_digits(dt);
         let n = tr.samples.len();
         let mut c = Columns {
@@ -673,7 +674,7 @@ fn _solve_seconds(
                 drop(tr);
                 Ok(s)
             })
-            .collect::<Result<Vec<f64>, rotor_model::SolveError>>()
+            .collect::<Result<Vec<f64>, rotor_seam::SolveError>>()
     })?
     .map_err(|e| from_solve(py, e))
 }

@@ -3,7 +3,7 @@
 use serde::Deserialize;
 
 use rotor_model::Num;
-use rotor_model::scene::MAX_GRID_ROWS;
+use rotor_seam::scene::MAX_GRID_ROWS;
 
 use crate::error::{Bad, ScenarioError};
 

@@ -29,8 +29,8 @@ use std::path::{Path, PathBuf};
 use serde::Deserialize;
 
 use rotor_model::params::{Params, one_line, read_small, text_of};
-use rotor_model::scene::{DEFAULT_STEP, MIN_TOL, Output, Scene};
 use rotor_model::{FieldError, Model, Num, State};
+use rotor_seam::scene::{DEFAULT_STEP, MIN_TOL, Output, Scene};
 
 use crate::compare::CompareSpec;
 use crate::error::{Bad, ScenarioError};
@@ -392,7 +392,7 @@ mod tests {
     /// Every metric of both kinds of steady state has exactly one key, and no key gates two.
     #[test]
     fn one_key_per_steady_metric() {
-        use rotor_model::SteadyState;
+        use rotor_seam::SteadyState;
         let cycle = SteadyState::LimitCycle {
             period: 1.0,
             omega_l_max: 1.0,

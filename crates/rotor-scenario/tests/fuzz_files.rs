@@ -11,8 +11,8 @@ use std::path::{Path, PathBuf};
 use std::sync::OnceLock;
 
 use proptest::prelude::*;
-use rotor_model::{Accuracy, Output, Scene};
 use rotor_scenario::Scenario;
+use rotor_seam::{Accuracy, Output, Scene};
 use rotor_testkit::mutate::{Mutation, apply, mutation};
 
 /// The real scenario files, as `(relative path, text)`.

@@ -25,8 +25,9 @@
 //! the cycle or from the continuation's restart state.
 //!
 //! ```no_run
-//! # fn f(solver: &dyn rotor_model::Solver) -> Result<(), rotor_shoot::ShootError> {
-//! use rotor_model::{Model, Scene, State};
+//! # fn f(solver: &dyn rotor_seam::Solver) -> Result<(), rotor_shoot::ShootError> {
+//! use rotor_model::{Model, State};
+//! use rotor_seam::Scene;
 //! let model = Model::table1();
 //! let scene = Scene { u: 1.5, ..Scene::with_tol(1e-10) };
 //! let (section, z) = rotor_shoot::Section::of_run(solver, &model, &scene, State::zeros(), 200.0)?;
@@ -37,9 +38,8 @@
 
 #![warn(missing_docs)]
 
-use rotor_model::{
-    Disc, EventKind, Model, OMEGA_L, OMEGA_U, Output, Scene, SolveError, Solver, State,
-};
+use rotor_model::{Disc, Model, OMEGA_L, OMEGA_U, State};
+use rotor_seam::{EventKind, Output, Scene, SolveError, Solver};
 
 /// Where a cycle is cut.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

@@ -3,7 +3,8 @@
 //! subcritical Hopf point H2 against the continuation's (rotor-bifurcation: event-driven
 //! flow with saltation matrices, an independent method).
 
-use rotor_model::{Model, Scene, Solver, State, SteadyState};
+use rotor_model::{Model, State};
+use rotor_seam::{Scene, Solver, SteadyState};
 use rotor_shoot::{Section, ShootOptions, shoot};
 
 fn solvers() -> Vec<(&'static str, Box<dyn Solver>)> {

@@ -2,8 +2,9 @@
 
 use std::time::Instant;
 
-use rotor_model::{Model, Output, Scene, SolveError, Trajectory};
+use rotor_model::Model;
 use rotor_scenario::Scenario;
+use rotor_seam::{Output, Scene, SolveError, Trajectory};
 
 use crate::solvers::{Knob, SOLVERS, SolverKind};
 

@@ -7,9 +7,9 @@
 //! plot styles, ladders, the CLI's `--solver` names. Adding a solver is one crate, one entry
 //! here, and its tolerances in the fixtures (`CONTRIBUTING.md`; a test adds a fourth one).
 
-use rotor_model::scene::{DEFAULT_STEP, DEFAULT_TOL};
-use rotor_model::{Accuracy, Solver};
 use rotor_scenario::{Scenario, ScenarioError};
+use rotor_seam::scene::{DEFAULT_STEP, DEFAULT_TOL};
+use rotor_seam::{Accuracy, Solver};
 use serde::{Serialize, Serializer};
 
 /// What a solver's accuracy setting is.
@@ -171,11 +171,12 @@ impl SolverKind {
         self.0.knob.accuracy(setting)
     }
 
-    /// The solver, with its default options. Every solver runs a [`rotor_model::Scene`]
-    /// through [`Solver::simulate`] and returns a [`rotor_model::Trajectory`]:
+    /// The solver, with its default options. Every solver runs a [`rotor_seam::Scene`]
+    /// through [`Solver::simulate`] and returns a [`rotor_seam::Trajectory`]:
     ///
     /// ```
-    /// use rotor_model::{Model, Output, Scene};
+    /// use rotor_model::Model;
+    /// use rotor_seam::{Output, Scene};
     /// use rotor_solvers::SOLVERS;
     /// let scene = Scene { u: 1.5, t_end: 20.0, output: Output::Grid { dt: 0.01 }, ..Scene::default() };
     /// for kind in SOLVERS {

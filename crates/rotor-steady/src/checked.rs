@@ -41,8 +41,9 @@
 //! wait 20 000 s for a slow transient.
 
 use nalgebra::Complex;
-use rotor_model::{Disc, EventKind, Model, OMEGA_L, OMEGA_U, Output, Scene, Solver, State};
-use rotor_model::{Event, SteadyState};
+use rotor_model::{Disc, Model, OMEGA_L, OMEGA_U, State};
+use rotor_seam::{Event, SteadyState};
+use rotor_seam::{EventKind, Output, Scene, Solver};
 use rotor_shoot::{Orbit, Section, ShootOptions, shoot};
 use rotor_solvers::SolverKind;
 

@@ -4,7 +4,8 @@
 //! shooting options for a period, the diagram row of a shot orbit).
 
 use rotor_bifurcation::PeriodicRow;
-use rotor_model::{Accuracy, Disc, EventKind, Model, OMEGA_L, OMEGA_U, Output, Scene, SteadyState};
+use rotor_model::{Disc, Model, OMEGA_L, OMEGA_U};
+use rotor_seam::{Accuracy, EventKind, Output, Scene, SteadyState};
 use rotor_shoot::{Orbit, Section, ShootOptions};
 use rotor_solvers::{Knob, SolverKind};
 use serde::Serialize;
@@ -70,7 +71,7 @@ pub(crate) fn shoot_opts(period: f64) -> ShootOptions {
 /// 1.2 periods (plus 0.2 s): a start for shooting. One crossing rather than a settled run, so
 /// that an unstable orbit's start has not drifted from it.
 pub(crate) fn first_crossing(
-    solver: &dyn rotor_model::Solver,
+    solver: &dyn rotor_seam::Solver,
     model: &Model,
     scene: &Scene,
     x: [f64; 3],
@@ -121,7 +122,7 @@ pub(crate) fn section_of(row: &PeriodicRow) -> Section {
 /// The diagram row of a shot orbit: its metrics read off a run over two periods from the
 /// fixed point, and its multipliers `[1, λ, 0]` (stick exit) or `[1, λ1, λ2]`.
 pub(crate) fn row_of(
-    solver: &dyn rotor_model::Solver,
+    solver: &dyn rotor_seam::Solver,
     model: &Model,
     scene: &Scene,
     orbit: &Orbit,

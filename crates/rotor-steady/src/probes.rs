@@ -18,7 +18,8 @@
 use rotor_bifurcation::continuation::{ContOptions, Continuer};
 use rotor_bifurcation::periodic::Shooter;
 use rotor_bifurcation::{Diagram, PointKind};
-use rotor_model::{Attractor, Model, Scene, State, SteadyState};
+use rotor_model::{Model, State};
+use rotor_seam::{Attractor, Scene, SteadyState};
 
 use crate::checked::{CheckOptions, checked_shot};
 use crate::steady::{SteadyAnswer, SteadyError, SteadyOptions, steady};
@@ -352,7 +353,7 @@ fn refusal(e: &SteadyError) -> Option<&'static str> {
         SteadyError::Neutral { .. } => Some("stability undecided"),
         SteadyError::NotReached { .. } | SteadyError::Unconfirmed { .. } => Some("slow transient"),
         SteadyError::Shoot(_) => Some("no orbit by shooting"),
-        SteadyError::Solve(rotor_model::SolveError::NoConvergence { detail }) => {
+        SteadyError::Solve(rotor_seam::SolveError::NoConvergence { detail }) => {
             Some(if detail.contains("no cycle near the orbit") {
                 "weakly unstable equilibrium"
             } else {

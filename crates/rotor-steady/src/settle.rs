@@ -9,7 +9,8 @@
 //! point — is followed until it has decayed, or reported as not settled at `max_time`,
 //! instead of as a limit cycle.
 
-use rotor_model::{Model, Output, Scene, SolveError, Stats, SteadyState};
+use rotor_model::Model;
+use rotor_seam::{Output, Scene, SolveError, Stats, SteadyState};
 
 use rotor_solvers::solvers::SolverKind;
 
@@ -357,7 +358,7 @@ pub fn settle(
             let projection = if geometric {
                 Some((q, ((rel * (1.0 - q) / c).ln() / q.ln()).ceil()))
             } else if decaying {
-                let a_eq = rotor_model::steady::EQUILIBRIUM_AMPLITUDE;
+                let a_eq = rotor_seam::steady::EQUILIBRIUM_AMPLITUDE;
                 Some((r, (a_eq / range).ln() / r.ln() + 2.0))
             } else {
                 None
@@ -453,7 +454,7 @@ mod tests {
             .unwrap();
         assert_eq!(
             one_run.metrics.unwrap().kind(),
-            rotor_model::SteadyKind::LimitCycle
+            rotor_seam::SteadyKind::LimitCycle
         );
         for kind in [SolverKind::SWITCH, SolverKind::MOREAU] {
             let s = settle(kind, &m, &base(u), &SettleOptions::default()).unwrap();

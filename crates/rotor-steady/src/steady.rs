@@ -15,7 +15,8 @@
 use nalgebra::Complex;
 use rotor_bifurcation::continuation::{ContOptions, Continuer};
 use rotor_bifurcation::periodic::{Shooter, T_RETURN};
-use rotor_model::{Model, Scene, SolveError, State, Stats, SteadyState};
+use rotor_model::{Model, State};
+use rotor_seam::{Scene, SolveError, Stats, SteadyState};
 use serde::Serialize;
 
 use crate::settle::{SettleError, SettleOptions, settle};
@@ -189,7 +190,8 @@ pub enum SteadyError {
 /// settle and finds the same cycle to O(h²).
 ///
 /// ```
-/// use rotor_model::{Model, Scene, State, SteadyState};
+/// use rotor_model::{Model, State};
+/// use rotor_seam::{Scene, SteadyState};
 /// use rotor_solvers::SolverKind;
 /// use rotor_steady::{SteadyMethod, steady};
 ///
@@ -261,7 +263,7 @@ pub fn shot(kind: SolverKind, model: &Model, scene: &Scene) -> Result<SteadyAnsw
         &Scene {
             x0: orbit.x,
             t_end,
-            output: rotor_model::Output::Final,
+            output: rotor_seam::Output::Final,
             metrics_from: Some(0.0),
             ..scene.clone()
         },
@@ -273,7 +275,7 @@ pub fn shot(kind: SolverKind, model: &Model, scene: &Scene) -> Result<SteadyAnsw
 /// `t_end` long) and the orbit's multipliers, with the trivial one first.
 pub(crate) fn shot_answer(
     orbit: &rotor_shoot::Orbit,
-    run: rotor_model::Trajectory,
+    run: rotor_seam::Trajectory,
     t_end: f64,
 ) -> Result<SteadyAnswer, SteadyError> {
     let state = run

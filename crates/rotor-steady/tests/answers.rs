@@ -5,7 +5,8 @@
 //! below); and the answer's JSON. (Integration tests: the Hopf test judges `steady` by the
 //! probes' attractors, and the probes use `steady`.)
 
-use rotor_model::{Attractor, Model, Scene, SteadyKind, SteadyState};
+use rotor_model::Model;
+use rotor_seam::{Attractor, Scene, SteadyKind, SteadyState};
 use rotor_solvers::SolverKind;
 use rotor_steady::probes::{Expected, expected};
 use rotor_steady::{SteadyAnswer, SteadyMethod, SteadyOptions, steady};

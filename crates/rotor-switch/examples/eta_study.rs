@@ -9,8 +9,9 @@
 use std::path::Path;
 use std::time::Instant;
 
-use rotor_model::{Model, Output, Scene, Solver};
+use rotor_model::Model;
 use rotor_scenario::Scenario;
+use rotor_seam::{Output, Scene, Solver};
 use rotor_switch::{SwitchOptions, SwitchSolver};
 
 fn main() {

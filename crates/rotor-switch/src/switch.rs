@@ -1,8 +1,9 @@
 //! The switch-model field, its guards, and the event-located integration loop.
 
-use rotor_model::{
-    Disc, DiscMode, Event, EventKind, FieldError, Integration, Mode, Model, OMEGA_L, OMEGA_U,
-    Recorder, Scene, SolveError, Solver, State, Stats, Trajectory, check_finite,
+use rotor_model::{Disc, DiscMode, FieldError, Mode, Model, OMEGA_L, OMEGA_U, State};
+use rotor_seam::{
+    Event, EventKind, Integration, Recorder, Scene, SolveError, Solver, Stats, Trajectory,
+    check_finite,
 };
 
 use crate::dopri5::{Dopri5, Dopri5Error, Dopri5Options};
@@ -39,8 +40,8 @@ pub struct SwitchOptions {
     pub zeno_count: u32,
     /// Zeno guard window, in s.
     pub zeno_window: f64,
-    /// [`rotor_model::Output::Metrics`]: how close, in tolerances, the first return after
-    /// skipped periods must come to the return before them ([`rotor_model::FastForward`]);
+    /// [`rotor_seam::Output::Metrics`]: how close, in tolerances, the first return after
+    /// skipped periods must come to the return before them ([`rotor_seam::FastForward`]);
     /// 0 rejects every skip (a check of the undo).
     pub skip_verify: f64,
 }
@@ -54,7 +55,7 @@ impl Default for SwitchOptions {
             guard_samples: 5,
             zeno_count: 1000,
             zeno_window: 1e-9,
-            skip_verify: rotor_model::fast_forward::VERIFY_TOLERANCES,
+            skip_verify: rotor_seam::fast_forward::VERIFY_TOLERANCES,
         }
     }
 }

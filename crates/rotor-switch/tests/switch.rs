@@ -2,11 +2,11 @@
 
 use std::path::{Path, PathBuf};
 
-use rotor_model::{
-    Accuracy, Disc, EventKind, Model, OMEGA_L, OMEGA_U, Output, OutputGrid, Scene, SolveError,
-    Solver, SteadyState, Trajectory,
-};
+use rotor_model::{Disc, Model, OMEGA_L, OMEGA_U};
 use rotor_scenario::Scenario;
+use rotor_seam::{
+    Accuracy, EventKind, Output, OutputGrid, Scene, SolveError, Solver, SteadyState, Trajectory,
+};
 use rotor_switch::{SwitchOptions, SwitchSolver};
 
 fn solver(eta: f64) -> SwitchSolver {

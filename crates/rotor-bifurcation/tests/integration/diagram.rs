@@ -5,7 +5,8 @@ use rotor_bifurcation::equilibria::{complex_pair, hopf_points, omega_reaching};
 use rotor_bifurcation::periodic::{Shooter, eig2};
 use rotor_bifurcation::{Diagram, DiagramOptions, diagram, start_point};
 use rotor_event::{EventOptions, SteadyOptions, steady_state};
-use rotor_model::{Model, State, SteadyState};
+use rotor_model::{Model, State};
+use rotor_seam::SteadyState;
 
 use crate::common::{cont_options, model, points, st_diagram, t1_diagram};
 
@@ -268,7 +269,7 @@ fn stribeck_diagram_structure() {
 
 #[test]
 fn hysteresis_of_a_brute_force_sweep_matches_the_bistable_window() {
-    use rotor_model::{Output, Scene, Solver};
+    use rotor_seam::{Output, Scene, Solver};
     let d = t1_diagram();
     let hopf = points(d, "hopf")[1].u;
     let fold = points(d, "fold")[0].u;

@@ -7,7 +7,8 @@ use rotor_bifurcation::continuation::{Continuer, End};
 use rotor_bifurcation::equilibria::{hopf_points, omega_reaching};
 use rotor_bifurcation::periodic::{SectionDerivs, Shooter, eig2};
 use rotor_bifurcation::start_point;
-use rotor_model::{Disc, EventKind, State};
+use rotor_model::{Disc, State};
+use rotor_seam::EventKind;
 
 use crate::common::{cont_options, model};
 

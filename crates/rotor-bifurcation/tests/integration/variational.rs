@@ -8,7 +8,8 @@
 use nalgebra::{Matrix3, Vector3};
 use rotor_bifurcation::monodromy::{Variational, along};
 use rotor_event::{StopAt, flow};
-use rotor_model::{Disc, EventKind, Mode, Model, State};
+use rotor_model::{Disc, Mode, Model, State};
+use rotor_seam::EventKind;
 
 use crate::common::model;
 

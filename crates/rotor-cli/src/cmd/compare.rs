@@ -5,7 +5,8 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result, bail};
 
-use rotor_model::{Params, SteadyState};
+use rotor_model::Params;
+use rotor_seam::SteadyState;
 
 use crate::common::{fixture_path, fixtures_dir, progress_bar, thread_pool, threads_arg};
 use crate::out;

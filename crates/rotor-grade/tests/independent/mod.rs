@@ -18,7 +18,8 @@
 //! * **Extrema** of each slipping disc's velocity (the steady metrics), located the same way
 //!   on θ ↦ ω̇(step(θ)).
 
-use rotor_model::{Disc, DiscMode, EventKind, Mode, Model, State};
+use rotor_model::{Disc, DiscMode, Mode, Model, State};
+use rotor_seam::EventKind;
 
 /// A Gauss–Legendre collocation tableau on [0, 1].
 #[derive(Debug, Clone)]
@@ -180,7 +181,7 @@ pub struct Problem<'a> {
 /// A velocity turn is recorded as an extremum only if the velocity moved by more than this
 /// (relative to 1 + |ω|) since the last extremum of that disc: smaller turns are rounding
 /// noise of a run settled on an equilibrium, and far below the 1e-6 rad/s amplitude at which
-/// an oscillation counts as a cycle (rotor_model::steady::EQUILIBRIUM_AMPLITUDE).
+/// an oscillation counts as a cycle (rotor_seam::steady::EQUILIBRIUM_AMPLITUDE).
 const TURN: f64 = 1e-10;
 
 impl Problem<'_> {

@@ -1,7 +1,8 @@
 //! Every fixture runs; large steps stay bounded; stuck equilibria stay exactly stuck.
 
-use rotor_model::{Accuracy, Output, Scene, Solver, State};
+use rotor_model::State;
 use rotor_moreau::MoreauSolver;
+use rotor_seam::{Accuracy, Output, Scene, Solver};
 
 use crate::scenarios;
 

@@ -12,11 +12,11 @@
 //! The solvers still share no integration code: what makes their comparison meaningful is
 //! that they integrate independently, not that they record differently.
 
-use crate::dynamics::{Mode, State};
 use crate::event::Event;
 use crate::fast_forward::{FastForward, Verdict};
 use crate::scene::{Output, OutputGrid, Sample, Scene, SolveError, Stats, Trajectory};
 use crate::steady::MetricsAccumulator;
+use rotor_model::{Mode, State};
 
 /// What a scene keeps of a run, collected as the solver goes.
 #[derive(Debug, Clone)]
@@ -166,9 +166,9 @@ impl Recorder {
     /// periods ([`Integration::shift`]), and still reports the cycle's metrics.
     ///
     /// ```
-    /// use rotor_model::{
-    ///     Disc, DiscMode, Event, EventKind, Integration, Mode, Output, Recorder, Scene,
-    ///     SolveError, State, Stats, SteadyState,
+    /// use rotor_model::{Disc, DiscMode, Mode, State};
+    /// use rotor_seam::{
+    ///     Event, EventKind, Integration, Output, Recorder, Scene, SolveError, Stats, SteadyState,
     /// };
     ///
     /// /// ω_l = 2 + tri(t), tri of period 4 between −1 and 1: maxima at t = 1 + 4k.
@@ -302,9 +302,9 @@ impl Recorder {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::dynamics::{Disc, DiscMode};
     use crate::event::EventKind;
     use crate::steady::SteadyState;
+    use rotor_model::{Disc, DiscMode};
 
     /// A triangle wave of period 4 and amplitude 1 (exact in binary arithmetic).
     fn tri(t: f64) -> f64 {

@@ -34,9 +34,9 @@
 //! state carries the phase error of the skipped periods, `m·|P_n − P*|`, of the same order as
 //! the phase error a full run accumulates over those periods.
 
-use crate::dynamics::{Disc, OMEGA_L, State};
 use crate::event::{Event, EventKind};
 use crate::scene::{Output, Scene, Stats};
+use rotor_model::{Disc, OMEGA_L, State};
 
 /// A return after the jump must lie within this many tolerances of the return before it: both
 /// lie within one tolerance of the fixed point (the skip criterion), and the integration adds

@@ -3,10 +3,10 @@
 use serde::Serialize;
 use thiserror::Error;
 
-use crate::dynamics::{Mode, Model, State};
 use crate::event::Event;
-use crate::field::FieldError;
 use crate::steady::SteadyState;
+use rotor_model::FieldError;
+use rotor_model::{Mode, Model, State};
 
 /// What a solver keeps while it runs. Every level keeps the final state and the counters.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -213,7 +213,7 @@ impl Scene {
     /// [`Scene::validate`], and the scene against a model: the motor torque k_m·u and the
     /// initial spring torque k_θ·α must be finite (a huge u overflows k_m·u to ∞, and a
     /// time-stepping scheme would then silently stay at rest).
-    pub fn validate_for(&self, model: &crate::Model) -> Result<(), SolveError> {
+    pub fn validate_for(&self, model: &rotor_model::Model) -> Result<(), SolveError> {
         self.validate()?;
         if !(model.params.k_m * self.u).is_finite() {
             return Err(FieldError::num("u", self.u, "the motor torque k_m u overflows").into());
@@ -571,7 +571,8 @@ pub fn check_finite(t: f64, x: &State) -> Result<(), SolveError> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::{Disc, DiscMode, EventKind, SteadyState};
+    use crate::{EventKind, SteadyState};
+    use rotor_model::{Disc, DiscMode};
 
     #[test]
     fn check_finite_names_the_first_non_finite_output() {

@@ -7,8 +7,8 @@
 
 use serde::{Deserialize, Serialize};
 
-use crate::dynamics::{Disc, OMEGA_L, OMEGA_U, State};
 use crate::event::{Event, EventKind};
+use rotor_model::{Disc, OMEGA_L, OMEGA_U, State};
 
 /// The steady state as `rotor steady` prints it (docs/design.md, "The CLI"), and as the
 /// reference data stores and reads it back.

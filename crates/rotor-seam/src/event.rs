@@ -2,7 +2,7 @@
 
 use serde::Serialize;
 
-use crate::dynamics::{Disc, State};
+use rotor_model::{Disc, State};
 
 /// What happened at an event.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
