@@ -12,8 +12,9 @@
 
 use std::fmt::Write;
 
-use crate::BenchReport;
 use crate::profile::Profile;
+use crate::word::Word;
+use crate::{BenchReport, SceneReport};
 
 /// One solver's points on one scene: (setting, digits, passes loose, passes strict, time).
 type Row = Vec<(f64, Option<f64>, Option<bool>, Option<bool>, Option<f64>)>;
@@ -74,6 +75,19 @@ impl BenchReport {
     pub fn to_results_md(&self, command: &str) -> Result<String, crate::BenchError> {
         self.check_finite()?;
         let mut s = String::new();
+        self.write_intro(&mut s, command);
+        self.write_solvers(&mut s);
+        self.write_profiles(&mut s);
+        let _ = writeln!(s, "## Scenes\n");
+        for sc in &self.scenes {
+            self.write_scene(&mut s, sc);
+        }
+        Ok(s)
+    }
+
+    /// The page's title, what the suite is and how it was measured (`command` wrote it),
+    /// and how a new solver's author places a row.
+    fn write_intro(&self, s: &mut String, command: &str) {
         let env = &self.environment;
         let _ = writeln!(
             s,
@@ -116,6 +130,11 @@ impl BenchReport {
              **strict** = 7. \"cheapest\" is the setting whose run passes the level in the \
              least time, with that time.\n"
         );
+    }
+
+    /// The table of solvers: the Rust solvers, then every peer and client with its method
+    /// and version (or its command), its knob and its status.
+    fn write_solvers(&self, s: &mut String) {
         let _ = writeln!(
             s,
             "## Solvers\n\n| solver | kind | knob | status |\n|---|---|---|---|"
@@ -146,6 +165,10 @@ impl BenchReport {
                     .map_or(String::new(), |r| format!(": {}", r.replace('|', "\\|")))
             );
         }
+    }
+
+    /// The performance profiles: the full suite's, then the `table1` tier's if there is one.
+    fn write_profiles(&self, s: &mut String) {
         let _ = writeln!(s, "\n## Performance profiles\n");
         let _ = writeln!(
             s,
@@ -164,80 +187,87 @@ impl BenchReport {
                     ": every scene"
                 }
             );
-            profile_table(&mut s, p);
+            profile_table(s, p);
             let _ = writeln!(s);
         }
-        let _ = writeln!(s, "## Scenes\n");
-        for sc in &self.scenes {
+    }
+
+    /// Scene `sc`'s heading and table: per solver, its digits at each setting and its
+    /// cheapest setting passing the loose and the strict level.
+    fn write_scene(&self, s: &mut String, sc: &SceneReport) {
+        let _ = writeln!(
+            s,
+            "### {} (tier `{}`)\n\n{}. u = {} V, {} s.\n",
+            sc.name,
+            if sc.tier.is_empty() { "?" } else { &sc.tier },
+            sc.description,
+            sc.u,
+            sc.t_end
+        );
+        let _ = writeln!(
+            s,
+            "| solver | digits at each setting | cheapest loose | cheapest strict |\n|---|---|---|---|"
+        );
+        for (name, knob, row) in &self.scene_rows(sc) {
+            let cells: Vec<String> = row
+                .iter()
+                .map(|p| format!("{} {:.0e}: {}", knob, p.0, digits(p.1)))
+                .collect();
             let _ = writeln!(
                 s,
-                "### {} (tier `{}`)\n\n{}. u = {} V, {} s.\n",
-                sc.name,
-                if sc.tier.is_empty() { "?" } else { &sc.tier },
-                sc.description,
-                sc.u,
-                sc.t_end
+                "| {name} | {} | {} | {} |",
+                if cells.is_empty() {
+                    "–".into()
+                } else {
+                    cells.join(", ")
+                },
+                cheapest(row, |p| p.2 == Some(true)),
+                cheapest(row, |p| p.3 == Some(true))
             );
-            let _ = writeln!(
-                s,
-                "| solver | digits at each setting | cheapest loose | cheapest strict |\n|---|---|---|---|"
-            );
-            let mut rows: Vec<(String, &str, Row)> = Vec::new();
-            for k in rotor_solvers::SOLVERS {
-                let row: Row = sc
-                    .points
-                    .iter()
-                    .filter(|p| p.solver == k)
-                    .map(|p| {
-                        (
-                            p.setting,
-                            p.digits,
-                            p.passes_loose,
-                            p.passes_strict,
-                            p.timing.map(|t| t.median_s),
-                        )
-                    })
-                    .collect();
-                rows.push((k.name().to_owned(), k.setting_name(), row));
-            }
-            for c in &self.clients {
-                let Some(cs) = c.scenes.iter().find(|x| x.scene == sc.name) else {
-                    continue;
-                };
-                let row: Row = cs
-                    .points
-                    .iter()
-                    .map(|p| {
-                        (
-                            p.setting,
-                            p.digits,
-                            p.passes_loose,
-                            p.passes_strict,
-                            p.time().map(|t| t.median_s),
-                        )
-                    })
-                    .collect();
-                rows.push((c.name.clone(), c.setting_name, row));
-            }
-            for (name, knob, row) in &rows {
-                let cells: Vec<String> = row
-                    .iter()
-                    .map(|p| format!("{} {:.0e}: {}", knob, p.0, digits(p.1)))
-                    .collect();
-                let _ = writeln!(
-                    s,
-                    "| {name} | {} | {} | {} |",
-                    if cells.is_empty() {
-                        "–".into()
-                    } else {
-                        cells.join(", ")
-                    },
-                    cheapest(row, |p| p.2 == Some(true)),
-                    cheapest(row, |p| p.3 == Some(true))
-                );
-            }
-            let _ = writeln!(s);
         }
-        Ok(s)
+        let _ = writeln!(s);
+    }
+
+    /// Every solver's points on scene `sc` with its name and knob: the Rust solvers', then
+    /// those of each client that ran the scene.
+    fn scene_rows(&self, sc: &SceneReport) -> Vec<(String, Word, Row)> {
+        let mut rows: Vec<(String, Word, Row)> = Vec::new();
+        for k in rotor_solvers::SOLVERS {
+            let row: Row = sc
+                .points
+                .iter()
+                .filter(|p| p.solver == k)
+                .map(|p| {
+                    (
+                        p.setting,
+                        p.digits,
+                        p.passes_loose,
+                        p.passes_strict,
+                        p.timing.map(|t| t.median_s),
+                    )
+                })
+                .collect();
+            rows.push((k.name().to_owned(), k.setting_name(), row));
+        }
+        for c in &self.clients {
+            let Some(cs) = c.scenes.iter().find(|x| x.scene == sc.name) else {
+                continue;
+            };
+            let row: Row = cs
+                .points
+                .iter()
+                .map(|p| {
+                    (
+                        p.setting,
+                        p.digits,
+                        p.passes_loose,
+                        p.passes_strict,
+                        p.time().map(|t| t.median_s),
+                    )
+                })
+                .collect();
+            rows.push((c.name.clone(), c.setting_name, row));
+        }
+        rows
     }
 }

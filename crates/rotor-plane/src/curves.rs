@@ -191,11 +191,7 @@ fn end_text(e: &ArcEnd) -> String {
 /// explicitly at 41 values of p). A grazing curve comes as its pieces of one Feigin type
 /// ([`split_grazing`]).
 pub(crate) fn from_diagram(base: &Params, opts: &PlaneOptions, d: &Diagram, p0: f64) -> Vec<Curve> {
-    let name = opts.param.as_str();
-    let p_scale = p0.abs().max(1e-3 * (opts.p_max - opts.p_min)).max(1e-12);
-    let inside_pu =
-        |p: f64, u: f64| p >= opts.p_min && p <= opts.p_max && u >= opts.u_min && u <= opts.u_max;
-    let ao = arc_opts(opts.max_points);
+    let tracer = Tracer::new(base, opts, p0);
     let mut curves = Vec::new();
     let mut counts = std::collections::BTreeMap::<&str, usize>::new();
     let mut label = |prefix: &'static str| {
@@ -207,161 +203,212 @@ pub(crate) fn from_diagram(base: &Params, opts: &PlaneOptions, d: &Diagram, p0: 
         match sp.kind {
             PointKind::Hopf => {
                 let Some(w0) = sp.omega else { continue };
-                let h = hopf_system(base, name);
-                let inside = |y: &[f64]| {
-                    y[1] > 0.0
-                        && params_at(base, name, y[0]).is_ok_and(|pp| {
-                            inside_pu(y[0], Model::new(pp).slip_equilibrium_at(y[1]).u)
-                        })
-                };
-                let (pts, ends) = both_ways(&h, &[p0, w0], &[p_scale, w0.max(0.1)], &ao, &inside);
-                let points = pts
-                    .iter()
-                    .filter_map(|y| {
-                        let m = Model::new(params_at(base, name, y[0]).ok()?);
-                        let res = h(y).ok()?[0];
-                        Some(CurvePoint {
-                            p: y[0],
-                            u: m.slip_equilibrium_at(y[1]).u,
-                            residual: res,
-                            omega: Some(y[1]),
-                            l1: first_lyapunov(&m, y[1]),
-                            multiplier: None,
-                            grazing_type: None,
-                            period_doubling: None,
-                            sigma_plus: None,
-                            sigma_minus: None,
-                            touch_omega_u: None,
-                            section_state: None,
-                        })
-                    })
-                    .collect();
-                curves.push(Curve {
-                    kind: CurveKind::Hopf,
-                    label: label("H"),
-                    points,
-                    ends: ends.iter().map(end_text).collect(),
-                });
+                curves.push(tracer.hopf(w0, label("H")));
             }
             PointKind::Grazing => {
                 let Some(w0) = sp.touch_omega_u else { continue };
-                let h = grazing_system(base, name, opts.tol);
-                let inside = |y: &[f64]| inside_pu(y[0], y[1]);
-                let (pts, ends) = both_ways(
-                    &h,
-                    &[p0, sp.u, w0],
-                    &[p_scale, sp.u.max(1.0), w0.abs().max(1.0)],
-                    &ao,
-                    &inside,
-                );
-                let lab = label("G");
-                let points: Vec<CurvePoint> = pts
-                    .iter()
-                    .filter_map(|y| {
-                        let m = Model::new(params_at(base, name, y[0]).ok()?);
-                        let g = h(y).ok()?;
-                        let f = grazing::classify(&m, y[1], y[2], opts.tol).ok();
-                        Some(CurvePoint {
-                            p: y[0],
-                            u: y[1],
-                            residual: g[0].abs().max(g[1].abs()),
-                            omega: None,
-                            l1: None,
-                            multiplier: f.map(|f| {
-                                f.slipping
-                                    .multipliers()
-                                    .iter()
-                                    .map(|z| z.norm())
-                                    .fold(0.0, f64::max)
-                            }),
-                            grazing_type: f.map(|f| f.kind),
-                            period_doubling: f.map(|f| f.period_doubling),
-                            sigma_plus: f.map(|f| f.sigma_plus),
-                            sigma_minus: f.map(|f| f.sigma_minus),
-                            touch_omega_u: Some(y[2]),
-                            section_state: None,
-                        })
-                    })
-                    .collect();
-                curves.extend(split_grazing(&lab, points, ends));
+                curves.extend(tracer.grazing(sp.u, w0, &label("G")));
             }
             PointKind::Fold if sp.discontinuous == Some(false) => {
                 let Some(z) = sp.section_state else { continue };
-                let h = fold_system(base, name, opts.tol);
-                let inside = |y: &[f64]| inside_pu(y[0], y[3]);
-                let (pts, ends) = both_ways(
-                    &h,
-                    &[p0, z[0], z[1], sp.u],
-                    &[
-                        p_scale,
-                        z[0].abs().max(1.0),
-                        z[1].abs().max(1.0),
-                        sp.u.max(1.0),
-                    ],
-                    &ao,
-                    &inside,
-                );
-                let points = pts
-                    .iter()
-                    .filter_map(|y| {
-                        let r = h(y).ok()?;
-                        Some(CurvePoint {
-                            p: y[0],
-                            u: y[3],
-                            residual: r.iter().fold(0.0f64, |a, v| a.max(v.abs())),
-                            omega: None,
-                            l1: None,
-                            multiplier: None,
-                            grazing_type: None,
-                            period_doubling: None,
-                            sigma_plus: None,
-                            sigma_minus: None,
-                            touch_omega_u: None,
-                            section_state: Some([y[1], y[2]]),
-                        })
-                    })
-                    .collect();
-                curves.push(Curve {
-                    kind: CurveKind::Fold,
-                    label: label("F"),
-                    points,
-                    ends: ends.iter().map(end_text).collect(),
-                });
+                curves.push(tracer.fold(sp.u, z, label("F")));
             }
-            PointKind::StickLimit => {
-                let n = 41;
-                let points = (0..n)
-                    .filter_map(|k| {
-                        let p = opts.p_min + (opts.p_max - opts.p_min) * k as f64 / (n - 1) as f64;
-                        let m = Model::new(params_at(base, name, p).ok()?);
-                        let u = m.slip_equilibrium_at(0.0).u;
-                        (u >= opts.u_min && u <= opts.u_max).then_some(CurvePoint {
-                            p,
-                            u,
-                            residual: 0.0,
-                            omega: Some(0.0),
-                            l1: None,
-                            multiplier: None,
-                            grazing_type: None,
-                            period_doubling: None,
-                            sigma_plus: None,
-                            sigma_minus: None,
-                            touch_omega_u: None,
-                            section_state: None,
-                        })
-                    })
-                    .collect();
-                curves.push(Curve {
-                    kind: CurveKind::StuckBoundary,
-                    label: "S".into(),
-                    points,
-                    ends: Vec::new(),
-                });
-            }
+            PointKind::StickLimit => curves.push(tracer.stuck_boundary()),
             _ => {}
         }
     }
     curves
+}
+
+impl CurvePoint {
+    /// A point at `(p, u)` whose defining condition has the value `residual`, with none of
+    /// the fields of a particular kind of curve.
+    fn at(p: f64, u: f64, residual: f64) -> CurvePoint {
+        CurvePoint {
+            p,
+            u,
+            residual,
+            omega: None,
+            l1: None,
+            multiplier: None,
+            grazing_type: None,
+            period_doubling: None,
+            sigma_plus: None,
+            sigma_minus: None,
+            touch_omega_u: None,
+            section_state: None,
+        }
+    }
+}
+
+/// Follows the curves through the special points of the one-parameter diagram at `p = p0`
+/// over the window of `opts`, in parameter `name` of `base`.
+struct Tracer<'a> {
+    base: &'a Params,
+    name: &'a str,
+    opts: &'a PlaneOptions,
+    p0: f64,
+    /// The scale of p in a curve's steps: `max(|p0|, 1e-3·(p_max − p_min), 1e-12)`.
+    p_scale: f64,
+    ao: ArcOptions,
+}
+
+impl<'a> Tracer<'a> {
+    /// The tracer of the curves through the diagram at `p0`.
+    fn new(base: &'a Params, opts: &'a PlaneOptions, p0: f64) -> Self {
+        Tracer {
+            base,
+            name: opts.param.as_str(),
+            opts,
+            p0,
+            p_scale: p0.abs().max(1e-3 * (opts.p_max - opts.p_min)).max(1e-12),
+            ao: arc_opts(opts.max_points),
+        }
+    }
+
+    /// Whether `(p, u)` lies in the window.
+    fn inside_pu(&self, p: f64, u: f64) -> bool {
+        let o = self.opts;
+        p >= o.p_min && p <= o.p_max && u >= o.u_min && u <= o.u_max
+    }
+
+    /// The Hopf curve through the diagram's Hopf point at ω = `w0`: `Re λ(ω; p) = 0` in
+    /// `(p, ω)` ([`hopf_system`]), each point with its u, ω and first Lyapunov coefficient.
+    fn hopf(&self, w0: f64, label: String) -> Curve {
+        let (base, name) = (self.base, self.name);
+        let h = hopf_system(base, name);
+        let inside = |y: &[f64]| {
+            y[1] > 0.0
+                && params_at(base, name, y[0]).is_ok_and(|pp| {
+                    self.inside_pu(y[0], Model::new(pp).slip_equilibrium_at(y[1]).u)
+                })
+        };
+        let (pts, ends) = both_ways(
+            &h,
+            &[self.p0, w0],
+            &[self.p_scale, w0.max(0.1)],
+            &self.ao,
+            &inside,
+        );
+        let points = pts
+            .iter()
+            .filter_map(|y| {
+                let m = Model::new(params_at(base, name, y[0]).ok()?);
+                let res = h(y).ok()?[0];
+                Some(CurvePoint {
+                    omega: Some(y[1]),
+                    l1: first_lyapunov(&m, y[1]),
+                    ..CurvePoint::at(y[0], m.slip_equilibrium_at(y[1]).u, res)
+                })
+            })
+            .collect();
+        Curve {
+            kind: CurveKind::Hopf,
+            label,
+            points,
+            ends: ends.iter().map(end_text).collect(),
+        }
+    }
+
+    /// The grazing curve through the diagram's grazing orbit at `u`, touching at ω_u = `w0`:
+    /// `G(u, w; p) = 0` in `(p, u, w)` ([`grazing_system`]), each point typed by Feigin's rule
+    /// ([`grazing::classify`]) and the curve split where the type changes
+    /// ([`split_grazing`]).
+    fn grazing(&self, u: f64, w0: f64, label: &str) -> Vec<Curve> {
+        let (base, name, tol) = (self.base, self.name, self.opts.tol);
+        let h = grazing_system(base, name, tol);
+        let inside = |y: &[f64]| self.inside_pu(y[0], y[1]);
+        let (pts, ends) = both_ways(
+            &h,
+            &[self.p0, u, w0],
+            &[self.p_scale, u.max(1.0), w0.abs().max(1.0)],
+            &self.ao,
+            &inside,
+        );
+        let points: Vec<CurvePoint> = pts
+            .iter()
+            .filter_map(|y| {
+                let m = Model::new(params_at(base, name, y[0]).ok()?);
+                let g = h(y).ok()?;
+                let f = grazing::classify(&m, y[1], y[2], tol).ok();
+                Some(CurvePoint {
+                    multiplier: f.map(|f| {
+                        f.slipping
+                            .multipliers()
+                            .iter()
+                            .map(|z| z.norm())
+                            .fold(0.0, f64::max)
+                    }),
+                    grazing_type: f.map(|f| f.kind),
+                    period_doubling: f.map(|f| f.period_doubling),
+                    sigma_plus: f.map(|f| f.sigma_plus),
+                    sigma_minus: f.map(|f| f.sigma_minus),
+                    touch_omega_u: Some(y[2]),
+                    ..CurvePoint::at(y[0], y[1], g[0].abs().max(g[1].abs()))
+                })
+            })
+            .collect();
+        split_grazing(label, points, ends)
+    }
+
+    /// The smooth-fold curve through the diagram's fold at `u` with section state `z`:
+    /// `(P(z) − z, det(∂P/∂z − I)) = 0` in `(p, α, ω_u, u)` ([`fold_system`]), each point with
+    /// its section state.
+    fn fold(&self, u: f64, z: [f64; 3], label: String) -> Curve {
+        let h = fold_system(self.base, self.name, self.opts.tol);
+        let inside = |y: &[f64]| self.inside_pu(y[0], y[3]);
+        let (pts, ends) = both_ways(
+            &h,
+            &[self.p0, z[0], z[1], u],
+            &[
+                self.p_scale,
+                z[0].abs().max(1.0),
+                z[1].abs().max(1.0),
+                u.max(1.0),
+            ],
+            &self.ao,
+            &inside,
+        );
+        let points = pts
+            .iter()
+            .filter_map(|y| {
+                let r = h(y).ok()?;
+                Some(CurvePoint {
+                    section_state: Some([y[1], y[2]]),
+                    ..CurvePoint::at(y[0], y[3], r.iter().fold(0.0f64, |a, v| a.max(v.abs())))
+                })
+            })
+            .collect();
+        Curve {
+            kind: CurveKind::Fold,
+            label,
+            points,
+            ends: ends.iter().map(end_text).collect(),
+        }
+    }
+
+    /// The stuck boundary `S`, explicitly: u of the slipping equilibrium at ω = 0, at 41
+    /// evenly spaced values of p over the window, where that u is in the window.
+    fn stuck_boundary(&self) -> Curve {
+        let (opts, n) = (self.opts, 41);
+        let points = (0..n)
+            .filter_map(|k| {
+                let p = opts.p_min + (opts.p_max - opts.p_min) * k as f64 / (n - 1) as f64;
+                let m = Model::new(params_at(self.base, self.name, p).ok()?);
+                let u = m.slip_equilibrium_at(0.0).u;
+                (u >= opts.u_min && u <= opts.u_max).then_some(CurvePoint {
+                    omega: Some(0.0),
+                    ..CurvePoint::at(p, u, 0.0)
+                })
+            })
+            .collect();
+        Curve {
+            kind: CurveKind::StuckBoundary,
+            label: "S".into(),
+            points,
+            ends: Vec::new(),
+        }
+    }
 }
 
 /// A grazing curve split where its Feigin type changes between persistence (a plain grazing

@@ -182,6 +182,65 @@ pub fn render(panels: &[Panel], width: f64, panel_height: f64) -> String {
     let _ = writeln!(s, r#"<rect width="100%" height="100%" fill="white"/>"#);
     for (k, p) in panels.iter().enumerate() {
         let oy = k as f64 * panel_height;
+        let Some(f) = Frame::fit(p, oy, width, panel_height) else {
+            continue;
+        };
+        write_axes(&mut s, p, &f);
+        let legend = write_series(&mut s, &p.series, &f);
+        write_legend(&mut s, &legend, &f);
+        write_labels(&mut s, &p.labels, &f);
+        let clear: Vec<f64> = p
+            .clear_x
+            .iter()
+            .map(|&x| f.sx(x))
+            .filter(|c| c.is_finite())
+            .collect();
+        write_bands(
+            &mut s,
+            &p.bands,
+            &clear,
+            (f.l, f.r),
+            |x| f.sx(x),
+            |y| f.sy(y),
+        );
+        write_ends(&mut s, &p.ends, &f);
+    }
+    s.push_str("</svg>\n");
+    s
+}
+
+/// A panel's plot box in pixels and the ranges of its axes, which map data to pixels.
+struct Frame {
+    /// Top of the panel \[px\] (its title sits 20 px below).
+    oy: f64,
+    /// Left edge of the plot box \[px\].
+    l: f64,
+    /// Right edge of the plot box \[px\] (left of the margin for curve names).
+    r: f64,
+    /// Top edge of the plot box \[px\].
+    t: f64,
+    /// Bottom edge of the plot box \[px\].
+    b: f64,
+    /// The x axis's range, in axis coordinates (log10 on a log axis).
+    x0: f64,
+    /// Upper end of the x axis's range.
+    x1: f64,
+    /// The y axis's range, in axis coordinates, padded by 5 % each way.
+    y0: f64,
+    /// Upper end of the y axis's range.
+    y1: f64,
+    /// Whether the x axis is logarithmic.
+    x_log: bool,
+    /// Whether the y axis is logarithmic.
+    y_log: bool,
+}
+
+impl Frame {
+    /// The frame of panel `p` at height `oy` in a document `width` wide: the axes span every
+    /// drawable point of its series, labels, curve ends and bands (a flat range widened by
+    /// ±0.5, the y range padded by 5 %), and the box leaves room for the legend above and the
+    /// right margin's curve names. `None` if the panel has no drawable point.
+    fn fit(p: &Panel, oy: f64, width: f64, panel_height: f64) -> Option<Frame> {
         let has_legend = p.series.iter().any(|s| !s.label.is_empty());
         let top = if has_legend { 50.0 } else { 30.0 };
         let (l, t, b) = (70.0, oy + top, oy + panel_height - 45.0);
@@ -212,7 +271,7 @@ pub fn render(panels: &[Panel], width: f64, panel_height: f64) -> String {
             }
         }
         if !x0.is_finite() {
-            continue;
+            return None;
         }
         if y1 - y0 < 1e-9 {
             y0 -= 0.5;
@@ -224,206 +283,260 @@ pub fn render(panels: &[Panel], width: f64, panel_height: f64) -> String {
             x0 -= 0.5;
             x1 += 0.5;
         }
-        let ay = |y: f64| b - (y - y0) / (y1 - y0) * (b - t);
         // Curve names whose curve reaches the right edge go into the margin.
-        let margin: Vec<&EndLabel> = p.ends.iter().filter(|e| e.margin).collect();
-        let margin_width = margin
+        let margin_width = p
+            .ends
             .iter()
+            .filter(|e| e.margin)
             .map(|m| 12.0 + SMALL_CHAR * m.text.chars().count() as f64)
             .fold(0.0, f64::max);
-        let r = width - 20.0 - margin_width;
-        // Axis coordinate -> pixels.
-        let ax = |x: f64| l + (x - x0) / (x1 - x0) * (r - l);
-        // Data coordinate -> pixels.
-        let sx = |x: f64| ax(axis(x, p.x_log));
-        let sy = |y: f64| ay(axis(y, p.y_log));
+        Some(Frame {
+            oy,
+            l,
+            r: width - 20.0 - margin_width,
+            t,
+            b,
+            x0,
+            x1,
+            y0,
+            y1,
+            x_log: p.x_log,
+            y_log: p.y_log,
+        })
+    }
+
+    /// Axis coordinate to pixels: `l + (x − x0) / (x1 − x0) · (r − l)`.
+    fn ax(&self, x: f64) -> f64 {
+        self.l + (x - self.x0) / (self.x1 - self.x0) * (self.r - self.l)
+    }
+
+    /// Axis coordinate to pixels: `b − (y − y0) / (y1 − y0) · (b − t)` (upward).
+    fn ay(&self, y: f64) -> f64 {
+        self.b - (y - self.y0) / (self.y1 - self.y0) * (self.b - self.t)
+    }
+
+    /// Data abscissa to pixels (NaN where a log axis cannot draw it).
+    fn sx(&self, x: f64) -> f64 {
+        self.ax(axis(x, self.x_log))
+    }
+
+    /// Data ordinate to pixels (NaN where a log axis cannot draw it).
+    fn sy(&self, y: f64) -> f64 {
+        self.ay(axis(y, self.y_log))
+    }
+}
+
+/// Writes panel `p`'s title, plot box, ticks with their grid lines, and axis labels.
+fn write_axes(s: &mut String, p: &Panel, f: &Frame) {
+    let (l, r, t, b) = (f.l, f.r, f.t, f.b);
+    let _ = writeln!(
+        s,
+        r#"<text x="{}" y="{}" text-anchor="middle" font-size="14">{}</text>"#,
+        (l + r) / 2.0,
+        f.oy + 20.0,
+        esc(&p.title)
+    );
+    let _ = writeln!(
+        s,
+        r#"<rect x="{l}" y="{t}" width="{}" height="{}" fill="none" stroke="black"/>"#,
+        r - l,
+        b - t
+    );
+    write_ticks(s, f);
+    let _ = writeln!(
+        s,
+        r#"<text x="{}" y="{}" text-anchor="middle">{}</text>"#,
+        (l + r) / 2.0,
+        b + 35.0,
+        esc(p.x_label)
+    );
+    let _ = writeln!(
+        s,
+        r#"<text x="{}" y="{}" text-anchor="middle" transform="rotate(-90 {} {})">{}</text>"#,
+        l - 50.0,
+        (t + b) / 2.0,
+        l - 50.0,
+        (t + b) / 2.0,
+        esc(p.y_label)
+    );
+}
+
+/// Writes the ticks of both axes, each with its grid line across the box and its value:
+/// about 8 round steps in x and 6 in y on a linear axis, decades on a log axis.
+fn write_ticks(s: &mut String, f: &Frame) {
+    let (l, r, t, b) = (f.l, f.r, f.t, f.b);
+    let x_ticks = if f.x_log {
+        log_ticks(f.x0, f.x1)
+    } else {
+        nice_ticks(f.x0, f.x1, 8)
+    };
+    for tx in x_ticks {
+        let x = f.ax(tx);
         let _ = writeln!(
             s,
-            r#"<text x="{}" y="{}" text-anchor="middle" font-size="14">{}</text>"#,
-            (l + r) / 2.0,
-            oy + 20.0,
-            esc(&p.title)
-        );
-        let _ = writeln!(
-            s,
-            r#"<rect x="{l}" y="{t}" width="{}" height="{}" fill="none" stroke="black"/>"#,
-            r - l,
-            b - t
-        );
-        let x_ticks = if p.x_log {
-            log_ticks(x0, x1)
-        } else {
-            nice_ticks(x0, x1, 8)
-        };
-        for tx in x_ticks {
-            let x = ax(tx);
-            let _ = writeln!(
-                s,
-                r##"<line x1="{x:.1}" y1="{b}" x2="{x:.1}" y2="{t}" stroke="#ddd"/><text x="{x:.1}" y="{}" text-anchor="middle">{}</text>"##,
-                b + 15.0,
-                if p.x_log {
-                    fmt_decade(tx)
-                } else {
-                    fmt_tick(tx)
-                }
-            );
-        }
-        let y_ticks = if p.y_log {
-            log_ticks(y0, y1)
-        } else {
-            nice_ticks(y0, y1, 6)
-        };
-        for ty in y_ticks {
-            let y = ay(ty);
-            let _ = writeln!(
-                s,
-                r##"<line x1="{l}" y1="{y:.1}" x2="{r}" y2="{y:.1}" stroke="#ddd"/><text x="{}" y="{:.1}" text-anchor="end">{}</text>"##,
-                l - 5.0,
-                y + 4.0,
-                if p.y_log {
-                    fmt_decade(ty)
-                } else {
-                    fmt_tick(ty)
-                }
-            );
-        }
-        let _ = writeln!(
-            s,
-            r#"<text x="{}" y="{}" text-anchor="middle">{}</text>"#,
-            (l + r) / 2.0,
-            b + 35.0,
-            esc(p.x_label)
-        );
-        let _ = writeln!(
-            s,
-            r#"<text x="{}" y="{}" text-anchor="middle" transform="rotate(-90 {} {})">{}</text>"#,
-            l - 50.0,
-            (t + b) / 2.0,
-            l - 50.0,
-            (t + b) / 2.0,
-            esc(p.y_label)
-        );
-        let mut legend: Vec<(&Series, String)> = Vec::new();
-        for ser in &p.series {
-            let mut d = String::new();
-            let mut pen_up = true;
-            for &(x, y) in &ser.points {
-                let (px, py) = (sx(x), sy(y));
-                if !(px.is_finite() && py.is_finite()) {
-                    pen_up = true;
-                    continue;
-                }
-                let _ = write!(d, "{}{px:.2},{py:.2} ", if pen_up { "M" } else { "L" });
-                pen_up = false;
-                if let Some(radius) = ser.marker {
-                    let _ = writeln!(
-                        s,
-                        r#"<circle cx="{px:.2}" cy="{py:.2}" r="{radius}" fill="{}"/>"#,
-                        ser.color
-                    );
-                }
+            r##"<line x1="{x:.1}" y1="{b}" x2="{x:.1}" y2="{t}" stroke="#ddd"/><text x="{x:.1}" y="{}" text-anchor="middle">{}</text>"##,
+            b + 15.0,
+            if f.x_log {
+                fmt_decade(tx)
+            } else {
+                fmt_tick(tx)
             }
-            let dash = ser
-                .dash
-                .map(|d| format!(r#" stroke-dasharray="{d}""#))
-                .unwrap_or_default();
-            if ser.width > 0.0 && !d.is_empty() {
-                let _ = writeln!(
-                    s,
-                    r#"<path d="{d}" fill="none" stroke="{}" stroke-width="{}"{dash}/>"#,
-                    ser.color, ser.width
-                );
+        );
+    }
+    let y_ticks = if f.y_log {
+        log_ticks(f.y0, f.y1)
+    } else {
+        nice_ticks(f.y0, f.y1, 6)
+    };
+    for ty in y_ticks {
+        let y = f.ay(ty);
+        let _ = writeln!(
+            s,
+            r##"<line x1="{l}" y1="{y:.1}" x2="{r}" y2="{y:.1}" stroke="#ddd"/><text x="{}" y="{:.1}" text-anchor="end">{}</text>"##,
+            l - 5.0,
+            y + 4.0,
+            if f.y_log {
+                fmt_decade(ty)
+            } else {
+                fmt_tick(ty)
             }
-            if !ser.label.is_empty() {
-                legend.push((ser, dash));
+        );
+    }
+}
+
+/// Writes each series as a path (a non-drawable point lifts the pen) with its markers, and
+/// returns the labelled series with their `stroke-dasharray` attribute, for the legend.
+fn write_series<'s, 'a>(
+    s: &mut String,
+    series: &'s [Series<'a>],
+    f: &Frame,
+) -> Vec<(&'s Series<'a>, String)> {
+    let mut legend = Vec::new();
+    for ser in series {
+        let mut d = String::new();
+        let mut pen_up = true;
+        for &(x, y) in &ser.points {
+            let (px, py) = (f.sx(x), f.sy(y));
+            if !(px.is_finite() && py.is_finite()) {
+                pen_up = true;
+                continue;
             }
-        }
-        // The legend: one row between the title and the plot box, so it never hides data.
-        let ly = oy + 36.0;
-        let mut lx = l;
-        for (ser, dash) in &legend {
-            let _ = writeln!(
-                s,
-                r#"<line x1="{lx}" y1="{ly}" x2="{}" y2="{ly}" stroke="{}" stroke-width="{}"{dash}/><text x="{}" y="{}">{}</text>"#,
-                lx + 30.0,
-                ser.color,
-                ser.width.max(1.5),
-                lx + 35.0,
-                ly + 4.0,
-                esc(ser.label)
-            );
+            let _ = write!(d, "{}{px:.2},{py:.2} ", if pen_up { "M" } else { "L" });
+            pen_up = false;
             if let Some(radius) = ser.marker {
                 let _ = writeln!(
                     s,
-                    r#"<circle cx="{}" cy="{ly}" r="{radius}" fill="{}"/>"#,
-                    lx + 15.0,
+                    r#"<circle cx="{px:.2}" cy="{py:.2}" r="{radius}" fill="{}"/>"#,
                     ser.color
                 );
             }
-            // ~6.7 px per character of the 12 px sans-serif, plus a gap.
-            lx += 35.0 + 6.7 * ser.label.chars().count() as f64 + 18.0;
         }
-        for lab in &p.labels {
-            let (px, py) = (sx(lab.x), sy(lab.y));
-            if !(px.is_finite() && py.is_finite()) {
-                continue;
-            }
+        let dash = ser
+            .dash
+            .map(|d| format!(r#" stroke-dasharray="{d}""#))
+            .unwrap_or_default();
+        if ser.width > 0.0 && !d.is_empty() {
             let _ = writeln!(
                 s,
-                r#"<path d="M{:.2},{:.2} L{:.2},{:.2} M{:.2},{:.2} L{:.2},{:.2}" stroke="black" stroke-width="1.5"/><text x="{:.2}" y="{:.2}" font-size="11">{}</text>"#,
-                px - 4.0,
-                py - 4.0,
-                px + 4.0,
-                py + 4.0,
-                px - 4.0,
-                py + 4.0,
-                px + 4.0,
-                py - 4.0,
-                px + 6.0,
-                py - 6.0,
-                esc(&lab.text)
+                r#"<path d="{d}" fill="none" stroke="{}" stroke-width="{}"{dash}/>"#,
+                ser.color, ser.width
             );
         }
-        let clear: Vec<f64> = p
-            .clear_x
-            .iter()
-            .map(|&x| sx(x))
-            .filter(|c| c.is_finite())
-            .collect();
-        write_bands(&mut s, &p.bands, &clear, (l, r), sx, sy);
-        for e in p.ends.iter().filter(|e| !e.margin) {
-            let (px, py) = (sx(e.x), sy(e.y));
-            if px.is_finite() && py.is_finite() {
-                let _ = writeln!(
-                    s,
-                    r#"<text x="{:.2}" y="{:.2}" font-size="11" fill="{}">{}</text>"#,
-                    px + 4.0,
-                    py - 4.0,
-                    e.color,
-                    esc(&e.text)
-                );
-            }
+        if !ser.label.is_empty() {
+            legend.push((ser, dash));
         }
-        let anchors: Vec<(f64, f64)> = margin.iter().map(|m| (sx(m.x), sy(m.y))).collect();
-        let rows = spread(&anchors.iter().map(|a| a.1).collect::<Vec<_>>(), t, b);
-        for ((m, (px, py)), ly) in margin.iter().zip(anchors).zip(rows) {
-            if !(px.is_finite() && py.is_finite()) {
-                continue;
-            }
+    }
+    legend
+}
+
+/// Writes the legend: one row between the title and the plot box, so it never hides data,
+/// each entry a 30 px stretch of its line (and its marker) and its label.
+fn write_legend(s: &mut String, legend: &[(&Series, String)], f: &Frame) {
+    let ly = f.oy + 36.0;
+    let mut lx = f.l;
+    for (ser, dash) in legend {
+        let _ = writeln!(
+            s,
+            r#"<line x1="{lx}" y1="{ly}" x2="{}" y2="{ly}" stroke="{}" stroke-width="{}"{dash}/><text x="{}" y="{}">{}</text>"#,
+            lx + 30.0,
+            ser.color,
+            ser.width.max(1.5),
+            lx + 35.0,
+            ly + 4.0,
+            esc(ser.label)
+        );
+        if let Some(radius) = ser.marker {
             let _ = writeln!(
                 s,
-                r#"<path d="M{px:.2},{py:.2} L{:.2},{ly:.2}" fill="none" stroke="{}" stroke-width="0.6"/><text x="{:.2}" y="{:.2}" font-size="11" fill="{}">{}</text>"#,
-                r + 6.0,
-                m.color,
-                r + 8.0,
-                ly + 4.0,
-                m.color,
-                esc(&m.text)
+                r#"<circle cx="{}" cy="{ly}" r="{radius}" fill="{}"/>"#,
+                lx + 15.0,
+                ser.color
+            );
+        }
+        // ~6.7 px per character of the 12 px sans-serif, plus a gap.
+        lx += 35.0 + 6.7 * ser.label.chars().count() as f64 + 18.0;
+    }
+}
+
+/// Writes each drawable labelled point as a small cross with its text above to the right.
+fn write_labels(s: &mut String, labels: &[Label], f: &Frame) {
+    for lab in labels {
+        let (px, py) = (f.sx(lab.x), f.sy(lab.y));
+        if !(px.is_finite() && py.is_finite()) {
+            continue;
+        }
+        let _ = writeln!(
+            s,
+            r#"<path d="M{:.2},{:.2} L{:.2},{:.2} M{:.2},{:.2} L{:.2},{:.2}" stroke="black" stroke-width="1.5"/><text x="{:.2}" y="{:.2}" font-size="11">{}</text>"#,
+            px - 4.0,
+            py - 4.0,
+            px + 4.0,
+            py + 4.0,
+            px - 4.0,
+            py + 4.0,
+            px + 4.0,
+            py - 4.0,
+            px + 6.0,
+            py - 6.0,
+            esc(&lab.text)
+        );
+    }
+}
+
+/// Writes the curves' names (see [`EndLabel`]): beside the end, or in the right margin on
+/// rows [`spread`] a line apart, each joined to its curve's end by a thin line.
+fn write_ends(s: &mut String, ends: &[EndLabel], f: &Frame) {
+    for e in ends.iter().filter(|e| !e.margin) {
+        let (px, py) = (f.sx(e.x), f.sy(e.y));
+        if px.is_finite() && py.is_finite() {
+            let _ = writeln!(
+                s,
+                r#"<text x="{:.2}" y="{:.2}" font-size="11" fill="{}">{}</text>"#,
+                px + 4.0,
+                py - 4.0,
+                e.color,
+                esc(&e.text)
             );
         }
     }
-    s.push_str("</svg>\n");
-    s
+    let margin: Vec<&EndLabel> = ends.iter().filter(|e| e.margin).collect();
+    let anchors: Vec<(f64, f64)> = margin.iter().map(|m| (f.sx(m.x), f.sy(m.y))).collect();
+    let rows = spread(&anchors.iter().map(|a| a.1).collect::<Vec<_>>(), f.t, f.b);
+    for ((m, (px, py)), ly) in margin.iter().zip(anchors).zip(rows) {
+        if !(px.is_finite() && py.is_finite()) {
+            continue;
+        }
+        let _ = writeln!(
+            s,
+            r#"<path d="M{px:.2},{py:.2} L{:.2},{ly:.2}" fill="none" stroke="{}" stroke-width="0.6"/><text x="{:.2}" y="{:.2}" font-size="11" fill="{}">{}</text>"#,
+            f.r + 6.0,
+            m.color,
+            f.r + 8.0,
+            ly + 4.0,
+            m.color,
+            esc(&m.text)
+        );
+    }
 }
 
 /// Writes the names of regions (see [`Band`]) into the box from `l` to `r` in x, keeping

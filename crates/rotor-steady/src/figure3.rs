@@ -155,79 +155,7 @@ pub fn figure3_section(sets: &[(&str, &str, &Model, &Diagram)]) -> ReportSection
             "\n## Figure 3 by three methods, {name}\n\nSwitch and Moreau–Jean in {:.2} s.\n",
             t0.elapsed().as_secs_f64()
         );
-        // The overlay.
-        let maxmin = |d: &Diagram| -> Vec<(f64, f64)> {
-            d.periodic
-                .iter()
-                .flat_map(|r| [(r.u, r.omega_l_max), (r.u, r.omega_l_min)])
-                .collect()
-        };
-        let mut eq: Vec<_> = event
-            .equilibria
-            .iter()
-            .filter(|e| e.kind == EquilibriumKind::Slip)
-            .map(|e| (e.u, e.omega))
-            .collect();
-        eq.sort_by(|a, b| a.1.total_cmp(&b.1));
-        let labels = label_points(&event.points)
-            .into_iter()
-            .map(|(l, p)| Label {
-                x: p.u,
-                y: p.omega_l_max.unwrap_or(if p.kind == PointKind::Hopf {
-                    p.omega.unwrap_or(0.0)
-                } else {
-                    0.0
-                }),
-                text: l,
-            })
-            .collect();
-        // Points closer than 2 % of the axis ranges share one label (as in the diagram's own
-        // figure).
-        let y_span = event
-            .periodic
-            .iter()
-            .map(|r| r.omega_l_max)
-            .fold(1.0f64, f64::max);
-        let x_span = event.periodic.iter().map(|r| r.u).fold(1.0f64, f64::max);
-        let labels = rotor_plot::merge_close(labels, x_span, y_span, 0.02);
-        let svg = overlay(
-            &format!("Figure 3 by three methods: {name}"),
-            "u [V]",
-            "omega_l max / min [rad/s]",
-            vec![
-                Layer {
-                    label: "equilibria",
-                    color: "#999999",
-                    marker: 0.0,
-                    width: 1.0,
-                    points: eq,
-                },
-                Layer {
-                    label: "event-driven (continuation)",
-                    color: "#000000",
-                    marker: 1.0,
-                    width: 0.0,
-                    points: maxmin(event),
-                },
-                Layer {
-                    label: "switch model (shooting)",
-                    color: "#1f77b4",
-                    marker: 3.5,
-                    width: 0.0,
-                    points: maxmin(&sw.diagram),
-                },
-                Layer {
-                    label: "Moreau-Jean, h = 1e-3 (shooting)",
-                    color: "#d62728",
-                    marker: 2.0,
-                    width: 0.0,
-                    points: maxmin(&mo.diagram),
-                },
-            ],
-            labels,
-            900.0,
-            520.0,
-        );
+        let svg = overlay_svg(name, event, &sw.diagram, &mo.diagram);
         sec.files
             .push((format!("figure3-{slug}.svg"), svg.into_bytes()));
         let md = &mut sec.markdown;
@@ -247,25 +175,8 @@ pub fn figure3_section(sets: &[(&str, &str, &Model, &Diagram)]) -> ReportSection
                 match matching(&d.diagram.points, p) {
                     Some(q) => {
                         let du = (q.u - p.u).abs();
-                        let gate_txt = if p.kind == PointKind::Hopf {
-                            "shared".to_string()
-                        } else if let Some(g) = gv {
-                            if du > g {
-                                sec.failures.push(format!(
-                                    "figure 3, {name} {label}: {sname} differs by {du:.1e} V \
-                                     from the event method, gate {g:.0e} V"
-                                ));
-                                format!("{g:e} FAIL")
-                            } else {
-                                format!("{g:e}")
-                            }
-                        } else {
-                            sec.failures.push(format!(
-                                "figure 3, {name} {label}: no gate for {sname} in \
-                                 fixtures/gates/bifurcation.toml"
-                            ));
-                            "none".to_string()
-                        };
+                        let at = (*name, label.as_str(), sname);
+                        let gate_txt = gate_cell(at, p.kind, du, gv, &mut sec.failures);
                         let _ = write!(cells, " {:.9} | {du:.1e} | {gate_txt} |", q.u);
                     }
                     None => {
@@ -288,4 +199,120 @@ pub fn figure3_section(sets: &[(&str, &str, &Model, &Diagram)]) -> ReportSection
         }
     }
     sec
+}
+
+/// The gate cell of a point of kind `kind` that method `sname` places `du` \[V\] from the
+/// event method's, at `(set name, point label, method)`: `shared` for a Hopf point, else the
+/// gate `gv` (marked `FAIL` when `du` exceeds it) or `none`; a failed or missing gate is
+/// added to `failures`.
+fn gate_cell(
+    (name, label, sname): (&str, &str, &str),
+    kind: PointKind,
+    du: f64,
+    gv: Option<f64>,
+    failures: &mut Vec<String>,
+) -> String {
+    if kind == PointKind::Hopf {
+        "shared".to_string()
+    } else if let Some(g) = gv {
+        if du > g {
+            failures.push(format!(
+                "figure 3, {name} {label}: {sname} differs by {du:.1e} V \
+                 from the event method, gate {g:.0e} V"
+            ));
+            format!("{g:e} FAIL")
+        } else {
+            format!("{g:e}")
+        }
+    } else {
+        failures.push(format!(
+            "figure 3, {name} {label}: no gate for {sname} in \
+             fixtures/gates/bifurcation.toml"
+        ));
+        "none".to_string()
+    }
+}
+
+/// The ω_l maximum and minimum of every periodic row of `d`, as points `(u, ω_l)`.
+fn maxmin(d: &Diagram) -> Vec<(f64, f64)> {
+    d.periodic
+        .iter()
+        .flat_map(|r| [(r.u, r.omega_l_max), (r.u, r.omega_l_min)])
+        .collect()
+}
+
+/// The labels of the event diagram's special points ([`label_points`]) at their ω_l maximum
+/// (a Hopf point at its ω, else 0), points closer than 2 % of the axis ranges sharing one
+/// label (as in the diagram's own figure).
+fn point_labels(event: &Diagram) -> Vec<Label> {
+    let labels = label_points(&event.points)
+        .into_iter()
+        .map(|(l, p)| Label {
+            x: p.u,
+            y: p.omega_l_max.unwrap_or(if p.kind == PointKind::Hopf {
+                p.omega.unwrap_or(0.0)
+            } else {
+                0.0
+            }),
+            text: l,
+        })
+        .collect();
+    let y_span = event
+        .periodic
+        .iter()
+        .map(|r| r.omega_l_max)
+        .fold(1.0f64, f64::max);
+    let x_span = event.periodic.iter().map(|r| r.u).fold(1.0f64, f64::max);
+    rotor_plot::merge_close(labels, x_span, y_span, 0.02)
+}
+
+/// The overlay of set `name`: the slipping equilibria, and the cycles' ω_l max / min of the
+/// event continuation and of the switch model's (`sw`) and Moreau–Jean's (`mo`) shooting,
+/// with the special points labelled.
+fn overlay_svg(name: &str, event: &Diagram, sw: &Diagram, mo: &Diagram) -> String {
+    let mut eq: Vec<_> = event
+        .equilibria
+        .iter()
+        .filter(|e| e.kind == EquilibriumKind::Slip)
+        .map(|e| (e.u, e.omega))
+        .collect();
+    eq.sort_by(|a, b| a.1.total_cmp(&b.1));
+    overlay(
+        &format!("Figure 3 by three methods: {name}"),
+        "u [V]",
+        "omega_l max / min [rad/s]",
+        vec![
+            Layer {
+                label: "equilibria",
+                color: "#999999",
+                marker: 0.0,
+                width: 1.0,
+                points: eq,
+            },
+            Layer {
+                label: "event-driven (continuation)",
+                color: "#000000",
+                marker: 1.0,
+                width: 0.0,
+                points: maxmin(event),
+            },
+            Layer {
+                label: "switch model (shooting)",
+                color: "#1f77b4",
+                marker: 3.5,
+                width: 0.0,
+                points: maxmin(sw),
+            },
+            Layer {
+                label: "Moreau-Jean, h = 1e-3 (shooting)",
+                color: "#d62728",
+                marker: 2.0,
+                width: 0.0,
+                points: maxmin(mo),
+            },
+        ],
+        point_labels(event),
+        900.0,
+        520.0,
+    )
 }

@@ -253,13 +253,7 @@ pub fn settle(
     let mut t = 0.0;
     let mut stats = Stats::default();
     let mut prev: Option<SteadyState> = None;
-    let mut prev_change = f64::INFINITY;
-    // The last three ratios of consecutive changes (q), and of consecutive ω_l ranges (r).
-    let mut qs = [f64::NAN; 3];
-    let mut rs = [f64::NAN; 3];
-    let mut prev_range = f64::NAN;
-    // Every chunk's change, for the jitter test below.
-    let mut changes: Vec<f64> = Vec::new();
+    let mut history = History::new(rel, opts);
     loop {
         let scene = Scene {
             x0: x,
@@ -276,129 +270,193 @@ pub fn settle(
         })?;
         if let Some(p) = prev {
             let (what, c) = change(&p, &st, opts.abs);
-            // Changes falling geometrically by q per chunk leave c·q/(1 − q) still to come:
-            // settled when all of it is within `rel`. Changes that do not fall are the
-            // solver's cycle-to-cycle jitter: settled when within `rel`.
-            let q = c / prev_change;
-            let settled = if q < 1.0 {
-                c / (1.0 - q) <= rel
-            } else {
-                c <= rel
-            };
-            prev_change = c;
-            if settled {
-                return Ok(Settled { state: st, stats });
-            }
-            // A change falling geometrically (three consecutive ratios q ≤ 0.99 within 10 % of
-            // 1 − q of each other) settles after n more chunks, c·qⁿ/(1 − q) = rel. An amplitude
-            // falling geometrically, by r per chunk (a focus decaying), changes by the same
-            // fraction 1 − r every chunk relative to itself; the run settles once it is below
-            // the amplitude that reads as an equilibrium, after ln(a_eq/a)/ln r chunks and two
-            // more to confirm. If either is past `max_time`, say so now rather than after
-            // simulating up to it. (Three ratios, not two: a passage near the ghost of a fold
-            // slows down and then speeds up again.)
-            let range = match st {
-                SteadyState::LimitCycle {
-                    omega_l_max,
-                    omega_l_min,
-                    ..
-                } => omega_l_max - omega_l_min,
-                SteadyState::Equilibrium { .. } => f64::NAN,
-            };
-            qs = [qs[1], qs[2], q];
-            rs = [rs[1], rs[2], range / prev_range];
-            prev_range = range;
-            // A ratio above 0.99 is a plateau rather than a decay that can be extrapolated
-            // (the passage near a fold's ghost changes by a nearly constant amount).
-            let steady_ratio = |v: &[f64; 3]| {
-                let x = v[2];
-                x > 0.0 && x <= 0.99 && v.iter().all(|y| (y - x).abs() <= 0.1 * (1.0 - x))
-            };
-            let (geometric, decaying) = (steady_ratio(&qs), steady_ratio(&rs));
-            let r = rs[2];
-            // An amplitude growing geometrically, by r ≥ 1.01 per chunk, while still below 1 %
-            // of the mean velocity: the orbit is leaving a weakly unstable equilibrium. It
-            // cannot settle before its amplitude has grown to that 1 % at least.
-            let growing = r >= 1.01
-                && rs.iter().all(|y| (y - r).abs() <= 0.1 * (r - 1.0))
-                && if let SteadyState::LimitCycle {
-                    omega_l_max,
-                    omega_l_min,
-                    ..
-                } = st
-                {
-                    range < 0.01 * (0.5 * (omega_l_max + omega_l_min)).abs().max(1.0)
-                } else {
-                    false
-                };
-            if growing {
-                let mean = match st {
-                    SteadyState::LimitCycle {
-                        omega_l_max,
-                        omega_l_min,
-                        ..
-                    } => (0.5 * (omega_l_max + omega_l_min)).abs().max(1.0),
-                    SteadyState::Equilibrium { .. } => 1.0,
-                };
-                let n = (0.01 * mean / range).ln() / r.ln();
-                if t + n * opts.chunk > opts.max_time {
-                    return Err(SettleError::NotSettled {
-                        t,
-                        chunk: opts.chunk,
-                        what,
-                        change: c,
-                        cause: Unsettled::SlowGrowth {
-                            per_chunk: r,
-                            needs: t + n * opts.chunk,
-                            max_time: opts.max_time,
-                        },
-                    });
-                }
-            }
-            let projection = if geometric {
-                Some((q, ((rel * (1.0 - q) / c).ln() / q.ln()).ceil()))
-            } else if decaying {
-                let a_eq = rotor_seam::steady::EQUILIBRIUM_AMPLITUDE;
-                Some((r, (a_eq / range).ln() / r.ln() + 2.0))
-            } else {
-                None
-            };
-            if let Some((q, n)) = projection {
-                let needs = t + n * opts.chunk;
-                if needs > opts.max_time {
-                    return Err(SettleError::NotSettled {
-                        t,
-                        chunk: opts.chunk,
-                        what,
-                        change: c,
-                        cause: Unsettled::SlowDecay {
-                            per_chunk: q,
-                            needs,
-                            max_time: opts.max_time,
-                        },
-                    });
-                }
-            }
-            // A fixed-step solver on a grazing cycle jitters from period to period with where
-            // its steps fall: a change that has not halved over the last five chunks (ten
-            // chunks into the run) will not fall below `rel` later either.
-            changes.push(c);
             let cause = unsettled(kind.is_fixed_step(), base.step(), &st);
-            let jitter = matches!(cause, Unsettled::GrazingBelowStep { .. })
-                && changes.len() >= 10
-                && c >= 0.5 * changes[changes.len() - 6];
-            if jitter || t >= opts.max_time {
-                return Err(SettleError::NotSettled {
-                    t,
-                    chunk: opts.chunk,
-                    what,
-                    change: c,
-                    cause,
-                });
+            match history.judge(c, &st, t, cause) {
+                Verdict::Settled => return Ok(Settled { state: st, stats }),
+                Verdict::Running => {}
+                Verdict::Unsettled(cause) => {
+                    return Err(SettleError::NotSettled {
+                        t,
+                        chunk: opts.chunk,
+                        what,
+                        change: c,
+                        cause,
+                    });
+                }
             }
         }
         prev = Some(st);
         x = tr.x_final;
+    }
+}
+
+/// What a chunk's change says of the run.
+enum Verdict {
+    /// Settled: the chunk's metrics are the steady state.
+    Settled,
+    /// Not settled yet: simulate another chunk.
+    Running,
+    /// It will not settle within `max_time`, for this reason.
+    Unsettled(Unsettled),
+}
+
+/// The changes of a run's metrics from chunk to chunk so far, which tell whether it has
+/// settled, or when it would.
+struct History {
+    /// The agreement that counts as settled (relative).
+    rel: f64,
+    /// The run's options.
+    opts: SettleOptions,
+    /// The previous chunk's change (∞ before the second chunk).
+    prev_change: f64,
+    /// The last three ratios of consecutive changes, q.
+    qs: [f64; 3],
+    /// The last three ratios of consecutive ω_l ranges, r.
+    rs: [f64; 3],
+    /// The previous chunk's ω_l range (NaN at an equilibrium).
+    prev_range: f64,
+    /// Every chunk's change, for the jitter test.
+    changes: Vec<f64>,
+}
+
+/// The ω_l range `max ω_l − min ω_l` of a cycle (NaN at an equilibrium).
+fn omega_l_range(st: &SteadyState) -> f64 {
+    match *st {
+        SteadyState::LimitCycle {
+            omega_l_max,
+            omega_l_min,
+            ..
+        } => omega_l_max - omega_l_min,
+        SteadyState::Equilibrium { .. } => f64::NAN,
+    }
+}
+
+/// Whether the last three ratios `v` are one steady ratio `x = v[2]` a run can be
+/// extrapolated by: `0 < x ≤ 0.99` and each within `0.1·(1 − x)` of it. A ratio above 0.99 is
+/// a plateau rather than a decay that can be extrapolated (the passage near a fold's ghost
+/// changes by a nearly constant amount).
+fn steady_ratio(v: &[f64; 3]) -> bool {
+    let x = v[2];
+    x > 0.0 && x <= 0.99 && v.iter().all(|y| (y - x).abs() <= 0.1 * (1.0 - x))
+}
+
+impl History {
+    /// No chunk compared yet, for a run settling to within `rel`.
+    fn new(rel: f64, opts: &SettleOptions) -> Self {
+        History {
+            rel,
+            opts: *opts,
+            prev_change: f64::INFINITY,
+            qs: [f64::NAN; 3],
+            rs: [f64::NAN; 3],
+            prev_range: f64::NAN,
+            changes: Vec::new(),
+        }
+    }
+
+    /// Records the change `c` of the chunk ending at `t` with metrics `st`, and judges the run:
+    /// settled, running, or not settling ([`Self::slow_growth`], [`Self::slow_decay`], or
+    /// `cause` once the run jitters or reaches `max_time`).
+    fn judge(&mut self, c: f64, st: &SteadyState, t: f64, cause: Unsettled) -> Verdict {
+        // Changes falling geometrically by q per chunk leave c·q/(1 − q) still to come:
+        // settled when all of it is within `rel`. Changes that do not fall are the
+        // solver's cycle-to-cycle jitter: settled when within `rel`.
+        let q = c / self.prev_change;
+        let settled = if q < 1.0 {
+            c / (1.0 - q) <= self.rel
+        } else {
+            c <= self.rel
+        };
+        self.prev_change = c;
+        if settled {
+            return Verdict::Settled;
+        }
+        let range = omega_l_range(st);
+        self.qs = [self.qs[1], self.qs[2], q];
+        self.rs = [self.rs[1], self.rs[2], range / self.prev_range];
+        self.prev_range = range;
+        if let Some(why) = self.slow_growth(st, t).or_else(|| self.slow_decay(c, t)) {
+            return Verdict::Unsettled(why);
+        }
+        // A fixed-step solver on a grazing cycle jitters from period to period with where
+        // its steps fall: a change that has not halved over the last five chunks (ten
+        // chunks into the run) will not fall below `rel` later either.
+        self.changes.push(c);
+        let n = self.changes.len();
+        let jitter = matches!(cause, Unsettled::GrazingBelowStep { .. })
+            && n >= 10
+            && c >= 0.5 * self.changes[n - 6];
+        if jitter || t >= self.opts.max_time {
+            Verdict::Unsettled(cause)
+        } else {
+            Verdict::Running
+        }
+    }
+
+    /// An amplitude growing geometrically, by `r ≥ 1.01` per chunk (the last three ratios
+    /// within `0.1·(r − 1)` of it), while still below 1 % of the mean velocity `ω̄`: the orbit
+    /// is leaving a weakly unstable equilibrium, and cannot settle before its amplitude `a`
+    /// has grown to that 1 %, after `n = ln(0.01·ω̄/a) / ln r` chunks. Said now if that is
+    /// past `max_time` (at the run's time `t`).
+    fn slow_growth(&self, st: &SteadyState, t: f64) -> Option<Unsettled> {
+        let (r, rs, range, opts) = (self.rs[2], &self.rs, self.prev_range, &self.opts);
+        let growing = r >= 1.01
+            && rs.iter().all(|y| (y - r).abs() <= 0.1 * (r - 1.0))
+            && if let SteadyState::LimitCycle {
+                omega_l_max,
+                omega_l_min,
+                ..
+            } = *st
+            {
+                range < 0.01 * (0.5 * (omega_l_max + omega_l_min)).abs().max(1.0)
+            } else {
+                false
+            };
+        if !growing {
+            return None;
+        }
+        let mean = match *st {
+            SteadyState::LimitCycle {
+                omega_l_max,
+                omega_l_min,
+                ..
+            } => (0.5 * (omega_l_max + omega_l_min)).abs().max(1.0),
+            SteadyState::Equilibrium { .. } => 1.0,
+        };
+        let n = (0.01 * mean / range).ln() / r.ln();
+        (t + n * opts.chunk > opts.max_time).then_some(Unsettled::SlowGrowth {
+            per_chunk: r,
+            needs: t + n * opts.chunk,
+            max_time: opts.max_time,
+        })
+    }
+
+    /// A decay that settles only past `max_time` (at the run's time `t`, last change `c`).
+    /// A change falling geometrically (three consecutive ratios q ≤ 0.99 within 10 % of
+    /// 1 − q of each other) settles after n more chunks, `c·qⁿ/(1 − q) = rel`. An amplitude
+    /// falling geometrically, by r per chunk (a focus decaying), changes by the same fraction
+    /// 1 − r every chunk relative to itself; the run settles once it is below the amplitude
+    /// that reads as an equilibrium, after `ln(a_eq/a)/ln r` chunks and two more to confirm.
+    /// If either is past `max_time`, it is said now rather than after simulating up to it.
+    /// (Three ratios, not two: a passage near the ghost of a fold slows down and then speeds
+    /// up again.)
+    fn slow_decay(&self, c: f64, t: f64) -> Option<Unsettled> {
+        let (q, r, range, opts) = (self.qs[2], self.rs[2], self.prev_range, &self.opts);
+        let projection = if steady_ratio(&self.qs) {
+            Some((q, ((self.rel * (1.0 - q) / c).ln() / q.ln()).ceil()))
+        } else if steady_ratio(&self.rs) {
+            let a_eq = rotor_seam::steady::EQUILIBRIUM_AMPLITUDE;
+            Some((r, (a_eq / range).ln() / r.ln() + 2.0))
+        } else {
+            None
+        };
+        let (q, n) = projection?;
+        let needs = t + n * opts.chunk;
+        (needs > opts.max_time).then_some(Unsettled::SlowDecay {
+            per_chunk: q,
+            needs,
+            max_time: opts.max_time,
+        })
     }
 }
 

@@ -198,24 +198,28 @@ fn beside(event: &Diagram, u: f64) -> (Vec<&PeriodicRow>, Vec<&PeriodicRow>) {
     (spaced(slip, u), spaced(stick, u))
 }
 
-fn grazing(
+/// One shot of the solver's cycle: its input u \[V\], its diagram row and its orbit.
+type Shot = (f64, PeriodicRow, Orbit);
+
+/// A grazing point fitted from shots: the root of the quadratic through the first three
+/// shots, the root through the last three (the point), and the four shots.
+type Fit = (f64, f64, Vec<Shot>);
+
+/// One solver shooting the cycles beside one grazing point.
+struct Shooting<'a> {
     kind: SolverKind,
-    model: &Model,
-    event: &Diagram,
-    g: &SpecialPoint,
-    opts: &BySolverOptions,
-) -> Result<Vec<SpecialPoint>, String> {
-    let solver = &*kind.solver();
-    let ug = g.u;
-    let (slips, sticks) = beside(event, ug);
-    if slips.is_empty() {
-        return Err("no slipping cycle of the continuation beside it".into());
-    }
-    let s = (slips[0].u - ug).signum();
-    // The solver's slipping cycle at the u of each of three continuation rows, from that row's
-    // state (one crossing on: an unstable cycle's start has not drifted), and its min ω_l.
-    let shoot_row = |u: f64, z0: Option<&[f64]>, row: &PeriodicRow| {
-        let sc = opts.scene(kind, u);
+    solver: &'a dyn rotor_seam::Solver,
+    model: &'a Model,
+    opts: &'a BySolverOptions,
+}
+
+impl Shooting<'_> {
+    /// The solver's slipping cycle (section: a maximum of ω_l) at `u`, from `z0` or else from
+    /// the first crossing of a run from `row`'s state (one crossing on: an unstable cycle's
+    /// start has not drifted); an error if the cycle it finds sticks.
+    fn slipping(&self, u: f64, z0: Option<&[f64]>, row: &PeriodicRow) -> Result<Shot, String> {
+        let (solver, model) = (self.solver, self.model);
+        let sc = self.opts.scene(self.kind, u);
         let z = match z0 {
             Some(z) => z.to_vec(),
             None => first_crossing(
@@ -251,58 +255,133 @@ fn grazing(
                 r.stick_time, r.period, o.multipliers, row.u
             ));
         }
-        Ok::<_, String>((u, r, o))
-    };
-    // At u_g + s·4δ, 2δ, δ: δ = 1e-4 V, or 5 % of the distance to the nearest other special
-    // point (the Stribeck set's low grazing orbit lies 2.4e-4 V from its Hopf point); the
-    // first from the nearest continuation row's state, each next from the last fixed point.
+        Ok((u, r, o))
+    }
+
+    /// The solver's stick-slip cycle (section: the stick exit) at the first of the nearest
+    /// eight continuation rows `sticks` that it sees sticking (a stick phase shorter than
+    /// Moreau–Jean's step is not seen).
+    fn stick_slip(&self, sticks: &[&PeriodicRow]) -> Result<Shot, String> {
+        let (solver, model) = (self.solver, self.model);
+        let mut why = String::from("no stick-slip cycle of the continuation beside it");
+        for row in sticks.iter().take(8) {
+            let sc = self.opts.scene(self.kind, row.u);
+            let sec = Section::StickExit;
+            let r = first_crossing(solver, model, &sc, row.section_state, row.period, sec)
+                .and_then(|z2| {
+                    let o = shoot(solver, model, &sc, sec, &z2, &shoot_opts(row.period))
+                        .map_err(|e| format!("stick-slip cycle at u = {}: {e}", sc.u))?;
+                    let r = row_of(solver, model, &sc, &o, row.branch)?;
+                    Ok((sc.u, r, o))
+                });
+            match r {
+                Ok(v) => return Ok(v),
+                Err(e) => why = e,
+            }
+        }
+        Err(why)
+    }
+}
+
+/// The points `(u, m(u))` of shots, `m(u) = min ω_l` of the shot's cycle.
+fn min_omega(shots: &[Shot]) -> Vec<(f64, f64)> {
+    shots.iter().map(|(u, r, _)| (*u, r.omega_l_min)).collect()
+}
+
+/// The fit from three slipping shots (outermost first, on the side `s` of the point): `r1`
+/// the root of the quadratic through them; one more shot `step/8` beyond `r1` on side `s`,
+/// from the nearest shot's fixed point (at `row`'s period); `r2` the root through the last
+/// three. An error if `r2` is not beyond the slipping cycles' side of that last shot.
+fn refine(
+    sh: &Shooting,
+    mut shots: Vec<Shot>,
+    s: f64,
+    step: f64,
+    row: &PeriodicRow,
+) -> Result<Fit, String> {
+    let r1 = quadratic_root(&min_omega(&shots))?;
+    let z_near = shots[2].2.z.clone();
+    shots.push(sh.slipping(r1 + s * step / 8.0, Some(&z_near), row)?);
+    let r2 = quadratic_root(&min_omega(&shots[1..]))?;
+    if s * (shots[3].0 - r2) <= 0.0 {
+        return Err(format!(
+            "the root u = {r2} of min omega_l is not beyond the slipping cycles' side"
+        ));
+    }
+    Ok((r1, r2, shots))
+}
+
+/// The fit from shots at `u_g + s·4δ`, `+ s·2δ`, `+ s·δ`, each from the state of the
+/// continuation row `slips` nearest in u (at a non-smooth fold the stick-slip cycle lies as
+/// close to the grazing orbit as the slipping one, so a start from the grazing orbit itself
+/// could reach either).
+fn fit_at_offsets(
+    sh: &Shooting,
+    ug: f64,
+    s: f64,
+    slips: &[&PeriodicRow],
+    delta: f64,
+) -> Result<Fit, String> {
+    let mut shots: Vec<Shot> = Vec::new();
+    for d in [4.0, 2.0, 1.0] {
+        let u = ug + s * d * delta;
+        let row = slips
+            .iter()
+            .min_by(|a, b| (a.u - u).abs().total_cmp(&(b.u - u).abs()))
+            .expect("not empty");
+        shots.push(sh.slipping(u, None, row)?);
+    }
+    refine(sh, shots, s, delta, slips[0])
+}
+
+/// The fit from shots at the u of three continuation rows `slips` themselves (at least 1e-5 V
+/// from the point, so that their min ω_l stays well above the finite-difference steps), each
+/// from its own row's state: no start is off by a change of u, which a strongly unstable
+/// cycle amplifies 4.65× per period (E).
+fn fit_at_rows(sh: &Shooting, ug: f64, s: f64, slips: &[&PeriodicRow]) -> Result<Fit, String> {
+    let rows: Vec<&PeriodicRow> = slips
+        .iter()
+        .copied()
+        .filter(|r| (r.u - ug).abs() >= 1e-5)
+        .take(3)
+        .collect();
+    if rows.len() < 3 {
+        return Err("fewer than three slipping rows 1e-5 V or more from it".into());
+    }
+    let mut shots = Vec::new();
+    for row in rows.iter().rev() {
+        shots.push(sh.slipping(row.u, None, row)?);
+    }
+    let d = (rows[0].u - ug).abs();
+    refine(sh, shots, s, d, rows[0])
+}
+
+/// The grazing point `u_g` of the solver's slipping cycles (on side `s`, rows `slips`):
+/// [`fit_at_offsets`] with δ = 1e-4 V, or 5 % of the distance to the nearest other special
+/// point of `event` (the Stribeck set's low grazing orbit lies 2.4e-4 V from its Hopf point),
+/// then δ/10 and δ/100; last [`fit_at_rows`]. The errors of every try, if all fail.
+fn fit_grazing(
+    sh: &Shooting,
+    event: &Diagram,
+    ug: f64,
+    s: f64,
+    slips: &[&PeriodicRow],
+) -> Result<Fit, String> {
     let other = event
         .points
         .iter()
         .map(|p| (p.u - ug).abs())
         .filter(|d| *d > 1e-6)
         .fold(f64::INFINITY, f64::min);
-    let m = |sh: &[(f64, PeriodicRow, Orbit)]| -> Vec<(f64, f64)> {
-        sh.iter().map(|(u, r, _)| (*u, r.omega_l_min)).collect()
-    };
     let first = 1e-4f64.min(0.05 * other);
     // Close to a non-smooth fold whose slipping cycle is strongly unstable (the Stribeck
     // set's E, multiplier 4.65) the shots at 1e-4 V can fall onto the stick-slip cycle; δ
     // then shrinks 10× per try, down to 1e-6 V (still far above the solvers' shifts of the
     // point, ≤ 2e-7 V measured).
     let mut last_err = String::new();
-    let mut done = None;
     for delta in [first, first / 10.0, first / 100.0] {
-        let attempt = || -> Result<_, String> {
-            let mut shots: Vec<(f64, PeriodicRow, Orbit)> = Vec::new();
-            for d in [4.0, 2.0, 1.0] {
-                // The continuation row nearest in u: at a non-smooth fold the stick-slip
-                // cycle lies as close to the grazing orbit as the slipping one, so a start
-                // from the grazing orbit itself could reach either.
-                let u = ug + s * d * delta;
-                let row = slips
-                    .iter()
-                    .min_by(|a, b| (a.u - u).abs().total_cmp(&(b.u - u).abs()))
-                    .expect("not empty");
-                shots.push(shoot_row(u, None, row)?);
-            }
-            let r1 = quadratic_root(&m(&shots))?;
-            // One more shot, δ/8 beyond the root, from the nearest shot's fixed point.
-            let z_near = shots[2].2.z.clone();
-            shots.push(shoot_row(r1 + s * delta / 8.0, Some(&z_near), slips[0])?);
-            let r2 = quadratic_root(&m(&shots[1..]))?;
-            if s * (shots[3].0 - r2) <= 0.0 {
-                return Err(format!(
-                    "the root u = {r2} of min omega_l is not beyond the slipping cycles' side"
-                ));
-            }
-            Ok((r1, r2, shots))
-        };
-        match attempt() {
-            Ok(v) => {
-                done = Some(v);
-                break;
-            }
+        match fit_at_offsets(sh, ug, s, slips, delta) {
+            Ok(v) => return Ok(v),
             Err(e) => {
                 if !last_err.is_empty() {
                     last_err.push_str("; ");
@@ -311,67 +390,50 @@ fn grazing(
             }
         }
     }
-    // Last: the shots at the u of three continuation rows themselves (at least 1e-5 V from the
-    // point, so that their min ω_l stays well above the finite-difference steps), each from its
-    // own row's state: no start is off by a change of u, which a strongly unstable cycle
-    // amplifies 4.65× per period (E).
-    if done.is_none() {
-        let rows: Vec<&PeriodicRow> = slips
-            .iter()
-            .copied()
-            .filter(|r| (r.u - ug).abs() >= 1e-5)
-            .take(3)
-            .collect();
-        let attempt = || -> Result<_, String> {
-            if rows.len() < 3 {
-                return Err("fewer than three slipping rows 1e-5 V or more from it".into());
-            }
-            let mut shots = Vec::new();
-            for row in rows.iter().rev() {
-                shots.push(shoot_row(row.u, None, row)?);
-            }
-            let r1 = quadratic_root(&m(&shots))?;
-            let d = (rows[0].u - ug).abs();
-            let z_near = shots[2].2.z.clone();
-            shots.push(shoot_row(r1 + s * d / 8.0, Some(&z_near), rows[0])?);
-            let r2 = quadratic_root(&m(&shots[1..]))?;
-            if s * (shots[3].0 - r2) <= 0.0 {
-                return Err(format!(
-                    "the root u = {r2} of min omega_l is not beyond the slipping cycles' side"
-                ));
-            }
-            Ok((r1, r2, shots))
-        };
-        match attempt() {
-            Ok(v) => done = Some(v),
-            Err(e) => last_err += &format!("; at the continuation's rows: {e}"),
-        }
+    fit_at_rows(sh, ug, s, slips)
+        .map_err(|e| last_err + &format!("; at the continuation's rows: {e}"))
+}
+
+/// The continuation's grazing orbit `g` located again by solver `kind` (see the module docs):
+/// the solver's grazing point, and with a non-smooth fold its discontinuous fold too.
+fn grazing(
+    kind: SolverKind,
+    model: &Model,
+    event: &Diagram,
+    g: &SpecialPoint,
+    opts: &BySolverOptions,
+) -> Result<Vec<SpecialPoint>, String> {
+    let solver = kind.solver();
+    let sh = Shooting {
+        kind,
+        solver: &*solver,
+        model,
+        opts,
+    };
+    let ug = g.u;
+    let (slips, sticks) = beside(event, ug);
+    if slips.is_empty() {
+        return Err("no slipping cycle of the continuation beside it".into());
     }
-    let (r1, r2, shots) = done.ok_or(last_err)?;
-    let (_, slip_row, slip_orbit) = &shots[3];
-    // The stick-slip side: the solver's stick-slip cycle at the nearest continuation row that
-    // it sees sticking (a stick phase shorter than Moreau–Jean's step is not seen).
-    let mut found = None;
-    let mut why = String::from("no stick-slip cycle of the continuation beside it");
-    for row in sticks.iter().take(8) {
-        let sc = opts.scene(kind, row.u);
-        let sec = Section::StickExit;
-        let r =
-            first_crossing(solver, model, &sc, row.section_state, row.period, sec).and_then(|z2| {
-                let o = shoot(solver, model, &sc, sec, &z2, &shoot_opts(row.period))
-                    .map_err(|e| format!("stick-slip cycle at u = {}: {e}", sc.u))?;
-                let r = row_of(solver, model, &sc, &o, row.branch)?;
-                Ok((sc.u, r, o))
-            });
-        match r {
-            Ok(v) => {
-                found = Some(v);
-                break;
-            }
-            Err(e) => why = e,
-        }
-    }
-    let (u_ss, ss_row, ss_orbit) = found.ok_or(why)?;
+    let s = (slips[0].u - ug).signum();
+    let (r1, r2, shots) = fit_grazing(&sh, event, ug, s, &slips)?;
+    let stick_slip = sh.stick_slip(&sticks)?;
+    Ok(grazing_points(ug, s, (r1, r2), &shots[3], &stick_slip))
+}
+
+/// The grazing point at `r2` (residual `|r2 − r1|`) from the solver's slipping cycle `slip`
+/// (on side `s` of `u_g`) and its stick-slip cycle `stick_slip`, typed by Feigin's rule:
+/// σ⁺ (slipping) + σ⁺ (stick-slip) odd is a non-smooth fold, also written as a discontinuous
+/// fold point; even is persistence. Whether the stick-slip cycle's side fits the type is said.
+fn grazing_points(
+    ug: f64,
+    s: f64,
+    (r1, r2): (f64, f64),
+    slip: &Shot,
+    stick_slip: &Shot,
+) -> Vec<SpecialPoint> {
+    let (u_slip, slip_row, slip_orbit) = slip;
+    let (u_ss, ss_row, ss_orbit) = stick_slip;
     let s2 = (u_ss - ug).signum();
     let (p_slip, m_slip) = sigma(&slip_orbit.multipliers);
     let (p_ss, m_ss) = sigma(&ss_orbit.multipliers);
@@ -396,7 +458,7 @@ fn grazing(
          stick-slip); multipliers {} (slipping, at u = {}), {} (stick-slip, at u = {u_ss}, \
          stick time {:.3e} s){check}",
         fmt(&slip_orbit.multipliers),
-        shots[3].0,
+        u_slip,
         fmt(&ss_orbit.multipliers),
         ss_row.stick_time
     );
@@ -430,7 +492,7 @@ fn grazing(
         );
         out.push(p);
     }
-    Ok(out)
+    out
 }
 
 fn smooth_fold(
