@@ -64,10 +64,10 @@ pub use options::{
     BenchOptions, LEAD_SCENES, PeerOptions, SceneSpec, SolverKind, Tier, select, suite, suite_dir,
     workspace_root,
 };
-pub use peers::available as peer_available;
-pub use peers::octave_available;
 pub use profile::Profile;
 pub use rotor_protocol::ClientSpec;
+pub use rotor_protocol::peers::available as peer_available;
+pub use rotor_protocol::peers::octave_available;
 
 use ladder::{Loaded, ladders, load};
 use levels::output_levels;

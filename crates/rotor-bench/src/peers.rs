@@ -1,176 +1,54 @@
-//! The repository's own peers, bench/peers/scipy_rotor.py (scipy `solve_ivp`, DOP853 with
-//! event functions; also as `scipy-radau`, `scipy-bdf`, `scipy-lsoda` with `--method`),
-//! bench/peers/siconos_rotor.py (Siconos `MoreauJeanOSI`) and bench/peers/octave_rotor.m
-//! (GNU Octave's `ode45` with event functions, restarted at every mode switch): clients of
-//! the same job-file protocol as any external solver, run when their interpreter imports
-//! the library (Octave: when it has `ode45` and `jsondecode`).
-
-use std::process::Command;
+//! Which of the repository's peers ([`rotor_protocol::peers`]) a benchmark runs, each with
+//! its ladder: those the options turn on and whose interpreter can run them; the others are
+//! reported as skipped, with the reason.
 
 use crate::clients::{ClientReport, ClientStatus};
-use crate::options::BenchOptions;
+use crate::options::{BenchOptions, PeerOptions};
 use rotor_protocol::ClientSpec;
-
-/// Whether `python -c "import <module>"` works; the error says why not.
-pub fn available(python: &str, module: &str) -> Result<(), String> {
-    match Command::new(python)
-        .args(["-c", &format!("import {module}")])
-        .output()
-    {
-        Ok(o) if o.status.success() => Ok(()),
-        Ok(o) => Err(format!(
-            "`{python} -c \"import {module}\"` failed: {}",
-            String::from_utf8_lossy(&o.stderr)
-                .lines()
-                .last()
-                .unwrap_or("")
-        )),
-        Err(e) => Err(format!("cannot run `{python}`: {e}")),
-    }
-}
-
-/// The command line that starts the Octave peer's launcher, before the job file: no start-up
-/// files, no banner, no history (Octave 7 reports an error at exit when it cannot save it).
-fn octave_argv(octave: &str) -> Vec<String> {
-    [octave, "--norc", "--quiet", "--no-history"]
-        .map(String::from)
-        .to_vec()
-}
-
-/// Whether `octave` runs and has what the Octave peer needs (`ode45`, and `jsondecode`,
-/// which came with GNU Octave 7); the error says why not.
-pub fn octave_available(octave: &str) -> Result<(), String> {
-    let probe = "if exist('ode45') && exist('jsondecode'), exit(0); end; \
-                 fputs(stderr, 'no ode45 or no jsondecode: GNU Octave >= 7 is needed'); exit(1);";
-    match Command::new(octave)
-        .args(octave_argv(octave).into_iter().skip(1))
-        .args(["--eval", probe])
-        .output()
-    {
-        Ok(o) if o.status.success() => Ok(()),
-        Ok(o) => Err(format!(
-            "`{octave}` cannot run the Octave peer: {}",
-            String::from_utf8_lossy(&o.stderr)
-                .lines()
-                .last()
-                .unwrap_or("")
-        )),
-        Err(e) => Err(format!("cannot run `{octave}`: {e}")),
-    }
-}
+use rotor_protocol::peers::{PEERS, Peer};
 
 /// A peer to run: its client spec and ladder, or the report of a peer that is skipped.
 pub(crate) type PeerLaunch = Result<(ClientSpec, Vec<f64>), Box<ClientReport>>;
 
+/// Whether the options turn a peer on, the interpreter that runs it, and its ladder. The
+/// scipy methods other than DOP853 run with scipy, on their own ladder (none: not run).
+fn setting<'a>(p: &'a PeerOptions, peer: &Peer) -> (bool, &'a str, &'a [f64]) {
+    match peer.name {
+        "scipy" => (p.scipy, &p.python, &p.scipy_tols),
+        "siconos" => (p.siconos, &p.siconos_python, &p.siconos_hs),
+        "octave" => (p.octave, &p.octave_cli, &p.octave_tols),
+        // scipy-radau, scipy-bdf, scipy-lsoda
+        _ => (
+            p.scipy && !p.scipy_method_tols.is_empty(),
+            &p.python,
+            &p.scipy_method_tols,
+        ),
+    }
+}
+
 /// The peers the options ask for, each with its ladder, or skipped with the reason.
 pub(crate) fn peers(opts: &BenchOptions, progress: &mut impl FnMut(&str)) -> Vec<PeerLaunch> {
     let p = &opts.peers;
-    let specs = [
-        (
-            "scipy",
-            p.scipy,
-            &p.python,
-            "scipy",
-            "scipy_rotor.py",
-            false,
-            &p.scipy_tols,
-        ),
-        (
-            "scipy-radau",
-            p.scipy && !p.scipy_method_tols.is_empty(),
-            &p.python,
-            "scipy",
-            "scipy_rotor.py --method Radau",
-            false,
-            &p.scipy_method_tols,
-        ),
-        (
-            "scipy-bdf",
-            p.scipy && !p.scipy_method_tols.is_empty(),
-            &p.python,
-            "scipy",
-            "scipy_rotor.py --method BDF",
-            false,
-            &p.scipy_method_tols,
-        ),
-        (
-            "scipy-lsoda",
-            p.scipy && !p.scipy_method_tols.is_empty(),
-            &p.python,
-            "scipy",
-            "scipy_rotor.py --method LSODA",
-            false,
-            &p.scipy_method_tols,
-        ),
-        (
-            "siconos",
-            p.siconos,
-            &p.siconos_python,
-            "siconos.kernel",
-            "siconos_rotor.py",
-            true,
-            &p.siconos_hs,
-        ),
-    ];
-    let mut launches: Vec<PeerLaunch> = specs
-        .into_iter()
-        .map(|(name, on, python, module, script, fixed_step, ladder)| {
-            // The script, then its own arguments (`--method M`).
-            let mut words = script.split(' ');
-            let script = words.next().unwrap_or_default();
-            let mut argv = vec![python.clone(), p.dir.join(script).display().to_string()];
-            argv.extend(words.map(str::to_owned));
-            let spec = ClientSpec {
-                name: name.into(),
-                argv,
-                fixed_step,
-                peer: true,
-            };
-            if !on {
-                return Err(Box::new(ClientReport::skipped(
-                    &spec,
-                    ClientStatus::Skipped,
-                    "turned off in the options".into(),
-                )));
-            }
-            if let Err(why) = available(python, module) {
-                progress(&format!("{name} peer skipped: {why}"));
-                return Err(Box::new(ClientReport::skipped(
+    PEERS
+        .iter()
+        .map(|peer| {
+            let (on, program, ladder) = setting(p, peer);
+            let spec = peer.spec(program, &p.dir);
+            let skip = |why: String| {
+                Err(Box::new(ClientReport::skipped(
                     &spec,
                     ClientStatus::Skipped,
                     why,
-                )));
+                )))
+            };
+            if !on {
+                return skip("turned off in the options".into());
             }
-            Ok((spec, ladder.clone()))
+            if let Err(why) = peer.available(program) {
+                progress(&format!("{} peer skipped: {why}", peer.name));
+                return skip(why);
+            }
+            Ok((spec.clone(), ladder.to_vec()))
         })
-        .collect();
-    launches.push(octave(p, progress));
-    launches
-}
-
-/// The Octave peer (`octave-cli ... bench/peers/octave_rotor_cli.m JOB`), or its skip.
-fn octave(p: &crate::options::PeerOptions, progress: &mut impl FnMut(&str)) -> PeerLaunch {
-    let mut argv = octave_argv(&p.octave_cli);
-    argv.push(p.dir.join("octave_rotor_cli.m").display().to_string());
-    let spec = ClientSpec {
-        name: "octave".into(),
-        argv,
-        fixed_step: false,
-        peer: true,
-    };
-    let skip = |why: String| {
-        Err(Box::new(ClientReport::skipped(
-            &spec,
-            ClientStatus::Skipped,
-            why,
-        )))
-    };
-    if !p.octave {
-        return skip("turned off in the options".into());
-    }
-    if let Err(why) = octave_available(&p.octave_cli) {
-        progress(&format!("octave peer skipped: {why}"));
-        return skip(why);
-    }
-    Ok((spec.clone(), p.octave_tols.clone()))
+        .collect()
 }

@@ -8,6 +8,8 @@
 
 #![warn(missing_docs)]
 
+pub mod peers;
+
 use std::io::Read;
 use std::path::{Path, PathBuf};
 use std::process::{Command, ExitStatus, Stdio};
