@@ -540,18 +540,24 @@ impl Run<'_> {
         hit
     }
 
-    /// A velocity guard (`s·ω − η` or `s·ω`) that dips below 0 and back between two samples,
-    /// as an orbit does that grazes the band. Without this check a tangential approach that
-    /// spends less than a sample interval inside the band (1.6e-4 s near the grazing orbit at
-    /// 4.6153 V, Table 1) passes through it unseen, with ω_l below 0 and no stick.
+    /// A velocity guard (`s·ω − η`, `s·ω` or `η − s·ω`) that dips below 0 and back between
+    /// two samples, as an orbit does that grazes the band. Without this check a tangential
+    /// approach that spends less than a sample interval inside the band (1.6e-4 s near the
+    /// grazing orbit at 4.6153 V, Table 1) passes through it unseen, with ω_l below 0 and no
+    /// stick; and a disc in `Trans` whose applied torque comes back inside the stick interval
+    /// soon after it entered the band (so ω turns back before the next sample) leaves the band
+    /// on the far side unseen and is then held stuck there by `Back`, outside the band
+    /// (ω_l = −3.5e-7 rad/s with η = 1e-10, found by the random energy-balance test).
     ///
-    /// Where the slope of `s·ω` on the dense output turns from negative to positive between
-    /// two samples, its minimum is located (Illinois on the slope) and the guard evaluated
-    /// there; if it is negative, its root before the minimum is the crossing. The slope is
-    /// the interpolant's derivative ([`Dopri5::dense_slope`]): no field evaluation.
+    /// Where the slope of `σ·ω` (σ = s, or −s for `TransOut`) on the dense output turns from
+    /// negative to positive between two samples, its minimum is located (Illinois on the
+    /// slope) and the guard evaluated there; if it is negative, its root before the minimum is
+    /// the crossing. The slope is the interpolant's derivative ([`Dopri5::dense_slope`]): no
+    /// field evaluation.
     fn dip(&self, k: usize, g: Guard, vals: &[(f64, f64)]) -> Option<f64> {
         let s = match g {
             Guard::BandEntry(s) | Guard::Zero(s) => s,
+            Guard::TransOut(s) => -s,
             _ => return None,
         };
         let (f, integ) = (&self.field, &self.integ);

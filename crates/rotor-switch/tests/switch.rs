@@ -520,6 +520,71 @@ fn a_grazing_approach_inside_one_sample_interval_still_enters_the_band() {
     }
 }
 
+/// A disc entering the band from slip with its applied torque just beyond the far bound goes
+/// through `Trans` towards the other side; when that torque comes back inside the stick
+/// interval soon after (the spring unwinding fast), ω turns back before the next guard sample.
+/// The crossing of the far band edge on the way must still be found: the disc leaves the band
+/// there and sticks on coming back, at |ω| ≤ η. Before `TransOut` had the dip check, it stayed
+/// in `Trans` through the whole excursion and `Back` held it stuck at ω_l = −3.5e-7 rad/s,
+/// 3500 η outside the band (the random energy-balance test found it: the stuck disc's
+/// friction then did work on the spring's drift, 1.4e-7 J over the quadrature bound). The
+/// parameters and start are that test's case: lower disc decelerating through 0 at 4.87 s
+/// with k_θ α = −0.32359 N m against T_sl = 0.32348 N m.
+#[test]
+fn a_transition_that_turns_back_between_samples_still_leaves_the_band() {
+    let p = rotor_model::Params::from_toml_str(
+        r#"
+        name = "random"
+        j_u = 0.5406073436037806
+        k_m = 4.714116599298132
+        k_theta = 0.1046432178723484
+        j_l = 0.06105737073702883
+        [upper]
+        t_s = 0.0
+        dt_s = 0.0
+        b = 2.4336122696572966
+        db = 0.0
+        [lower]
+        family = "exponential"
+        t_s = 0.32348111778736705
+        t_1 = 0.06436069664743727
+        t_2 = -0.3911801459278995
+        w_1 = 7.189790210189608
+        w_2 = 0.5226286358212893
+        b = 0.006297360499862394
+        "#,
+        Path::new("random.toml"),
+    )
+    .unwrap();
+    let m = Model::new(p);
+    let eta = SwitchOptions::default().eta;
+    let t = run(
+        eta,
+        &m,
+        &Scene {
+            u: 1.3365041040337289,
+            x0: rotor_model::State::new(
+                0.8659456400432735,
+                -0.32796852503374785,
+                -0.8366875147756173,
+            ),
+            t_end: 10.0,
+            output: Output::Events,
+            ..Scene::default()
+        },
+    );
+    let sticks: Vec<f64> = t
+        .events
+        .iter()
+        .filter(|e| e.kind == EventKind::StickStart(Disc::Lower))
+        .map(|e| e.x[OMEGA_L])
+        .collect();
+    assert!(!sticks.is_empty(), "no stick of the lower disc");
+    for w in &sticks {
+        assert!(w.abs() <= eta, "the lower disc sticks at omega_l = {w:e}");
+    }
+}
+
 /// A stuck disc keeps the velocity it entered the band with, which may lie just below 0 (it
 /// came in through the transition region). When it breaks away forward, ω crosses 0 inside
 /// the band: that is the stick exit, not a reversal (the exact solution sticks at ω = 0 and
