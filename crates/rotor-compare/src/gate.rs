@@ -3,8 +3,8 @@
 //! (a) the transient window, sample by sample on the common grid: max and RMS of the
 //! difference in ω_u and ω_l; (b) the steady state: kind, and each metric within its own
 //! tolerance, one key per metric (period, each extreme of ω_l and ω_u, and each of the
-//! equilibrium's ω_u, ω_l and α relative with `steady_abs` as a floor, the stick time in
-//! seconds); (c) events: lower-disc stick onsets and exits in
+//! equilibrium's ω_u, ω_l and α relative with `steady_abs` as a floor, a stuck disc's
+//! velocity beyond the solvers' stuck bands only, the stick time in seconds); (c) events: lower-disc stick onsets and exits in
 //! the transient window matched one to one within `event_time`.
 //! Every comparison is written `!(diff <= tol)` so that a NaN fails.
 
@@ -97,12 +97,17 @@ impl GateResult {
 
 /// Compares two trajectories of the same scenario under a pair's tolerances.
 /// `transient` is the sample-by-sample window; quantities without a tolerance are skipped.
+/// `stuck_band` is the sum of the two solvers' [`SolverInfo::stuck_band`]s
+/// ([`steady_differences`]).
+///
+/// [`SolverInfo::stuck_band`]: rotor_solvers::SolverInfo::stuck_band
 pub fn check_pair(
     pair: &str,
     a: &Trajectory,
     b: &Trajectory,
     transient: Option<[f64; 2]>,
     tol: &PairTolerance,
+    stuck_band: f64,
 ) -> GateResult {
     let mut m = Vec::new();
     if let Some([t0, t1]) = transient {
@@ -209,7 +214,7 @@ pub fn check_pair(
                 tol: 0.0,
             });
         } else {
-            m.extend(steady_differences(&sa, &sb, tol, floor));
+            m.extend(steady_differences(&sa, &sb, tol, floor, stuck_band));
         }
     }
     GateResult {
@@ -223,11 +228,21 @@ pub fn check_pair(
 /// `|va − vb| ≤ max(tol·max(|va|, |vb|), floor)`; `stick_time` is absolute. A metric whose
 /// tolerance the file does not state is measured against 0 and fails: the file must gate
 /// every metric of the steady state it reaches.
+///
+/// A disc at rest at an equilibrium: where one solver reports its velocity (`omega_u`,
+/// `omega_l`) as 0 exactly and the other within `stuck_band` of 0 (the two solvers'
+/// [`SolverInfo::stuck_band`]s summed: the switch model holds a stuck disc at the velocity it
+/// entered its band with, |ω| ≤ η), only the part of the difference beyond the band counts
+/// ([`beyond_stuck_band`]). Relative to a value that is 0 by construction, the band itself
+/// would read as a difference of 100 %, which no gate could tell from a real one.
+///
+/// [`SolverInfo::stuck_band`]: rotor_solvers::SolverInfo::stuck_band
 pub fn steady_differences(
     sa: &SteadyState,
     sb: &SteadyState,
     tol: &PairTolerance,
     floor: f64,
+    stuck_band: f64,
 ) -> Vec<Measured> {
     sa.values()
         .into_iter()
@@ -237,7 +252,7 @@ pub fn steady_differences(
                 .for_metric(name)
                 .expect("every metric of SteadyState::values has a quantity");
             let t = t.unwrap_or(0.0);
-            let d = (va - vb).abs();
+            let d = beyond_stuck_band(name, va, vb, stuck_band);
             let diff = if !q.relative {
                 d
             } else {
@@ -264,6 +279,21 @@ pub fn steady_differences(
             }
         })
         .collect()
+}
+
+/// `|va − vb|`, less `stuck_band` (not below 0) where `name` is an equilibrium's disc
+/// velocity (`omega_u`, `omega_l`) that one of the two reports as 0 exactly: a stuck disc
+/// that the other solver holds inside its band (see [`steady_differences`]). A NaN stays NaN.
+pub fn beyond_stuck_band(name: &str, va: f64, vb: f64, stuck_band: f64) -> f64 {
+    let d = (va - vb).abs();
+    let stuck = matches!(name, "omega_u" | "omega_l") && (va == 0.0 || vb == 0.0);
+    if stuck && d <= stuck_band {
+        0.0
+    } else if stuck {
+        d - stuck_band
+    } else {
+        d
+    }
 }
 
 /// The steady metrics of a trajectory, if computed.
@@ -304,7 +334,8 @@ pub fn gate_scenario(r: &ScenarioResult) -> (Vec<GateResult>, Vec<Failure>) {
         let (Some(ta), Some(tb)) = (r.traj(a), r.traj(b)) else {
             continue;
         };
-        let g = check_pair(&pair, ta, tb, sc.compare.transient, tol);
+        let band = a.info().stuck_band + b.info().stuck_band;
+        let g = check_pair(&pair, ta, tb, sc.compare.transient, tol, band);
         fails.extend(g.failures(&sc.name));
         gates.push(g);
     }
@@ -363,13 +394,13 @@ mod tests {
     #[test]
     fn identical_results_pass_and_a_difference_fails() {
         let a = traj(Some(EQ));
-        let g = check_pair("p", &a, &a, Some([0.0, 1.0]), &tol());
+        let g = check_pair("p", &a, &a, Some([0.0, 1.0]), &tol(), 0.0);
         // Both the window and the metrics were measured, and passed.
         assert_eq!(g.measured.len(), 1 + EQ.values().len());
         assert!(g.failures("s").is_empty());
         let mut b = a.clone();
         b.samples[50].x[2] += 1e-6;
-        let f = check_pair("p", &a, &b, Some([0.0, 1.0]), &tol()).failures("s");
+        let f = check_pair("p", &a, &b, Some([0.0, 1.0]), &tol(), 0.0).failures("s");
         assert_eq!(f.len(), 1, "{f:?}");
         assert!(f[0].quantity.contains("transient max"));
     }
@@ -378,7 +409,7 @@ mod tests {
     fn a_window_without_samples_fails_rather_than_passing_empty() {
         let a = traj(Some(EQ));
         // Between grid points 0.50 and 0.51: no sample to compare.
-        let f = check_pair("p", &a, &a, Some([0.501, 0.509]), &tol()).failures("s");
+        let f = check_pair("p", &a, &a, Some([0.501, 0.509]), &tol(), 0.0).failures("s");
         assert!(
             f.iter().any(|f| f.quantity.contains("transient max")),
             "{f:?}"
@@ -410,7 +441,11 @@ mod tests {
             ..PairTolerance::default()
         };
         let a = traj(Some(CYCLE));
-        assert!(check_pair("p", &a, &a, None, &tol).failures("s").is_empty());
+        assert!(
+            check_pair("p", &a, &a, None, &tol, 0.0)
+                .failures("s")
+                .is_empty()
+        );
         type Shift = fn(&mut SteadyState, f64);
         let shifts: [(&str, Shift, f64); 6] = [
             (
@@ -473,7 +508,7 @@ mod tests {
             for (factor, fails) in [(2.0, true), (0.5, false)] {
                 let mut b = a.clone();
                 shift(b.metrics.as_mut().unwrap(), factor * gate);
-                let f = check_pair("p", &a, &b, None, &tol).failures("s");
+                let f = check_pair("p", &a, &b, None, &tol, 0.0).failures("s");
                 // ω_l's minimum is gated absolutely (rad/s) by its own 3e-9, not through
                 // the relative gates' floor: 6e-9 fails and 1.5e-9 passes.
                 assert_eq!(!f.is_empty(), fails, "{name} x{factor}: {f:?}");
@@ -487,12 +522,57 @@ mod tests {
         }
         // An equilibrium gated with cycle tolerances only: its metrics are not gated, so fail.
         let e = traj(Some(EQ));
-        let f = check_pair("p", &e, &e, None, &tol).failures("s");
+        let f = check_pair("p", &e, &e, None, &tol, 0.0).failures("s");
         assert_eq!(f.len(), 3, "{f:?}");
         assert!(
             f[0].quantity.contains("no equilibrium_omega_u_rel stated"),
             "{f:?}"
         );
+    }
+
+    /// A stuck disc: the reference at rest (ω = 0), the other solver inside its stuck band.
+    /// Within the band its velocity passes a gate of 0; beyond it, the excess fails, and only
+    /// that quantity. A slipping equilibrium (neither at 0) is compared as before, band or not.
+    #[test]
+    fn a_stuck_disc_inside_the_band_agrees_and_the_excess_fails() {
+        let tol = PairTolerance {
+            equilibrium_omega_u_rel: Some(0.0),
+            equilibrium_omega_l_rel: Some(0.0),
+            equilibrium_alpha_rel: Some(1e-9),
+            steady_abs: Some(1e-12),
+            ..PairTolerance::default()
+        };
+        let eq = |w_u: f64, w_l: f64| {
+            traj(Some(SteadyState::Equilibrium {
+                omega_u: w_u,
+                omega_l: w_l,
+                alpha: -0.08,
+            }))
+        };
+        let fails = |a: &Trajectory, b: &Trajectory, band: f64| -> Vec<String> {
+            check_pair("p", a, b, None, &tol, band)
+                .failures("s")
+                .into_iter()
+                .map(|f| f.quantity)
+                .collect()
+        };
+        let rest = eq(0.0, 0.0);
+        let eta = 1e-10;
+        // Held at 0.99999 η and −η: inside the band.
+        assert!(fails(&rest, &eq(0.99999 * eta, -eta), eta).is_empty());
+        // Without the band the same is a 100 % difference.
+        assert_eq!(fails(&rest, &eq(0.99999 * eta, -eta), 0.0).len(), 2);
+        // 1.01 η: the excess fails, in ω_l alone.
+        assert_eq!(
+            fails(&rest, &eq(eta, 1.01 * eta), eta),
+            ["steady omega_l".to_owned()]
+        );
+        // A slipping equilibrium is not stuck: 1e-11 apart fails a gate of 0 whatever the
+        // band.
+        assert_eq!(fails(&eq(2.0, 2.0), &eq(2.0, 2.0 + 1e-11), eta).len(), 1);
+        assert!((beyond_stuck_band("omega_l", 0.0, 3e-10, eta) - 2e-10).abs() < 1e-25);
+        assert_eq!(beyond_stuck_band("alpha", 0.0, 3e-10, eta), 3e-10);
+        assert!(beyond_stuck_band("omega_u", 0.0, f64::NAN, eta).is_nan());
     }
 
     /// The transient gates: max, RMS, and the stick event times (count and kind too).
@@ -515,12 +595,12 @@ mod tests {
             ev(0.4, EventKind::StickEnd(Disc::Lower)),
         ];
         assert!(
-            check_pair("p", &a, &a, Some([0.0, 1.0]), &tol)
+            check_pair("p", &a, &a, Some([0.0, 1.0]), &tol, 0.0)
                 .failures("s")
                 .is_empty()
         );
         let fails = |b: &Trajectory| {
-            check_pair("p", &a, b, Some([0.0, 1.0]), &tol)
+            check_pair("p", &a, b, Some([0.0, 1.0]), &tol, 0.0)
                 .failures("s")
                 .into_iter()
                 .map(|f| f.quantity)
@@ -571,7 +651,7 @@ mod tests {
         };
         let a = traj(Some(EQ));
         assert!(
-            check_pair("p", &a, &a, Some([0.0, 1.0]), &tol)
+            check_pair("p", &a, &a, Some([0.0, 1.0]), &tol, 0.0)
                 .failures("s")
                 .is_empty()
         );
@@ -579,7 +659,7 @@ mod tests {
         // Sample 0 has ω_l = sin 0 = 0, so 1e-300 is representable there.
         b.samples[0].x[2] += 1e-300;
         assert_eq!(
-            check_pair("p", &a, &b, Some([0.0, 1.0]), &tol)
+            check_pair("p", &a, &b, Some([0.0, 1.0]), &tol, 0.0)
                 .failures("s")
                 .len(),
             1
@@ -590,7 +670,7 @@ mod tests {
     fn gated_metrics_missing_on_one_side_fail() {
         let (a, b) = (traj(Some(EQ)), traj(None));
         for (x, y) in [(&a, &b), (&b, &a), (&b, &b)] {
-            let f = check_pair("p", x, y, None, &tol()).failures("s");
+            let f = check_pair("p", x, y, None, &tol(), 0.0).failures("s");
             assert!(
                 f.len() == 1 && f[0].quantity.contains("steady metrics"),
                 "{f:?}"

@@ -13,11 +13,13 @@
 //!
 //! The measurement of a relative steady metric is `|a − b| / max(|a|, |b|)`, taken from the
 //! two solvers' metrics: unlike the gate's own scaled difference ([`crate::gate`]), it does not
-//! depend on the gate through the `steady_abs` floor.
+//! depend on the gate through the `steady_abs` floor. A stuck disc's velocity that one solver
+//! reports as 0 and the other holds inside its stuck band measures only what lies beyond the
+//! band ([`beyond_stuck_band`]), as the gate does.
 
 use rotor_scenario::{STEADY_QUANTITIES, Scenario};
 
-use crate::gate::gate_scenario;
+use crate::gate::{beyond_stuck_band, gate_scenario};
 pub use crate::stress::MAX_LOOSENESS;
 use rotor_solvers::run::ScenarioResult;
 use rotor_solvers::solvers::{SolverKind, pair_name, pairs};
@@ -144,6 +146,7 @@ pub fn margins(r: &ScenarioResult) -> Vec<Margin> {
             continue;
         };
         let tol = &r.scenario.tolerance[&pair];
+        let band = a.info().stuck_band + b.info().stuck_band;
         let metrics = |k| r.traj(k).and_then(|t| t.metrics).map(|m| m.values());
         let (ma, mb) = (metrics(a), metrics(b));
         for m in &g.measured {
@@ -154,7 +157,9 @@ pub fn margins(r: &ScenarioResult) -> Vec<Margin> {
                     let value = |v: &[(&str, f64)]| v.iter().find(|x| x.0 == q.metric).map(|x| x.1);
                     match (value(ma), value(mb)) {
                         (Some(va), Some(vb)) if va == vb => 0.0,
-                        (Some(va), Some(vb)) => (va - vb).abs() / va.abs().max(vb.abs()),
+                        (Some(va), Some(vb)) => {
+                            beyond_stuck_band(q.metric, va, vb, band) / va.abs().max(vb.abs())
+                        }
                         _ => f64::NAN,
                     }
                 }

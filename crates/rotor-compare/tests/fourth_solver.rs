@@ -179,6 +179,8 @@ static EULER: SolverInfo = SolverInfo {
         dash: Some("1 3"),
         width: 1.5,
     },
+    // A stuck disc is put at ω = 0 (see the module above).
+    stuck_band: 0.0,
     make: || Box::new(euler::EulerSolver),
 };
 

@@ -68,6 +68,12 @@ pub struct SolverInfo {
     pub ladder: &'static [f64],
     /// How its curves are drawn in the reports.
     pub style: Style,
+    /// The largest |ω| at which it holds a stuck disc, by construction \[rad/s\]: 0 for a
+    /// method that puts a stuck disc at rest exactly, the band half-width η for the switch
+    /// model (a stuck disc keeps the velocity it entered the band with). Two solvers' stuck
+    /// velocities are no difference within the sum of their bands
+    /// (`rotor_compare::gate::steady_differences`).
+    pub stuck_band: f64,
     /// A solver with its default options.
     pub make: fn() -> Box<dyn Solver>,
 }
@@ -89,6 +95,7 @@ pub static EVENT: SolverInfo = SolverInfo {
         dash: None,
         width: 2.5,
     },
+    stuck_band: 0.0,
     make: || Box::new(rotor_event::EventSolver::default()),
 };
 
@@ -105,6 +112,8 @@ pub static SWITCH: SolverInfo = SolverInfo {
         dash: Some("6 3"),
         width: 1.5,
     },
+    // SwitchOptions::default().eta (a unit test holds them equal).
+    stuck_band: 1e-10,
     make: || Box::new(rotor_switch::SwitchSolver::default()),
 };
 
@@ -123,6 +132,7 @@ pub static MOREAU: SolverInfo = SolverInfo {
         dash: Some("2 2"),
         width: 1.5,
     },
+    stuck_band: 0.0,
     make: || Box::new(rotor_moreau::MoreauSolver::default()),
 };
 
@@ -292,5 +302,14 @@ mod tests {
             assert_eq!(k.solver().name(), k.name());
             assert!(SOLVERS[..i].iter().all(|o| o.name() != k.name()));
         }
+    }
+
+    #[test]
+    fn stuck_bands_are_the_solvers_own() {
+        assert_eq!(
+            SWITCH.stuck_band,
+            rotor_switch::SwitchOptions::default().eta
+        );
+        assert_eq!((EVENT.stuck_band, MOREAU.stuck_band), (0.0, 0.0));
     }
 }
