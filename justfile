@@ -23,7 +23,7 @@ proptest-long:
 # Siconos; GNU Octave; any other peer registered in crates/rotor-bench/src/peers.rs, when installed) and
 # the tanh-regularised and first-order clients (bench/clients/), so that the published results
 # place a wrong method and an honest first-order one beside the solvers and peers:
-# reports/bench/results.md (+ bench.svg, .json, .csv, .txt). About 9 minutes on 2 idle cores.
+# reports/bench/results.md (+ bench.svg, .json, .csv, .txt). 6 to 9 minutes on 2 idle cores.
 bench:
     mkdir -p target && cc -O2 -o target/first_order bench/clients/first_order.c -lm
     cargo run --release -- bench --external "tanh=python3 bench/clients/tanh_regularised.py" --external "first_order:h=target/first_order" --json reports/bench/bench.json --svg reports/bench/bench.svg --csv reports/bench/bench.csv --results reports/bench/results.md > reports/bench/bench.txt

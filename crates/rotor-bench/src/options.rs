@@ -253,8 +253,8 @@ pub fn workspace_root() -> PathBuf {
 impl Default for BenchOptions {
     /// The whole suite ([`suite`]: every scenario of `fixtures/scenarios`, its own horizon,
     /// windows and grid; both tiers), with short ladders for the peers and clients (the whole
-    /// run with every peer and two clients takes 8 min 39 s on two cores, BENCHMARK.md; most
-    /// of it Octave, Radau, BDF and Siconos): event and switch at tol 1e-3 … 1e-12,
+    /// run with every peer and two clients takes 6 to 9 minutes on two cores, BENCHMARK.md; most
+    /// of it Octave, Radau, BDF, Siconos and the tanh client): event and switch at tol 1e-3 … 1e-12,
     /// Moreau–Jean at h = 1e-2 … 1e-4 (1-2-5), reference = event at tol 1e-13, median of up
     /// to 15 runs within 0.3 s per point (a run longer than that is timed once); the scipy
     /// peer at rtol = atol = 1e-4, 1e-7, 1e-10 (DOP853) and 1e-6, 1e-9 (Radau, BDF, LSODA),
