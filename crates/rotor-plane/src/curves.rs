@@ -223,7 +223,7 @@ pub(crate) fn from_diagram(base: &Params, opts: &PlaneOptions, d: &Diagram, p0: 
 impl CurvePoint {
     /// A point at `(p, u)` whose defining condition has the value `residual`, with none of
     /// the fields of a particular kind of curve.
-    fn at(p: f64, u: f64, residual: f64) -> CurvePoint {
+    pub(crate) fn at(p: f64, u: f64, residual: f64) -> CurvePoint {
         CurvePoint {
             p,
             u,

@@ -162,20 +162,7 @@ mod tests {
     /// lift between the pieces; a segment that crosses the whole window keeps both cuts.
     #[test]
     fn curves_are_clipped_to_the_window() {
-        let pt = |p: f64, u: f64| CurvePoint {
-            p,
-            u,
-            residual: 0.0,
-            omega: None,
-            l1: None,
-            multiplier: None,
-            grazing_type: None,
-            period_doubling: None,
-            sigma_plus: None,
-            sigma_minus: None,
-            touch_omega_u: None,
-            section_state: None,
-        };
+        let pt = |p: f64, u: f64| CurvePoint::at(p, u, 0.0);
         let c = [pt(-1.0, 0.0), pt(0.5, 1.5), pt(2.0, 3.0), pt(0.5, 4.5)];
         let out = clip_p(&c, 0.0, 1.0);
         let fin: Vec<(f64, f64)> = out.iter().copied().filter(|q| q.0.is_finite()).collect();
