@@ -281,6 +281,14 @@ pub fn steady_differences(
         .collect()
 }
 
+/// The band within which a pair's stuck velocities are no difference: the sum of the two
+/// solvers' [`SolverInfo::stuck_band`]s (see [`steady_differences`]).
+///
+/// [`SolverInfo::stuck_band`]: rotor_solvers::SolverInfo::stuck_band
+pub fn stuck_band(a: SolverKind, b: SolverKind) -> f64 {
+    a.info().stuck_band + b.info().stuck_band
+}
+
 /// `|va − vb|`, less `stuck_band` (not below 0) where `name` is an equilibrium's disc
 /// velocity (`omega_u`, `omega_l`) that one of the two reports as 0 exactly: a stuck disc
 /// that the other solver holds inside its band (see [`steady_differences`]). A NaN stays NaN.
@@ -334,8 +342,7 @@ pub fn gate_scenario(r: &ScenarioResult) -> (Vec<GateResult>, Vec<Failure>) {
         let (Some(ta), Some(tb)) = (r.traj(a), r.traj(b)) else {
             continue;
         };
-        let band = a.info().stuck_band + b.info().stuck_band;
-        let g = check_pair(&pair, ta, tb, sc.compare.transient, tol, band);
+        let g = check_pair(&pair, ta, tb, sc.compare.transient, tol, stuck_band(a, b));
         fails.extend(g.failures(&sc.name));
         gates.push(g);
     }

@@ -19,7 +19,7 @@
 
 use rotor_scenario::{STEADY_QUANTITIES, Scenario};
 
-use crate::gate::{beyond_stuck_band, gate_scenario};
+use crate::gate::{beyond_stuck_band, gate_scenario, stuck_band};
 pub use crate::stress::MAX_LOOSENESS;
 use rotor_solvers::run::ScenarioResult;
 use rotor_solvers::solvers::{SolverKind, pair_name, pairs};
@@ -146,7 +146,7 @@ pub fn margins(r: &ScenarioResult) -> Vec<Margin> {
             continue;
         };
         let tol = &r.scenario.tolerance[&pair];
-        let band = a.info().stuck_band + b.info().stuck_band;
+        let band = stuck_band(a, b);
         let metrics = |k| r.traj(k).and_then(|t| t.metrics).map(|m| m.values());
         let (ma, mb) = (metrics(a), metrics(b));
         for m in &g.measured {

@@ -258,7 +258,7 @@ fn every_gate_of_every_fixture_fails_its_negative_control() {
                     // A stuck disc's velocity is compared beyond the two solvers' stuck
                     // bands (the switch model's η): the excess goes beyond the band too.
                     let band = if matches!(name, "omega_u" | "omega_l") {
-                        a.info().stuck_band + b.info().stuck_band
+                        rotor_compare::gate::stuck_band(a, b)
                     } else {
                         0.0
                     };
