@@ -159,7 +159,10 @@ impl Flow<'_> {
 
     /// State and mode just after the lower disc leaves stick with upper velocity `w`, in the
     /// direction of the torque that breaks it loose (upward for u > 0, downward for u < 0).
+    /// `alpha` is a located exit's; the state starts on the edge of the stick interval that
+    /// exit leaves through ([`exit_alpha`]).
     fn exit_state(&self, alpha: f64, w: f64, upper: DiscMode) -> (State, Mode) {
+        let alpha = exit_alpha(self.model, alpha);
         let x = State::new(alpha, if upper == DiscMode::Stick { 0.0 } else { w }, 0.0);
         let lower = DiscMode::slip_of(self.model.applied_torque(Disc::Lower, &x, self.u));
         (x, Mode { upper, lower })
@@ -189,6 +192,32 @@ impl Flow<'_> {
         }
         Ok([end.x[0], end.x[1]])
     }
+}
+
+/// α on the edge of the lower disc's stick interval that an exit near `alpha` leaves
+/// through: `k_θ α = T_hi` (or `T_lo`), rounded outward until the model's own stick test
+/// ([`Model::stick_exit`]) says the disc leaves.
+///
+/// The stick-exit map's section is that edge, exactly: `k_θ α = T_sl` and `ω_l = 0` at every
+/// exit. A located exit's α is only as exact as its time, `ulp(t)·k_θ·|α̇|` off the edge
+/// (1.4e-13 rad at t = 300 s and ω_u = 2.4 rad/s), and may lie inside the interval by more
+/// than the torque's rounding. A run started there in slip at `ω_l = 0` sees the disc stick
+/// again at once and leave a few 1e-14 s later: a "return" of zero length, which the secant
+/// method takes for a fixed point.
+pub(crate) fn exit_alpha(model: &Model, alpha: f64) -> f64 {
+    let (lo, hi) = model.friction(Disc::Lower).static_interval();
+    let k = model.params.k_theta;
+    let x = |a: f64| State::new(a, 0.0, 0.0);
+    let up = k * alpha >= 0.5 * (lo + hi);
+    let mut a = if up { hi / k } else { lo / k };
+    // The quotient is within an ulp or two of the edge: a few outward steps at most.
+    for _ in 0..8 {
+        if model.stick_exit(Disc::Lower, &x(a), 0.0).is_some() {
+            break;
+        }
+        a = if up { a.next_up() } else { a.next_down() };
+    }
+    a
 }
 
 /// The steady state reached from `x0` at input `u`, refined (see the module docs).
@@ -486,7 +515,7 @@ fn refine_stick_slip(
     opts: &SteadyOptions,
 ) -> Result<Steady, SolveError> {
     let (e, upper) = *exit;
-    let alpha = e.x[0];
+    let alpha = exit_alpha(flow.model, e.x[0]);
     let mut w = e.x[1];
     let mut upper_mode = upper;
     if upper != DiscMode::Stick {
@@ -674,5 +703,77 @@ impl Sink for CountSections {
     fn section(&mut self, _t: f64, _x: &State) -> bool {
         self.sections += 1;
         self.sections >= self.stop_at
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn stribeck() -> Model {
+        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("../../fixtures/params/stribeck.toml");
+        Model::new(rotor_model::Params::from_file(&path).unwrap())
+    }
+
+    /// A located exit 250 ulps inside the interval (as at t ≈ 300 s) and one as far outside
+    /// both start on the edge, where the model's stick test says the disc leaves, within a
+    /// few ulps of `T_hi/k_θ`; a downward exit starts on the lower edge.
+    #[test]
+    fn an_exit_starts_on_the_edge_of_the_stick_interval() {
+        let m = stribeck();
+        let (lo, hi) = m.friction(Disc::Lower).static_interval();
+        let k = m.params.k_theta;
+        let edge = hi / k;
+        let ulp = edge.next_up() - edge;
+        for located in [edge - 250.0 * ulp, edge + 250.0 * ulp] {
+            let a = exit_alpha(&m, located);
+            let x = State::new(a, 0.0, 0.0);
+            assert_eq!(m.stick_exit(Disc::Lower, &x, 0.0), Some(DiscMode::SlipPos));
+            assert!((a - edge).abs() <= 4.0 * ulp, "{a} vs {edge}");
+        }
+        let a = exit_alpha(&m, lo / k + 1e-13);
+        let x = State::new(a, 0.0, 0.0);
+        assert_eq!(m.stick_exit(Disc::Lower, &x, 0.0), Some(DiscMode::SlipNeg));
+    }
+
+    /// The Stribeck set at 1.5 V from rest: a stick-slip cycle whose period is the one a
+    /// plain run of the same solver shows between its last two stick exits. The refinement
+    /// once started its return map inside the stick interval and answered an "equilibrium"
+    /// on the stick boundary with ω_u = 2.43 rad/s.
+    #[test]
+    fn the_stribeck_stick_slip_cycle_is_refined_as_a_cycle() {
+        let m = stribeck();
+        let st = steady_state(
+            &m,
+            1.5,
+            State::zeros(),
+            &SteadyOptions::default(),
+            &EventOptions::default(),
+        )
+        .unwrap();
+        let SteadyState::LimitCycle { period, .. } = st.state else {
+            panic!("{:?}", st.state)
+        };
+        let run = crate::flow::flow(
+            &m,
+            1.5,
+            1e-12,
+            State::zeros(),
+            m.mode_at(&State::zeros(), 1.5),
+            300.0,
+            crate::flow::StopAt::Time,
+        )
+        .unwrap();
+        let exits: Vec<f64> = run
+            .events
+            .iter()
+            .filter(|e| e.kind == EventKind::StickEnd(Disc::Lower))
+            .map(|e| e.t)
+            .collect();
+        let plain = exits[exits.len() - 1] - exits[exits.len() - 2];
+        // Both at tol 1e-12 on a cycle that attracts at multiplier 3e-8 per period: they
+        // agree to the event times' accuracy, far below 1e-8 s.
+        assert!((period - plain).abs() < 1e-8, "{period} vs {plain}");
     }
 }

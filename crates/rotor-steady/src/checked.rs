@@ -325,6 +325,7 @@ fn equilibrium_answer(e: &rotor_model::SlipEquilibrium) -> SteadyAnswer {
         multipliers: None,
         stable: None,
         stats: Default::default(),
+        on_cycle: None,
     }
 }
 
@@ -355,8 +356,20 @@ fn decays_onto(run: &Run, rate_tol: f64) -> Option<rotor_model::SlipEquilibrium>
 }
 
 /// The steady state `kind` reaches from `scene.x0` at `scene.u`, by shooting on its own
-/// return map and checked by a bounded simulation from the start (see the module docs).
+/// return map and checked by a bounded simulation from the start (see the module docs), and
+/// against the model ([`crate::verify`]).
 pub fn checked_shot(
+    kind: SolverKind,
+    model: &Model,
+    scene: &Scene,
+    opts: &CheckOptions,
+) -> Result<Checked, SteadyError> {
+    let c = shot_and_checked(kind, model, scene, opts)?;
+    crate::verify::verify(kind, model, scene, &c.answer)?;
+    Ok(c)
+}
+
+fn shot_and_checked(
     kind: SolverKind,
     model: &Model,
     scene: &Scene,
@@ -423,6 +436,7 @@ pub fn checked_shot(
             t: run.t,
             answer: SteadyAnswer {
                 state: s.state,
+                on_cycle: matches!(s.state, SteadyState::LimitCycle { .. }).then_some(s.x),
                 method: SteadyMethod::Simulated,
                 multipliers: None,
                 stable: None,
@@ -600,6 +614,7 @@ fn at_rest(run: &Run) -> Option<SteadyAnswer> {
                 multipliers: None,
                 stable: None,
                 stats: Default::default(),
+                on_cycle: None,
             });
     }
     let e = stable_equilibrium(run, omega_l)?;

@@ -12,6 +12,9 @@ pub mod probes;
 mod settle;
 pub mod solver_points;
 mod steady;
+pub mod verify;
 
 pub use settle::{SettleError, SettleOptions, Settled, Unsettled, settle};
-pub use steady::{SHOOT_RUN, SteadyAnswer, SteadyError, SteadyMethod, SteadyOptions, shot, steady};
+pub use steady::{
+    SHOOT_RUN, SteadyAnswer, SteadyError, SteadyMethod, SteadyOptions, shot, simulated, steady,
+};

@@ -9,7 +9,7 @@
 //! point — is followed until it has decayed, or reported as not settled at `max_time`,
 //! instead of as a limit cycle.
 
-use rotor_model::Model;
+use rotor_model::{Model, State};
 use rotor_seam::{Output, Scene, SolveError, Stats, SteadyState};
 
 use rotor_solvers::solvers::SolverKind;
@@ -233,6 +233,8 @@ pub struct Settled {
     pub state: SteadyState,
     /// The work counters of all chunks, summed.
     pub stats: Stats,
+    /// The last chunk's final state (on the cycle, for a cycle).
+    pub x: State,
 }
 
 /// Simulates `base` (its `t_end`, `output` and `metrics_from` are replaced) in chunks until
@@ -272,7 +274,13 @@ pub fn settle(
             let (what, c) = change(&p, &st, opts.abs);
             let cause = unsettled(kind.is_fixed_step(), base.step(), &st);
             match history.judge(c, &st, t, cause) {
-                Verdict::Settled => return Ok(Settled { state: st, stats }),
+                Verdict::Settled => {
+                    return Ok(Settled {
+                        state: st,
+                        stats,
+                        x: tr.x_final,
+                    });
+                }
                 Verdict::Running => {}
                 Verdict::Unsettled(cause) => {
                     return Err(SettleError::NotSettled {

@@ -71,6 +71,11 @@ pub struct SteadyAnswer {
     /// a shot orbit's metrics run); zero otherwise.
     #[serde(skip)]
     pub stats: Stats,
+    /// A state on a cycle (the fixed point of the return map, or a settled run's final
+    /// state), from which one period of the solver's run returns to it
+    /// ([`crate::verify`]); `None` for an equilibrium.
+    #[serde(skip)]
+    pub on_cycle: Option<State>,
 }
 
 fn complex_list<S: serde::Serializer>(
@@ -168,6 +173,15 @@ pub enum SteadyError {
         /// The simulation's.
         simulate: Box<SteadyError>,
     },
+    /// The answer fails the model's own check ([`crate::verify`]): an "equilibrium" where
+    /// the field does not vanish, a "cycle" that does not return to its start.
+    #[error("the {what} found is refuted by the model's own equations: {detail}")]
+    Refuted {
+        /// `equilibrium` or `cycle`.
+        what: &'static str,
+        /// The condition that failed, with its residual and the allowance.
+        detail: String,
+    },
     /// A value of the answer is not finite.
     #[error("the steady state has a non-finite {name}: {value}")]
     NonFinite {
@@ -223,20 +237,9 @@ pub fn steady(
     let answer = if kind == SolverKind::EVENT {
         refined(model, scene.u, scene.x0, opts)?
     } else {
-        let s = settle(kind, model, scene, &opts.settle)?;
-        SteadyAnswer {
-            state: s.state,
-            method: SteadyMethod::Simulated,
-            multipliers: None,
-            stable: None,
-            stats: s.stats,
-        }
+        simulated(kind, model, scene, opts)?
     };
-    for (name, value) in answer.state.values() {
-        if !value.is_finite() {
-            return Err(SteadyError::NonFinite { name, value });
-        }
-    }
+    crate::verify::verify(kind, model, scene, &answer)?;
     Ok(answer)
 }
 
@@ -268,7 +271,32 @@ pub fn shot(kind: SolverKind, model: &Model, scene: &Scene) -> Result<SteadyAnsw
             ..scene.clone()
         },
     )?;
-    shot_answer(&orbit, run, t_end)
+    let answer = shot_answer(&orbit, run, t_end)?;
+    crate::verify::verify(kind, model, scene, &answer)?;
+    Ok(answer)
+}
+
+/// The steady state that `kind` settles on by simulating from `scene.x0` until its metrics
+/// stop changing ([`crate::settle`]), for every solver (the event-driven one included:
+/// `rotor steady --method simulate`), checked against the model ([`crate::verify`]).
+pub fn simulated(
+    kind: SolverKind,
+    model: &Model,
+    scene: &Scene,
+    opts: &SteadyOptions,
+) -> Result<SteadyAnswer, SteadyError> {
+    scene.validate()?;
+    let s = settle(kind, model, scene, &opts.settle)?;
+    let answer = SteadyAnswer {
+        on_cycle: matches!(s.state, SteadyState::LimitCycle { .. }).then_some(s.x),
+        state: s.state,
+        method: SteadyMethod::Simulated,
+        multipliers: None,
+        stable: None,
+        stats: s.stats,
+    };
+    crate::verify::verify(kind, model, scene, &answer)?;
+    Ok(answer)
 }
 
 /// The answer of a shot orbit: the metrics of `run` (two periods from the orbit's state,
@@ -296,6 +324,7 @@ pub(crate) fn shot_answer(
         multipliers: Some(multipliers),
         stable: Some(orbit.is_stable()),
         stats: run.stats,
+        on_cycle: Some(orbit.x),
     })
 }
 
@@ -324,6 +353,7 @@ fn refined(
         multipliers: None,
         stable: None,
         stats: Stats::default(),
+        on_cycle: st.on_cycle,
     };
     let (rotor_event::Method::Refined, Some(x)) = (st.method, st.on_cycle) else {
         return Ok(answer);

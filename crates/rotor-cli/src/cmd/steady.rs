@@ -15,10 +15,12 @@ pub struct Args {
     /// when a run from the start of at most 600 s is seen to go to it (or to a stable
     /// equilibrium), and fall back to `simulate` when that check refuses (a slow transient,
     /// an unstable or neutral orbit); "method" says which answered ("shoot" with "stable"
-    /// and "multipliers", or "simulated"). `simulate`: the event-driven refinement, or
-    /// switch and moreau run until the metrics settle (right from every start, slow next to
-    /// a special point). `shoot`: Newton on the solver's own return map from a 300 s run's
-    /// last section crossing, unchecked: the orbit stable or not (docs/methods.md, 4b).
+    /// and "multipliers", or "simulated"). `simulate`: every solver, the event-driven one
+    /// too, runs until its metrics settle (right from every start, slow next to a special
+    /// point). `shoot`: Newton on the solver's own return map from a 300 s run's last section
+    /// crossing, unchecked: the orbit stable or not (docs/methods.md, 4b). Every answer is
+    /// checked against the model's equations before it is printed (an equilibrium's field
+    /// vanishes, a cycle returns to its start after one period); one that fails is refused.
     #[arg(long, value_name = "shoot|simulate")]
     pub method: Option<String>,
 }
@@ -43,7 +45,7 @@ pub(crate) fn steady(common: &Common, method: Option<&str>) -> Result<()> {
     let model = load_model(common.params.as_deref())?;
     let answer = match how {
         How::Shoot => rotor_steady::shot(kind, &model, &scene),
-        How::Simulate => rotor_steady::steady(kind, &model, &scene, &opts),
+        How::Simulate => rotor_steady::simulated(kind, &model, &scene, &opts),
         How::Checked => rotor_steady::checked::checked_or_simulated(kind, &model, &scene, &opts),
     }
     .with_context(|| format!("solver {}", kind.name()))?;
