@@ -1,4 +1,4 @@
-//! The speeds of issue 31 as whole processes (a benchmark, not a test: these machines'
+//! The speeds `rotor steady` and `rotor bifurcation` aim at, as whole processes (a benchmark, not a test: these machines'
 //! timings move by ±15 %, and more when the cores are shared).
 //!
 //! ```sh

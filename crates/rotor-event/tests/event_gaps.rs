@@ -1,4 +1,4 @@
-//! Event-location gaps of the event-driven solver (issue 33, item 3), each in a situation
+//! Event-location gaps of the event-driven solver, each in a situation
 //! built to provoke it, with the expected answer derived independently (a closed-form
 //! solution, an exactly symmetric system, or the same state started in its consistent mode).
 

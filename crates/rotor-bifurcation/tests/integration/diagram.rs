@@ -349,7 +349,7 @@ fn hysteresis_of_a_brute_force_sweep_matches_the_bistable_window() {
     );
 }
 
-/// Grazing of the upper disc (issue 33, item 2). On the Stribeck set the upper disc has static
+/// Grazing of the upper disc. On the Stribeck set the upper disc has static
 /// friction (T_su = 0.38 N m), so a cycle reaching ω_u = 0 would be a special point of its own.
 /// No cycle of the diagram comes near it: the smallest ω_u over every periodic branch point is
 /// 0.0577 rad/s, on the slipping cycles next to D (0.18378 V, where the cycles' mean ω_u is

@@ -9,7 +9,8 @@ use crate::common::{model, st_diagram, t1_diagram};
 /// The u-diagram's Hopf points carry their first Lyapunov coefficient, and its sign (their
 /// criticality) agrees with the direction of the small cycles the diagram finds by shooting:
 /// Table 1's H1 supercritical (l1 < 0), H2 and both Hopf points of the Stribeck set
-/// subcritical (l1 > 0). Table 1's H2 has l1 ≈ 1.7e-3 (issue 33, from independent code).
+/// subcritical (l1 > 0). Table 1's H2 has l1 ≈ 1.7e-3 (an independent computation outside this
+/// repository, to two digits).
 #[test]
 fn the_lyapunov_coefficient_agrees_with_the_cycles_direction() {
     for (name, d) in [("table1", t1_diagram()), ("stribeck", st_diagram())] {
@@ -38,6 +39,6 @@ fn the_lyapunov_coefficient_agrees_with_the_cycles_direction() {
         }
     }
     let h2 = crate::common::points(t1_diagram(), "hopf")[1].l1.unwrap();
-    // Two significant digits, as the issue quotes it.
+    // Two significant digits, as the independent computation gives it.
     assert!((h2 - 1.7e-3).abs() < 0.05e-3, "{h2}");
 }

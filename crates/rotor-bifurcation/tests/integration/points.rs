@@ -281,7 +281,7 @@ fn special_points_are_pinned_to_1e8_volt() {
     }
 }
 
-/// The Stribeck set with `lower.t_s = 0.128` (issue 33): at u ≈ 1.95963 V the stable
+/// The Stribeck set with `lower.t_s = 0.128`: at u ≈ 1.95963 V the stable
 /// stick-slip branch (below) and the stable slipping branch (above, turning back in a smooth
 /// fold at ≈ 1.95972 V) are one branch passing through grazing. Feigin's counts say
 /// persistence (σ⁺ = 0 + 0), and the Filippov flow confirms it 1e-8 V on either side.
@@ -289,7 +289,7 @@ fn special_points_are_pinned_to_1e8_volt() {
 fn a_persistence_through_grazing_is_not_a_fold() {
     let m = Model::new(model("stribeck").params.with("lower.t_s", 0.128).unwrap());
     let d = diagram(&m, &DiagramOptions::default()).unwrap();
-    // The values the issue reports, to the 5 decimals it gives them.
+    // The values an independent computation gave, to its 5 decimals.
     let near = |p: &&SpecialPoint, u: f64| (p.u - u).abs() < 1e-5;
     let g: Vec<_> = points(&d, "grazing")
         .into_iter()

@@ -4,7 +4,7 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result};
 
-use super::bench::write_bench;
+use super::bench_out::{write_bench, write_results};
 
 /// `rotor bench --merge`: the shards' reports joined into one.
 pub(crate) fn bench_merge(
@@ -28,5 +28,5 @@ pub(crate) fn bench_merge(
         .collect::<Result<Vec<_>>>()?;
     let report = rotor_bench::merge(&reports)?;
     write_bench(&report, outputs)?;
-    super::bench::write_results(&report, results)
+    write_results(&report, results)
 }

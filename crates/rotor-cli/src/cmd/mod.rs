@@ -2,6 +2,7 @@
 
 pub mod bench;
 pub mod bench_merge;
+mod bench_out;
 pub mod bifurcation;
 pub mod bifurcation2;
 pub mod check;
