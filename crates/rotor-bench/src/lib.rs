@@ -33,7 +33,8 @@
 #![warn(missing_docs)]
 
 mod clients;
-mod colors;
+pub mod colors;
+mod figures;
 mod ladder;
 mod levels;
 mod measure;
@@ -56,6 +57,7 @@ pub use clients::{
     ClientPoint, ClientReport, ClientScene, ClientStatus, Failure, FailureKind, Overhead, PerStep,
     Ratio,
 };
+pub use figures::Figure;
 pub use ladder::{LadderPoint, ReferenceReport, SceneReport};
 pub use levels::OutputLevel;
 pub use measure::{Errors, RefData, SteadyRef, Timing, solver, time_at_error, timed};

@@ -55,7 +55,7 @@ impl Profile {
 
     /// The profile as an SVG figure: ρ(τ) against τ (log), one step line per entry.
     pub fn to_svg(&self) -> String {
-        render(&[self.panel()], 760.0, 420.0)
+        render(&[self.panel()], 760.0, 440.0)
     }
 
     /// The profile's plot panel.
@@ -77,9 +77,10 @@ impl Profile {
                     pts.push((t, Profile::rho(e, t)));
                 }
                 pts.push((tau_max, Profile::rho(e, tau_max)));
+                let st = crate::colors::style(&e.name);
                 Series {
-                    marker: None,
-                    ..Series::line(&e.name, crate::colors::color(&e.name), pts)
+                    dash: st.dash,
+                    ..Series::line(&e.name, st.color, pts)
                 }
             })
             .collect();
@@ -93,8 +94,8 @@ impl Profile {
                 },
                 self.scenes.len()
             ),
-            "tau (time / best time on the scene)",
-            "fraction of scenes solved within tau",
+            "τ (time / best time on the scene)",
+            "fraction of scenes solved within τ",
             series,
         );
         panel.x_log = true;

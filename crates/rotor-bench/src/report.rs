@@ -1,12 +1,8 @@
-//! The report as a text table, JSON, CSV and a work-precision SVG.
+//! The report as a text table, JSON and CSV (its figures: [`crate::figures`]).
 
-use rotor_solvers::SOLVERS;
 use std::fmt::Write;
 
-use rotor_plot::{Panel, Series, render};
-
 use crate::clients::{ClientReport, FailureKind};
-use crate::colors::color;
 use crate::measure::Errors;
 use crate::{BenchError, BenchReport, OutputLevel, Profile, SceneReport};
 
@@ -209,83 +205,6 @@ impl BenchReport {
             .into_inner()
             .map_err(|e| BenchError::Serialise(e.to_string()))?;
         String::from_utf8(bytes).map_err(|e| BenchError::Serialise(e.to_string()))
-    }
-
-    /// Work-precision plot: per scene, steady-state error and transient error against run
-    /// time, log–log, one line per solver and peer, markers at the points (a non-finite
-    /// number in the report is an error).
-    pub fn to_svg(&self) -> Result<String, BenchError> {
-        self.check_finite()?;
-        let mut panels = Vec::new();
-        type Pick = fn(&Errors) -> Option<f64>;
-        let kinds: [(&str, &str, Pick); 2] = [
-            (
-                "steady-state error",
-                "max(|dT|/T, |d max wl|/max wl)",
-                |e| e.steady_rel,
-            ),
-            ("transient error", "max |d omega_l| [rad/s]", |e| {
-                e.transient_max
-            }),
-        ];
-        for sc in &self.scenes {
-            for (what, y_label, pick) in kinds {
-                let mut series = Vec::new();
-                for kind in SOLVERS {
-                    let pts: Vec<(f64, f64)> = sc
-                        .points
-                        .iter()
-                        .filter(|p| p.solver == kind)
-                        .filter_map(|p| Some((p.timing?.median_s, pick(&p.errors)?)))
-                        .collect();
-                    series.push(Series {
-                        marker: Some(3.0),
-                        ..Series::line(kind.name(), color(kind.name()), pts)
-                    });
-                }
-                for c in &self.clients {
-                    let Some(cs) = c.scenes.iter().find(|s| s.scene == sc.name) else {
-                        continue;
-                    };
-                    let pts: Vec<(f64, f64)> = cs
-                        .points
-                        .iter()
-                        .filter(|p| placed(p.failure.as_ref()))
-                        .filter_map(|p| Some((p.time()?.median_s, pick(&p.errors)?)))
-                        .collect();
-                    if pts.is_empty() {
-                        continue;
-                    }
-                    series.push(Series {
-                        label: &c.name,
-                        color: color(&c.name),
-                        dash: Some("6 4"),
-                        width: 1.5,
-                        marker: Some(3.0),
-                        points: pts,
-                    });
-                }
-                let mut panel = Panel::new(
-                    format!(
-                        "{} (u = {} V, {} s): {what} vs run time",
-                        sc.name, sc.u, sc.t_end
-                    ),
-                    "run time [s] (median)",
-                    y_label,
-                    series,
-                );
-                panel.x_log = true;
-                panel.y_log = true;
-                panels.push(panel);
-            }
-        }
-        if self.profile.entries.len() > 1 {
-            panels.push(self.profile.panel());
-            if let Some(t1) = &self.profile_table1 {
-                panels.push(t1.panel());
-            }
-        }
-        Ok(render(&panels, 760.0, 420.0))
     }
 }
 
@@ -658,7 +577,7 @@ pub fn ratio3(x: f64) -> String {
 }
 
 /// Whether a point is placed on the plots: it ran and gave a usable trace.
-fn placed(f: Option<&crate::clients::Failure>) -> bool {
+pub(crate) fn placed(f: Option<&crate::clients::Failure>) -> bool {
     f.is_none_or(|f| f.kind == FailureKind::FailsGate)
 }
 

@@ -94,7 +94,8 @@ impl BenchReport {
             "# rotorbench results: every solver on every scene\n\n\
              Suite **{}**, {} scenes, written by `{command}`. `just bench` regenerates it \
              over the whole suite, with `bench.json`, `bench.csv`, `bench.svg` (the \
-             work-precision plots and the performance profiles) and `bench.txt`.\n\n\
+             performance profiles), `bench-<scene>.svg` (each scene's work precision, its \
+             data in `bench-<scene>.csv`), `bench.html` (all of them) and `bench.txt`.\n\n\
              Measured on {} core(s), {}, load average {} at the start and {} at \
              the end; times are the median of up to {} runs within {} s per point (a run longer \
              than that is timed once), in-process (`solve_seconds`) where a client reports it. \

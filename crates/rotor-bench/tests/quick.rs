@@ -160,13 +160,22 @@ fn json_csv_and_svg_are_complete_and_refuse_a_non_finite_number() {
             .is_some_and(|e| e.len() == 3)
     );
 
-    let svg = r.to_svg().unwrap();
+    // The summary figure: the performance profile.
+    let summary = r.to_svg().unwrap();
+    assert!(summary.starts_with("<svg") && summary.contains("Performance profile"));
+    // One figure per scene and the profile's, each with its data.
+    let figures = r.figures().unwrap();
+    assert_eq!(figures.len(), r.scenes.len() + 1);
+    assert_eq!(figures[0].name, r.scenes[0].name);
+    assert_eq!(figures.last().unwrap().svg, summary);
+    let svg = &figures[0].svg;
     assert!(svg.starts_with("<svg") && svg.trim_end().ends_with("</svg>"));
     for bad in ["NaN", "inf"] {
         assert!(!svg.contains(bad), "SVG holds {bad}");
     }
     // Two panels (steady and transient error), each with a marker per timed point with a
-    // positive error (a zero has no place on a log axis) and one per solver in the legend.
+    // positive error (a zero has no place on a log axis), one per solver in the legend, and
+    // an open marker over each point that fails the loose gate.
     let drawn = |err: fn(&rotor_bench::Errors) -> Option<f64>| {
         r.scenes[0]
             .points
@@ -180,10 +189,29 @@ fn json_csv_and_svg_are_complete_and_refuse_a_non_finite_number() {
         (drawn(|e| e.steady_rel), drawn(|e| e.transient_max)),
         (9, 9)
     );
-    assert_eq!(svg.matches("<circle").count(), 2 * 9 + 2 * 3);
+    let failing = r.scenes[0]
+        .points
+        .iter()
+        .filter(|p| p.passes_loose == Some(false))
+        .count();
+    let markers = svg.matches("<circle").count() + svg.matches("<polygon").count();
+    assert_eq!(markers, 2 * 9 + 2 * 3 + 2 * failing);
+    assert_eq!(
+        svg.matches(r##"fill="white" stroke="#"##).count(),
+        2 * failing
+    );
     for name in ["event", "switch", "moreau"] {
         assert!(svg.contains(&format!(">{name}</text>")), "legend {name}");
     }
+    let rows: Vec<&str> = figures[0].csv.lines().collect();
+    assert_eq!(rows.len(), 1 + 9);
+    assert_eq!(
+        rows.iter().filter(|l| l.ends_with(",false")).count(),
+        failing
+    );
+    let page = r.to_html("bench").unwrap();
+    assert!(page.contains(r#"src="bench.svg""#));
+    assert!(page.contains(&format!(r#"href="bench-{}.csv""#, r.scenes[0].name)));
 
     let csv = r.to_csv().unwrap();
     let rows: Vec<&str> = csv.lines().collect();
@@ -203,6 +231,7 @@ fn json_csv_and_svg_are_complete_and_refuse_a_non_finite_number() {
         r.to_json().unwrap_err(),
         r.to_csv().unwrap_err(),
         r.to_svg().unwrap_err(),
+        r.figures().unwrap_err(),
     ] {
         let e = e.to_string();
         assert!(e.contains("output_levels[1].ratio = NaN"), "{e}");

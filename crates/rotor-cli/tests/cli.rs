@@ -261,6 +261,21 @@ fn bench_quick_prints_the_table_and_writes_the_plot() {
     assert!(v.is_object());
     let figure = std::fs::read_to_string(&svg).unwrap();
     assert!(figure.starts_with("<svg") && !figure.contains("NaN"));
+    // Beside the summary: each scene's figure and data, the profile's data, and the page.
+    let scenes = v["scenes"].as_array().unwrap();
+    assert!(!scenes.is_empty());
+    for sc in scenes {
+        let name = sc["name"].as_str().unwrap();
+        for ext in ["svg", "csv"] {
+            assert!(
+                dir.join(format!("b-{name}.{ext}")).is_file(),
+                "b-{name}.{ext}"
+            );
+        }
+    }
+    assert!(dir.join("b-profile.csv").is_file());
+    let page = std::fs::read_to_string(dir.join("b.html")).unwrap();
+    assert!(page.contains(r#"src="b.svg""#), "{page}");
 }
 
 /// The report of a run is the same bytes every time (its run times go to the uncommitted

@@ -183,6 +183,7 @@ pub fn scenario_svg(r: &ScenarioResult) -> String {
                             .filter(|s| s.t <= t_max)
                             .map(|s| (s.t, s.x[idx]))
                             .collect(),
+                        ..Series::default()
                     })
                 })
                 .collect(),
@@ -229,6 +230,7 @@ pub fn friction_svg(sets: &[(&str, Params)]) -> String {
                     width: 1.8,
                     marker: None,
                     points: pts,
+                    ..Series::default()
                 }
             })
             .collect();

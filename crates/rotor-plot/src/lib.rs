@@ -17,10 +17,59 @@ pub struct Series<'a> {
     pub dash: Option<&'a str>,
     /// Stroke width; `0.0` draws no line (markers only).
     pub width: f64,
-    /// Draws a filled circle of this radius at every point.
+    /// Draws a marker of this radius at every point (its shape: `shape`).
     pub marker: Option<f64>,
+    /// The markers' shape: a second channel beside the colour, for greyscale print and
+    /// colour-blind readers.
+    pub shape: Shape,
+    /// Markers drawn open (outline only, white inside): the figures use them for points that
+    /// fail a gate, filled ones for points that pass.
+    pub hollow: bool,
     /// The points `(x, y)` in data coordinates, in drawing order.
     pub points: Vec<(f64, f64)>,
+}
+
+/// A marker's shape.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Shape {
+    /// A circle.
+    #[default]
+    Circle,
+    /// A square standing on a side.
+    Square,
+    /// A triangle pointing up.
+    TriangleUp,
+    /// A square standing on a corner.
+    Diamond,
+    /// A triangle pointing down.
+    TriangleDown,
+}
+
+impl Shape {
+    /// Every shape, in the order the figures hand them out.
+    pub const ALL: [Shape; 5] = [
+        Shape::Circle,
+        Shape::Square,
+        Shape::TriangleUp,
+        Shape::Diamond,
+        Shape::TriangleDown,
+    ];
+}
+
+impl Default for Series<'_> {
+    /// An unlabelled black solid line of width 1.5 without markers or points.
+    fn default() -> Self {
+        Self {
+            label: "",
+            color: "#000000",
+            dash: None,
+            width: 1.5,
+            marker: None,
+            shape: Shape::Circle,
+            hollow: false,
+            points: Vec::new(),
+        }
+    }
 }
 
 impl<'a> Series<'a> {
@@ -29,10 +78,8 @@ impl<'a> Series<'a> {
         Self {
             label,
             color,
-            dash: None,
-            width: 1.5,
-            marker: None,
             points,
+            ..Self::default()
         }
     }
 }
@@ -171,6 +218,30 @@ fn esc(s: &str) -> String {
         .replace('>', "&gt;")
 }
 
+/// Text with `_{…}` marking a subscript (`ω_{l}`), escaped for SVG, the subscripts as
+/// lowered, smaller `tspan`s.
+fn rich(s: &str) -> String {
+    let mut out = String::new();
+    let mut rest = s;
+    while let Some(k) = rest.find("_{") {
+        let Some(close) = rest[k..].find('}') else {
+            break;
+        };
+        out.push_str(&esc(&rest[..k]));
+        out.push_str(r#"<tspan baseline-shift="sub" font-size="75%">"#);
+        out.push_str(&esc(&rest[k + 2..k + close]));
+        out.push_str("</tspan>");
+        rest = &rest[k + close + 1..];
+    }
+    out.push_str(&esc(rest));
+    out
+}
+
+/// The number of characters `s` shows (markup of [`rich`] aside), for width estimates.
+fn shown_chars(s: &str) -> usize {
+    s.chars().count() - 3 * s.matches("_{").count()
+}
+
 /// Renders panels stacked vertically into one SVG document.
 pub fn render(panels: &[Panel], width: f64, panel_height: f64) -> String {
     let height = panel_height * panels.len() as f64;
@@ -213,6 +284,8 @@ pub fn render(panels: &[Panel], width: f64, panel_height: f64) -> String {
 struct Frame {
     /// Top of the panel \[px\] (its title sits 20 px below).
     oy: f64,
+    /// Width of the document \[px\]: the legend wraps before its right edge.
+    width: f64,
     /// Left edge of the plot box \[px\].
     l: f64,
     /// Right edge of the plot box \[px\] (left of the margin for curve names).
@@ -241,9 +314,16 @@ impl Frame {
     /// ±0.5, the y range padded by 5 %), and the box leaves room for the legend above and the
     /// right margin's curve names. `None` if the panel has no drawable point.
     fn fit(p: &Panel, oy: f64, width: f64, panel_height: f64) -> Option<Frame> {
-        let has_legend = p.series.iter().any(|s| !s.label.is_empty());
-        let top = if has_legend { 50.0 } else { 30.0 };
-        let (l, t, b) = (70.0, oy + top, oy + panel_height - 45.0);
+        let l = 70.0;
+        let rows = legend_layout(&p.series, l, width - 10.0)
+            .last()
+            .map_or(0, |e| e.1 + 1);
+        let top = if rows > 0 {
+            50.0 + LEGEND_ROW * (rows - 1) as f64
+        } else {
+            30.0
+        };
+        let (t, b) = (oy + top, oy + panel_height - 45.0);
         let pts = p
             .series
             .iter()
@@ -283,6 +363,12 @@ impl Frame {
             x0 -= 0.5;
             x1 += 0.5;
         }
+        // Markers at the ends of the x range would be cut in half by the frame: pad by 3 %.
+        if p.series.iter().any(|s| s.marker.is_some()) {
+            let pad = 0.03 * (x1 - x0);
+            x0 -= pad;
+            x1 += pad;
+        }
         // Curve names whose curve reaches the right edge go into the margin.
         let margin_width = p
             .ends
@@ -292,6 +378,7 @@ impl Frame {
             .fold(0.0, f64::max);
         Some(Frame {
             oy,
+            width,
             l,
             r: width - 20.0 - margin_width,
             t,
@@ -334,7 +421,7 @@ fn write_axes(s: &mut String, p: &Panel, f: &Frame) {
         r#"<text x="{}" y="{}" text-anchor="middle" font-size="14">{}</text>"#,
         (l + r) / 2.0,
         f.oy + 20.0,
-        esc(&p.title)
+        rich(&p.title)
     );
     let _ = writeln!(
         s,
@@ -348,7 +435,7 @@ fn write_axes(s: &mut String, p: &Panel, f: &Frame) {
         r#"<text x="{}" y="{}" text-anchor="middle">{}</text>"#,
         (l + r) / 2.0,
         b + 35.0,
-        esc(p.x_label)
+        rich(p.x_label)
     );
     let _ = writeln!(
         s,
@@ -357,7 +444,7 @@ fn write_axes(s: &mut String, p: &Panel, f: &Frame) {
         (t + b) / 2.0,
         l - 50.0,
         (t + b) / 2.0,
-        esc(p.y_label)
+        rich(p.y_label)
     );
 }
 
@@ -424,11 +511,7 @@ fn write_series<'s, 'a>(
             let _ = write!(d, "{}{px:.2},{py:.2} ", if pen_up { "M" } else { "L" });
             pen_up = false;
             if let Some(radius) = ser.marker {
-                let _ = writeln!(
-                    s,
-                    r#"<circle cx="{px:.2}" cy="{py:.2}" r="{radius}" fill="{}"/>"#,
-                    ser.color
-                );
+                write_marker(s, ser, px, py, radius);
             }
         }
         let dash = ser
@@ -449,12 +532,81 @@ fn write_series<'s, 'a>(
     legend
 }
 
-/// Writes the legend: one row between the title and the plot box, so it never hides data,
-/// each entry a 30 px stretch of its line (and its marker) and its label.
+/// Height of a legend row \[px\].
+const LEGEND_ROW: f64 = 16.0;
+
+/// Where each labelled series' legend entry goes, `(x, row)` in series order: entries left to
+/// right from `left`, a new row where the next would pass `right` (each entry a 30 px stretch
+/// of line, its label at ~[`CHAR`] px a character, and an 18 px gap).
+fn legend_layout(series: &[Series], left: f64, right: f64) -> Vec<(f64, usize)> {
+    let mut out = Vec::new();
+    let (mut x, mut row) = (left, 0);
+    for ser in series.iter().filter(|s| !s.label.is_empty()) {
+        let w = 35.0 + CHAR * shown_chars(ser.label) as f64;
+        if x > left && x + w > right {
+            x = left;
+            row += 1;
+        }
+        out.push((x, row));
+        x += w + 18.0;
+    }
+    out
+}
+
+/// Writes one marker of `ser`'s shape, colour and fill, centred at `(cx, cy)`.
+fn write_marker(s: &mut String, ser: &Series, cx: f64, cy: f64, r: f64) {
+    let fill = if ser.hollow { "white" } else { ser.color };
+    let paint = format!(
+        r#"fill="{fill}" stroke="{}" stroke-width="{}""#,
+        ser.color,
+        if ser.hollow { 1.3 } else { 0.0 }
+    );
+    let poly = |pts: &[(f64, f64)]| {
+        pts.iter()
+            .map(|(dx, dy)| format!("{:.2},{:.2}", cx + dx * r, cy + dy * r))
+            .collect::<Vec<_>>()
+            .join(" ")
+    };
+    let _ = match ser.shape {
+        Shape::Circle => writeln!(s, r#"<circle cx="{cx:.2}" cy="{cy:.2}" r="{r}" {paint}/>"#),
+        Shape::Square => writeln!(
+            s,
+            r#"<polygon points="{}" {paint}/>"#,
+            poly(&[(-0.9, -0.9), (0.9, -0.9), (0.9, 0.9), (-0.9, 0.9)])
+        ),
+        Shape::Diamond => writeln!(
+            s,
+            r#"<polygon points="{}" {paint}/>"#,
+            poly(&[(0.0, -1.25), (1.25, 0.0), (0.0, 1.25), (-1.25, 0.0)])
+        ),
+        Shape::TriangleUp => writeln!(
+            s,
+            r#"<polygon points="{}" {paint}/>"#,
+            poly(&[(0.0, -1.3), (1.15, 0.75), (-1.15, 0.75)])
+        ),
+        Shape::TriangleDown => writeln!(
+            s,
+            r#"<polygon points="{}" {paint}/>"#,
+            poly(&[(0.0, 1.3), (1.15, -0.75), (-1.15, -0.75)])
+        ),
+    };
+}
+
+/// Writes the legend between the title and the plot box, so it never hides data: rows of
+/// entries ([`legend_layout`]) that stay inside the document, each a 30 px stretch of its
+/// line (and its marker) and its label.
 fn write_legend(s: &mut String, legend: &[(&Series, String)], f: &Frame) {
-    let ly = f.oy + 36.0;
-    let mut lx = f.l;
-    for (ser, dash) in legend {
+    let series: Vec<&Series> = legend.iter().map(|(ser, _)| *ser).collect();
+    let owned: Vec<Series> = series
+        .iter()
+        .map(|ser| Series {
+            label: ser.label,
+            ..Series::default()
+        })
+        .collect();
+    let places = legend_layout(&owned, f.l, f.width - 10.0);
+    for ((ser, dash), (lx, row)) in legend.iter().zip(places) {
+        let ly = f.oy + 36.0 + LEGEND_ROW * row as f64;
         let _ = writeln!(
             s,
             r#"<line x1="{lx}" y1="{ly}" x2="{}" y2="{ly}" stroke="{}" stroke-width="{}"{dash}/><text x="{}" y="{}">{}</text>"#,
@@ -463,18 +615,11 @@ fn write_legend(s: &mut String, legend: &[(&Series, String)], f: &Frame) {
             ser.width.max(1.5),
             lx + 35.0,
             ly + 4.0,
-            esc(ser.label)
+            rich(ser.label)
         );
         if let Some(radius) = ser.marker {
-            let _ = writeln!(
-                s,
-                r#"<circle cx="{}" cy="{ly}" r="{radius}" fill="{}"/>"#,
-                lx + 15.0,
-                ser.color
-            );
+            write_marker(s, ser, lx + 15.0, ly, radius);
         }
-        // ~6.7 px per character of the 12 px sans-serif, plus a gap.
-        lx += 35.0 + 6.7 * ser.label.chars().count() as f64 + 18.0;
     }
 }
 
@@ -810,5 +955,71 @@ mod tests {
         assert_eq!(svg.matches("<circle").count(), 3);
         assert!(svg.contains(">A</text>"));
         assert!(!svg.contains("NaN") && !svg.contains("inf"));
+    }
+
+    /// Twelve long legend labels in a 600 px document wrap into rows, every entry's estimated
+    /// extent inside the document, and the plot box moves down to make room.
+    #[test]
+    fn a_long_legend_wraps_inside_the_document() {
+        let labels: Vec<String> = (0..12).map(|i| format!("runner number {i}")).collect();
+        let series: Vec<Series> = labels
+            .iter()
+            .map(|l| Series::line(l, "red", vec![(0.0, 0.0), (1.0, 1.0)]))
+            .collect();
+        let places = legend_layout(&series, 70.0, 590.0);
+        assert_eq!(places.len(), 12);
+        for (ser, (x, _)) in series.iter().zip(&places) {
+            assert!(x + 35.0 + CHAR * shown_chars(ser.label) as f64 <= 590.0);
+        }
+        let rows = places.last().unwrap().1 + 1;
+        assert!(rows >= 3, "{rows}");
+        let svg = render(&[Panel::new("t", "x", "y", series)], 600.0, 400.0);
+        let top = 50.0 + LEGEND_ROW * (rows - 1) as f64;
+        assert!(svg.contains(&format!(r#"<rect x="70" y="{top}""#)), "{svg}");
+    }
+
+    /// Markers: each shape is drawn as itself, an open one white inside with its colour's
+    /// outline; markers at the ends of the x range stay off the frame (3 % padding).
+    #[test]
+    fn markers_have_shapes_open_ones_are_white_inside_and_none_sits_on_the_frame() {
+        let pts = vec![(1.0, 1.0), (2.0, 2.0)];
+        let series: Vec<Series> = Shape::ALL
+            .iter()
+            .map(|&shape| Series {
+                color: "#123456",
+                marker: Some(3.0),
+                shape,
+                hollow: shape == Shape::Square,
+                points: pts.clone(),
+                ..Series::default()
+            })
+            .collect();
+        let svg = render(&[Panel::new("t", "x", "y", series)], 600.0, 400.0);
+        assert_eq!(svg.matches("<circle").count(), 2);
+        assert_eq!(svg.matches("<polygon").count(), 8);
+        assert_eq!(
+            svg.matches(r##"fill="white" stroke="#123456" stroke-width="1.3""##)
+                .count(),
+            2
+        );
+        // x = 1 maps 3 % of the range inside the box's left edge at 70 px.
+        let first = svg.find("<circle cx=\"").unwrap();
+        let cx: f64 = svg[first + 12..]
+            .split('"')
+            .next()
+            .unwrap()
+            .parse()
+            .unwrap();
+        assert!(cx > 75.0, "{cx}");
+    }
+
+    #[test]
+    fn subscripts_are_lowered_spans_and_text_is_escaped() {
+        assert_eq!(
+            rich("ω_{l} < 1"),
+            r#"ω<tspan baseline-shift="sub" font-size="75%">l</tspan> &lt; 1"#
+        );
+        assert_eq!(shown_chars("max ω_{l}"), 6);
+        assert_eq!(rich("a_b"), "a_b");
     }
 }

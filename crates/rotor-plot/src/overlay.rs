@@ -37,6 +37,7 @@ pub fn overlay(
             width: l.width,
             marker: (l.marker > 0.0).then_some(l.marker),
             points: l.points,
+            ..Series::default()
         })
         .collect();
     let mut panel = Panel::new(title, x_label, y_label, series);

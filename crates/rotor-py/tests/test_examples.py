@@ -50,3 +50,12 @@ def test_the_readme_python_block_runs_as_written():
     assert len(scope["cycles"]) == 50 and scope["diagram"]["points"]
     verdict = rotorbench.check("t1-u1.5-rest", *(scope["m"][c] for c in ("t", "alpha", "omega_u", "omega_l")))
     assert verdict["passed"]
+
+
+def test_redraw_bench_draws_a_published_figure_from_its_csv(tmp_path):
+    src = REPO / "reports" / "bench" / "bench-t1-u1.5-rest.csv"
+    rows = src.read_text().splitlines()[1:]
+    out = run("redraw_bench.py", str(src), "w.png", cwd=tmp_path)
+    assert (tmp_path / "w.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    runners = {r.split(",")[0] for r in rows}
+    assert out.strip() == f"w.png: {len(runners)} runners, {len(rows)} points"

@@ -108,7 +108,7 @@ pub static SWITCH: SolverInfo = SolverInfo {
     default: DEFAULT_TOL,
     ladder: &DECADES_3_12,
     style: Style {
-        color: "#e66101",
+        color: "#D55E00",
         dash: Some("6 3"),
         width: 1.5,
     },
@@ -128,7 +128,7 @@ pub static MOREAU: SolverInfo = SolverInfo {
     default: DEFAULT_STEP,
     ladder: &[1e-2, 5e-3, 2e-3, 1e-3, 5e-4, 2e-4, 1e-4, 1e-5],
     style: Style {
-        color: "#5e3c99",
+        color: "#0072B2",
         dash: Some("2 2"),
         width: 1.5,
     },

@@ -24,7 +24,32 @@ pub(crate) fn write_bench(
                 .with_context(|| format!("{}: cannot write", path.display()))?;
         }
     }
+    if let Some(path) = svg.filter(|p| p.as_os_str() != "-") {
+        write_figures(report, path)?;
+    }
     Ok(())
+}
+
+/// Beside the summary figure `<stem>.svg`: every scene's figure `<stem>-<scene>.svg`, each
+/// figure's data `<stem>-<name>.csv`, and the page `<stem>.html` that shows them all.
+fn write_figures(report: &rotor_bench::BenchReport, svg: &Path) -> Result<()> {
+    use rotor_compare::report::write_output;
+    let stem = svg
+        .file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_else(|| "bench".into());
+    let dir = svg.parent().unwrap_or(Path::new(""));
+    let write = |name: String, bytes: &[u8]| {
+        let path = dir.join(name);
+        write_output(&path, bytes).with_context(|| format!("{}: cannot write", path.display()))
+    };
+    for f in report.figures()? {
+        if f.name != "profile" {
+            write(format!("{stem}-{}.svg", f.name), f.svg.as_bytes())?;
+        }
+        write(format!("{stem}-{}.csv", f.name), f.csv.as_bytes())?;
+    }
+    write(format!("{stem}.html"), report.to_html(&stem)?.as_bytes())
 }
 
 /// `--results FILE`: the published-results page.
