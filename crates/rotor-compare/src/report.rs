@@ -9,7 +9,7 @@ use rotor_scenario::Scenario;
 use rotor_seam::SteadyState;
 
 use crate::gate::{Failure, GateResult, gate_scenario};
-use rotor_plot::{Panel, Series, render};
+use rotor_plot::{Panel, Series, render, render_rows};
 use rotor_solvers::run::{ScenarioResult, solver_setting};
 use rotor_solvers::solvers::SolverKind;
 
@@ -148,48 +148,86 @@ pub fn scenario_csv(r: &ScenarioResult) -> String {
     String::from_utf8(w.into_inner().expect("in memory")).expect("ASCII")
 }
 
-/// Per-scenario SVG: ω_u and ω_l of every solver overlaid (the source's Figs. 4–7).
+/// Per-scenario SVG over the whole run: α, ω_u and ω_l of every solver overlaid (the source's
+/// Figs. 4–7), each with a panel under it of every other solver's difference from the first
+/// (the accuracy reference) on the comparison grid, log scale: the overlay shows that the
+/// solvers agree, the difference panel by how much. A difference of exactly 0 (both stuck)
+/// has no place on the log axis and leaves a gap.
 pub fn scenario_svg(r: &ScenarioResult) -> String {
     let sc = &r.scenario;
-    let t_max = sc
-        .compare
-        .transient
-        .map_or(sc.t_end, |w| w[1].max(sc.t_end.min(60.0)));
     let labels: Vec<String> = r.runs.iter().map(|run| label(run.kind, sc)).collect();
-    let mk = |idx: usize, name: &'static str| {
-        Panel::new(
-            format!("{}: {} (u = {} V)", sc.name, name, sc.u),
-            "t [s]",
-            if idx == 1 {
-                "ω_u [rad/s]"
-            } else {
-                "ω_l [rad/s]"
-            },
-            r.runs
-                .iter()
-                .enumerate()
-                .filter_map(|(i, run)| {
-                    let tr = run.result.as_ref().ok()?;
-                    let style = run.kind.info().style;
-                    Some(Series {
-                        label: &labels[i],
-                        color: style.color,
-                        dash: style.dash,
-                        width: style.width,
-                        marker: None,
-                        points: tr
-                            .samples
-                            .iter()
-                            .filter(|s| s.t <= t_max)
-                            .map(|s| (s.t, s.x[idx]))
-                            .collect(),
-                        ..Series::default()
-                    })
+    let reference = r.runs.first().and_then(|run| run.result.as_ref().ok());
+    let quantities: [(usize, &str, &str, &str); 3] = [
+        (0, "twist", "α [rad]", "|Δα| [rad]"),
+        (1, "upper disc", "ω_{u} [rad/s]", "|Δω_{u}| [rad/s]"),
+        (2, "lower disc", "ω_{l} [rad/s]", "|Δω_{l}| [rad/s]"),
+    ];
+    let mut panels = Vec::new();
+    let mut heights = Vec::new();
+    for (idx, name, y_label, d_label) in quantities {
+        let overlay = r
+            .runs
+            .iter()
+            .enumerate()
+            .filter_map(|(i, run)| {
+                let tr = run.result.as_ref().ok()?;
+                let style = run.kind.info().style;
+                Some(Series {
+                    label: &labels[i],
+                    color: style.color,
+                    dash: style.dash,
+                    width: style.width,
+                    points: tr.samples.iter().map(|s| (s.t, s.x[idx])).collect(),
+                    ..Series::default()
                 })
-                .collect(),
-        )
-    };
-    render(&[mk(1, "upper disc"), mk(2, "lower disc")], 900.0, 320.0)
+            })
+            .collect();
+        panels.push(Panel::new(
+            format!("{}: {name} (u = {} V)", sc.name, sc.u),
+            "t [s]",
+            y_label,
+            overlay,
+        ));
+        heights.push(300.0);
+        let Some(re) = reference else {
+            continue;
+        };
+        let diffs: Vec<Series> = r
+            .runs
+            .iter()
+            .enumerate()
+            .skip(1)
+            .filter_map(|(i, run)| {
+                let tr = run.result.as_ref().ok()?;
+                let style = run.kind.info().style;
+                Some(Series {
+                    label: &labels[i],
+                    color: style.color,
+                    width: 1.0,
+                    points: tr
+                        .samples
+                        .iter()
+                        .zip(&re.samples)
+                        .map(|(a, b)| (a.t, (a.x[idx] - b.x[idx]).abs()))
+                        .collect(),
+                    ..Series::default()
+                })
+            })
+            .collect();
+        if diffs.is_empty() {
+            continue;
+        }
+        let mut panel = Panel::new(
+            format!("{}: {name}, difference from {}", sc.name, labels[0]),
+            "t [s]",
+            d_label,
+            diffs,
+        );
+        panel.y_log = true;
+        panels.push(panel);
+        heights.push(230.0);
+    }
+    render_rows(&panels, 900.0, &heights)
 }
 
 /// Line styles of the parameter sets in the friction plot.

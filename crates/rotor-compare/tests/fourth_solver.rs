@@ -270,6 +270,10 @@ fn a_fourth_solver_needs_its_crate_one_entry_and_its_tolerances() {
             .unwrap()
             .ends_with(",omega_u_euler,omega_l_euler")
     );
-    assert!(scenario_svg(&r).contains("explicit Euler (h 1e-4)"));
+    // Its figure: α, ω_u and ω_l overlaid over the whole run, each with a panel of every
+    // solver's difference from the reference under it; the fourth solver in all six legends.
+    let svg = scenario_svg(&r);
+    assert_eq!(svg.matches(", difference from event-driven").count(), 3);
+    assert_eq!(svg.matches(">explicit Euler (h 1e-4)</text>").count(), 6);
     std::fs::remove_dir_all(&dir).ok();
 }
