@@ -56,9 +56,10 @@ const FLOOR_REL: f64 = 1e-14;
 /// verified to fewer than [`REQUIRED_DIGITS`] on some graded quantity: the three that start
 /// next to an unstable equilibrium (st-u0.19-eq-pert, t1-u0.4-eq-pert, t1-u2.5-eq-pert), whose
 /// growth away from it amplifies every early error. The event-driven solver's error is
-/// proportional to its tolerance there (measured on those three from tol 1e-11 to 1e-14
-/// against a run at 1.2e-15: a factor 9.0–11.4 per decade in the event times and the
-/// trace), so 5e-14 gains about 1.3 digits.
+/// proportional to its tolerance there (measured on those three against a run at 1.2e-15: a
+/// factor 7.5–10.4 per decade from tol 1e-11 to 1e-13 in the event times and the trace;
+/// `cargo run --release -p rotor-grade --example reference_tol`), so 5e-14 gains about 1.3
+/// digits.
 pub const TIGHT_REFERENCE_TOL: f64 = 5e-14;
 /// The run the error of a [`TIGHT_REFERENCE_TOL`] reference is estimated against: 1.2e-15,
 /// the smallest round tolerance the solvers accept (`rotor_seam::MIN_TOL` = 1.1e-15), 1.6
