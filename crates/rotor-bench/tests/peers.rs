@@ -203,8 +203,10 @@ fn two_jobs_run_two_clients_side_by_side() {
 }
 
 /// The regularised client (tanh(omega/1e-3), LSODA) runs, and fails the loose gate with the
-/// failing quantities named, among them the lower disc's stick intervals (its disc creeps
-/// instead of sticking, so the trace shows none of them).
+/// failing quantities named: the spring (`alpha`) and `omega_l`, which wind up at the wrong
+/// rate while its disc creeps instead of sticking. (Its creep, ≲ 1e-3 rad/s, is within the
+/// loose level's stuck threshold, 1e-3 of ω_l's scale: at loose its stick intervals are
+/// graded like a stuck disc's, and on this scene they pass.)
 #[test]
 fn the_regularised_client_fails_the_gates_with_the_quantities_named() {
     let o = options();
@@ -226,11 +228,14 @@ fn the_regularised_client_fails_the_gates_with_the_quantities_named() {
     let f = p.failure.as_ref().unwrap();
     assert_eq!(f.kind, FailureKind::FailsGate);
     assert!(
-        p.failing.iter().any(|q| q == "stick_lower"),
+        ["alpha", "omega_l"]
+            .iter()
+            .all(|n| p.failing.iter().any(|q| q == n)),
         "{:?}",
         p.failing
     );
-    assert!(f.detail.contains("stick_lower"), "{f:?}");
+    assert!(f.detail.contains("omega_l"), "{f:?}");
+    assert_eq!(p.passes_strict, Some(false));
 }
 
 /// The first-order client (`bench/clients/first_order.c`: backward Euler in the velocities

@@ -1,6 +1,7 @@
 //! The digits `rotor check` gives honest solvers of every kind on every fixture: the
 //! event-driven solver at several tolerances, the switch model, Moreau–Jean at several steps.
-//! Each run's grid trace and events are graded as an external trace is. This is how the
+//! Each run's grid trace and events are graded as an external trace is, at the strict level
+//! (whose stuck threshold, `check::stuck_threshold`, is the finest any level uses). This is how the
 //! levels' digits (`check::STRICT_DIGITS`, `check::LOOSE_DIGITS`) were chosen:
 //!
 //! ```sh
@@ -45,7 +46,7 @@ fn main() {
             };
             let trace = Trace::of_run("run", tr.samples);
             let events = EventsFile::of_run("run", &tr.events);
-            match check(&sc, &r, &trace, Some(&events), Level::Digits(1)) {
+            match check(&sc, &r, &trace, Some(&events), Level::Strict) {
                 Ok(rep) => {
                     let cols: Vec<String> = rep
                         .quantities
@@ -69,13 +70,13 @@ fn main() {
                 Err(e) => println!("{:>8} {setting:e}: {e}", kind.name()),
             }
         }
-        // The reference's own verified digits per quantity.
+        // The reference's own verified digits per quantity: −log10(stated error / scale).
         if let Ok(rep) = check(
             &sc,
             &r,
             &Trace::of_run("ref", r.samples.clone()),
-            None,
-            Level::Digits(1),
+            Some(&EventsFile::of_run("ref", &r.events)),
+            Level::Strict,
         ) {
             let cols: Vec<String> = rep
                 .quantities
@@ -85,7 +86,11 @@ fn main() {
                     Some(format!("{}={:.1}", q.name, -(e / q.scale).log10()))
                 })
                 .collect();
-            println!("  reference verified: {}", cols.join(" "));
+            println!(
+                "  reference verified (tol {:e}): {}",
+                r.json.tol,
+                cols.join(" ")
+            );
             let orbit = rep.quantities.iter().find(|q| q.name == "orbit");
             println!(
                 "  reference's own orbit distance: {:?}",

@@ -12,15 +12,22 @@
 //!   and time; a missing, extra or unmatched event is named and fails the quantity. Scale:
 //!   the motion's time scale [`time_scale`] (the reference cycle's period, else 1 s).
 //! * **`stick_lower`, `stick_upper`**: the stick intervals visible in the trace (samples with
-//!   |ω| ≤ [`STUCK`]) matched one to one with the reference's, for every trace, with or without
-//!   an events file. A sample grid shows an onset only to within one step, so the difference
+//!   |ω| ≤ [`stuck_threshold`], the level's tolerance of that disc's ω samples) matched one to
+//!   one with the reference's (the same threshold), for every trace, with or without an events
+//!   file. A sample grid shows an onset only to within one step, so the difference
 //!   is how far the reference's exact onset (or exit) lies outside the step in which the trace
 //!   shows it: a lower bound of the trace's own error, never blame for the grid.
 //! * **steady state** over `[steady_from, t_end]`: the kind, each metric read off the grid by
 //!   the same reconstruction for the trace and the reference ([`crate::gridmetrics`]; scale:
 //!   the period for times, the disc's scale for speeds), and **`orbit`**, the orbit's shape
-//!   compared phase-free: the largest distance of a steady sample of the trace from the
-//!   reference's steady orbit ([`crate::orbit`]), in scaled coordinates.
+//!   compared phase-free: each steady sample's offset from the reference's steady orbit (the
+//!   sample minus the orbit's nearest point, in scaled coordinates) against the reference
+//!   sample's offset at the same time, the largest difference
+//!   ([`crate::orbit::Orbit::largest_offset_difference`]).
+//!
+//! Every quantity but `steady_kind` (0 or ∞) has a stated, independently verified error in the
+//! reference ([`reference_error`]; `crate::reference`), and no level asks more digits of a
+//! quantity than that error allows, less one ([`CheckError::BeyondReference`]).
 //!
 //! **Phase drift.** A stable cycle's phase is neutral, so a method whose period is off by a
 //! relative ε drifts by ε·t: at time t its samples are off by up to `ε·t·max|ẋ|`. The
@@ -48,7 +55,7 @@ use rotor_scenario::Scenario;
 use rotor_seam::{Event, EventKind, Sample, SteadyState};
 use serde::{Serialize, Serializer};
 
-use crate::gridmetrics::{STUCK, StickExit, grid_metrics};
+use crate::gridmetrics::{StickExit, grid_metrics_at};
 use crate::orbit::Orbit;
 use crate::reference::Reference;
 use crate::trace::{At, EventsFile, Trace, disc_name, event_row};
@@ -60,14 +67,16 @@ pub const BENCHMARK: &str = rotor_suite::VERSION;
 /// Digits of the `loose` level: engineering accuracy, 0.1 % of each quantity's scale. What
 /// any converging method reaches at a reasonable cost: a first-order time-stepper at
 /// h = 1e-5 on the 1.5 V cycle (`bench/clients/first_order.c`, tested in
-/// `tests/grade_levels.rs`).
+/// `crates/rotor-bench/tests/peers.rs`).
 pub const LOOSE_DIGITS: u32 = 3;
 /// Digits of the `strict` level: what a well-converged adaptive integrator reaches (the
 /// event-driven solver at tol 1e-11, scipy's DOP853 at rtol 1e-11 restarted at each mode
-/// switch). No level is tighter than 10× the reference's stated error on any quantity of
-/// any scenario (one digit below the reference's own; `tests/grade_levels.rs`): the worst is
-/// t1-u2.5-eq-pert's ω_l, 8.2 digits, whose start from an unstable equilibrium amplifies
-/// every error until the cycle.
+/// switch). Every graded quantity of every reference is verified to at least
+/// [`crate::reference::REQUIRED_DIGITS`] = strict + 2 digits, so strict is a full digit inside
+/// the most any reference can grade (its digits less one); the weakest is st-u2.5-rest's α
+/// and ω_l, 9.2 digits (`cargo run --release -p rotor-grade --example grade_digits`,
+/// "reference verified"; enforced by `tests/grade.rs`,
+/// `strict_is_a_full_digit_inside_every_reference`).
 pub const STRICT_DIGITS: u32 = 7;
 
 /// Absolute floor of the scale of α \[rad\] and of ω_u, ω_l [rad/s]: for a variable that
@@ -455,14 +464,15 @@ pub fn time_scale(reference: &Reference) -> f64 {
     }
 }
 
-/// The reference's stated error that bounds a quantity's (trace errors for the samples and
-/// the orbit, event times for events and stick intervals, each metric's own), if stated.
+/// The reference's stated error that bounds a quantity's (trace errors for the samples, event
+/// times for events and stick intervals, the orbit's and each metric's own), if stated.
+/// `steady_kind` has none: it is 0 or ∞, and the reference's kind is verified
+/// (`tests/reference_verified.rs`).
 pub fn reference_error(reference: &Reference, quantity: &str) -> Option<f64> {
     let e = |k: &str| reference.json.error.get(k).copied();
     match quantity {
-        "alpha" | "omega_u" | "omega_l" => e(quantity),
+        "alpha" | "omega_u" | "omega_l" | "orbit" => e(quantity),
         "events" | "stick_lower" | "stick_upper" => e("event_time"),
-        "orbit" => None,
         "steady_kind" => None,
         q => {
             let m = q.strip_prefix("steady_")?;
@@ -614,12 +624,30 @@ fn grade_events(reference: &[Event], trace: &[Event], t_scale: f64, level: Level
     g
 }
 
-/// Runs of consecutive stuck samples of velocity `i` (|x_i| ≤ [`STUCK`]), as index pairs.
-fn stuck_runs(samples: &[Sample], i: usize) -> Vec<(usize, usize)> {
+/// |ω| at or below which a sample of a disc counts as stuck at `level` \[rad/s\]: the level's
+/// tolerance of that disc's ω samples, `S_ω·10^−digits` (`scale`: the disc's scale `S_ω`,
+/// [`state_scales`]).
+///
+/// A stuck reference sample is exactly 0, so a trace sample within the level's sample
+/// tolerance of 0 agrees with it at that level, whatever the trace's solver holds a stuck disc
+/// at: exactly 0 (event-driven), its complementarity solver's rounding (≈ 1e-13, Moreau–Jean),
+/// or anywhere in a band `|ω| ≤ η` (a switch model, Karnopp's law). A sample further from 0
+/// fails the `omega_u`/`omega_l` quantity at that level anyway, so the stick intervals are
+/// graded exactly as finely as the samples. Both traces are classified alike, so a slipping
+/// sample of the reference inside the threshold (next to an onset or a reversal) is a stuck
+/// sample of a correct trace too: only a trace whose error there exceeds the distance of the
+/// reference's |ω| from the threshold sees another run, as with any threshold. Loose: 1e-3 of
+/// the disc's scale (a few mrad/s); strict: 1e-7 of it (about 1e-6 rad/s on Table 1).
+pub fn stuck_threshold(scale: f64, level: Level) -> f64 {
+    scale * 10f64.powi(-(level.digits() as i32))
+}
+
+/// Runs of consecutive stuck samples of velocity `i` (|x_i| ≤ `stuck`), as index pairs.
+fn stuck_runs(samples: &[Sample], i: usize, stuck: f64) -> Vec<(usize, usize)> {
     let mut runs = Vec::new();
     let mut start = None;
     for (k, s) in samples.iter().enumerate() {
-        match (s.x[i].abs() <= STUCK, start) {
+        match (s.x[i].abs() <= stuck, start) {
             (true, None) => start = Some(k),
             (false, Some(a)) => {
                 runs.push((a, k - 1));
@@ -640,6 +668,7 @@ fn grade_stick(
     disc: Disc,
     trace: &[Sample],
     reference: &Reference,
+    scale: [f64; 3],
     t_scale: f64,
     level: Level,
 ) -> Option<Graded> {
@@ -647,9 +676,10 @@ fn grade_stick(
         Disc::Upper => 1,
         Disc::Lower => 2,
     };
+    let stuck = stuck_threshold(scale[i], level);
     let name = format!("stick_{}", disc_name(disc));
     let rs = &reference.samples;
-    let (ref_runs, runs) = (stuck_runs(rs, i), stuck_runs(trace, i));
+    let (ref_runs, runs) = (stuck_runs(rs, i, stuck), stuck_runs(trace, i, stuck));
     if ref_runs.is_empty() && runs.is_empty() {
         return None;
     }
@@ -736,8 +766,8 @@ fn grade_stick(
     let mut notes = Vec::new();
     if !missing.is_empty() {
         notes.push(format!(
-            "{} stick interval(s) of the reference not in the trace (|omega| <= {STUCK:e} rad/s), \
-             from {}",
+            "{} stick interval(s) of the reference not in the trace (|omega| <= {stuck:.1e} rad/s \
+             at this level), from {}",
             missing.len(),
             list(&missing)
         ));
@@ -769,9 +799,10 @@ fn grade_steady(
         u: sc.u,
     };
     let mut q = Vec::new();
+    let stuck = stuck_threshold(scale[2], level);
     let (sa, sr) = (
-        grid_metrics(trace, from, exit),
-        grid_metrics(&reference.samples, from, exit),
+        grid_metrics_at(trace, from, exit, stuck),
+        grid_metrics_at(&reference.samples, from, exit, stuck),
     );
     let (Ok(a), Ok(r)) = (sa, sr) else {
         q.push(graded("steady_kind", f64::INFINITY, 1.0, level));
@@ -803,17 +834,11 @@ fn grade_steady(
     }
     // The orbit's shape, phase-free (a cycle only: the equilibrium's samples are graded at
     // equal times above, and a slow focus is still on its way there at `steady_from`).
-    let SteadyState::LimitCycle { period, .. } = reference.steady().unwrap_or(r) else {
+    let Some(distance) = orbit_distance(sc, reference, r, trace, from, scale) else {
         return q;
     };
-    let window = &trace[trace.partition_point(|s| s.t < from - TIME_TOL)..];
-    let rs = &reference.samples;
-    let start = &rs[rs
-        .partition_point(|s| s.t < from - TIME_TOL)
-        .min(rs.len() - 1)];
-    let mut g = match Orbit::cycle(sc, start.x, period, reference.json.tol, scale) {
-        Ok(o) => {
-            let (d, at) = o.largest_distance(window);
+    let mut g = match distance {
+        Ok((d, at)) => {
             let mut g = graded("orbit", d, 1.0, level);
             g.at = Some(at).filter(|t| t.is_finite());
             g
@@ -829,6 +854,34 @@ fn grade_steady(
     }
     q.push(g);
     q
+}
+
+/// The `orbit` quantity of `trace`: the largest difference between its samples' offsets at
+/// `t ≥ from` from the reference's steady orbit and the reference samples' offsets at the same
+/// times ([`Orbit::largest_offset_difference`]; the orbit recomputed by the reference solver
+/// from the reference's sample at `from`, over the period of `reference`'s steady state, else
+/// of `cycle`), in coordinates scaled by `scale`, and the time of the sample where it is.
+/// `None` when the steady state is no cycle.
+pub fn orbit_distance(
+    sc: &Scenario,
+    reference: &Reference,
+    cycle: SteadyState,
+    trace: &[Sample],
+    from: f64,
+    scale: [f64; 3],
+) -> Option<Result<(f64, f64), rotor_seam::SolveError>> {
+    let SteadyState::LimitCycle { period, .. } = reference.steady().unwrap_or(cycle) else {
+        return None;
+    };
+    let window = &trace[trace.partition_point(|s| s.t < from - TIME_TOL)..];
+    let rs = &reference.samples;
+    let k = rs
+        .partition_point(|s| s.t < from - TIME_TOL)
+        .min(rs.len() - 1);
+    Some(
+        Orbit::cycle(sc, rs[k].x, period, reference.json.tol, scale)
+            .map(|o| o.largest_offset_difference(window, &rs[k..])),
+    )
 }
 
 /// Grades a trace (and optionally its events) against the reference of scenario `sc` at
@@ -881,7 +934,14 @@ pub fn check(
         None => not_graded.push("events".to_owned()),
     }
     for disc in [Disc::Lower, Disc::Upper] {
-        q.extend(grade_stick(disc, &trace.samples, reference, t_scale, level));
+        q.extend(grade_stick(
+            disc,
+            &trace.samples,
+            reference,
+            scale,
+            t_scale,
+            level,
+        ));
     }
     if let Some(from) = sc.compare.steady_from {
         q.extend(grade_steady(

@@ -10,7 +10,9 @@
 //! ([`rotor_seam::MetricsAccumulator`]), each event located on the model's field from the
 //! sample before it (RK4, 200 steps per sample interval, within that interval):
 //!
-//! * the lower disc is stuck at a sample with |ω_l| ≤ [`STUCK`]. A stick phase starts where
+//! * the lower disc is stuck at a sample with |ω_l| ≤ a threshold (the grade's: the level's
+//!   sample tolerance of ω_l, [`crate::check::stuck_threshold`]; [`STUCK`] in
+//!   [`grid_metrics`]). A stick phase starts where
 //!   the slip field from the last moving sample brings ω_l to 0, and ends where the stick
 //!   field from the last stuck sample (whose torque is still inside the stick interval) brings
 //!   the applied torque `k_θ α` to the interval's edge;
@@ -38,9 +40,10 @@ use rotor_model::{Disc, DiscMode, Model, OMEGA_L, OMEGA_U, State};
 use rotor_seam::steady::EQUILIBRIUM_AMPLITUDE;
 use rotor_seam::{Sample, SteadyState};
 
-/// |ω_l| at or below which a sample counts as stuck [rad/s]: an event-driven solver writes
-/// exactly 0, a time-stepping one its complementarity solver's rounding (≈ 1e-13 for
-/// Moreau–Jean and Siconos); a regularised friction law creeps far above it.
+/// |ω_l| at or below which [`grid_metrics`] counts a sample as stuck [rad/s]: an event-driven
+/// solver writes exactly 0, a time-stepping one its complementarity solver's rounding (≈ 1e-13
+/// for Moreau–Jean and Siconos); a regularised friction law creeps far above it. The grade
+/// (`rotor check`) uses [`grid_metrics_at`] with a threshold that follows its level instead.
 pub const STUCK: f64 = 1e-9;
 
 /// Why a trace has no steady metrics.
@@ -64,11 +67,22 @@ pub struct StickExit<'a> {
     pub u: f64,
 }
 
-/// The steady-state metrics of `samples` over `t ≥ from` (see the module docs).
+/// The steady-state metrics of `samples` over `t ≥ from` (see the module docs), a sample
+/// counting as stuck at |ω_l| ≤ [`STUCK`].
 pub fn grid_metrics(
     samples: &[Sample],
     from: f64,
     exit: StickExit,
+) -> Result<SteadyState, GridMetricsError> {
+    grid_metrics_at(samples, from, exit, STUCK)
+}
+
+/// [`grid_metrics`] with a sample counting as stuck at |ω_l| ≤ `stuck` \[rad/s\].
+pub fn grid_metrics_at(
+    samples: &[Sample],
+    from: f64,
+    exit: StickExit,
+    stuck: f64,
 ) -> Result<SteadyState, GridMetricsError> {
     let start = samples.partition_point(|s| s.t < from - 1e-9);
     let w = &samples[start..];
@@ -89,7 +103,7 @@ pub fn grid_metrics(
     if range(w) <= EQUILIBRIUM_AMPLITUDE {
         return Ok(equilibrium);
     }
-    let phases = stick_phases(w, exit);
+    let phases = stick_phases(w, exit, stuck);
     // Anchors: (index of the sample at or after the anchor, time).
     let anchors: Vec<(usize, f64)> = if phases.iter().filter(|p| p.exit.is_some()).count() >= 2 {
         phases
@@ -97,7 +111,7 @@ pub fn grid_metrics(
             .filter_map(|p| p.exit.map(|t| (p.last + 1, t)))
             .collect()
     } else {
-        maxima(w, exit)
+        maxima(w, exit, stuck)
     };
     let [.., (ka, ta), (kb, tb)] = anchors[..] else {
         return Ok(equilibrium);
@@ -105,12 +119,12 @@ pub fn grid_metrics(
     // One sample beyond each anchor's bracketing pair, so that an extremum at an anchor has
     // both neighbours.
     let cycle = &w[ka.saturating_sub(2)..=(kb + 1).min(w.len() - 1)];
-    let (wl_min, wl_max) = extremes(cycle, OMEGA_L, exit);
+    let (wl_min, wl_max) = extremes(cycle, OMEGA_L, exit, stuck);
     let tail = &w[w.partition_point(|s| s.t < last.t - (tb - ta))..];
     if wl_max - wl_min <= EQUILIBRIUM_AMPLITUDE || range(tail) <= EQUILIBRIUM_AMPLITUDE {
         return Ok(equilibrium);
     }
-    let (wu_min, wu_max) = extremes(cycle, OMEGA_U, exit);
+    let (wu_min, wu_max) = extremes(cycle, OMEGA_U, exit, stuck);
     let stick_time = phases
         .iter()
         .filter_map(|p| Some((p.onset, p.exit?)))
@@ -137,8 +151,8 @@ struct StickPhase {
 }
 
 /// The stick phases of the lower disc (see the module docs).
-fn stick_phases(s: &[Sample], exit: StickExit) -> Vec<StickPhase> {
-    let stuck = |k: usize| s[k].x[OMEGA_L].abs() <= STUCK;
+fn stick_phases(s: &[Sample], exit: StickExit, threshold: f64) -> Vec<StickPhase> {
+    let stuck = |k: usize| s[k].x[OMEGA_L].abs() <= threshold;
     let mut out = Vec::new();
     let mut k = 0;
     while k < s.len() {
@@ -178,12 +192,12 @@ fn stick_phases(s: &[Sample], exit: StickExit) -> Vec<StickPhase> {
 
 /// The maxima of ω_l in slip: (index of the sample after, time where the slip field's ω̇_l
 /// reaches 0 from the sample before).
-fn maxima(s: &[Sample], exit: StickExit) -> Vec<(usize, f64)> {
+fn maxima(s: &[Sample], exit: StickExit, stuck: f64) -> Vec<(usize, f64)> {
     let m = exit.model;
     let mut out = Vec::new();
     for k in 1..s.len().saturating_sub(1) {
         let (a, b, c) = (s[k - 1].x[OMEGA_L], s[k].x[OMEGA_L], s[k + 1].x[OMEGA_L]);
-        if !(b > a && b >= c && b.abs() > STUCK) {
+        if !(b > a && b >= c && b.abs() > stuck) {
             continue;
         }
         // The maximum lies in [t_{k−1}, t_{k+1}]: from the earlier sample, along the slip
@@ -202,7 +216,7 @@ fn maxima(s: &[Sample], exit: StickExit) -> Vec<(usize, f64)> {
 /// strict local extremum in slip, with both neighbours in the slice, is moved to the true
 /// extremum: from the sample before it along the field to where the component's derivative
 /// changes sign (a plateau, as in a stick phase, stays the sample's value).
-fn extremes(s: &[Sample], i: usize, exit: StickExit) -> (f64, f64) {
+fn extremes(s: &[Sample], i: usize, exit: StickExit, stuck: f64) -> (f64, f64) {
     let v = |k: usize| s[k].x[i];
     let (mut kmin, mut kmax) = (0, 0);
     for k in 1..s.len() {
@@ -220,7 +234,7 @@ fn extremes(s: &[Sample], i: usize, exit: StickExit) -> (f64, f64) {
         }
         let (a, b, c) = (v(k - 1), v(k), v(k + 1));
         let strict = sign * (b - a) > 0.0 && sign * (b - c) > 0.0;
-        let moving = s[k - 1..=k + 1].iter().all(|q| q.x[OMEGA_L].abs() > STUCK);
+        let moving = s[k - 1..=k + 1].iter().all(|q| q.x[OMEGA_L].abs() > stuck);
         if !strict || !moving {
             return b;
         }

@@ -52,6 +52,27 @@ pub const ERROR_MARGIN: f64 = 2.0;
 /// Smallest stated error, relative to the quantity's scale: a few units of double rounding.
 const FLOOR_REL: f64 = 1e-14;
 
+/// Tolerance of the reference run of a scenario whose reference at [`REFERENCE_TOL`] is
+/// verified to fewer than [`REQUIRED_DIGITS`] on some graded quantity: the three that start
+/// next to an unstable equilibrium (st-u0.19-eq-pert, t1-u0.4-eq-pert, t1-u2.5-eq-pert), whose
+/// growth away from it amplifies every early error. The event-driven solver's error is
+/// proportional to its tolerance there (measured on those three against a run at 1.2e-15: a
+/// factor 7.5–10.4 per decade from tol 1e-11 to 1e-13 in the event times and the trace;
+/// `cargo run --release -p rotor-grade --example reference_tol`), so 5e-14 gains about 1.3
+/// digits.
+pub const TIGHT_REFERENCE_TOL: f64 = 5e-14;
+/// The run the error of a [`TIGHT_REFERENCE_TOL`] reference is estimated against: 1.2e-15,
+/// the smallest round tolerance the solvers accept (`rotor_seam::MIN_TOL` = 1.1e-15), 1.6
+/// decades tighter (its error a 40th of the reference's: within the [`ERROR_MARGIN`]).
+pub const TIGHT_CHECK_TOL: f64 = 1.2e-15;
+/// Digits to which every graded quantity of every reference must be verified: the strict
+/// level's, one more because no level is graded closer than one digit to the reference
+/// ([`crate::check`]'s `BeyondReference`), and one more so that strict is a full digit inside
+/// what the reference can grade (a regenerated reference that loses a few tenths of a digit
+/// does not stop grading strict). A reference below it at [`REFERENCE_TOL`] is computed at
+/// [`TIGHT_REFERENCE_TOL`].
+pub const REQUIRED_DIGITS: f64 = crate::check::STRICT_DIGITS as f64 + 2.0;
+
 /// The `<name>.json` of a reference.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct ReferenceJson {
@@ -253,11 +274,39 @@ fn differences(
     out
 }
 
-/// Computes the reference of a scenario (three event-driven runs: the reference, the tighter
-/// one, and the cross-check runs of the other two solvers).
+/// The fewest digits to which any graded quantity of `r` is verified: `−log10(error/scale)`
+/// over the quantities of its own trace and events graded by [`crate::check::check`] (their
+/// scales are the grade's), 0 if they cannot be graded.
+pub fn verified_digits(sc: &Scenario, r: &Reference) -> f64 {
+    let trace = crate::trace::Trace::of_run("reference", r.samples.clone());
+    let events = crate::trace::EventsFile::of_run("reference.events", &r.events);
+    let Ok(rep) = crate::check::check(sc, r, &trace, Some(&events), crate::check::Level::Digits(1))
+    else {
+        return 0.0;
+    };
+    rep.quantities
+        .iter()
+        .filter_map(|q| crate::check::reference_error(r, &q.name).map(|e| -(e / q.scale).log10()))
+        .fold(f64::INFINITY, f64::min)
+}
+
+/// Computes the reference of a scenario: at [`REFERENCE_TOL`] (error against [`CHECK_TOL`]),
+/// or, where that is verified to fewer than [`REQUIRED_DIGITS`] on some graded quantity
+/// ([`verified_digits`]), at [`TIGHT_REFERENCE_TOL`] (against [`TIGHT_CHECK_TOL`]).
 pub fn compute(sc: &Scenario) -> Result<Reference, ReferenceError> {
-    let r = event_run(sc, REFERENCE_TOL)?;
-    let tight = event_run(sc, CHECK_TOL)?;
+    let r = compute_at(sc, REFERENCE_TOL, CHECK_TOL)?;
+    if verified_digits(sc, &r) >= REQUIRED_DIGITS {
+        return Ok(r);
+    }
+    compute_at(sc, TIGHT_REFERENCE_TOL, TIGHT_CHECK_TOL)
+}
+
+/// The reference of a scenario at tolerance `tol`, its errors estimated against `check_tol`
+/// (three event-driven runs: the reference, the tighter one, and the orbit; and the
+/// cross-check runs of the other two solvers).
+fn compute_at(sc: &Scenario, tol: f64, check_tol: f64) -> Result<Reference, ReferenceError> {
+    let r = event_run(sc, tol)?;
+    let tight = event_run(sc, check_tol)?;
     // The stated error: the difference to the tighter run, with a margin and a floor.
     let scale_of = |name: &str| -> f64 {
         let comp = match name {
@@ -295,7 +344,7 @@ pub fn compute(sc: &Scenario) -> Result<Reference, ReferenceError> {
             scenario: sc.name.clone(),
             source: SolveError::NoConvergence {
                 detail: format!(
-                    "the reference and the run at tol {CHECK_TOL:e} differ in {name} (another \
+                    "the reference and the run at tol {check_tol:e} differ in {name} (another \
                      event sequence or steady kind): no error can be stated"
                 ),
             },
@@ -351,7 +400,7 @@ pub fn compute(sc: &Scenario) -> Result<Reference, ReferenceError> {
         };
         m.map(rounded)
     });
-    let error = error
+    let error: BTreeMap<String, f64> = error
         .into_iter()
         .map(|(n, e)| (n, round_sig(e, 2, Rounding::Up)))
         .collect();
@@ -360,11 +409,11 @@ pub fn compute(sc: &Scenario) -> Result<Reference, ReferenceError> {
             *d = d.map(|x| round_sig(x, 2, Rounding::Scaled));
         }
     }
-    let json = ReferenceJson {
+    let mut json = ReferenceJson {
         scenario: sc.name.clone(),
         steady,
         solver: "event".into(),
-        tol: REFERENCE_TOL,
+        tol,
         dt: sc.compare.dt,
         t_end: sc.t_end,
         steady_from: sc.compare.steady_from,
@@ -373,17 +422,42 @@ pub fn compute(sc: &Scenario) -> Result<Reference, ReferenceError> {
         error,
         error_method: format!(
             "{ERROR_MARGIN} x the largest difference from the event-driven solver at tol \
-             {CHECK_TOL:e} (trace: over every sample of the run; event_time: over the matched \
-             events; steady metrics: the last complete cycle in [steady_from, t_end]), at \
-             least {FLOOR_REL:e} of the quantity's scale (event_time, period, stick_time: of \
-             t_end); an equilibrium's alpha, omega_u, omega_l take the larger of theirs and \
-             the trace's; the trace is rounded to {trace_digits} significant digits. Verified \
-             against an independent solution (Gauss-Legendre collocation of order 10, own \
-             event location, error estimated by step halving): \
+             {check_tol:e} (trace: over every sample of the run; event_time: over the matched \
+             events; steady metrics: the last complete cycle in [steady_from, t_end]; orbit: \
+             the orbit quantity of `rotor check` of that run's trace, the distance of its \
+             steady samples from this reference's orbit), at least {FLOOR_REL:e} of the \
+             quantity's scale (event_time, period, stick_time: of t_end; orbit: of 1); an \
+             equilibrium's alpha, omega_u, omega_l take the larger of theirs and the trace's; \
+             the trace is rounded to {trace_digits} significant digits. Verified against an \
+             independent solution (Gauss-Legendre collocation of order 10, own event \
+             location, error estimated by step halving): \
              crates/rotor-grade/tests/reference_verified.rs"
         ),
         cross_check,
     };
+    // The orbit: what `rotor check` charges the tighter run (nearly exact) in `orbit` is
+    // what it charges an exact trace, up to the tighter run's own error: the error of this
+    // reference's orbit quantity, stated as the others are.
+    if let (Some(from), Some(SteadyState::LimitCycle { .. })) = (sc.compare.steady_from, steady) {
+        let partial = Reference {
+            samples: samples.clone(),
+            events: switches(&r.events),
+            json: json.clone(),
+        };
+        let scale = crate::check::state_scales(&samples);
+        let cycle = steady.expect("a cycle");
+        if let Some(d) =
+            crate::check::orbit_distance(sc, &partial, cycle, &tight.samples, from, scale)
+        {
+            let (d, _) = d.map_err(|source| ReferenceError::Solve {
+                scenario: format!("{} (orbit)", sc.name),
+                source,
+            })?;
+            let stated = (ERROR_MARGIN * d).max(FLOOR_REL);
+            json.error
+                .insert("orbit".into(), round_sig(stated, 2, Rounding::Up));
+        }
+    }
     Ok(Reference {
         samples,
         events: switches(&r.events),

@@ -151,15 +151,9 @@ fn every_solver_passes_check_at_its_level() {
             let own = parse_trace(&write_trace(&r.samples, sc.compare.dt), Path::new("r.csv"));
             let ev = parse_events(&write_events(&r.events), Path::new("r.events.csv")).unwrap();
             let rep = check(sc, &r, &own.unwrap(), Some(&ev), Level::Strict).unwrap();
-            // The orbit is the reference solver's own, recomputed densely: it differs from
-            // the stored trace by the stored trace's error and the polyline's chord error
-            // (about 3e-9 of the scale at most: `rotor_grade::orbit`), not by 0.
-            let orbit_err =
-                r.error("omega_l") / r.samples.iter().map(|s| s.x[2].abs()).fold(1e-3, f64::max);
-            if !rep.quantities.iter().all(|q| {
-                q.difference == 0.0
-                    || (q.name == "orbit" && q.difference <= 10.0 * orbit_err + 3e-9)
-            }) {
+            // Every difference is 0, the orbit's too: it compares the trace's offsets from
+            // the orbit with the reference's own at the same times.
+            if !rep.quantities.iter().all(|q| q.difference == 0.0) {
                 out.push(format!("{} reference:\n{}", sc.name, rep.table()));
             }
             out

@@ -27,7 +27,7 @@ use rayon::prelude::*;
 use rotor_grade::reference;
 use rotor_model::{Disc, OMEGA_L, OMEGA_U, State};
 use rotor_scenario::Scenario;
-use rotor_seam::{EventKind, SteadyState};
+use rotor_seam::{EventKind, Sample, SteadyState};
 
 fn fixtures() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../../fixtures")
@@ -330,6 +330,45 @@ fn verify(case: &Case, r: &reference::Reference) -> (Vec<Check>, Vec<String>) {
         )),
     }
 
+    // The orbit: `rotor check`'s `orbit` quantity of the independent solution (its steady
+    // samples' offsets from the reference's orbit against the reference samples' offsets),
+    // which is what an exact trace scores there. Its own error: the largest scaled difference
+    // of its two runs over the steady samples (the offset moves by at most as much), plus
+    // a few units of rounding of the scaled values.
+    if let (Some(from), Some(cycle @ SteadyState::LimitCycle { .. })) =
+        (sc.compare.steady_from, r.json.steady)
+    {
+        let scale = rotor_grade::check::state_scales(&r.samples);
+        let as_samples = |run: &Run| -> Vec<Sample> {
+            run.samples.iter().map(|&(t, x)| Sample { t, x }).collect()
+        };
+        let (fs, cs) = (as_samples(&fine.run), as_samples(&coarse.run));
+        let distance = |tr: &[Sample]| {
+            rotor_grade::check::orbit_distance(sc, r, cycle, tr, from, scale)
+                .expect("a cycle")
+                .expect("the reference orbit")
+                .0
+        };
+        let own = fs
+            .iter()
+            .zip(&cs)
+            .filter(|(f, _)| f.t >= from - 1e-9)
+            .map(|(f, c)| {
+                (0..3)
+                    .map(|i| ((f.x[i] - c.x[i]) / scale[i]).powi(2))
+                    .sum::<f64>()
+                    .sqrt()
+            })
+            .fold(0.0, f64::max)
+            + ulps(1.0);
+        checks.push(Check {
+            name: "steady orbit".into(),
+            stated: stated("orbit"),
+            difference: distance(&fs),
+            own,
+        });
+    }
+
     // Every stated error is verified.
     for q in r.json.error.keys() {
         let verified = checks
@@ -421,8 +460,9 @@ fn every_stated_error_of_the_reference_holds_against_an_independent_solution() {
 }
 
 /// The check can fail: the committed reference of t1-u1.5-rest with one quantity moved by
-/// 1.5× its stated error away from the independent solution (one trace sample, one event
-/// time, the period) fails on that quantity alone; unmoved, it passes.
+/// 1.5× its stated error away from the independent solution (one trace sample of the
+/// transient, one event time, the period; one steady sample across the orbit by 2×) fails on
+/// that quantity alone; unmoved, it passes.
 #[test]
 fn a_reference_moved_by_more_than_its_stated_error_fails() {
     let c = case("t1-u1.5-rest");
@@ -439,7 +479,7 @@ fn a_reference_moved_by_more_than_its_stated_error_fails() {
     let moved = |q: &str| 1.5 * c.r.error(q);
 
     let mut r = c.r.clone();
-    let i = 15_000;
+    let i = 5_000; // t = 50 s, before steady_from = 100 s: the orbit does not see it
     let here = (r.samples[i].x[2] - c.fine.run.samples[i].1[2]).signum();
     r.samples[i].x[2] += here * moved("omega_l");
     assert_eq!(failing(&r), ["trace omega_l"]);
@@ -460,4 +500,25 @@ fn a_reference_moved_by_more_than_its_stated_error_fails() {
         .steady
         .map(|s| s.map(|n, v| if n == "period" { v + by } else { v }));
     assert_eq!(failing(&r), ["steady period"]);
+
+    // One steady sample (t = 150 s) moved across the orbit (normal to the reference's
+    // tangent there, in scaled coordinates) by 2× the orbit's stated error: the unmoved
+    // offsets differ by at most half the stated error (measured 4.1e-12 against 8.2e-12),
+    // so at least 1.5× remains, whichever side the move goes.
+    let mut r = c.r.clone();
+    let k = 15_000;
+    let scale = rotor_grade::check::state_scales(&r.samples);
+    let tangent: Vec<f64> = (0..3)
+        .map(|i| (r.samples[k + 1].x[i] - r.samples[k - 1].x[i]) / scale[i])
+        .collect();
+    let tn = tangent.iter().map(|x| x * x).sum::<f64>().sqrt();
+    let mut n: Vec<f64> = (0..3)
+        .map(|i| f64::from(i == 0) - tangent[0] * tangent[i] / (tn * tn))
+        .collect();
+    let nn = n.iter().map(|x| x * x).sum::<f64>().sqrt();
+    n.iter_mut().for_each(|x| *x /= nn);
+    for i in 0..3 {
+        r.samples[k].x[i] += 2.0 * c.r.error("orbit") * n[i] * scale[i];
+    }
+    assert_eq!(failing(&r), ["steady orbit"]);
 }
