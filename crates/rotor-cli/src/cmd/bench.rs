@@ -168,7 +168,21 @@ pub(crate) fn bench(
         None => std::thread::available_parallelism().map_or(1, |n| n.get().min(2)),
     };
     eprintln!("{}", plan(&opts));
-    let report = rotor_bench::run(&opts, |m| eprintln!("{m}"))?;
+    // One line per step, as always; on a terminal a spinner below them with the count and
+    // the elapsed time, so a run of minutes shows that it moves.
+    let spinner = crate::common::progress_spinner("bench");
+    let mut steps = 0usize;
+    let report = rotor_bench::run(&opts, |m| {
+        steps += 1;
+        if spinner.is_hidden() {
+            eprintln!("{m}");
+        } else {
+            spinner.println(m);
+            spinner.set_message(format!("bench: {steps} steps"));
+        }
+    });
+    spinner.finish_and_clear();
+    let report = report?;
     write_bench(&report, [json, svg, csv])?;
     write_results(&report, clients.results)?;
     // The report is written first (nothing is lost); then a named client that placed no
