@@ -1483,3 +1483,69 @@ fn exit_status_is_two_for_unusable_input_and_one_for_a_failed_run() {
     );
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// BENCHMARK.md's event conventions, as the grader applies them: it matches a trace's events
+/// one to one with the reference's, so an event at t = 0 (a start in stick, or an exit from
+/// stick at the start) is an extra event and fails; and the reference solver writes a smooth
+/// disc's velocity crossing 0 (Table 1's upper disc, no static friction) as a reversal.
+#[test]
+fn event_conventions_of_benchmark_md_are_the_graders() {
+    let fixtures = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../fixtures");
+    let dir = rotor_testkit::tmp_dir("rotor-cli-events");
+    // (scenario, the row BENCHMARK.md says is not an event): t1-u1.5-rest starts with the
+    // lower disc stuck; st-u1.5-rest's upper disc leaves its stick at once.
+    for (name, row) in [
+        ("t1-u1.5-rest", "0,lower,stick_start"),
+        ("st-u1.5-rest", "0,upper,stick_end"),
+    ] {
+        let trace = fixtures.join(format!("reference/{name}.csv"));
+        let events =
+            std::fs::read_to_string(fixtures.join(format!("reference/{name}.events.csv"))).unwrap();
+        let run = |text: &str| {
+            let f = dir.join(format!("{name}.events.csv"));
+            std::fs::write(&f, text).unwrap();
+            rotor(&[
+                "check",
+                name,
+                "--trace",
+                trace.to_str().unwrap(),
+                "--events",
+                f.to_str().unwrap(),
+            ])
+        };
+        // The reference's own events pass (its first event is later than t = 0) ...
+        assert!(
+            !events.lines().nth(1).unwrap().starts_with("0,"),
+            "{events}"
+        );
+        let o = run(&events);
+        assert_eq!(o.status.code(), Some(0), "{name}: {o:?}");
+        // ... and with the start written as an event they fail, naming it as extra.
+        let (header, rest) = events.split_once('\n').unwrap();
+        let o = run(&format!("{header}\n{row}\n{rest}"));
+        let err = String::from_utf8_lossy(&o.stderr);
+        let out = String::from_utf8_lossy(&o.stdout);
+        assert_eq!(o.status.code(), Some(1), "{name}: {err}");
+        assert!(
+            out.contains("extra (not in the reference)"),
+            "{name}: {out}"
+        );
+    }
+    // A smooth upper disc crossing 0: from ω_u = −1 rad/s at 1.5 V it turns forward.
+    let req = rotor_jobs::request::Request {
+        solver: "event",
+        u: 1.5,
+        x0: [0.0, -1.0, 0.0],
+        tol: None,
+        h: None,
+    };
+    let (kind, scene) = req.simulation(5.0, 0.01).unwrap();
+    let model = rotor_model::Model::new(rotor_model::Params::table1());
+    let traj = kind.solver().simulate_finite(&model, &scene).unwrap();
+    let written = String::from_utf8(rotor_grade::trace::write_events(&traj.events)).unwrap();
+    assert!(
+        written.lines().any(|l| l.ends_with(",upper,reversal")),
+        "{written}"
+    );
+    std::fs::remove_dir_all(&dir).ok();
+}
