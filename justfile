@@ -3,6 +3,10 @@ test:
     cargo test --release --workspace
 report:
     cargo run --release
+# Rewrite the suite's reference data (every scenario; a few seconds). Without --out,
+# `rotor reference` writes to the current directory.
+reference:
+    cargo run --release -- reference --out fixtures/reference
 ci:
     bash .ci/run
 lint:

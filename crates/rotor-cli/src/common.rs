@@ -3,7 +3,7 @@
 
 use std::path::{Path, PathBuf};
 
-use anyhow::{Result, anyhow, bail};
+use anyhow::{Result, anyhow};
 use rotor_model::{Model, Params, State};
 use rotor_solvers::SolverKind;
 
@@ -11,18 +11,29 @@ use crate::out;
 
 #[derive(clap::Args, Debug)]
 pub(crate) struct Common {
+    /// A scenario file, or a name in fixtures/scenarios (`t1-u1.5-rest`): its u, x0 and
+    /// parameter set (and, for `simulate`, its horizon and grid, so that `rotor check` takes
+    /// the trace). Without it, --u is required.
+    #[arg(value_name = "SCENARIO")]
+    pub(crate) scenario: Option<PathBuf>,
     /// Solver: switch, event or moreau.
     #[arg(long)]
     pub(crate) solver: String,
-    /// Motor input voltage, in V.
-    #[arg(long, allow_hyphen_values = true)]
-    pub(crate) u: f64,
+    /// Motor input voltage, in V (the model describes the rig over a few volts: a warning
+    /// above 10 V).
+    #[arg(
+        long,
+        allow_hyphen_values = true,
+        required_unless_present = "scenario",
+        conflicts_with = "scenario"
+    )]
+    pub(crate) u: Option<f64>,
     /// Parameter file, or the name of one in fixtures/params (`stribeck`; default: the
     /// source's Table 1).
-    #[arg(long)]
+    #[arg(long, conflicts_with = "scenario")]
     pub(crate) params: Option<PathBuf>,
     /// Initial state alpha,omega_u,omega_l (default: rest).
-    #[arg(long, allow_hyphen_values = true)]
+    #[arg(long, allow_hyphen_values = true, conflicts_with = "scenario")]
     pub(crate) x0: Option<String>,
     /// Integration tolerance (switch, event).
     #[arg(long, allow_hyphen_values = true)]
@@ -30,6 +41,71 @@ pub(crate) struct Common {
     /// Step size (moreau), in s.
     #[arg(long, allow_hyphen_values = true)]
     pub(crate) h: Option<f64>,
+}
+
+/// An input the command cannot use (a bad flag value, a file that is not what it should
+/// be): exit status 2, as for what clap refuses. Every other error is a failure of the run
+/// (exit 1). See [`exit_code`].
+#[derive(Debug)]
+pub(crate) struct Unusable(pub(crate) String);
+
+impl std::fmt::Display for Unusable {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(&self.0)
+    }
+}
+
+impl std::error::Error for Unusable {}
+
+/// The error of an input the command cannot use ([`Unusable`], exit 2).
+pub(crate) fn unusable(msg: impl std::fmt::Display) -> anyhow::Error {
+    anyhow::Error::new(Unusable(msg.to_string()))
+}
+
+/// The exit status of an error: 2 when the input is unusable (a refused flag value, a
+/// parameter or scenario file that does not load, shards that do not fit together), 1 when
+/// the run failed (a solver, a gate, a client that solved nothing, a write).
+pub(crate) fn exit_code(e: &anyhow::Error) -> u8 {
+    let bad_input = e.chain().any(|c| {
+        c.is::<Unusable>()
+            || c.is::<rotor_model::ParamsError>()
+            || c.is::<rotor_model::FieldError>()
+            || c.is::<rotor_scenario::ScenarioError>()
+            || c.is::<rotor_suite::SuiteError>()
+            || invalid_scene(c)
+            || matches!(
+                c.downcast_ref::<rotor_report::ReportError>(),
+                Some(rotor_report::ReportError::DuplicateName { .. })
+            )
+            || matches!(
+                c.downcast_ref::<rotor_bench::BenchError>(),
+                Some(rotor_bench::BenchError::Options(_) | rotor_bench::BenchError::Scenario(_))
+            )
+            || matches!(
+                c.downcast_ref::<rotor_jobs::sweep::SweepError>(),
+                Some(
+                    rotor_jobs::sweep::SweepError::Arg(_)
+                        | rotor_jobs::sweep::SweepError::File { .. }
+                        | rotor_jobs::sweep::SweepError::Merge(_)
+                )
+            )
+    });
+    if bad_input { 2 } else { 1 }
+}
+
+/// Whether a solver refused the scene itself (an input it cannot run, as u = 1e308), also
+/// where a steady-state error carries it transparently.
+fn invalid_scene(c: &(dyn std::error::Error + 'static)) -> bool {
+    use rotor_seam::SolveError::InvalidScene;
+    matches!(c.downcast_ref(), Some(InvalidScene(_)))
+        || matches!(
+            c.downcast_ref(),
+            Some(rotor_steady::SteadyError::Solve(InvalidScene(_)))
+        )
+        || matches!(
+            c.downcast_ref(),
+            Some(rotor_steady::SettleError::Solve(InvalidScene(_)))
+        )
 }
 
 pub(crate) fn kind_by_name(name: &str) -> Result<SolverKind> {
@@ -63,12 +139,12 @@ pub(crate) fn load_model(params: Option<&Path>) -> Result<Model> {
 pub(crate) fn fixture_path(flag: &str, p: &Path, kind: &str) -> Result<PathBuf> {
     let dir = fixtures_dir()?.join(kind);
     rotor_solvers::fixtures::resolve(p, Some(&dir)).ok_or_else(|| {
-        anyhow!(
+        unusable(format_args!(
             "{flag} {}: no such file, nor a name in {} (names: {})",
             p.display(),
             dir.canonicalize().unwrap_or_else(|_| dir.clone()).display(),
             rotor_solvers::fixtures::names(&dir).join(", ")
-        )
+        ))
     })
 }
 
@@ -78,15 +154,17 @@ pub(crate) fn parse_x0(s: Option<&str>) -> Result<State> {
     };
     let parts: Vec<&str> = s.split(',').map(str::trim).collect();
     if parts.len() != 3 {
-        bail!("--x0 {s:?}: expected three comma-separated numbers alpha,omega_u,omega_l");
+        return Err(unusable(format_args!(
+            "--x0 {s:?}: expected three comma-separated numbers alpha,omega_u,omega_l"
+        )));
     }
     let mut x = State::zeros();
     for (i, p) in parts.iter().enumerate() {
         let v: f64 = p
             .parse()
-            .map_err(|_| anyhow!("--x0 {s:?}: {p:?} is not a number"))?;
+            .map_err(|_| unusable(format_args!("--x0 {s:?}: {p:?} is not a number")))?;
         if !v.is_finite() {
-            bail!("--x0 {s:?}: {p:?} is not finite");
+            return Err(unusable(format_args!("--x0 {s:?}: {p:?} is not finite")));
         }
         x[i] = v;
     }
@@ -110,7 +188,7 @@ pub(crate) fn threads_arg(s: &str) -> Result<usize, String> {
 /// count in words ("1 thread", "8 threads, from SLURM_CPUS_PER_TASK") for the run's summary.
 pub(crate) fn thread_pool(explicit: Option<usize>) -> Result<String> {
     use rotor_compare::threads::Source;
-    let (n, src) = rotor_compare::threads::resolve(explicit).map_err(|e| anyhow!(e))?;
+    let (n, src) = rotor_compare::threads::resolve(explicit).map_err(unusable)?;
     rayon::ThreadPoolBuilder::new()
         .num_threads(n)
         .build_global()
@@ -134,7 +212,7 @@ pub(crate) fn check(field: &str, v: f64, ok: bool, what: &str) -> Result<()> {
 
 /// A bad input as the command line spells it: the field as its flag (`t_end` is `--t-end`).
 pub(crate) fn flagged(e: rotor_model::FieldError) -> anyhow::Error {
-    anyhow!(e.as_flag())
+    unusable(e.as_flag())
 }
 
 /// A sweep's error as the command line spells it: a refused argument names its flag
@@ -146,13 +224,86 @@ pub(crate) fn sweep_flagged(e: rotor_jobs::sweep::SweepError) -> anyhow::Error {
     }
 }
 
+/// The largest |u| [V] taken without a warning. Every special point of both parameter
+/// sets lies below 5 V (the last, Table 1's fold E, at 4.84 V) and the bifurcation
+/// diagrams span 0 to 7 V; above that the rotor only settles to a faster slipping
+/// equilibrium, its speed growing as k_m u / (b_u + b_l) (about 1.8 rad/s per volt for
+/// Table 1). Twice the last special point is far enough past all of it that a larger
+/// value is more likely a slip of the keyboard (millivolts, a missing decimal point) than
+/// a question about the rig.
+pub(crate) const U_PLAUSIBLE: f64 = 10.0;
+
+/// A warning for an input far outside what the model describes ([`U_PLAUSIBLE`]), with
+/// the slipping speed it would give; `None` for a plausible one.
+pub(crate) fn implausible_u(u: f64, model: &Model) -> Option<String> {
+    if !u.is_finite() || u.abs() <= U_PLAUSIBLE {
+        return None;
+    }
+    let p = &model.params;
+    // The slipping equilibrium's speed when viscous friction dominates:
+    // k_m u = (b_u + b_l) ω + the (bounded) Coulomb parts.
+    let omega = p.k_m * u / (p.upper.b + p.lower.viscous());
+    if !omega.is_finite() {
+        return None; // the solvers refuse it, naming the overflow
+    }
+    let shown = if u.abs() > 1e6 {
+        format!("{u:e}")
+    } else {
+        format!("{u}")
+    };
+    Some(format!(
+        "--u {shown}: far outside the few volts the model describes (every special point of \
+         both parameter sets lies below 5 V, the bifurcation diagrams span 0 to 7 V; above \
+         {U_PLAUSIBLE} V only a faster slipping equilibrium remains): the discs would slip at \
+         about {omega:.2e} rad/s. Millivolts or a missing decimal point?"
+    ))
+}
+
+/// What a run starts from: the scenario's u, x0 and model when one is given, else the
+/// flags'. The scenario, if any, comes back for its horizon and grid.
+pub(crate) struct Start {
+    pub(crate) u: f64,
+    pub(crate) x0: State,
+    pub(crate) model: Model,
+    pub(crate) scenario: Option<rotor_scenario::Scenario>,
+}
+
+/// Loads the start of `simulate` and `steady` ([`Start`]), warning about an implausible u.
+pub(crate) fn start(common: &Common) -> Result<Start> {
+    let s = match &common.scenario {
+        Some(p) => {
+            let sc = rotor_solvers::load_scenario(&fixture_path("SCENARIO", p, "scenarios")?)?;
+            Start {
+                u: sc.u,
+                x0: sc.x0,
+                model: sc.model,
+                scenario: Some(sc),
+            }
+        }
+        None => Start {
+            // clap requires --u without a scenario.
+            u: common.u.unwrap_or(f64::NAN),
+            x0: parse_x0(common.x0.as_deref())?,
+            model: load_model(common.params.as_deref())?,
+            scenario: None,
+        },
+    };
+    if let Some(w) = implausible_u(s.u, &s.model) {
+        eprintln!("warning: {w}");
+    }
+    Ok(s)
+}
+
 /// The checked request of `simulate` and `steady` (the same checks and words as the Python
 /// package's), with a warning for a setting the solver ignores.
-pub(crate) fn request(common: &Common) -> Result<rotor_jobs::request::Request<'_>> {
-    let x = parse_x0(common.x0.as_deref())?;
+pub(crate) fn request<'a>(
+    common: &'a Common,
+    start: &Start,
+) -> Result<rotor_jobs::request::Request<'a>> {
+    let x = start.x0;
     let req = rotor_jobs::request::Request {
         solver: &common.solver,
-        u: common.u,
+        u: start.u,
         x0: [x[0], x[1], x[2]],
         tol: common.tol,
         h: common.h,
@@ -163,12 +314,33 @@ pub(crate) fn request(common: &Common) -> Result<rotor_jobs::request::Request<'_
     Ok(req)
 }
 
+/// Whether progress is shown: stderr is a terminal, and not in CI.
+fn show_progress() -> bool {
+    use std::io::IsTerminal;
+    std::env::var_os("CI").is_none() && std::io::stderr().is_terminal()
+}
+
+/// A spinner with the elapsed time on stderr, for work whose size is not known in advance;
+/// hidden as [`progress_bar`] is.
+pub(crate) fn progress_spinner(what: &str) -> indicatif::ProgressBar {
+    if !show_progress() {
+        return indicatif::ProgressBar::hidden();
+    }
+    let bar = indicatif::ProgressBar::new_spinner();
+    if let Ok(style) =
+        indicatif::ProgressStyle::with_template("{spinner} {msg} [{elapsed_precise}]")
+    {
+        bar.set_style(style);
+    }
+    bar.set_message(what.to_owned());
+    bar.enable_steady_tick(std::time::Duration::from_millis(200));
+    bar
+}
+
 /// A progress bar on stderr when it is a terminal; hidden in CI and when piped, so logs and
 /// captured output stay clean.
 pub(crate) fn progress_bar(len: u64, what: &str) -> indicatif::ProgressBar {
-    use std::io::IsTerminal;
-    let quiet = std::env::var_os("CI").is_some() || !std::io::stderr().is_terminal();
-    if quiet {
+    if !show_progress() {
         return indicatif::ProgressBar::hidden();
     }
     let bar = indicatif::ProgressBar::new(len);
@@ -179,16 +351,6 @@ pub(crate) fn progress_bar(len: u64, what: &str) -> indicatif::ProgressBar {
     }
     bar.set_message(what.to_owned());
     bar
-}
-
-/// The checkout's fixtures directory, which `rotor reference` writes: ./fixtures when run in
-/// the workspace root, else the one this binary was built from.
-pub(crate) fn checkout_fixtures() -> PathBuf {
-    let local = PathBuf::from("fixtures");
-    if local.is_dir() {
-        return local;
-    }
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("../../fixtures")
 }
 
 /// The suite's directory, for scenarios and parameter sets given by name: ./fixtures in a
@@ -202,3 +364,11 @@ pub(crate) fn fixtures_dir() -> Result<PathBuf> {
     }
     Ok(rotor_suite::locate()?.dir)
 }
+
+/// Returns an [`Unusable`] error (exit 2) with a `format!` message: `bail!` for bad input.
+macro_rules! refuse {
+    ($($t:tt)*) => {
+        return Err($crate::common::unusable(format_args!($($t)*)))
+    };
+}
+pub(crate) use refuse;

@@ -30,7 +30,8 @@ struct Cli {
 enum Command {
     /// Simulate one scene and write the trajectory as CSV (t,alpha,omega_u,omega_l).
     Simulate(cmd::simulate::Args),
-    /// Run to steady state and print it as one JSON object.
+    /// Run to steady state and print it as one JSON object. It takes no --t-end or --dt: it
+    /// runs as long as its answer needs, and prints one state, not a trace.
     Steady(cmd::steady::Args),
     /// Bifurcation diagram over u: equilibria, periodic branches with Floquet multipliers,
     /// special points (Hopf, grazing, folds), as JSON, and optionally CSV and an SVG figure.
@@ -55,8 +56,10 @@ enum Command {
     /// List the benchmark suite: every scenario with its tier (table1: only the lower disc
     /// sticks; full: both may), what it tests, and the suite's version.
     Scenarios(cmd::scenarios::Args),
-    /// Write the benchmark's reference data for every scenario: trace, events and steady
-    /// state of the event-driven solver, with their stated errors.
+    /// Write the benchmark's reference data for every scenario (or the --scenario ones):
+    /// trace, events and steady state of the event-driven solver, with their stated errors,
+    /// into --out DIR or the current directory (the checkout's own: --out
+    /// fixtures/reference). About 3 s for the whole suite on 2 cores.
     Reference(cmd::reference::Args),
     /// Grade one trace (CSV t,alpha,omega_u,omega_l on the scenario's grid) against the
     /// reference with the scenario's own gates. Exit 0: every gate passes; 1: a gate fails;
@@ -141,8 +144,7 @@ fn main() -> ExitCode {
         );
         return ExitCode::from(2);
     }
-    // Outputs that cannot be written are refused before any work; for `check` that is
-    // unusable input (exit 2).
+    // Outputs that cannot be written are refused before any work: unusable input (exit 2).
     if let Some(cmd) = &cli.command
         && let Err(e) = cmd
             .outputs()
@@ -150,8 +152,7 @@ fn main() -> ExitCode {
             .try_for_each(|(f, p)| out::writable(f, p))
     {
         eprintln!("error: {e:#}");
-        let unusable = matches!(cmd, Command::Check(_));
-        return ExitCode::from(if unusable { 2 } else { 1 });
+        return ExitCode::from(2);
     }
     let res = match &cli.command {
         Some(Command::Simulate(a)) => cmd::simulate::run(a),
@@ -172,9 +173,12 @@ fn main() -> ExitCode {
         Ok(()) => ExitCode::SUCCESS,
         // The reader of standard output has gone: stop quietly, as a Unix tool does.
         Err(e) if out::is_closed_pipe(&e) => ExitCode::SUCCESS,
+        // One convention for every command (README, "Exit status"): 0 done, 1 the run
+        // failed (a solver, a gate, a client), 2 the input is unusable (what clap refuses
+        // while parsing, and a value or file refused after it).
         Err(e) => {
             eprintln!("error: {e:#}");
-            ExitCode::FAILURE
+            ExitCode::from(common::exit_code(&e))
         }
     }
 }

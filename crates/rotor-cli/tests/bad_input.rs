@@ -31,10 +31,10 @@ fn rotor(args: &[&str]) -> Output {
 /// first line starts with `error:` and contains every needle; no panic message anywhere.
 fn assert_clean_error(o: &Output, what: &str, needles: &[&str]) {
     let err = String::from_utf8_lossy(&o.stderr);
-    // Exit 1 for rotor's own validation errors (anyhow from main), 2 for what clap refuses
-    // while parsing (its message ends with the hint to try --help); never 101 (a panic) or
-    // a signal.
-    let want = if err.contains("try '--help'") { 2 } else { 1 };
+    // Exit 2 for unusable input, whether clap refuses it while parsing (its message ends
+    // with the hint to try --help) or rotor after (README, "Exit status"); never 1 (a
+    // failed run), 101 (a panic) or a signal.
+    let want = 2;
     assert_eq!(
         o.status.code(),
         Some(want),

@@ -234,7 +234,7 @@ fn bifurcation_writes_the_contract_json_and_a_figure() {
         dir.join("bad.json").to_str().unwrap(),
     ]);
     let err = String::from_utf8_lossy(&o.stderr);
-    assert_eq!(o.status.code(), Some(1), "{err}");
+    assert_eq!(o.status.code(), Some(2), "{err}");
     assert!(err.contains("--u-max") && err.contains('1'), "{err}");
     assert!(!dir.join("bad.json").exists());
 }
@@ -1238,4 +1238,329 @@ fn bifurcation_by_each_solver_reproduces_the_branch() {
         !o.status.success() && err.contains("--solver \"x\""),
         "{err}"
     );
+}
+
+/// `rotor reference` writes where it is told (`--out`) or into the current directory, never
+/// into the checkout the binary was built from: run in an empty directory on the cheapest
+/// scene, it leaves the checkout's reference files untouched (bytes and modification time),
+/// and what it writes is the checkout's reference byte for byte (the computation is
+/// deterministic, so the suite's files are exactly what the command makes).
+#[test]
+fn reference_writes_to_the_current_directory_or_out_never_the_checkout() {
+    let checkout = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../fixtures/reference");
+    let names = [
+        "st-u0.05-rest.csv",
+        "st-u0.05-rest.events.csv",
+        "st-u0.05-rest.json",
+    ];
+    let before: Vec<(Vec<u8>, std::time::SystemTime)> = names
+        .iter()
+        .map(|n| {
+            let p = checkout.join(n);
+            (
+                std::fs::read(&p).unwrap(),
+                std::fs::metadata(&p).unwrap().modified().unwrap(),
+            )
+        })
+        .collect();
+    let dir = rotor_testkit::tmp_dir("rotor-cli-reference");
+    let run = |args: &[&str]| {
+        let o = Command::new(env!("CARGO_BIN_EXE_rotor"))
+            .args(args)
+            .current_dir(&dir)
+            .output()
+            .unwrap();
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        String::from_utf8_lossy(&o.stderr).into_owned()
+    };
+    let err = run(&["reference", "--scenario", "st-u0.05-rest"]);
+    // It says up front how much it will run.
+    assert!(err.contains("reference data of 1 scenario(s)"), "{err}");
+    run(&["reference", "--scenario", "st-u0.05-rest", "--out", "sub"]);
+    for (n, (bytes, mtime)) in names.iter().zip(&before) {
+        let p = checkout.join(n);
+        assert_eq!(&std::fs::read(&p).unwrap(), bytes, "{n} rewritten");
+        assert_eq!(
+            &std::fs::metadata(&p).unwrap().modified().unwrap(),
+            mtime,
+            "{n} rewritten"
+        );
+        for out in [dir.clone(), dir.join("sub")] {
+            assert_eq!(&std::fs::read(out.join(n)).unwrap(), bytes, "{n}");
+        }
+    }
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+/// `rotor simulate SCENARIO` runs the scenario's own scene (its u, x0, parameters, horizon
+/// and grid), so that `rotor check SCENARIO` takes the trace as it stands; the horizon and
+/// grid are read from the scenario file here, not restated.
+#[test]
+fn simulate_a_scenario_runs_its_horizon_and_check_accepts_the_trace() {
+    let fixtures = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../fixtures");
+    let sc =
+        rotor_scenario::Scenario::from_file(&fixtures.join("scenarios/t1-u1.5-rest.toml")).unwrap();
+    let dir = rotor_testkit::tmp_dir("rotor-cli-sim-scenario");
+    let csv = dir.join("my.csv");
+    let csv = csv.to_str().unwrap();
+    let o = rotor(&[
+        "simulate",
+        "t1-u1.5-rest",
+        "--solver",
+        "event",
+        "--csv",
+        csv,
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let text = std::fs::read_to_string(csv).unwrap();
+    let rows: Vec<&str> = text.lines().skip(1).collect();
+    let t = |l: &str| l.split(',').next().unwrap().parse::<f64>().unwrap();
+    assert_eq!(t(rows[rows.len() - 1]), sc.t_end);
+    assert_eq!(t(rows[1]), sc.compare.dt);
+    assert_eq!(rows.len() as f64, (sc.t_end / sc.compare.dt).round() + 1.0);
+    let o = rotor(&["check", "t1-u1.5-rest", "--trace", csv]);
+    assert_eq!(
+        o.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    // A scenario fixes u, x0 and the parameters: giving them too is refused (exit 2).
+    for extra in [
+        &["--u", "2"][..],
+        &["--x0", "0,0,0"],
+        &["--params", "stribeck"],
+    ] {
+        let o = rotor(
+            &[
+                &[
+                    "simulate",
+                    "t1-u1.5-rest",
+                    "--solver",
+                    "event",
+                    "--csv",
+                    "-",
+                ],
+                extra,
+            ]
+            .concat(),
+        );
+        assert_eq!(o.status.code(), Some(2), "{extra:?}");
+    }
+    // `steady` takes a scenario as well: the same start as the flags that spell it.
+    let by_name = rotor(&["steady", "t1-u1.5-rest", "--solver", "event"]);
+    let by_flags = rotor(&["steady", "--solver", "event", "--u", "1.5"]);
+    assert!(by_name.status.success() && by_flags.status.success());
+    assert_eq!(by_name.stdout, by_flags.stdout);
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+/// Implausible inputs: an input far beyond the model's few volts is run with a warning that
+/// says why; an output interval that does not divide the horizon is refused, naming both
+/// (it wrote rows at 0 and 1 for --dt 5 --t-end 1, off the grid it was asked for).
+#[test]
+fn implausible_inputs_are_warned_about_or_refused() {
+    let o = rotor(&[
+        "simulate", "--solver", "event", "--u", "1e6", "--t-end", "0.1", "--csv", "-",
+    ]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(o.status.success(), "{err}");
+    assert!(
+        err.starts_with("warning: --u 1000000:") && err.contains("rad/s") && err.contains("5 V"),
+        "{err}"
+    );
+    // The warning's speed is the slipping equilibrium's, k_m u / (b_u + b_l) for Table 1.
+    let p = rotor_model::Params::table1();
+    let omega = p.k_m * 1e6 / (p.upper.b + p.lower.viscous());
+    assert!(err.contains(&format!("{omega:.2e}")), "{err}");
+    // The README's inputs draw none.
+    for u in ["1.5", "-6", "10"] {
+        let o = rotor(&["steady", "--solver", "switch", "--u", u]);
+        assert!(o.status.success() && o.stderr.is_empty(), "{u}: {o:?}");
+    }
+    for (dt, t_end) in [("5", "1"), ("0.3", "1"), ("0.03", "0.1")] {
+        let o = rotor(&[
+            "simulate", "--solver", "event", "--u", "1.5", "--dt", dt, "--t-end", t_end, "--csv",
+            "-",
+        ]);
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "{dt} {t_end}: {err}");
+        assert!(
+            err.contains(&format!("--dt {dt}")) && err.contains(&format!("--t-end {t_end}")),
+            "{err}"
+        );
+        assert!(o.stdout.is_empty());
+    }
+    // The default interval, not asked for, draws a warning naming both instead.
+    let o = rotor(&[
+        "simulate", "--solver", "event", "--u", "1.5", "--t-end", "1.005", "--csv", "-",
+    ]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(o.status.success(), "{err}");
+    assert!(
+        err.starts_with("warning: the default --dt 0.01 does not divide --t-end 1.005"),
+        "{err}"
+    );
+    // A dt that divides t_end in decimal but not in binary (0.1 / 0.01) is a whole grid.
+    for (dt, t_end) in [("0.25", "1"), ("0.01", "0.1"), ("0.1", "0.3")] {
+        let o = rotor(&[
+            "simulate", "--solver", "event", "--u", "1.5", "--dt", dt, "--t-end", t_end, "--csv",
+            "-",
+        ]);
+        assert!(o.status.success(), "{dt} {t_end}: {o:?}");
+    }
+}
+
+/// `steady` takes no horizon and no grid: its help does not list them, and given, they are
+/// refused with the reason (exit 2), not clap's bare "unexpected argument".
+#[test]
+fn steady_refuses_t_end_and_dt_with_the_reason_and_does_not_list_them() {
+    let help = String::from_utf8(rotor(&["steady", "--help"]).stdout).unwrap();
+    let listed = |flag: &str| {
+        help.lines()
+            .any(|l| l.trim_start().starts_with(&format!("{flag} ")))
+    };
+    assert!(
+        !listed("--t-end") && !listed("--dt") && listed("--solver"),
+        "{help}"
+    );
+    assert!(help.contains("takes no --t-end or --dt"), "{help}");
+    for (flag, needle) in [("--t-end", "takes no horizon"), ("--dt", "not a trace")] {
+        let o = rotor(&["steady", "--solver", "event", "--u", "1.5", flag, "5"]);
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "{err}");
+        assert!(
+            err.starts_with(&format!("error: {flag} 5:")) && err.contains(needle),
+            "{err}"
+        );
+    }
+    // `simulate` lists both.
+    let help = String::from_utf8(rotor(&["simulate", "--help"]).stdout).unwrap();
+    let listed = |flag: &str| {
+        help.lines()
+            .any(|l| l.trim_start().starts_with(&format!("{flag} ")))
+    };
+    assert!(listed("--t-end") && listed("--dt"), "{help}");
+}
+
+/// One exit-status convention for every command (README, "Exit status"): 2 for unusable
+/// input, whether the argument parser or rotor refuses it; 1 for a run that fails.
+#[test]
+fn exit_status_is_two_for_unusable_input_and_one_for_a_failed_run() {
+    let dir = rotor_testkit::tmp_dir("rotor-cli-exit");
+    let bad_params = dir.join("bad.toml");
+    std::fs::write(&bad_params, "j_u = -1\n").unwrap();
+    let bad_params = bad_params.to_str().unwrap();
+    let unusable: &[&[&str]] = &[
+        &["simulate", "--solver", "event"],
+        &["simulate", "--solver", "rk4", "--u", "1.5", "--csv", "-"],
+        &[
+            "simulate", "--solver", "event", "--u", "1.5", "--t-end", "-1", "--csv", "-",
+        ],
+        &[
+            "steady", "--solver", "event", "--u", "1.5", "--params", bad_params,
+        ],
+        &[
+            "steady",
+            "--solver",
+            "event",
+            "--u",
+            "1.5",
+            "--params",
+            "nosuchset",
+        ],
+        &["steady", "no-such-scenario", "--solver", "event"],
+        &[
+            "steady", "--solver", "event", "--u", "1.5", "--method", "guess",
+        ],
+        &["job", "t1-u1.5-rest"],
+        &["bench", "--quick", "--jobs", "0"],
+        &["bench", "--quick", "--tier", "half"],
+        &["sweep", "--u", "0:1:2", "--param", "k_theta", "--csv", "-"],
+        &["merge", "--csv", "-"],
+        &["bifurcation", "--u-min", "3", "--u-max", "1", "--json", "-"],
+        &["reference", "--scenario", "no-such-scenario"],
+        &["compare", "no-such-scenario"],
+    ];
+    for args in unusable {
+        let o = rotor(args);
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "{args:?}: {err}");
+        assert!(err.starts_with("error:"), "{args:?}: {err}");
+    }
+    // A failed run: a client that solves nothing (the bench's report is still written).
+    let o = rotor(&["bench", "--quick", "--external", "broken=false"]);
+    assert_eq!(
+        o.status.code(),
+        Some(1),
+        "{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+/// BENCHMARK.md's event conventions, as the grader applies them: it matches a trace's events
+/// one to one with the reference's, so an event at t = 0 (a start in stick, or an exit from
+/// stick at the start) is an extra event and fails; and the reference solver writes a smooth
+/// disc's velocity crossing 0 (Table 1's upper disc, no static friction) as a reversal.
+#[test]
+fn event_conventions_of_benchmark_md_are_the_graders() {
+    let fixtures = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../fixtures");
+    let dir = rotor_testkit::tmp_dir("rotor-cli-events");
+    // (scenario, the row BENCHMARK.md says is not an event): t1-u1.5-rest starts with the
+    // lower disc stuck; st-u1.5-rest's upper disc leaves its stick at once.
+    for (name, row) in [
+        ("t1-u1.5-rest", "0,lower,stick_start"),
+        ("st-u1.5-rest", "0,upper,stick_end"),
+    ] {
+        let trace = fixtures.join(format!("reference/{name}.csv"));
+        let events =
+            std::fs::read_to_string(fixtures.join(format!("reference/{name}.events.csv"))).unwrap();
+        let run = |text: &str| {
+            let f = dir.join(format!("{name}.events.csv"));
+            std::fs::write(&f, text).unwrap();
+            rotor(&[
+                "check",
+                name,
+                "--trace",
+                trace.to_str().unwrap(),
+                "--events",
+                f.to_str().unwrap(),
+            ])
+        };
+        // The reference's own events pass (its first event is later than t = 0) ...
+        assert!(
+            !events.lines().nth(1).unwrap().starts_with("0,"),
+            "{events}"
+        );
+        let o = run(&events);
+        assert_eq!(o.status.code(), Some(0), "{name}: {o:?}");
+        // ... and with the start written as an event they fail, naming it as extra.
+        let (header, rest) = events.split_once('\n').unwrap();
+        let o = run(&format!("{header}\n{row}\n{rest}"));
+        let err = String::from_utf8_lossy(&o.stderr);
+        let out = String::from_utf8_lossy(&o.stdout);
+        assert_eq!(o.status.code(), Some(1), "{name}: {err}");
+        assert!(
+            out.contains("extra (not in the reference)"),
+            "{name}: {out}"
+        );
+    }
+    // A smooth upper disc crossing 0: from ω_u = −1 rad/s at 1.5 V it turns forward.
+    let req = rotor_jobs::request::Request {
+        solver: "event",
+        u: 1.5,
+        x0: [0.0, -1.0, 0.0],
+        tol: None,
+        h: None,
+    };
+    let (kind, scene) = req.simulation(5.0, 0.01).unwrap();
+    let model = rotor_model::Model::new(rotor_model::Params::table1());
+    let traj = kind.solver().simulate_finite(&model, &scene).unwrap();
+    let written = String::from_utf8(rotor_grade::trace::write_events(&traj.events)).unwrap();
+    assert!(
+        written.lines().any(|l| l.ends_with(",upper,reversal")),
+        "{written}"
+    );
+    std::fs::remove_dir_all(&dir).ok();
 }

@@ -253,12 +253,19 @@ impl CheckReport {
                 q.tolerance,
                 q.digits,
                 if q.passed { "pass" } else { "FAIL" },
-                q.at.map_or(String::new(), |t| format!(" (at t = {t} s)")),
+                q.at.map_or(String::new(), |t| format!(" (at t = {} s)", grid_time(t))),
                 q.note.as_ref().map_or(String::new(), |n| format!(": {n}")),
             ));
         }
         out
     }
+}
+
+/// A time as the trace writes it: rounded to 1e-9 s, the grid's time tolerance (a sample at
+/// k·dt is 125.71000000000001 in floating point; the table shows 125.71).
+fn grid_time(t: f64) -> f64 {
+    let r = (t * 1e9).round() / 1e9;
+    if r.is_finite() { r } else { t }
 }
 
 /// A trace (or events file) that cannot be graded; the message names the file and the line,
@@ -1022,4 +1029,18 @@ pub fn grade(
     let sc = rotor_solvers::load_scenario(scenario)?;
     let r = crate::reference::read(&crate::reference::dir_for(scenario), &sc.name)?;
     Ok(check(&sc, &r, trace, events, level)?)
+}
+
+#[cfg(test)]
+mod time_format_tests {
+    /// 12571 steps of 0.01 s are 125.71000000000001 in floating point; the table prints the
+    /// grid's digits, and keeps a time no grid rounding applies to.
+    #[test]
+    fn grid_times_print_with_the_digits_they_have() {
+        let t = 12571.0 * 0.01;
+        assert_eq!(format!("{t}"), "125.71000000000001");
+        assert_eq!(format!("{}", super::grid_time(t)), "125.71");
+        assert_eq!(format!("{}", super::grid_time(0.035)), "0.035");
+        assert_eq!(super::grid_time(1e300), 1e300);
+    }
 }

@@ -103,7 +103,7 @@ fn reference_files_match_the_event_solver_within_their_stated_error() {
         .collect();
     assert!(
         bad.is_empty(),
-        "rerun `rotor reference`:\n{}",
+        "rerun `rotor reference --out fixtures/reference`:\n{}",
         bad.join("\n")
     );
     let sc = all.iter().find(|s| s.name == "t1-u1.5-rest").unwrap();

@@ -2,7 +2,7 @@
 
 use std::path::{Path, PathBuf};
 
-use anyhow::{Result, anyhow, bail};
+use anyhow::{Result, bail};
 
 use super::bench_out::{write_bench, write_results};
 use crate::common::{check, fixture_path, fixtures_dir};
@@ -138,14 +138,14 @@ pub(crate) fn bench(
     }
     for name in clients.fixed_step {
         if !opts.clients.iter().any(|c| &c.name == name) {
-            bail!("--fixed-step {name:?}: no --external client of that name");
+            crate::common::refuse!("--fixed-step {name:?}: no --external client of that name");
         }
     }
     let tier = clients
         .tier
         .map(rotor_bench::Tier::parse)
         .transpose()
-        .map_err(|m| anyhow!(m))?;
+        .map_err(crate::common::unusable)?;
     if !clients.scenarios.is_empty() {
         let paths = clients
             .scenarios
@@ -163,11 +163,26 @@ pub(crate) fn bench(
         .map_err(crate::common::sweep_flagged)?;
     opts.keep = clients.keep.map(Path::to_path_buf);
     opts.jobs = match clients.jobs {
-        Some(0) => bail!("--jobs 0: at least one client must run at a time"),
+        Some(0) => crate::common::refuse!("--jobs 0: at least one client must run at a time"),
         Some(n) => n,
         None => std::thread::available_parallelism().map_or(1, |n| n.get().min(2)),
     };
-    let report = rotor_bench::run(&opts, |m| eprintln!("{m}"))?;
+    eprintln!("{}", plan(&opts));
+    // One line per step, as always; on a terminal a spinner below them with the count and
+    // the elapsed time, so a run of minutes shows that it moves.
+    let spinner = crate::common::progress_spinner("bench");
+    let mut steps = 0usize;
+    let report = rotor_bench::run(&opts, |m| {
+        steps += 1;
+        if spinner.is_hidden() {
+            eprintln!("{m}");
+        } else {
+            spinner.println(m);
+            spinner.set_message(format!("bench: {steps} steps"));
+        }
+    });
+    spinner.finish_and_clear();
+    let report = report?;
     write_bench(&report, [json, svg, csv])?;
     write_results(&report, clients.results)?;
     // The report is written first (nothing is lost); then a named client that placed no
@@ -195,4 +210,39 @@ pub(crate) fn bench(
         );
     }
     Ok(())
+}
+
+/// What a bench will run, said before it starts: scenes, graded runs per scene (each
+/// setting of each ladder, then timed again when fast), and the measured length of the
+/// longest form.
+fn plan(opts: &rotor_bench::BenchOptions) -> String {
+    let scenes = opts
+        .shard
+        .unwrap_or(rotor_jobs::sweep::Shard::ALL)
+        .count(opts.scenes.len().max(1));
+    let ours: usize = opts.ladders.iter().map(|(_, l)| l.len()).sum();
+    let clients: usize = opts
+        .clients
+        .iter()
+        .map(|c| {
+            if c.fixed_step {
+                opts.client_hs.len()
+            } else {
+                opts.client_tols.len()
+            }
+        })
+        .sum();
+    let p = &opts.peers;
+    let peers = usize::from(p.scipy) * (p.scipy_tols.len() + 3 * p.scipy_method_tols.len())
+        + usize::from(p.siconos) * p.siconos_hs.len()
+        + usize::from(p.octave) * p.octave_tols.len();
+    let per_scene = ours + clients + peers;
+    format!(
+        "bench: {scenes} scene(s) x {per_scene} settings ({ours} of the three solvers, {clients} \
+         of {} external client(s), up to {peers} of the peers that are installed) = up to {} \
+         graded runs, each fast one timed again; the whole suite with every peer and two \
+         clients took 6 to 9 minutes on 2 cores (BENCHMARK.md, section 5)",
+        opts.clients.len(),
+        scenes * per_scene
+    )
 }

@@ -2,7 +2,7 @@
 
 use std::path::{Path, PathBuf};
 
-use anyhow::{Context, Result, anyhow};
+use anyhow::{Context, Result};
 
 use crate::common::{load_model, say};
 
@@ -66,12 +66,12 @@ pub(crate) fn bifurcation(
     };
     // The library names the field: "u_min = ...", which is the flag --u-min.
     opts.validate().map_err(|e| {
-        anyhow!(
+        crate::common::unusable(format_args!(
             "{}",
             e.to_string()
                 .replace("u_min", "--u-min")
                 .replace("u_max", "--u-max")
-        )
+        ))
     })?;
     let kind = rotor_jobs::request::solver_kind(solver).map_err(crate::common::flagged)?;
     let event = rotor_bifurcation::diagram(&model, &opts)?;

@@ -2,7 +2,7 @@
 
 use std::path::{Path, PathBuf};
 
-use anyhow::{Context, Result, anyhow};
+use anyhow::{Context, Result};
 
 use crate::common::{load_model, say};
 
@@ -59,17 +59,25 @@ pub(crate) fn bifurcation2(
         ..rotor_plane::PlaneOptions::new(param, p_min, p_max)
     };
     rotor_plane::validate(&base, &opts).map_err(|e| {
-        anyhow!(
+        crate::common::unusable(format_args!(
             "{}",
             e.to_string()
                 .replace("p_min", "--p-min")
                 .replace("p_max", "--p-max")
                 .replace("u_min", "--u-min")
                 .replace("u_max", "--u-max")
-        )
+        ))
     })?;
+    eprintln!(
+        "bifurcation2: every codimension-one point of the u-diagram continued in ({param}, u) \
+         for {param} in [{p_min}, {p_max}], then simulations in every band (about 1 s for \
+         the README's ranges)"
+    );
+    let spinner = crate::common::progress_spinner("curves");
     let t0 = std::time::Instant::now();
-    let plane = rotor_plane::plane(&base, &opts)?;
+    let plane = rotor_plane::plane(&base, &opts);
+    spinner.finish_and_clear();
+    let plane = plane?;
     let secs = t0.elapsed().as_secs_f64();
     write_output(json, plane.to_json()?.as_bytes())
         .with_context(|| format!("{}: cannot write", json.display()))?;

@@ -59,7 +59,18 @@ pub(crate) fn compare(
     rotor_report::check_names(&scenarios)?;
     let stribeck = Params::from_file(&fixtures_dir()?.join("params/stribeck.toml"))?;
     let threads = thread_pool(threads)?;
-    eprintln!("{} scenarios on {threads}", scenarios.len());
+    eprintln!(
+        "{} scenarios x {} solvers ({} runs){} on {threads}",
+        scenarios.len(),
+        rotor_solvers::SOLVERS.len(),
+        scenarios.len() * rotor_solvers::SOLVERS.len(),
+        if main_job {
+            ", then both bifurcation diagrams, the plane, the probes and the stress table \
+             (about 11 s on 2 idle cores)"
+        } else {
+            ""
+        }
+    );
     let t0 = std::time::Instant::now();
     let bar = progress_bar(scenarios.len() as u64, "scenarios");
     let sets = rotor_report::param_sets(stribeck);

@@ -2,7 +2,7 @@
 
 use std::path::{Path, PathBuf};
 
-use anyhow::{Result, bail};
+use anyhow::Result;
 
 use crate::common::{check, fixture_path};
 use crate::out;
@@ -51,7 +51,7 @@ pub(crate) fn job(
             check("h", h, h > 0.0, "must be a positive number of seconds")?;
             (true, h)
         }
-        _ => bail!(
+        _ => crate::common::refuse!(
             "rotor job {}: give --tol T (a client with a tolerance) or --h H (a fixed-step \
              client), one of them",
             scenario.display()
@@ -59,7 +59,7 @@ pub(crate) fn job(
     };
     for (flag, p) in [("--trace", trace), ("--events", events)] {
         if p.as_os_str().is_empty() {
-            bail!("{flag} \"\": an empty path");
+            crate::common::refuse!("{flag} \"\": an empty path");
         }
     }
     let path = fixture_path("scenario", scenario, "scenarios")?;

@@ -2,7 +2,7 @@
 
 use std::path::{Path, PathBuf};
 
-use anyhow::{Context, Result, bail};
+use anyhow::{Context, Result};
 
 #[derive(clap::Args, Debug)]
 pub struct Args {
@@ -19,7 +19,7 @@ pub fn run(a: &Args) -> Result<()> {
 
 pub(crate) fn merge(shards: &[PathBuf], csv: &Path) -> Result<()> {
     if shards.is_empty() {
-        bail!("merge: no shard files given");
+        crate::common::refuse!("merge: no shard files given");
     }
     let merged = rotor_jobs::sweep::merge(shards)?;
     rotor_compare::report::write_output_with(csv, |w| merged.write_to(w))

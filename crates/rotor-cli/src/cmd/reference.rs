@@ -6,13 +6,18 @@ use anyhow::{Context, Result};
 use rayon::prelude::*;
 use rotor_grade::reference;
 
-use crate::common::{checkout_fixtures, thread_pool, threads_arg};
+use crate::common::{fixture_path, fixtures_dir, progress_bar, thread_pool, threads_arg};
 
 #[derive(clap::Args, Debug)]
 pub struct Args {
-    /// Output directory (default: fixtures/reference).
+    /// Output directory (default: the current directory). The checkout's own reference
+    /// data is rewritten only when asked for: `--out fixtures/reference`.
     #[arg(long)]
     pub out: Option<PathBuf>,
+    /// Only these scenarios (files, or names of the suite; repeatable; default: every
+    /// scenario of the suite).
+    #[arg(long = "scenario", value_name = "SCENARIO")]
+    pub scenario: Vec<PathBuf>,
     /// Threads to run on (default: SLURM_CPUS_PER_TASK when set, else the cores
     /// available to the process).
     #[arg(long, value_name = "N", value_parser = threads_arg)]
@@ -20,26 +25,45 @@ pub struct Args {
 }
 
 pub fn run(a: &Args) -> Result<()> {
+    let files = if a.scenario.is_empty() {
+        let dir = fixtures_dir()?.join("scenarios");
+        rotor_scenario::Scenario::list_dir(&dir)
+            .with_context(|| format!("{}: cannot list scenarios", dir.display()))?
+    } else {
+        a.scenario
+            .iter()
+            .map(|p| fixture_path("--scenario", p, "scenarios"))
+            .collect::<Result<_>>()?
+    };
     let threads = thread_pool(a.threads)?;
-    eprintln!("reference data on {threads}");
-    let fixtures = checkout_fixtures();
-    let out = a.out.clone().unwrap_or_else(|| default_out(&fixtures));
-    write_reference(&fixtures.join("scenarios"), &out)
+    let out = a.out.clone().unwrap_or_else(|| PathBuf::from("."));
+    eprintln!(
+        "reference data of {} scenario(s) into {} on {threads}: each run by the event-driven \
+         solver at two tolerances and cross-checked by the other two (the whole suite: about 3 s \
+         on 2 cores)",
+        files.len(),
+        out.display()
+    );
+    write_reference(&files, &out)
 }
 
-/// `rotor reference [--out DIR]`: the reference files of every scenario.
-pub fn write_reference(scenarios_dir: &Path, out: &Path) -> Result<()> {
-    let files = rotor_scenario::Scenario::list_dir(scenarios_dir)
-        .with_context(|| format!("{}: cannot list scenarios", scenarios_dir.display()))?;
+/// `rotor reference [--out DIR]`: the reference files of the scenarios in `files`.
+pub fn write_reference(files: &[PathBuf], out: &Path) -> Result<()> {
     let scenarios = files
         .iter()
         .map(|f| rotor_solvers::load_scenario(f))
         .collect::<Result<Vec<_>, _>>()?;
     std::fs::create_dir_all(out).with_context(|| format!("{}: cannot create", out.display()))?;
+    let bar = progress_bar(scenarios.len() as u64, "scenarios");
     let refs = scenarios
         .par_iter()
-        .map(reference::compute)
+        .map(|s| {
+            let r = reference::compute(s);
+            bar.inc(1);
+            r
+        })
         .collect::<Result<Vec<_>, _>>()?;
+    bar.finish_and_clear();
     for r in &refs {
         let name = &r.json.scenario;
         for (path, bytes) in reference::paths(out, name)
@@ -66,9 +90,4 @@ pub fn write_reference(scenarios_dir: &Path, out: &Path) -> Result<()> {
         out.display()
     ))?;
     Ok(())
-}
-
-/// The default reference directory.
-pub fn default_out(fixtures: &Path) -> PathBuf {
-    fixtures.join("reference")
 }

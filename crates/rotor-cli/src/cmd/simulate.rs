@@ -4,35 +4,76 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result};
 
-use crate::common::{Common, load_model, request, warn_inexact};
+use crate::common::{Common, request, start, unusable, warn_inexact};
 
 #[derive(clap::Args, Debug)]
 pub struct Args {
     #[command(flatten)]
     pub common: Common,
-    /// Horizon, in s.
-    #[arg(long, default_value_t = 100.0, allow_hyphen_values = true)]
-    pub t_end: f64,
-    /// Output interval, in s (rows at 0, dt, 2dt, ..., t_end).
-    #[arg(long, default_value_t = 0.01, allow_hyphen_values = true)]
-    pub dt: f64,
+    /// Horizon, in s (default: the scenario's, else 100).
+    #[arg(long, allow_hyphen_values = true)]
+    pub t_end: Option<f64>,
+    /// Output interval, in s (rows at 0, dt, 2dt, ..., t_end; it must divide t_end; default:
+    /// the scenario's grid, else 0.01).
+    #[arg(long, allow_hyphen_values = true)]
+    pub dt: Option<f64>,
     /// Output CSV file (`-`: standard output).
     #[arg(long)]
     pub csv: PathBuf,
 }
 
+/// The horizon without a scenario or --t-end, in s.
+pub const DEFAULT_T_END: f64 = 100.0;
+/// The output interval without a scenario or --dt, in s.
+pub const DEFAULT_DT: f64 = 0.01;
+
 pub fn run(a: &Args) -> Result<()> {
     simulate(&a.common, a.t_end, a.dt, &a.csv)
 }
 
-pub(crate) fn simulate(common: &Common, t_end: f64, dt: f64, csv_path: &Path) -> Result<()> {
-    let (kind, scene) = request(common)?
+/// Refuses an output interval given with --dt that does not divide the horizon: the rows
+/// would leave the grid 0, dt, ..., t_end (dt = 5 over t_end = 1 wrote rows at 0 and 1).
+/// The default interval (not asked for) draws a warning naming both instead. Within 1e-9 of
+/// a whole number of steps, the grid's own time tolerance (BENCHMARK.md, the trace format).
+pub(crate) fn check_grid(t_end: f64, dt: f64, given: bool) -> Result<()> {
+    if !(t_end > 0.0 && dt > 0.0 && t_end.is_finite() && dt.is_finite()) {
+        return Ok(()); // refused with its own words by the request's checks
+    }
+    let n = (t_end / dt).round();
+    if n < 1.0 || (n * dt - t_end).abs() > 1e-9 * t_end.max(1.0) {
+        if !given {
+            eprintln!(
+                "warning: the default --dt {dt} does not divide --t-end {t_end}: the last \
+                 row, at t_end, is off the grid 0, dt, 2 dt, ..."
+            );
+            return Ok(());
+        }
+        return Err(unusable(format_args!(
+            "--dt {dt}: does not divide --t-end {t_end} (the rows are at 0, dt, 2 dt, ..., \
+             t_end; give a dt with t_end / dt a whole number)"
+        )));
+    }
+    Ok(())
+}
+
+pub(crate) fn simulate(
+    common: &Common,
+    t_end: Option<f64>,
+    dt: Option<f64>,
+    csv_path: &Path,
+) -> Result<()> {
+    let start = start(common)?;
+    let sc = start.scenario.as_ref();
+    let t_end = t_end.unwrap_or(sc.map_or(DEFAULT_T_END, |s| s.t_end));
+    let given = dt.is_some();
+    let dt = dt.unwrap_or(sc.map_or(DEFAULT_DT, |s| s.compare.dt));
+    let (kind, scene) = request(common, &start)?
         .simulation(t_end, dt)
         .map_err(crate::common::flagged)?;
-    let model = load_model(common.params.as_deref())?;
+    check_grid(t_end, dt, given)?;
     let solver = kind.solver();
     let traj = solver
-        .simulate_finite(&model, &scene)
+        .simulate_finite(&start.model, &scene)
         .with_context(|| format!("solver {}", solver.name()))?;
     warn_inexact(&traj.stats);
     rotor_compare::report::write_output_with(csv_path, |w| {

@@ -1,8 +1,8 @@
 //! `rotor steady`: the steady state as one JSON object.
 
-use anyhow::{Context, Result, bail};
+use anyhow::{Context, Result};
 
-use crate::common::{Common, load_model, request, warn_inexact};
+use crate::common::{Common, request, start, unusable, warn_inexact};
 use crate::out;
 
 #[derive(clap::Args, Debug)]
@@ -23,9 +23,28 @@ pub struct Args {
     /// vanishes, a cycle returns to its start after one period); one that fails is refused.
     #[arg(long, value_name = "shoot|simulate")]
     pub method: Option<String>,
+    /// Not taken (hidden from the help): `steady` runs as long as its answer needs. Given,
+    /// it is refused with that reason instead of clap's bare "unexpected argument".
+    #[arg(long, hide = true, allow_hyphen_values = true)]
+    pub t_end: Option<String>,
+    /// Not taken (hidden), as --t-end: `steady` prints one state, not a trace.
+    #[arg(long, hide = true, allow_hyphen_values = true)]
+    pub dt: Option<String>,
 }
 
 pub fn run(a: &Args) -> Result<()> {
+    if let Some(v) = &a.t_end {
+        return Err(unusable(format_args!(
+            "--t-end {v}: steady takes no horizon; it runs until its answer settles (or \
+             shoots), as long as that needs. `rotor simulate --t-end` runs a fixed horizon"
+        )));
+    }
+    if let Some(v) = &a.dt {
+        return Err(unusable(format_args!(
+            "--dt {v}: steady prints one state, not a trace on a grid; `rotor simulate --dt` \
+             writes one"
+        )));
+    }
     steady(&a.common, a.method.as_deref())
 }
 
@@ -39,10 +58,17 @@ pub(crate) fn steady(common: &Common, method: Option<&str>) -> Result<()> {
         None => How::Checked,
         Some("simulate") => How::Simulate,
         Some("shoot") => How::Shoot,
-        Some(other) => bail!("--method {other:?}: expected shoot or simulate"),
+        Some(other) => {
+            return Err(unusable(format_args!(
+                "--method {other:?}: expected shoot or simulate"
+            )));
+        }
     };
-    let (kind, scene, opts) = request(common)?.steady().map_err(crate::common::flagged)?;
-    let model = load_model(common.params.as_deref())?;
+    let start = start(common)?;
+    let (kind, scene, opts) = request(common, &start)?
+        .steady()
+        .map_err(crate::common::flagged)?;
+    let model = start.model;
     let answer = match how {
         How::Shoot => rotor_steady::shot(kind, &model, &scene),
         How::Simulate => rotor_steady::simulated(kind, &model, &scene, &opts),

@@ -2,7 +2,7 @@
 
 use std::path::{Path, PathBuf};
 
-use anyhow::{Result, anyhow, bail};
+use anyhow::Result;
 
 use crate::common::{
     check, kind_by_name, load_model, parse_x0, progress_bar, sweep_flagged, thread_pool,
@@ -73,9 +73,9 @@ pub(crate) fn sweep(
     use rayon::prelude::*;
     use rotor_jobs::sweep::{Axis, Shard, Sweep, SweepStart, run};
     let base = load_model(params)?.params;
-    let (name, range) = param
-        .split_once('=')
-        .ok_or_else(|| anyhow!("--param {param:?}: expected NAME=A:B:N"))?;
+    let (name, range) = param.split_once('=').ok_or_else(|| {
+        crate::common::unusable(format_args!("--param {param:?}: expected NAME=A:B:N"))
+    })?;
     check("t_end", t_end, t_end > 0.0, "must be positive and finite")?;
     let start = match x0 {
         Some("eq") => SweepStart::PerturbedEquilibrium,
@@ -96,10 +96,20 @@ pub(crate) fn sweep(
         .map_err(sweep_flagged)?
         .unwrap_or(Shard::ALL);
     if resume && csv.as_os_str() == "-" {
-        bail!("--resume needs an output file, not standard output");
+        crate::common::refuse!("--resume needs an output file, not standard output");
     }
     let threads = thread_pool(threads)?;
     let total = shard.count(s.len());
+    eprintln!(
+        "sweep: {total} grid points to run ({} u x {} {name}{}) on {threads}",
+        s.u.n,
+        s.p.n,
+        if total < s.len() {
+            ", this shard's"
+        } else {
+            ""
+        }
+    );
     let bar = progress_bar(total as u64, "points");
     let t0 = std::time::Instant::now();
     let ran = run(&s, shard, csv, resume, |idx, f, sink| {
