@@ -444,6 +444,10 @@ pub fn write_report(
         }
     }
     write_atomic(&dir.join("README.md"), md.as_bytes())?;
+    let names: Vec<&str> = results.iter().map(|r| r.scenario.name.as_str()).collect();
+    let bench = dir.join("bench").join("bench.svg").is_file();
+    let page = crate::html::index_html(&md, &names, bench);
+    write_atomic(&dir.join("index.html"), page.as_bytes())?;
     write_atomic(&dir.join(TIMINGS_FILE), times.as_bytes())?;
     Ok(all_fails)
 }

@@ -294,6 +294,8 @@ struct Frame {
     oy: f64,
     /// Width of the document \[px\]: the legend wraps before its right edge.
     width: f64,
+    /// Centre of the turned y axis label \[px\], left of the widest tick label.
+    y_label_x: f64,
     /// Left edge of the plot box \[px\].
     l: f64,
     /// Right edge of the plot box \[px\] (left of the margin for curve names).
@@ -322,16 +324,6 @@ impl Frame {
     /// ±0.5, the y range padded by 5 %), and the box leaves room for the legend above and the
     /// right margin's curve names. `None` if the panel has no drawable point.
     fn fit(p: &Panel, oy: f64, width: f64, panel_height: f64) -> Option<Frame> {
-        let l = 70.0;
-        let rows = legend_layout(&p.series, l, width - 10.0)
-            .last()
-            .map_or(0, |e| e.1 + 1);
-        let top = if rows > 0 {
-            50.0 + LEGEND_ROW * (rows - 1) as f64
-        } else {
-            30.0
-        };
-        let (t, b) = (oy + top, oy + panel_height - 45.0);
         let pts = p
             .series
             .iter()
@@ -377,6 +369,23 @@ impl Frame {
             x0 -= pad;
             x1 += pad;
         }
+        // The plot box starts right of the widest y tick label, with the axis label left of it.
+        let widest = tick_labels(y0, y1, p.y_log, 6)
+            .iter()
+            .map(|(_, t)| t.chars().count())
+            .max()
+            .unwrap_or(0) as f64;
+        let l = (36.0 + CHAR * widest).max(70.0);
+        let y_label_x = l - 17.0 - CHAR * widest;
+        let rows = legend_layout(&p.series, l, width - 10.0)
+            .last()
+            .map_or(0, |e| e.1 + 1);
+        let top = if rows > 0 {
+            50.0 + LEGEND_ROW * (rows - 1) as f64
+        } else {
+            30.0
+        };
+        let (t, b) = (oy + top, oy + panel_height - 45.0);
         // Curve names whose curve reaches the right edge go into the margin.
         let margin_width = p
             .ends
@@ -387,6 +396,7 @@ impl Frame {
         Some(Frame {
             oy,
             width,
+            y_label_x,
             l,
             r: width - 20.0 - margin_width,
             t,
@@ -448,9 +458,9 @@ fn write_axes(s: &mut String, p: &Panel, f: &Frame) {
     let _ = writeln!(
         s,
         r#"<text x="{}" y="{}" text-anchor="middle" transform="rotate(-90 {} {})">{}</text>"#,
-        l - 50.0,
+        f.y_label_x,
         (t + b) / 2.0,
-        l - 50.0,
+        f.y_label_x,
         (t + b) / 2.0,
         rich(p.y_label)
     );
@@ -460,42 +470,38 @@ fn write_axes(s: &mut String, p: &Panel, f: &Frame) {
 /// about 8 round steps in x and 6 in y on a linear axis, decades on a log axis.
 fn write_ticks(s: &mut String, f: &Frame) {
     let (l, r, t, b) = (f.l, f.r, f.t, f.b);
-    let x_ticks = if f.x_log {
-        log_ticks(f.x0, f.x1)
-    } else {
-        nice_ticks(f.x0, f.x1, 8)
-    };
-    for tx in x_ticks {
+    for (tx, label) in tick_labels(f.x0, f.x1, f.x_log, 8) {
         let x = f.ax(tx);
         let _ = writeln!(
             s,
-            r##"<line x1="{x:.1}" y1="{b}" x2="{x:.1}" y2="{t}" stroke="#ddd"/><text x="{x:.1}" y="{}" text-anchor="middle">{}</text>"##,
+            r##"<line x1="{x:.1}" y1="{b}" x2="{x:.1}" y2="{t}" stroke="#ddd"/><text x="{x:.1}" y="{}" text-anchor="middle">{label}</text>"##,
             b + 15.0,
-            if f.x_log {
-                fmt_decade(tx)
-            } else {
-                fmt_tick(tx)
-            }
         );
     }
-    let y_ticks = if f.y_log {
-        log_ticks(f.y0, f.y1)
-    } else {
-        nice_ticks(f.y0, f.y1, 6)
-    };
-    for ty in y_ticks {
+    for (ty, label) in tick_labels(f.y0, f.y1, f.y_log, 6) {
         let y = f.ay(ty);
         let _ = writeln!(
             s,
-            r##"<line x1="{l}" y1="{y:.1}" x2="{r}" y2="{y:.1}" stroke="#ddd"/><text x="{}" y="{:.1}" text-anchor="end">{}</text>"##,
+            r##"<line x1="{l}" y1="{y:.1}" x2="{r}" y2="{y:.1}" stroke="#ddd"/><text x="{}" y="{:.1}" text-anchor="end">{label}</text>"##,
             l - 5.0,
             y + 4.0,
-            if f.y_log {
-                fmt_decade(ty)
-            } else {
-                fmt_tick(ty)
-            }
         );
+    }
+}
+
+/// An axis's ticks over `[lo, hi]` (axis coordinates) with their labels: about `n` round
+/// steps on a linear axis, decades on a log axis.
+fn tick_labels(lo: f64, hi: f64, log: bool, n: usize) -> Vec<(f64, String)> {
+    if log {
+        log_ticks(lo, hi)
+            .into_iter()
+            .map(|v| (v, fmt_decade(v)))
+            .collect()
+    } else {
+        nice_ticks(lo, hi, n)
+            .into_iter()
+            .map(|v| (v, fmt_tick(v)))
+            .collect()
     }
 }
 
