@@ -9,5 +9,6 @@ pub mod report;
 pub mod snapshot;
 pub mod stress;
 pub mod threads;
+pub mod whole;
 
 pub use gate::{Failure, GateResult, Measured, check_pair};

@@ -165,26 +165,61 @@ impl Scenario {
     }
 
     /// Refuses `[tolerance.<pair>]` tables of pairs not in `known` (the pairs a runner gates):
-    /// a misspelt pair name would leave that pair ungated.
-    pub fn check_pairs(&self, known: &[String]) -> Result<(), ScenarioError> {
-        match self.tolerance.keys().find(|p| !known.contains(p)) {
-            None => Ok(()),
-            Some(pair) => Err(ScenarioError::Invalid {
-                path: self.path.clone(),
-                error: FieldError::new(
-                    "tolerance",
-                    format!("{pair:?}"),
-                    format!(
-                        "unknown solver pair (expected one of {})",
-                        known
-                            .iter()
-                            .map(|k| format!("{k:?}"))
-                            .collect::<Vec<_>>()
-                            .join(", ")
-                    ),
+    /// a misspelt pair name would leave that pair ungated. `whole_only` are the known pairs
+    /// compared over the whole run alone (two non-reference solvers): their tables state the
+    /// whole-run keys only, and every other known pair's table is more than that.
+    pub fn check_pairs(
+        &self,
+        known: &[String],
+        whole_only: &[String],
+    ) -> Result<(), ScenarioError> {
+        let invalid = |field: String, value: String, reason: String| ScenarioError::Invalid {
+            path: self.path.clone(),
+            error: FieldError::new(field, value, reason),
+        };
+        if let Some(pair) = self.tolerance.keys().find(|p| !known.contains(p)) {
+            return Err(invalid(
+                "tolerance".into(),
+                format!("{pair:?}"),
+                format!(
+                    "unknown solver pair (expected one of {})",
+                    known
+                        .iter()
+                        .map(|k| format!("{k:?}"))
+                        .collect::<Vec<_>>()
+                        .join(", ")
                 ),
-            }),
+            ));
         }
+        for (pair, tol) in &self.tolerance {
+            let only = whole_only.contains(pair);
+            if only && !tol.whole_only() {
+                let (key, v) = tol
+                    .stated()
+                    .into_iter()
+                    .find(|(k, _)| !crate::WHOLE_KEYS.contains(k))
+                    .expect("a table that is not whole-run only states another key");
+                return Err(invalid(
+                    format!("tolerance.{pair}.{key}"),
+                    Num(v).to_string(),
+                    format!(
+                        "this pair is compared over the whole run only: state {} alone",
+                        crate::WHOLE_KEYS.join(", ")
+                    ),
+                ));
+            }
+            let windows = self.compare.transient.is_some() || self.compare.steady_from.is_some();
+            if !only && windows && tol.whole_only() {
+                return Err(invalid(
+                    format!("tolerance.{pair}"),
+                    "(whole-run keys only)".into(),
+                    "the reference's pairs gate compare.transient and compare.steady_from too: \
+                     state their tolerances"
+                        .into(),
+                ));
+            }
+        }
+        Ok(())
     }
 
     /// All `*.toml` scenario files in a directory, sorted by file name.
