@@ -134,6 +134,27 @@ pub struct Matched {
     pub maxima: bool,
 }
 
+/// Largest |Δt| of the two runs' mode switches matched in order, ∞ if their sequences differ
+/// (0 without switches): the `event_time` of the reference's `cross_check`
+/// (`fixtures/reference/*.json`), which matches the switches alone.
+pub fn switch_time_difference(a: &Trajectory, b: &Trajectory) -> f64 {
+    let pick = |tr: &Trajectory| -> Vec<Event> {
+        tr.events
+            .iter()
+            .filter(|e| is_switch(e.kind))
+            .copied()
+            .collect()
+    };
+    let (ea, eb) = (pick(a), pick(b));
+    if ea.len() != eb.len() || ea.iter().zip(&eb).any(|(x, y)| x.kind != y.kind) {
+        return f64::INFINITY;
+    }
+    ea.iter()
+        .zip(&eb)
+        .map(|(x, y)| (y.t - x.t).abs())
+        .fold(0.0, f64::max)
+}
+
 /// The shift Δt(t): linear between matched switches, held before the first and after the
 /// last, 0 without switches.
 pub fn shift_at(shifts: &[(f64, f64)], t: f64) -> f64 {
@@ -244,5 +265,109 @@ pub fn whole_run(model: &Model, u: f64, a: &Trajectory, b: &Trajectory, band: f6
         raw,
         excluded,
         maxima,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use rotor_model::{DiscMode, Mode, State};
+    use rotor_seam::{Sample, Stats};
+
+    fn ev(t: f64, kind: EventKind) -> Event {
+        Event {
+            t,
+            x: State::zeros(),
+            kind,
+        }
+    }
+
+    fn traj(events: Vec<Event>) -> Trajectory {
+        Trajectory {
+            samples: (0..=100)
+                .map(|k| Sample {
+                    t: k as f64 * 0.01,
+                    x: State::new(0.0, 1.0, 0.0),
+                })
+                .collect(),
+            events,
+            t_final: 1.0,
+            x_final: State::zeros(),
+            mode_final: Mode {
+                upper: DiscMode::SlipPos,
+                lower: DiscMode::SlipPos,
+            },
+            metrics: None,
+            stats: Stats::default(),
+        }
+    }
+
+    #[test]
+    fn the_shift_is_linear_between_anchors_and_held_outside() {
+        let s = [(1.0, 2e-6), (3.0, 4e-6)];
+        assert_eq!(shift_at(&[], 5.0), 0.0);
+        assert_eq!(shift_at(&s, 0.0), 2e-6);
+        assert!((shift_at(&s, 2.0) - 3e-6).abs() < 1e-18);
+        assert_eq!(shift_at(&s, 3.0), 4e-6);
+        assert_eq!(shift_at(&s, 9.0), 4e-6);
+    }
+
+    /// Maxima are matched with the switches where both runs report the same sequence; where
+    /// they do not, the switches alone; switches that differ are not matched at all.
+    #[test]
+    fn maxima_are_matched_only_where_both_runs_report_them() {
+        let exit = EventKind::StickEnd(Disc::Lower);
+        let max = EventKind::Max(Disc::Lower);
+        let a = traj(vec![ev(0.1, exit), ev(0.3, max), ev(0.6, max)]);
+        let b = traj(vec![
+            ev(0.1 + 1e-6, exit),
+            ev(0.3 + 2e-6, max),
+            ev(0.6, max),
+        ]);
+        let m = matched_events(&a, &b).unwrap();
+        assert!(m.maxima && m.events.len() == 3);
+        let dt = whole_run(&Model::table1(), 1.5, &a, &b, 0.0).event_time;
+        assert!((dt - 2e-6).abs() < 1e-15, "{dt:e}");
+        // One maximum fewer (a decay's last one, below the solver's resolution).
+        let c = traj(vec![ev(0.1 + 1e-6, exit), ev(0.3 + 2e-6, max)]);
+        let m = matched_events(&a, &c).unwrap();
+        assert!(!m.maxima && m.events.len() == 1);
+        // Another switch: nothing matched, the event gate is infinite.
+        let d = traj(vec![ev(0.1, EventKind::StickStart(Disc::Lower))]);
+        assert!(matched_events(&a, &d).is_none());
+        let w = whole_run(&Model::table1(), 1.5, &a, &d, 0.0);
+        assert!(w.event_time.is_infinite() && w.events == 0);
+        // Upper-disc extrema are not matched (their count depends on the tolerance too).
+        let e = traj(vec![
+            ev(0.1, exit),
+            ev(0.2, EventKind::Max(Disc::Upper)),
+            ev(0.3, max),
+            ev(0.6, max),
+        ]);
+        assert!(matched_events(&a, &e).unwrap().maxima);
+    }
+
+    /// Grids that differ are not compared (NaN, which fails every gate), never agreement.
+    #[test]
+    fn different_grids_compare_nothing() {
+        let a = traj(Vec::new());
+        let mut b = a.clone();
+        b.samples.pop();
+        let w = whole_run(&Model::table1(), 1.5, &a, &b, 0.0);
+        assert!(w.aligned.iter().chain(&w.raw).all(|x| x.is_nan()));
+        let w = whole_run(&Model::table1(), 1.5, &a, &a, 0.0);
+        assert_eq!((w.aligned, w.raw, w.event_time), ([0.0; 3], [0.0; 3], 0.0));
+    }
+
+    /// A sample between the two runs' switch (one run switched, the other not yet) is left
+    /// out of the aligned comparison; the others are compared.
+    #[test]
+    fn samples_within_a_shift_of_a_switch_are_excluded() {
+        let start = EventKind::StickStart(Disc::Lower);
+        let a = traj(vec![ev(0.5 - 1e-3, start)]);
+        let b = traj(vec![ev(0.5 + 1e-3, start)]);
+        let w = whole_run(&Model::table1(), 1.5, &a, &b, 0.0);
+        assert_eq!(w.excluded, 1);
+        assert_eq!(w.events, 1);
     }
 }

@@ -365,3 +365,140 @@ fn a_shift_of_every_solver_alike_changes_the_snapshot() {
     }
     assert!(cycles >= 7, "{cycles}");
 }
+
+/// The reference's recorded cross-check (`fixtures/reference/<name>.json`, `cross_check`: the
+/// switch model's and Moreau-Jean's largest differences from the reference over the whole run,
+/// per trace component, over the mode switches and per steady metric) is what the comparison
+/// measures now. The reference run is the comparison's event-driven run (the same solver,
+/// tolerance 1e-12, scene and grid), so the two must agree to the two significant digits the
+/// file keeps: within half a unit of the second digit, 5 % of the value. A solver change that
+/// moves a whole-run difference therefore fails here until the reference is regenerated
+/// (`rotor reference`), and every recorded event time is within the whole-run event gate.
+#[test]
+fn the_reference_cross_check_is_what_the_comparison_measures() {
+    let results = all();
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../fixtures/reference");
+    let (mut checked, mut nonzero) = (0, 0);
+    let mut bad = Vec::new();
+    for r in &results {
+        let reference = rotor_grade::reference::read(&dir, &r.scenario.name)
+            .unwrap_or_else(|e| panic!("{}: {e}", r.scenario.name));
+        let c = stale_cross_check(r, &reference.json);
+        checked += c.checked;
+        nonzero += c.nonzero;
+        bad.extend(c.stale);
+    }
+    assert!(
+        bad.is_empty(),
+        "{} of {checked} recorded cross-check differences are stale (regenerate with `rotor \
+         reference`):\n{}",
+        bad.len(),
+        bad.join("\n")
+    );
+    // 22 references x 2 solvers x (4 trace and event + 3 or 6 steady metrics), most of them
+    // not 0.
+    assert!(
+        checked >= 22 * 2 * 4 && nonzero > checked / 2,
+        "{checked} {nonzero}"
+    );
+
+    // Negative control: the switch model's ω_l off by 1e-5 rad/s after 20 s (3x the recorded
+    // whole-run difference at t1-u1.5-rest) makes the record stale, in omega_l alone.
+    let mut p = results
+        .into_iter()
+        .find(|r| r.scenario.name == "t1-u1.5-rest")
+        .unwrap();
+    for run in &mut p.runs {
+        if run.kind == SolverKind::SWITCH {
+            for s in &mut run.result.as_mut().unwrap().samples {
+                if s.t > 20.0 {
+                    s.x[2] += 1e-5;
+                }
+            }
+        }
+    }
+    let reference = rotor_grade::reference::read(&dir, "t1-u1.5-rest").unwrap();
+    let c = stale_cross_check(&p, &reference.json);
+    assert!(
+        c.stale.len() == 1 && c.stale[0].contains("switch: omega_l "),
+        "{:?}",
+        c.stale
+    );
+}
+
+/// What [`stale_cross_check`] found.
+struct CrossCheckAudit {
+    checked: usize,
+    nonzero: usize,
+    stale: Vec<String>,
+}
+
+/// Each recorded difference of a reference's `cross_check` against the comparison's runs now:
+/// the trace's largest difference per component at equal times, the mode switches' largest
+/// time difference, and each steady metric's absolute difference.
+fn stale_cross_check(
+    r: &ScenarioResult,
+    json: &rotor_grade::reference::ReferenceJson,
+) -> CrossCheckAudit {
+    use rotor_compare::whole::{switch_time_difference, whole_run};
+    let sc = &r.scenario;
+    let event = r.traj(SolverKind::EVENT).unwrap();
+    let mut audit = CrossCheckAudit {
+        checked: 0,
+        nonzero: 0,
+        stale: Vec::new(),
+    };
+    for kind in [SolverKind::SWITCH, SolverKind::MOREAU] {
+        let other = r.traj(kind).unwrap();
+        let recorded = &json.cross_check[kind.name()].differences;
+        let band = rotor_compare::gate::stuck_band(SolverKind::EVENT, kind);
+        let w = whole_run(&sc.model, sc.u, event, other, band);
+        let mut now: Vec<(String, f64)> = vec![
+            ("alpha".into(), w.raw[0]),
+            ("omega_u".into(), w.raw[1]),
+            ("omega_l".into(), w.raw[2]),
+            ("event_time".into(), switch_time_difference(event, other)),
+        ];
+        // The steady metrics, absolute; an equilibrium's alpha, omega_u, omega_l share the
+        // trace's names and the file keeps the larger.
+        if let (Some(ma), Some(mb)) = (event.metrics, other.metrics) {
+            for ((name, va), (_, vb)) in ma.values().into_iter().zip(mb.values()) {
+                let d = (va - vb).abs();
+                match now.iter_mut().find(|x| x.0 == name) {
+                    Some(x) => x.1 = x.1.max(d),
+                    None => now.push((name.into(), d)),
+                }
+            }
+        }
+        for (name, m) in &now {
+            let rec = recorded.get(name).copied().flatten();
+            // Two significant digits: within half a unit of the second, 5 % of the value.
+            let agree = match rec {
+                None => !m.is_finite(),
+                Some(rec) => (rec - m).abs() <= 0.05 * m.abs(),
+            };
+            if !agree {
+                audit.stale.push(format!(
+                    "{} {}: {name} recorded {rec:?}, measured now {m:.3e}",
+                    sc.name,
+                    kind.name()
+                ));
+            }
+            audit.checked += 1;
+            audit.nonzero += usize::from(*m > 0.0);
+        }
+        // Every recorded event time lies within the pair's whole-run event gate.
+        let gate = sc.tolerance[&pair_name(SolverKind::EVENT, kind)]
+            .whole_event_time
+            .unwrap();
+        if let Some(Some(rec)) = recorded.get("event_time") {
+            assert!(
+                *rec <= gate,
+                "{} {}: recorded event_time {rec:e} over the gate {gate:e}",
+                sc.name,
+                kind.name()
+            );
+        }
+    }
+    audit
+}

@@ -286,3 +286,20 @@ fn a_solver_wrong_after_the_window_fails_the_whole_run_gates() {
         );
     }
 }
+
+/// The report's whole-run table has a row per scenario and pair of solvers, with the phase
+/// (event times), the aligned differences and those at equal times.
+#[test]
+fn the_report_shows_the_whole_run_of_every_pair() {
+    let md = rotor_compare::report::whole_run_table(results());
+    for name in ["t1-u1.5-rest", "t1-u2.5-eq-pert"] {
+        for pair in ["event-switch", "event-moreau", "switch-moreau"] {
+            let row = md
+                .lines()
+                .find(|l| l.starts_with(&format!("| {name} | {pair} |")))
+                .unwrap_or_else(|| panic!("{name} {pair}: no row in\n{md}"));
+            assert!(row.contains("(switches and maxima)"), "{row}");
+            assert_eq!(row.matches("e-").count(), 7, "{row}");
+        }
+    }
+}
