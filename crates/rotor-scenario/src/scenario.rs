@@ -386,6 +386,64 @@ mod tests {
         assert!(err("").contains("empty"));
     }
 
+    /// The whole-run keys come as a set of four; a table of them alone is the table of a pair
+    /// of two non-reference solvers, which `check_pairs` accepts only for those pairs, and
+    /// a reference pair's table of them alone (its window and steady state ungated) is refused.
+    #[test]
+    fn whole_run_tables_are_checked_for_their_pair() {
+        let ok = std::fs::read_to_string(fixtures().join("t1-u1.5-rest.toml")).unwrap();
+        let sc = Scenario::from_toml_str(&ok, &fixtures().join("x.toml")).unwrap();
+        let known = ["event-switch", "event-moreau", "switch-moreau"].map(String::from);
+        let others = ["switch-moreau".to_owned()];
+        sc.check_pairs(&known, &others).unwrap();
+        assert!(sc.tolerance["switch-moreau"].whole_only());
+        assert!(sc.tolerance["event-switch"].gates_whole());
+        // One of the four missing.
+        let e = err(&ok.replacen("whole_omega_u", "# whole_omega_u", 1));
+        assert!(
+            e.contains("tolerance.event-switch.whole_omega_u = (missing)")
+                && e.contains("whole-run"),
+            "{e}"
+        );
+        // Another key in the whole-run-only pair's table.
+        let extra = ok.replace(
+            "[tolerance.switch-moreau]\n",
+            "[tolerance.switch-moreau]\nperiod_rel = 1e-6\n",
+        );
+        let e = Scenario::from_toml_str(&extra, &fixtures().join("x.toml"))
+            .and_then(|sc| sc.check_pairs(&known, &others))
+            .unwrap_err()
+            .to_string();
+        // (Refused as it is read: with a steady key the table must gate the window too.)
+        assert!(
+            e.contains("tolerance.switch-moreau.") && e.contains("non-reference"),
+            "{e}"
+        );
+        // Whole-run-only in form but named for the reference: refused by the runner's check.
+        let e = sc.check_pairs(&known, &[]).unwrap_err().to_string();
+        assert!(
+            e.contains("tolerance.switch-moreau") && e.contains("whole-run keys only"),
+            "{e}"
+        );
+        // A reference pair stating only the whole-run keys.
+        let i = ok.find("[tolerance.event-moreau]").unwrap();
+        let j = ok.find("[tolerance.switch-moreau]").unwrap();
+        let whole: String = ok[i..j]
+            .lines()
+            .filter(|l| l.starts_with('[') || l.starts_with("whole_"))
+            .map(|l| format!("{l}\n"))
+            .collect();
+        let bare = format!("{}{whole}\n{}", &ok[..i], &ok[j..]);
+        let e = Scenario::from_toml_str(&bare, &fixtures().join("x.toml"))
+            .and_then(|sc| sc.check_pairs(&known, &others))
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("tolerance.event-moreau") && e.contains("whole-run keys only"),
+            "{e}"
+        );
+    }
+
     /// A retired shared key is refused, naming itself, its value and the keys that replaced
     /// it; a misspelt key is an unknown field; a group with one key missing names that key.
     #[test]

@@ -401,7 +401,8 @@ fn check_pair_coverage(
         return Err(bad.at(
             &format!("tolerance.{pair}.transient_max"),
             "(missing)".into(),
-            "is required when compare.transient is set: the window would be ungated",
+            "is required when compare.transient is set: the window would be ungated (only the \
+             table of two non-reference solvers states the whole-run keys alone)",
         ));
     }
     // A steady state is gated either as an equilibrium or as a cycle, with every metric of
