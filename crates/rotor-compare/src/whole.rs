@@ -1,5 +1,5 @@
 //! The whole run compared: every sample of α, ω_u and ω_l over `[0, t_end]` and every mode
-//! switch, with the phase that legitimately separates two correct runs taken out by
+//! switch and maximum of ω_l, with the phase that legitimately separates two correct runs taken out by
 //! derivation, not by a wider gate.
 //!
 //! **Why the samples at equal times are not the quantity to gate.** On a stable cycle the
@@ -13,12 +13,16 @@
 //! gate set on it would be too wide to catch a real error anywhere else.
 //!
 //! **The shift, measured where it is defined.** The two runs' mode switches (stick onsets,
-//! stick exits and reversals of both discs) are matched one to one in order: both runs must
-//! switch in the same sequence, or the gate fails. Their time differences
-//! `Δt_k = t_B,k − t_A,k` ARE the phase, sampled at the instants where it is sharply located.
-//! Between two matched switches the phase is interpolated linearly in t (a constant period
-//! error drifts linearly); before the first and after the last it is held at the nearest
-//! switch's. `whole_event_time` gates `max_k |Δt_k|`.
+//! stick exits and reversals of both discs) and maxima of ω_l are matched one to one in order
+//! ([`matched_events`]): both runs must switch in the same sequence, or the gate fails. Their
+//! time differences `Δt_k = t_B,k − t_A,k` ARE the phase, sampled at the instants where it is
+//! sharply located. Between two matched anchors (the stick exits and the maxima of ω_l, whose
+//! times are well conditioned: [`is_anchor`]) the phase is interpolated linearly in t (a
+//! constant period error drifts linearly); before the first and after the last it is held at
+//! the nearest anchor's. `whole_event_time` gates `max_k |Δt_k|` over every matched event.
+//! Where the runs report different numbers of maxima (an oscillation decaying toward a stable
+//! equilibrium below a solver's reporting threshold) the switches are matched alone; the phase
+//! does not drift there.
 //!
 //! **The shape, with the phase taken out.** If B lags A by Δt(t), then
 //! `B(t) = A(t − Δt) + e(t) = A(t) − Δt·Ȧ(t) + O(Δt²·Ä) + e(t)`, where e is the difference of
@@ -40,9 +44,9 @@
 //! [`WholeRun::excluded`]). `whole_alpha`, `whole_omega_u` and `whole_omega_l` gate
 //! `max_t |r(t)|` of each component over every other sample.
 //!
-//! A run that goes wrong after the transient window then fails: a changed friction or an
-//! offset changes the shape (r) or the switch times (Δt) or both, and neither is excused by the
-//! other (`tests/whole_run.rs`).
+//! A run that goes wrong after the transient window then fails: a changed input or friction
+//! or an offset changes the shape (r) or the event times (Δt) or both, and neither is excused
+//! by the other (`tests/whole_run.rs`; docs/methods.md §7 has the measurements).
 
 use rotor_model::{Disc, DiscMode, Mode, Model, State};
 use rotor_seam::{Event, EventKind, Trajectory};
@@ -53,8 +57,8 @@ pub struct WholeRun {
     /// Events matched (mode switches, and the maxima of ω_l where both runs report the same
     /// sequence of them); 0 where the switches differ.
     pub events: usize,
-    /// Largest |Δt| of the matched switches \[s\]; ∞ if the runs switch in different
-    /// sequences, 0 if neither switches.
+    /// Largest |Δt| of the matched events \[s\]; ∞ if the runs switch in different
+    /// sequences, 0 if nothing is matched.
     pub event_time: f64,
     /// Largest phase-aligned difference |r| of α \[rad\], ω_u and ω_l \[rad/s\] over every
     /// sample not excluded; NaN if the grids differ (nothing compared must not read as
