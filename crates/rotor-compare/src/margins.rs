@@ -242,7 +242,7 @@ mod tests {
         assert_eq!(row(true, 2e-12, 1e-11).violation(), None);
         assert_eq!(row(true, 2e-12, 1.5e-11).violation(), None);
         assert_eq!(row(true, 0.0, 0.0).violation(), None);
-        // Wider than 10x (issue 28's examples: 2e-11 over 3.05e-14; 4e-8 over 7.42e-10).
+        // Wider than 10x (gates once stated as 2e-11 over 3.05e-14 and 4e-8 over 7.42e-10).
         let e = row(true, 3.05e-14, 2e-11).violation().unwrap();
         assert!(e.contains("wider") && e.contains("period_rel"), "{e}");
         assert!(
