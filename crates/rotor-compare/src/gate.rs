@@ -5,15 +5,23 @@
 //! tolerance, one key per metric (period, each extreme of ω_l and ω_u, and each of the
 //! equilibrium's ω_u, ω_l and α relative with `steady_abs` as a floor, a stuck disc's
 //! velocity beyond the solvers' stuck bands only, the stick time in seconds); (c) events: lower-disc stick onsets and exits in
-//! the transient window matched one to one within `event_time`.
+//! the transient window matched one to one within `event_time`; (d) the whole run
+//! ([`crate::whole`]): every mode switch and ω_l maximum over `[0, t_end]` matched one to one
+//! within `whole_event_time`, and every sample of α, ω_u and ω_l, phase-aligned by the matched
+//! events, within `whole_alpha`, `whole_omega_u` and `whole_omega_l`. (d) is measured for
+//! every pair of solvers (`switch-moreau` too: [`rotor_solvers::all_pairs`]), (a)–(c) for the
+//! reference's pairs.
 //! Every comparison is written `!(diff <= tol)` so that a NaN fails.
 
 use rotor_model::Disc;
 use rotor_scenario::PairTolerance;
 use rotor_seam::{EventKind, SteadyState, Trajectory};
 
+use rotor_model::Model;
 use rotor_solvers::run::ScenarioResult;
-use rotor_solvers::solvers::{SolverKind, pair_name, pairs};
+use rotor_solvers::solvers::{SolverKind, all_pairs, pair_name, pairs};
+
+use crate::whole::whole_run;
 
 /// A measured difference with its gate.
 #[derive(Debug, Clone, PartialEq, serde::Serialize)]
@@ -223,6 +231,60 @@ pub fn check_pair(
     }
 }
 
+/// The whole-run gates of a pair ([`crate::whole`]): the matched events' times and the
+/// phase-aligned samples of α, ω_u and ω_l over `[0, t_end]`, each against its key. A key
+/// that the table does not state is measured against 0 and fails: every pair must gate the
+/// whole run.
+pub fn check_whole(
+    model: &Model,
+    u: f64,
+    a: &Trajectory,
+    b: &Trajectory,
+    tol: &PairTolerance,
+    stuck_band: f64,
+) -> Vec<Measured> {
+    let w = whole_run(model, u, a, b, stuck_band);
+    let events = if w.event_time.is_finite() {
+        format!("whole event times ({} matched)", w.events)
+    } else {
+        "whole event times (sequences differ)".to_owned()
+    };
+    [
+        (
+            "whole alpha (phase-aligned)".to_owned(),
+            "whole_alpha",
+            w.aligned[0],
+        ),
+        (
+            "whole omega_u (phase-aligned)".to_owned(),
+            "whole_omega_u",
+            w.aligned[1],
+        ),
+        (
+            "whole omega_l (phase-aligned)".to_owned(),
+            "whole_omega_l",
+            w.aligned[2],
+        ),
+        (events, "whole_event_time", w.event_time),
+    ]
+    .into_iter()
+    .map(|(quantity, key, diff)| match tol.get(key) {
+        Some(t) => Measured {
+            quantity,
+            key: Some(key),
+            diff,
+            tol: t,
+        },
+        None => Measured {
+            quantity: format!("{quantity} (no {key} stated)"),
+            key: Some(key),
+            diff: f64::INFINITY,
+            tol: 0.0,
+        },
+    })
+    .collect()
+}
+
 /// The steady metrics of two results of the same kind, each against its own tolerance
 /// ([`PairTolerance::for_metric`]). A relative difference is scaled so that `diff ≤ tol` ⇔
 /// `|va − vb| ≤ max(tol·max(|va|, |vb|), floor)`; `stick_time` is absolute. A metric whose
@@ -327,7 +389,8 @@ pub fn gate_scenario(r: &ScenarioResult) -> (Vec<GateResult>, Vec<Failure>) {
         }
     }
     let kinds: Vec<SolverKind> = r.runs.iter().map(|run| run.kind).collect();
-    for (a, b) in pairs(&kinds) {
+    let reference = pairs(&kinds);
+    for (a, b) in all_pairs(&kinds) {
         let pair = pair_name(a, b);
         let Some(tol) = sc.tolerance.get(&pair) else {
             fails.push(Failure {
@@ -342,7 +405,17 @@ pub fn gate_scenario(r: &ScenarioResult) -> (Vec<GateResult>, Vec<Failure>) {
         let (Some(ta), Some(tb)) = (r.traj(a), r.traj(b)) else {
             continue;
         };
-        let g = check_pair(&pair, ta, tb, sc.compare.transient, tol, stuck_band(a, b));
+        let band = stuck_band(a, b);
+        let mut g = if reference.contains(&(a, b)) {
+            check_pair(&pair, ta, tb, sc.compare.transient, tol, band)
+        } else {
+            GateResult {
+                pair: pair.clone(),
+                measured: Vec::new(),
+            }
+        };
+        g.measured
+            .extend(check_whole(&sc.model, sc.u, ta, tb, tol, band));
         fails.extend(g.failures(&sc.name));
         gates.push(g);
     }

@@ -1,7 +1,7 @@
 //! The fixtures' gate rule (CONTRIBUTING.md, "Gates and snapshots"), measured and enforced.
 //!
-//! Every `[tolerance.<pair>]` key of a fixture is set to [`rule`] of what it measures on its
-//! scenario: [`MARGIN`] × the measurement, rounded up to one significant digit, at least the
+//! Every `[tolerance.<pair>]` key of a fixture (the whole-run keys of [`crate::whole`] too, in
+//! rad, rad/s or s) is set to [`rule`] of what it measures on its scenario: [`MARGIN`] × the measurement, rounded up to one significant digit, at least the
 //! rounding floor ([`RELATIVE_FLOOR`] for the relative steady metrics, [`ABSOLUTE_FLOOR`] s or
 //! rad/s for the others), and 0 where the solvers agree exactly. A test
 //! (`tests/fixtures.rs`) holds every gate to [`Margin::violation`]:
@@ -22,7 +22,7 @@ use rotor_scenario::{STEADY_QUANTITIES, Scenario};
 use crate::gate::{beyond_stuck_band, gate_scenario, stuck_band};
 pub use crate::stress::MAX_LOOSENESS;
 use rotor_solvers::run::ScenarioResult;
-use rotor_solvers::solvers::{SolverKind, pair_name, pairs};
+use rotor_solvers::solvers::{SolverKind, all_pairs, pair_name};
 
 /// The rule's margin over the measured difference.
 pub const MARGIN: f64 = 5.0;
@@ -140,12 +140,14 @@ pub fn margins(r: &ScenarioResult) -> Vec<Margin> {
     let kinds: Vec<SolverKind> = r.runs.iter().map(|run| run.kind).collect();
     let gates = gate_scenario(r).0;
     let mut out = Vec::new();
-    for (a, b) in pairs(&kinds) {
+    for (a, b) in all_pairs(&kinds) {
         let pair = pair_name(a, b);
-        let Some(g) = gates.iter().find(|g| g.pair == pair) else {
+        let (Some(g), Some(tol)) = (
+            gates.iter().find(|g| g.pair == pair),
+            r.scenario.tolerance.get(&pair),
+        ) else {
             continue;
         };
-        let tol = &r.scenario.tolerance[&pair];
         let band = stuck_band(a, b);
         let metrics = |k| r.traj(k).and_then(|t| t.metrics).map(|m| m.values());
         let (ma, mb) = (metrics(a), metrics(b));
@@ -240,8 +242,7 @@ mod tests {
         assert_eq!(row(true, 2e-12, 1e-11).violation(), None);
         assert_eq!(row(true, 2e-12, 1.5e-11).violation(), None);
         assert_eq!(row(true, 0.0, 0.0).violation(), None);
-        // Wider than 10x (gates once found in the fixtures: 2e-11 over 3.05e-14; 4e-8 over
-        // 7.42e-10).
+        // Wider than 10x (gates once stated as 2e-11 over 3.05e-14 and 4e-8 over 7.42e-10).
         let e = row(true, 3.05e-14, 2e-11).violation().unwrap();
         assert!(e.contains("wider") && e.contains("period_rel"), "{e}");
         assert!(

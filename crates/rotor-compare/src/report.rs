@@ -335,6 +335,67 @@ pub struct Section {
 /// The file that holds the run's times beside the report (ignored by git).
 pub const TIMINGS_FILE: &str = "timings.md";
 
+/// The report's whole-run section: per scenario and pair of solvers, the differences over
+/// every sample and event of `[0, t_end]` ([`crate::whole`]): the matched events and their
+/// largest time difference (the phase), the largest phase-aligned difference of α, ω_u, ω_l
+/// (the shape; gated) and the largest difference at equal times (phase and shape together;
+/// shown, not gated).
+pub fn whole_run_table(results: &[ScenarioResult]) -> String {
+    let mut md = String::from(
+        "\n## The whole run, every pair of solvers\n\n\
+         Every sample of α, ω_u, ω_l and every mode switch and maximum of ω_l over [0, t_end] \
+         (`rotor_compare::whole`, docs/methods.md \"The whole run\"). The matched events' time \
+         differences are the phase between the two runs; the samples are compared after \
+         taking that phase out to first order (r = B − A + Δt·f(A), Δt interpolated between \
+         the matched stick exits and maxima of ω_l), which leaves the difference of shape. \
+         Aligned differences and event times are gated (`whole_*`); the difference at equal \
+         times, phase and shape together, is shown for comparison: it grows with the run's \
+         length on a cycle (a relative period error ε shifts the phase by ε·t) and with the \
+         amplification of an unstable start.\n\n\
+         | scenario | pair | events matched | max Δt event [s] | aligned α [rad] | aligned ω_u \
+         [rad/s] | aligned ω_l [rad/s] | equal-time α | equal-time ω_u | equal-time ω_l |\n\
+         |---|---|---|---|---|---|---|---|---|---|\n",
+    );
+    for r in results {
+        let sc = &r.scenario;
+        let kinds: Vec<SolverKind> = r.runs.iter().map(|run| run.kind).collect();
+        for (a, b) in rotor_solvers::all_pairs(&kinds) {
+            let (Some(ta), Some(tb)) = (r.traj(a), r.traj(b)) else {
+                continue;
+            };
+            let w = crate::whole::whole_run(&sc.model, sc.u, ta, tb, crate::gate::stuck_band(a, b));
+            let events = if !w.event_time.is_finite() {
+                "sequences differ".to_owned()
+            } else if w.maxima {
+                format!("{} (switches and maxima)", w.events)
+            } else {
+                format!("{} (switches only)", w.events)
+            };
+            let e = |x: f64| {
+                if x.is_finite() {
+                    format!("{x:.1e}")
+                } else {
+                    "—".into()
+                }
+            };
+            let _ = writeln!(
+                md,
+                "| {} | {} | {events} | {} | {} | {} | {} | {} | {} | {} |",
+                sc.name,
+                rotor_solvers::pair_name(a, b),
+                e(w.event_time),
+                e(w.aligned[0]),
+                e(w.aligned[1]),
+                e(w.aligned[2]),
+                e(w.raw[0]),
+                e(w.raw[1]),
+                e(w.raw[2]),
+            );
+        }
+    }
+    md
+}
+
 /// Writes the whole report into `dir` and returns the failures.
 pub fn write_report(
     dir: &Path,
@@ -395,7 +456,9 @@ pub fn write_report(
          relative, 1e-12 s or rad/s), or 0 where every solver agrees exactly (the scenario \
          files give each one's origin); a test holds every gate between its measurement and \
          10x it (tests/fixtures.rs). Relative for the steady metrics except the stick time \
-         (s), rad/s for the transient, s for events.\n\n\
+         (s), rad/s for the transient, s for events; the `whole_*` gates cover every sample \
+         and event of [0, t_end], phase-aligned (the next section), for every pair of \
+         solvers.\n\n\
          | scenario | pair | quantity | key | difference | tolerance | margin | |\n|---|---|---|---|---|---|---|---|\n",
     );
     // Each scenario's trace and figure, rendered side by side (44 MB of CSV for the fixtures:
@@ -431,6 +494,7 @@ pub fn write_report(
             svg.as_bytes(),
         )?;
     }
+    md.push_str(&whole_run_table(results));
     write_atomic(
         &dir.join("friction.svg"),
         friction_svg(param_sets).as_bytes(),

@@ -11,7 +11,7 @@ use rotor_compare::snapshot::snapshot;
 use rotor_model::{Disc, State};
 use rotor_scenario::Scenario;
 use rotor_seam::{Event, EventKind, SteadyState, Trajectory};
-use rotor_solvers::{SOLVERS, ScenarioResult, SolverKind, pair_name, pairs, run_scenario};
+use rotor_solvers::{SOLVERS, ScenarioResult, SolverKind, all_pairs, pair_name, run_scenario};
 
 /// Every fixture through the three solvers, once per test binary (shared by the tests).
 fn all() -> Vec<ScenarioResult> {
@@ -106,8 +106,14 @@ fn every_fixture_agrees_across_the_three_solvers_and_a_perturbation_is_caught() 
             .any(|f| f.pair == "event-switch" && f.quantity.contains("period"))
     );
     assert!(
-        fails.iter().all(|f| f.pair == "event-switch"),
-        "only the perturbed pair fails"
+        fails
+            .iter()
+            .any(|f| f.pair == "event-switch" && f.quantity.starts_with("whole omega_l")),
+        "{fails:?}"
+    );
+    assert!(
+        fails.iter().all(|f| f.pair.contains("switch")),
+        "only the perturbed solver's pairs fail: {fails:?}"
     );
 }
 
@@ -197,7 +203,10 @@ fn shift_metric(m: &mut SteadyState, name: &str, by: f64) {
 /// The negative control of every gate of every fixture: each stated tolerance, one at a time,
 /// is exceeded (three times the gate, plus the measured difference) in one solver's result,
 /// and exactly that quantity must fail. So no gate is stated but not applied, or applied to
-/// another quantity.
+/// another quantity. The whole-run gates are exceeded after the transient window (the last
+/// sample, the last matched event): what a solver that goes wrong after it would do. Moving
+/// solver b's result may also fail the whole-run gates of b's other pair (`switch-moreau`
+/// shares b), never anything else of another pair.
 #[test]
 fn every_gate_of_every_fixture_fails_its_negative_control() {
     let results = all();
@@ -205,7 +214,7 @@ fn every_gate_of_every_fixture_fails_its_negative_control() {
     for r in &results {
         let sc = &r.scenario;
         let [t0, t1] = sc.compare.transient.unwrap();
-        for (a, b) in pairs(&SOLVERS) {
+        for (a, b) in all_pairs(&SOLVERS) {
             let pair = pair_name(a, b);
             let tol = sc.tolerance[&pair];
             let base = gate_scenario(r)
@@ -243,6 +252,29 @@ fn every_gate_of_every_fixture_fails_its_negative_control() {
                             x: State::zeros(),
                             kind: EventKind::StickStart(Disc::Lower),
                         }),
+                    }
+                } else if let Some(rest) = q.strip_prefix("whole ") {
+                    if rest.starts_with("event times") {
+                        let last = tr
+                            .events
+                            .iter_mut()
+                            .rev()
+                            .find(|e| rotor_compare::whole::is_switch(e.kind));
+                        match last {
+                            Some(e) if e.t > t1 => e.t += excess,
+                            // No switch after the window: one that appears must fail.
+                            _ => tr.events.push(Event {
+                                t: 0.5 * (t1 + sc.t_end),
+                                x: State::zeros(),
+                                kind: EventKind::StickStart(Disc::Lower),
+                            }),
+                        }
+                    } else {
+                        let i = ["alpha", "omega_u", "omega_l"]
+                            .iter()
+                            .position(|c| rest.starts_with(&format!("{c} ")))
+                            .unwrap_or_else(|| panic!("{q}"));
+                        tr.samples.last_mut().unwrap().x[i] += excess;
                     }
                 } else if let Some(name) = q.strip_prefix("steady ") {
                     let metrics = tr.metrics.as_mut().unwrap();
@@ -283,7 +315,9 @@ fn every_gate_of_every_fixture_fails_its_negative_control() {
                     sc.name
                 );
                 assert!(
-                    fails.iter().all(|f| f.pair == pair),
+                    fails.iter().all(|f| f.pair == pair
+                        || (f.pair.split('-').any(|s| s == b.name())
+                            && f.quantity.starts_with("whole "))),
                     "{} {pair}: {q}: another pair failed: {fails:?}",
                     sc.name
                 );
@@ -291,8 +325,9 @@ fn every_gate_of_every_fixture_fails_its_negative_control() {
             }
         }
     }
-    // 14 fixtures x 2 pairs x (3 transient + 3 equilibrium or 6 cycle metrics).
-    assert!(checked >= 14 * 2 * 6, "{checked}");
+    // 14 fixtures x 2 pairs x (3 transient + 3 equilibrium or 6 cycle metrics), and 3 pairs x
+    // 4 whole-run gates.
+    assert!(checked >= 14 * (2 * 6 + 3 * 4), "{checked}");
 }
 
 /// A shift of 1e-6 (relative) of a cycle's period in all three solvers alike passes every pair
@@ -329,4 +364,141 @@ fn a_shift_of_every_solver_alike_changes_the_snapshot() {
         }
     }
     assert!(cycles >= 7, "{cycles}");
+}
+
+/// The reference's recorded cross-check (`fixtures/reference/<name>.json`, `cross_check`: the
+/// switch model's and Moreau-Jean's largest differences from the reference over the whole run,
+/// per trace component, over the mode switches and per steady metric) is what the comparison
+/// measures now. The reference run is the comparison's event-driven run (the same solver,
+/// tolerance 1e-12, scene and grid), so the two must agree to the two significant digits the
+/// file keeps: within half a unit of the second digit, 5 % of the value. A solver change that
+/// moves a whole-run difference therefore fails here until the reference is regenerated
+/// (`rotor reference`), and every recorded event time is within the whole-run event gate.
+#[test]
+fn the_reference_cross_check_is_what_the_comparison_measures() {
+    let results = all();
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../fixtures/reference");
+    let (mut checked, mut nonzero) = (0, 0);
+    let mut bad = Vec::new();
+    for r in &results {
+        let reference = rotor_grade::reference::read(&dir, &r.scenario.name)
+            .unwrap_or_else(|e| panic!("{}: {e}", r.scenario.name));
+        let c = stale_cross_check(r, &reference.json);
+        checked += c.checked;
+        nonzero += c.nonzero;
+        bad.extend(c.stale);
+    }
+    assert!(
+        bad.is_empty(),
+        "{} of {checked} recorded cross-check differences are stale (regenerate with `rotor \
+         reference`):\n{}",
+        bad.len(),
+        bad.join("\n")
+    );
+    // 22 references x 2 solvers x (4 trace and event + 3 or 6 steady metrics), most of them
+    // not 0.
+    assert!(
+        checked >= 22 * 2 * 4 && nonzero > checked / 2,
+        "{checked} {nonzero}"
+    );
+
+    // Negative control: the switch model's ω_l off by 1e-5 rad/s after 20 s (3x the recorded
+    // whole-run difference at t1-u1.5-rest) makes the record stale, in omega_l alone.
+    let mut p = results
+        .into_iter()
+        .find(|r| r.scenario.name == "t1-u1.5-rest")
+        .unwrap();
+    for run in &mut p.runs {
+        if run.kind == SolverKind::SWITCH {
+            for s in &mut run.result.as_mut().unwrap().samples {
+                if s.t > 20.0 {
+                    s.x[2] += 1e-5;
+                }
+            }
+        }
+    }
+    let reference = rotor_grade::reference::read(&dir, "t1-u1.5-rest").unwrap();
+    let c = stale_cross_check(&p, &reference.json);
+    assert!(
+        c.stale.len() == 1 && c.stale[0].contains("switch: omega_l "),
+        "{:?}",
+        c.stale
+    );
+}
+
+/// What [`stale_cross_check`] found.
+struct CrossCheckAudit {
+    checked: usize,
+    nonzero: usize,
+    stale: Vec<String>,
+}
+
+/// Each recorded difference of a reference's `cross_check` against the comparison's runs now:
+/// the trace's largest difference per component at equal times, the mode switches' largest
+/// time difference, and each steady metric's absolute difference.
+fn stale_cross_check(
+    r: &ScenarioResult,
+    json: &rotor_grade::reference::ReferenceJson,
+) -> CrossCheckAudit {
+    use rotor_compare::whole::{switch_time_difference, whole_run};
+    let sc = &r.scenario;
+    let event = r.traj(SolverKind::EVENT).unwrap();
+    let mut audit = CrossCheckAudit {
+        checked: 0,
+        nonzero: 0,
+        stale: Vec::new(),
+    };
+    for kind in [SolverKind::SWITCH, SolverKind::MOREAU] {
+        let other = r.traj(kind).unwrap();
+        let recorded = &json.cross_check[kind.name()].differences;
+        let band = rotor_compare::gate::stuck_band(SolverKind::EVENT, kind);
+        let w = whole_run(&sc.model, sc.u, event, other, band);
+        let mut now: Vec<(String, f64)> = vec![
+            ("alpha".into(), w.raw[0]),
+            ("omega_u".into(), w.raw[1]),
+            ("omega_l".into(), w.raw[2]),
+            ("event_time".into(), switch_time_difference(event, other)),
+        ];
+        // The steady metrics, absolute; an equilibrium's alpha, omega_u, omega_l share the
+        // trace's names and the file keeps the larger.
+        if let (Some(ma), Some(mb)) = (event.metrics, other.metrics) {
+            for ((name, va), (_, vb)) in ma.values().into_iter().zip(mb.values()) {
+                let d = (va - vb).abs();
+                match now.iter_mut().find(|x| x.0 == name) {
+                    Some(x) => x.1 = x.1.max(d),
+                    None => now.push((name.into(), d)),
+                }
+            }
+        }
+        for (name, m) in &now {
+            let rec = recorded.get(name).copied().flatten();
+            // Two significant digits: within half a unit of the second, 5 % of the value.
+            let agree = match rec {
+                None => !m.is_finite(),
+                Some(rec) => (rec - m).abs() <= 0.05 * m.abs(),
+            };
+            if !agree {
+                audit.stale.push(format!(
+                    "{} {}: {name} recorded {rec:?}, measured now {m:.3e}",
+                    sc.name,
+                    kind.name()
+                ));
+            }
+            audit.checked += 1;
+            audit.nonzero += usize::from(*m > 0.0);
+        }
+        // Every recorded event time lies within the pair's whole-run event gate.
+        let gate = sc.tolerance[&pair_name(SolverKind::EVENT, kind)]
+            .whole_event_time
+            .unwrap();
+        if let Some(Some(rec)) = recorded.get("event_time") {
+            assert!(
+                *rec <= gate,
+                "{} {}: recorded event_time {rec:e} over the gate {gate:e}",
+                sc.name,
+                kind.name()
+            );
+        }
+    }
+    audit
 }

@@ -184,8 +184,9 @@ static EULER: SolverInfo = SolverInfo {
     make: || Box::new(euler::EulerSolver),
 };
 
-/// The scenario's tolerances for the new pair, by the fixtures' rule: each about 5x the
-/// difference measured on this scenario at h = 1e-4 (first order: O(h) differences).
+/// The scenario's tolerances for the new pairs, by the fixtures' rule: each about 5x the
+/// difference measured on this scenario at h = 1e-4 (first order: O(h) differences). The
+/// reference's pair gates everything; the pairs with the other two solvers the whole run.
 const EULER_TOLERANCES: &str = "
 [tolerance.event-euler]
 # Explicit Euler on the switch model, h = 1e-4, band 1e-6: first order.
@@ -199,6 +200,25 @@ omega_u_max_rel = 6e-5    # measured 1.1e-05 relative, margin 5.7x
 omega_u_min_rel = 2e-5    # measured 2.8e-06 relative, margin 7.2x
 stick_time = 3e-3         # measured 4.3e-04 s, margin 7.0x
 steady_abs = 1e-12        # rounding floor of the relative gates: |difference| <= 1e-12 passes
+# Whole run (rotor_compare::whole), phase-aligned: Euler's shape and phase errors.
+whole_alpha = 5e-3        # measured 9.4e-04 rad, margin 5.3x
+whole_omega_u = 3e-3      # measured 4.5e-04 rad/s, margin 6.7x
+whole_omega_l = 1e-2      # measured 2.0e-03 rad/s, margin 5.1x
+whole_event_time = 8e-2   # measured 1.5e-02 s over 130 switches and maxima, margin 5.4x
+
+# The new solver against each of the other two, over the whole run only: its own error
+# dominates, so the same measurements.
+[tolerance.switch-euler]
+whole_alpha = 5e-3        # measured 9.4e-04 rad, margin 5.3x
+whole_omega_u = 3e-3      # measured 4.5e-04 rad/s, margin 6.7x
+whole_omega_l = 1e-2      # measured 2.0e-03 rad/s, margin 5.1x
+whole_event_time = 8e-2   # measured 1.5e-02 s over 130 switches and maxima, margin 5.4x
+
+[tolerance.moreau-euler]
+whole_alpha = 5e-3        # measured 9.4e-04 rad, margin 5.3x
+whole_omega_u = 3e-3      # measured 4.5e-04 rad/s, margin 6.7x
+whole_omega_l = 1e-2      # measured 2.0e-03 rad/s, margin 5.1x
+whole_event_time = 8e-2   # measured 1.5e-02 s over 130 switches and maxima, margin 5.4x
 ";
 
 #[test]
@@ -239,11 +259,20 @@ fn a_fourth_solver_needs_its_crate_one_entry_and_its_tolerances() {
     // Its gates follow the fixtures' rule like the others (`rotor_compare::margins`).
     let outside: Vec<String> = margins(&r).iter().filter_map(|m| m.violation()).collect();
     assert!(outside.is_empty(), "{outside:#?}");
-    assert_eq!(gates.len(), 3, "event-switch, event-moreau and event-euler");
+    assert_eq!(
+        gates.len(),
+        6,
+        "event-switch, event-moreau, event-euler, and switch-moreau, switch-euler, moreau-euler"
+    );
     assert!(
         gates
             .iter()
-            .any(|g| g.pair == "event-euler" && g.measured.len() == 9)
+            .any(|g| g.pair == "event-euler" && g.measured.len() == 9 + 4)
+    );
+    assert!(
+        gates
+            .iter()
+            .any(|g| g.pair == "moreau-euler" && g.measured.len() == 4)
     );
     // Its negative control: twice its period gate moved fails.
     let mut p = r.clone();

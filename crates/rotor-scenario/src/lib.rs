@@ -17,5 +17,5 @@ pub use error::ScenarioError;
 pub use scenario::Scenario;
 pub use tolerance::{
     CYCLE_KEYS, EQUILIBRIUM_KEYS, PairTolerance, RETIRED_KEYS, STEADY_QUANTITIES, SteadyQuantity,
-    TOLERANCE_KEYS,
+    TOLERANCE_KEYS, WHOLE_KEYS,
 };

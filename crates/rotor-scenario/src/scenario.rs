@@ -165,26 +165,61 @@ impl Scenario {
     }
 
     /// Refuses `[tolerance.<pair>]` tables of pairs not in `known` (the pairs a runner gates):
-    /// a misspelt pair name would leave that pair ungated.
-    pub fn check_pairs(&self, known: &[String]) -> Result<(), ScenarioError> {
-        match self.tolerance.keys().find(|p| !known.contains(p)) {
-            None => Ok(()),
-            Some(pair) => Err(ScenarioError::Invalid {
-                path: self.path.clone(),
-                error: FieldError::new(
-                    "tolerance",
-                    format!("{pair:?}"),
-                    format!(
-                        "unknown solver pair (expected one of {})",
-                        known
-                            .iter()
-                            .map(|k| format!("{k:?}"))
-                            .collect::<Vec<_>>()
-                            .join(", ")
-                    ),
+    /// a misspelt pair name would leave that pair ungated. `whole_only` are the known pairs
+    /// compared over the whole run alone (two non-reference solvers): their tables state the
+    /// whole-run keys only, and every other known pair's table is more than that.
+    pub fn check_pairs(
+        &self,
+        known: &[String],
+        whole_only: &[String],
+    ) -> Result<(), ScenarioError> {
+        let invalid = |field: String, value: String, reason: String| ScenarioError::Invalid {
+            path: self.path.clone(),
+            error: FieldError::new(field, value, reason),
+        };
+        if let Some(pair) = self.tolerance.keys().find(|p| !known.contains(p)) {
+            return Err(invalid(
+                "tolerance".into(),
+                format!("{pair:?}"),
+                format!(
+                    "unknown solver pair (expected one of {})",
+                    known
+                        .iter()
+                        .map(|k| format!("{k:?}"))
+                        .collect::<Vec<_>>()
+                        .join(", ")
                 ),
-            }),
+            ));
         }
+        for (pair, tol) in &self.tolerance {
+            let only = whole_only.contains(pair);
+            if only && !tol.whole_only() {
+                let (key, v) = tol
+                    .stated()
+                    .into_iter()
+                    .find(|(k, _)| !crate::WHOLE_KEYS.contains(k))
+                    .expect("a table that is not whole-run only states another key");
+                return Err(invalid(
+                    format!("tolerance.{pair}.{key}"),
+                    Num(v).to_string(),
+                    format!(
+                        "this pair is compared over the whole run only: state {} alone",
+                        crate::WHOLE_KEYS.join(", ")
+                    ),
+                ));
+            }
+            let windows = self.compare.transient.is_some() || self.compare.steady_from.is_some();
+            if !only && windows && tol.whole_only() {
+                return Err(invalid(
+                    format!("tolerance.{pair}"),
+                    "(whole-run keys only)".into(),
+                    "the reference's pairs gate compare.transient and compare.steady_from too: \
+                     state their tolerances"
+                        .into(),
+                ));
+            }
+        }
+        Ok(())
     }
 
     /// All `*.toml` scenario files in a directory, sorted by file name.
@@ -349,6 +384,64 @@ mod tests {
         let e = err(&ok.replace("table1", "nothere"));
         assert!(e.contains("nothere.toml") && e.contains("params"), "{e}");
         assert!(err("").contains("empty"));
+    }
+
+    /// The whole-run keys come as a set of four; a table of them alone is the table of a pair
+    /// of two non-reference solvers, which `check_pairs` accepts only for those pairs, and
+    /// a reference pair's table of them alone (its window and steady state ungated) is refused.
+    #[test]
+    fn whole_run_tables_are_checked_for_their_pair() {
+        let ok = std::fs::read_to_string(fixtures().join("t1-u1.5-rest.toml")).unwrap();
+        let sc = Scenario::from_toml_str(&ok, &fixtures().join("x.toml")).unwrap();
+        let known = ["event-switch", "event-moreau", "switch-moreau"].map(String::from);
+        let others = ["switch-moreau".to_owned()];
+        sc.check_pairs(&known, &others).unwrap();
+        assert!(sc.tolerance["switch-moreau"].whole_only());
+        assert!(sc.tolerance["event-switch"].gates_whole());
+        // One of the four missing.
+        let e = err(&ok.replacen("whole_omega_u", "# whole_omega_u", 1));
+        assert!(
+            e.contains("tolerance.event-switch.whole_omega_u = (missing)")
+                && e.contains("whole-run"),
+            "{e}"
+        );
+        // Another key in the whole-run-only pair's table.
+        let extra = ok.replace(
+            "[tolerance.switch-moreau]\n",
+            "[tolerance.switch-moreau]\nperiod_rel = 1e-6\n",
+        );
+        let e = Scenario::from_toml_str(&extra, &fixtures().join("x.toml"))
+            .and_then(|sc| sc.check_pairs(&known, &others))
+            .unwrap_err()
+            .to_string();
+        // (Refused as it is read: with a steady key the table must gate the window too.)
+        assert!(
+            e.contains("tolerance.switch-moreau.") && e.contains("non-reference"),
+            "{e}"
+        );
+        // Whole-run-only in form but named for the reference: refused by the runner's check.
+        let e = sc.check_pairs(&known, &[]).unwrap_err().to_string();
+        assert!(
+            e.contains("tolerance.switch-moreau") && e.contains("whole-run keys only"),
+            "{e}"
+        );
+        // A reference pair stating only the whole-run keys.
+        let i = ok.find("[tolerance.event-moreau]").unwrap();
+        let j = ok.find("[tolerance.switch-moreau]").unwrap();
+        let whole: String = ok[i..j]
+            .lines()
+            .filter(|l| l.starts_with('[') || l.starts_with("whole_"))
+            .map(|l| format!("{l}\n"))
+            .collect();
+        let bare = format!("{}{whole}\n{}", &ok[..i], &ok[j..]);
+        let e = Scenario::from_toml_str(&bare, &fixtures().join("x.toml"))
+            .and_then(|sc| sc.check_pairs(&known, &others))
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("tolerance.event-moreau") && e.contains("whole-run keys only"),
+            "{e}"
+        );
     }
 
     /// A retired shared key is refused, naming itself, its value and the keys that replaced

@@ -42,6 +42,15 @@ pub struct PairTolerance {
     /// Absolute floor of the relative steady-state tolerances [s or rad/s or rad]: a value
     /// that is ~0 is compared absolutely.
     pub steady_abs: Option<f64>,
+    /// Max phase-aligned |Δα| over every sample of `[0, t_end]` \[rad\]
+    /// (`rotor_compare::whole`).
+    pub whole_alpha: Option<f64>,
+    /// Max phase-aligned |Δω_u| over every sample of `[0, t_end]` [rad/s].
+    pub whole_omega_u: Option<f64>,
+    /// Max phase-aligned |Δω_l| over every sample of `[0, t_end]` [rad/s].
+    pub whole_omega_l: Option<f64>,
+    /// Max |Δt| of the matched mode switches and ω_l maxima over `[0, t_end]` \[s\].
+    pub whole_event_time: Option<f64>,
 }
 
 /// Keys of `[tolerance.<pair>]` tables that one quantity's key each replaced: a file that
@@ -74,6 +83,10 @@ pub(crate) struct RawPairTolerance {
     equilibrium_omega_l_rel: Option<f64>,
     equilibrium_alpha_rel: Option<f64>,
     steady_abs: Option<f64>,
+    whole_alpha: Option<f64>,
+    whole_omega_u: Option<f64>,
+    whole_omega_l: Option<f64>,
+    whole_event_time: Option<f64>,
     omega_l_rel: Option<f64>,
     omega_l_min_rel: Option<f64>,
     omega_u_rel: Option<f64>,
@@ -110,12 +123,16 @@ impl RawPairTolerance {
             equilibrium_omega_l_rel: self.equilibrium_omega_l_rel,
             equilibrium_alpha_rel: self.equilibrium_alpha_rel,
             steady_abs: self.steady_abs,
+            whole_alpha: self.whole_alpha,
+            whole_omega_u: self.whole_omega_u,
+            whole_omega_l: self.whole_omega_l,
+            whole_event_time: self.whole_event_time,
         })
     }
 }
 
 /// Every key of a [`PairTolerance`], in file order.
-pub const TOLERANCE_KEYS: [&str; 13] = [
+pub const TOLERANCE_KEYS: [&str; 17] = [
     "transient_max",
     "transient_rms",
     "event_time",
@@ -129,6 +146,21 @@ pub const TOLERANCE_KEYS: [&str; 13] = [
     "equilibrium_omega_l_rel",
     "equilibrium_alpha_rel",
     "steady_abs",
+    "whole_alpha",
+    "whole_omega_u",
+    "whole_omega_l",
+    "whole_event_time",
+];
+
+/// The keys gating the whole run (every sample and every matched event over `[0, t_end]`,
+/// phase-aligned): a table that states one must state all of them. A table may state these
+/// alone: the pairs of two non-reference solvers (`switch-moreau`) are compared over the
+/// whole run only.
+pub const WHOLE_KEYS: [&str; 4] = [
+    "whole_alpha",
+    "whole_omega_u",
+    "whole_omega_l",
+    "whole_event_time",
 ];
 
 /// The keys gating a limit cycle: a pair that states one must state all of them.
@@ -210,6 +242,10 @@ impl PairTolerance {
             "equilibrium_omega_l_rel" => self.equilibrium_omega_l_rel,
             "equilibrium_alpha_rel" => self.equilibrium_alpha_rel,
             "steady_abs" => self.steady_abs,
+            "whole_alpha" => self.whole_alpha,
+            "whole_omega_u" => self.whole_omega_u,
+            "whole_omega_l" => self.whole_omega_l,
+            "whole_event_time" => self.whole_event_time,
             _ => None,
         }
     }
@@ -231,6 +267,10 @@ impl PairTolerance {
             "equilibrium_omega_l_rel" => &mut self.equilibrium_omega_l_rel,
             "equilibrium_alpha_rel" => &mut self.equilibrium_alpha_rel,
             "steady_abs" => &mut self.steady_abs,
+            "whole_alpha" => &mut self.whole_alpha,
+            "whole_omega_u" => &mut self.whole_omega_u,
+            "whole_omega_l" => &mut self.whole_omega_l,
+            "whole_event_time" => &mut self.whole_event_time,
             _ => return None,
         })
     }
@@ -255,6 +295,17 @@ impl PairTolerance {
     /// Whether any steady-state tolerance is stated.
     pub fn gates_steady(&self) -> bool {
         STEADY_QUANTITIES.iter().any(|q| self.get(q.key).is_some())
+    }
+
+    /// Whether every whole-run tolerance ([`WHOLE_KEYS`]) is stated.
+    pub fn gates_whole(&self) -> bool {
+        WHOLE_KEYS.iter().all(|k| self.get(k).is_some())
+    }
+
+    /// Whether the table states the whole-run tolerances and nothing else: the table of a pair
+    /// of two non-reference solvers.
+    pub fn whole_only(&self) -> bool {
+        self.stated().iter().all(|(k, _)| WHOLE_KEYS.contains(k))
     }
 }
 
@@ -331,6 +382,7 @@ fn check_pair_coverage(
             "transient_max" | "transient_rms" | "event_time" => {
                 (transient, "needs compare.transient (the window it gates)")
             }
+            k if WHOLE_KEYS.contains(&k) => (true, ""),
             "steady_abs" => (
                 steady && tol.gates_steady(),
                 "is the floor of the steady-state tolerances and needs one of them (and compare.steady_from)",
@@ -341,17 +393,22 @@ fn check_pair_coverage(
             return Err(bad.at(&format!("tolerance.{pair}.{name}"), Num(v).to_string(), why));
         }
     }
-    if transient && tol.transient_max.is_none() {
+    // A table of the whole run alone (a pair of two non-reference solvers) gates no window and
+    // no steady state; which pairs may have one, the runner knows
+    // ([`Scenario::check_pairs`](crate::Scenario::check_pairs)).
+    let whole_only = tol.whole_only() && !tol.stated().is_empty();
+    if transient && !whole_only && tol.transient_max.is_none() {
         return Err(bad.at(
             &format!("tolerance.{pair}.transient_max"),
             "(missing)".into(),
-            "is required when compare.transient is set: the window would be ungated",
+            "is required when compare.transient is set: the window would be ungated (only the \
+             table of two non-reference solvers states the whole-run keys alone)",
         ));
     }
     // A steady state is gated either as an equilibrium or as a cycle, with every metric of
     // its kind: a tolerance that is missing would leave that metric ungated (the gate fails
     // a steady state whose kind has no tolerances).
-    if steady && !tol.gates_steady() {
+    if steady && !whole_only && !tol.gates_steady() {
         return Err(bad.at(
             &format!("tolerance.{pair}.{}", EQUILIBRIUM_KEYS[0]),
             "(missing)".into(),
@@ -365,6 +422,7 @@ fn check_pair_coverage(
     for (group, what) in [
         (&CYCLE_KEYS[..], "cycle"),
         (&EQUILIBRIUM_KEYS[..], "equilibrium"),
+        (&WHOLE_KEYS[..], "whole-run"),
     ] {
         if group.iter().any(|k| tol.get(k).is_some())
             && let Some(missing) = group.iter().find(|k| tol.get(k).is_none())

@@ -12,5 +12,6 @@ pub mod solvers;
 pub use input::{check_number, solver_kind};
 pub use run::{RunResult, ScenarioResult, run_scenario, run_scenario_with, solver_setting};
 pub use solvers::{
-    Knob, SOLVERS, SolverInfo, SolverKind, load_scenario, load_scenario_for, pair_name, pairs,
+    Knob, SOLVERS, SolverInfo, SolverKind, all_pairs, load_scenario, load_scenario_for, pair_name,
+    pairs,
 };

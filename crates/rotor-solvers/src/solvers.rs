@@ -267,14 +267,38 @@ pub fn pair_names(solvers: &[SolverKind]) -> Vec<String> {
         .collect()
 }
 
+/// Every pair of a solver set, each once, in the set's order: the reference against each
+/// other solver ([`pairs`]) first, then each two of the others (`switch-moreau`), which are
+/// compared over the whole run only (`rotor_compare::whole`).
+pub fn all_pairs(solvers: &[SolverKind]) -> Vec<(SolverKind, SolverKind)> {
+    let mut v = pairs(solvers);
+    for (i, &a) in solvers.iter().enumerate().skip(1) {
+        for &b in &solvers[i + 1..] {
+            v.push((a, b));
+        }
+    }
+    v
+}
+
 /// Loads a scenario file whose `[tolerance.*]` tables may name only pairs of `solvers` (a
-/// misspelt pair would leave a pair ungated).
+/// misspelt pair would leave a pair ungated); the pairs without the reference state the
+/// whole-run tolerances alone.
 pub fn load_scenario_for(
     path: &std::path::Path,
     solvers: &[SolverKind],
 ) -> Result<Scenario, ScenarioError> {
     let sc = Scenario::from_file(path)?;
-    sc.check_pairs(&pair_names(solvers))?;
+    let names = |v: Vec<(SolverKind, SolverKind)>| -> Vec<String> {
+        v.into_iter().map(|(a, b)| pair_name(a, b)).collect()
+    };
+    let all = names(all_pairs(solvers));
+    let reference = pair_names(solvers);
+    let others: Vec<String> = all
+        .iter()
+        .filter(|p| !reference.contains(p))
+        .cloned()
+        .collect();
+    sc.check_pairs(&all, &others)?;
     Ok(sc)
 }
 
@@ -290,6 +314,11 @@ mod tests {
     #[test]
     fn pairs_are_the_reference_against_each_other_solver() {
         assert_eq!(pair_names(&SOLVERS), ["event-switch", "event-moreau"]);
+        let all: Vec<String> = all_pairs(&SOLVERS)
+            .into_iter()
+            .map(|(a, b)| pair_name(a, b))
+            .collect();
+        assert_eq!(all, ["event-switch", "event-moreau", "switch-moreau"]);
         assert_eq!(SolverKind::by_name("moreau"), Some(SolverKind::MOREAU));
         assert_eq!(SolverKind::by_name("rk4"), None);
         assert_eq!(
