@@ -2,7 +2,7 @@
 //! the window, the codimension-two points and the regions named, the file's value of p
 //! dashed.
 
-use rotor_plot::{Band, EndLabel, Label, Panel, Series, merge_close, render};
+use rotor_plot::{Band, EndLabel, Label, Panel, Series, merge_close, render_rows};
 
 use crate::curves::{CurveKind, CurvePoint};
 use crate::picture::Plane;
@@ -10,30 +10,53 @@ use crate::regions::crossings;
 
 impl Plane {
     /// The (p, u) plane as an SVG figure over the computed window: each curve in its kind's
-    /// colour and named in the margin when it reaches the window's right edge, else at its
-    /// left end; the codimension-two points marked and named (those nearer than 3 % of the
-    /// window share a label); the file's value of p dashed, with a dot where each curve
+    /// colour and dash and named in the margin when it reaches the window's right edge, else
+    /// at its left end; the codimension-two points marked and named (those nearer than 3 % of
+    /// the panel share a label); the file's value of p dashed, with a dot where each curve
     /// crosses it (the one-parameter diagram's points); each region named in its band.
+    ///
+    /// Where the codimension-two points crowd the bottom of the window (two or more in its
+    /// lowest tenth of u, as the Stribeck set's Hopf, grazing and stick limits below 0.25 V),
+    /// a second panel shows that strip enlarged.
     pub fn to_svg(&self, title: &str) -> String {
-        let color = |k: CurveKind| match k {
-            CurveKind::Hopf => "#1f77b4",
-            CurveKind::Grazing => "#2ca02c",
-            CurveKind::Fold => "#d62728",
-            CurveKind::DiscontinuousFold => "#9467bd",
-            CurveKind::StuckBoundary => "#7f7f7f",
-        };
-        let ([p_lo, p_hi], [u_lo, u_hi]) = (self.p_range, self.u_range);
+        let [u_lo, u_hi] = self.u_range;
+        let low: Vec<f64> = self
+            .points
+            .iter()
+            .filter(|q| (self.p_range[0]..=self.p_range[1]).contains(&q.p))
+            .map(|q| q.u)
+            .filter(|&u| u <= u_lo + 0.1 * (u_hi - u_lo))
+            .collect();
+        let mut panels = vec![self.panel(title.to_owned(), [u_lo, u_hi])];
+        if low.len() >= 2 {
+            let top = low.iter().fold(u_lo, |a, &b| a.max(b));
+            let zoom = [u_lo, top + 0.5 * (top - u_lo).max(1e-3 * (u_hi - u_lo))];
+            panels.push(self.panel(format!("{title}, u ≤ {:.3} V enlarged", zoom[1]), zoom));
+        }
+        let heights: Vec<f64> = panels.iter().map(|_| 560.0).collect();
+        render_rows(&panels, 760.0, &heights)
+    }
+
+    /// One panel of the figure over `u ∈ window` (see [`Plane::to_svg`]).
+    fn panel(&self, title: String, window: [f64; 2]) -> Panel<'_> {
+        let ([p_lo, p_hi], [u_lo, u_hi]) = (self.p_range, window);
         let (span_p, span_u) = (p_hi - p_lo, u_hi - u_lo);
         let drawn: Vec<Vec<(f64, f64)>> = self
             .curves
             .iter()
-            .map(|c| clip_p(&c.points, p_lo, p_hi))
+            .map(|c| clip_u(clip_p(&c.points, p_lo, p_hi), u_lo, u_hi))
             .collect();
         let mut series: Vec<Series> = self
             .curves
             .iter()
             .zip(&drawn)
-            .map(|(c, pts)| Series::line("", color(c.kind), pts.clone()))
+            .map(|(c, pts)| {
+                let (color, dash) = style(c.kind);
+                Series {
+                    dash,
+                    ..Series::line("", color, pts.clone())
+                }
+            })
             .collect();
         for (kind, text) in [
             (CurveKind::Hopf, "Hopf"),
@@ -43,7 +66,11 @@ impl Plane {
             (CurveKind::StuckBoundary, "stuck boundary"),
         ] {
             if self.curves.iter().any(|c| c.kind == kind) {
-                series.push(Series::line(text, color(kind), Vec::new()));
+                let (color, dash) = style(kind);
+                series.push(Series {
+                    dash,
+                    ..Series::line(text, color, Vec::new())
+                });
             }
         }
         if (p_lo..=p_hi).contains(&self.p_file) {
@@ -67,7 +94,11 @@ impl Plane {
                 ..Series::line("", "#000000", dots)
             });
         }
-        let mut panel = Panel::new(title.to_owned(), &self.param, "u [V]", series);
+        let mut panel = Panel::new(title, "", "u [V]", series);
+        panel.x_label = match axis_label(&self.param) {
+            "" => &self.param,
+            known => known,
+        };
         panel.clear_x.push(self.p_file);
         for (c, pts) in self.curves.iter().zip(&drawn) {
             let finite = || pts.iter().filter(|q| q.0.is_finite() && q.1.is_finite());
@@ -84,7 +115,7 @@ impl Plane {
                     x,
                     y,
                     text: c.label.clone(),
-                    color: color(c.kind).to_owned(),
+                    color: style(c.kind).0.to_owned(),
                     margin,
                 });
             }
@@ -92,7 +123,7 @@ impl Plane {
         panel.labels = merge_close(
             self.points
                 .iter()
-                .filter(|q| (p_lo..=p_hi).contains(&q.p))
+                .filter(|q| (p_lo..=p_hi).contains(&q.p) && (u_lo..=u_hi).contains(&q.u))
                 .map(|q| Label {
                     x: q.p,
                     y: q.u,
@@ -108,11 +139,59 @@ impl Plane {
             .iter()
             .map(|r| Band {
                 text: r.name.clone(),
-                places: r.bands.iter().map(|b| (b[0], b[1], b[2])).collect(),
+                places: r
+                    .bands
+                    .iter()
+                    .filter_map(|b| {
+                        let (lo, hi) = (b[1].max(u_lo), b[2].min(u_hi));
+                        (lo < hi).then_some((b[0], lo, hi))
+                    })
+                    .collect(),
             })
             .collect();
-        render(&[panel], 760.0, 560.0)
+        panel
     }
+}
+
+/// A curve kind's colour (Okabe–Ito's palette, which colour-blind readers tell apart) and
+/// dash pattern (a second channel for greyscale print).
+fn style(k: CurveKind) -> (&'static str, Option<&'static str>) {
+    match k {
+        CurveKind::Hopf => ("#0072B2", None),
+        CurveKind::Grazing => ("#009E73", Some("6 3")),
+        CurveKind::Fold => ("#D55E00", Some("2 2")),
+        CurveKind::DiscontinuousFold => ("#CC79A7", Some("8 3 2 3")),
+        CurveKind::StuckBoundary => ("#7F7F7F", Some("4 2")),
+    }
+}
+
+/// The axis label of a parameter: its symbol and unit where the model names them, with the
+/// parameter file's field in brackets; else the field itself.
+fn axis_label(field: &str) -> &'static str {
+    match field {
+        "k_theta" => "k_{θ} [N m/rad] (k_theta)",
+        "k_m" => "k_{m} [N m/V] (k_m)",
+        "j_u" => "J_{u} [kg m²] (j_u)",
+        "j_l" => "J_{l} [kg m²] (j_l)",
+        "lower.t_s" => "T_{sl}, the lower disc's static friction [N m] (lower.t_s)",
+        "upper.t_s" => "T_{su}, the upper disc's static friction [N m] (upper.t_s)",
+        "lower.b" => "b_{l} [N m s/rad] (lower.b)",
+        "upper.b" => "b_{u} [N m s/rad] (upper.b)",
+        _ => "",
+    }
+}
+
+/// `pts` with the points outside `u ∈ [lo, hi]` lifted out (NaN: the pen lifts there).
+fn clip_u(pts: Vec<(f64, f64)>, lo: f64, hi: f64) -> Vec<(f64, f64)> {
+    pts.into_iter()
+        .map(|q| {
+            if q.1.is_finite() && !(lo..=hi).contains(&q.1) {
+                (f64::NAN, f64::NAN)
+            } else {
+                q
+            }
+        })
+        .collect()
 }
 
 /// A curve's points with p in `[lo, hi]`, cut where it leaves and enters that window (the

@@ -74,6 +74,12 @@ fn the_stribeck_set_has_its_codimension_two_points_where_the_curves_say() {
     };
     let pl = plane(&base, &opts).unwrap();
     let kinds: Vec<Codim2Kind> = pl.points.iter().map(|q| q.kind).collect();
+    // Its figure: the parameter's symbol and unit on the x axis, and a second panel with the
+    // strip below ~0.3 V enlarged, where its Hopf, grazing and stuck-boundary curves and
+    // three codimension-two points crowd into the lowest 5 % of the window.
+    let svg = pl.to_svg("Stribeck set");
+    assert!(svg.contains("static friction [N m] (lower.t_s)"), "x label");
+    assert!(svg.contains("enlarged</text>"), "zoom panel");
     for k in [
         Codim2Kind::Bautin,
         Codim2Kind::GrazingFold,
