@@ -105,6 +105,8 @@ pub(crate) fn render(d: &Diagram, title: &str) -> String {
                 ),
             ),
             (PointKind::Fold, _) => (p.omega_l_max, format!("F{k} fold {:.4}", p.u)),
+            // Where the stuck equilibrium ends and the lower disc starts to slip: ω_l = 0.
+            (PointKind::StickLimit, _) => (Some(0.0), format!("S stick limit {:.4}", p.u)),
             _ => (None, String::new()),
         };
         if let Some(y) = y

@@ -686,16 +686,49 @@ fn write_legend(s: &mut String, legend: &[(&Series, String)], f: &Frame) {
     }
 }
 
-/// Writes each drawable labelled point as a small cross with its text above to the right.
+/// Writes each drawable labelled point as a small cross with its text on a white halo (a
+/// curve through the text does not strike it through). The text goes to the first place,
+/// in order of preference, that overlaps no label placed before and stays inside the plot
+/// box: above right, below right, above left, below left, then further up or down; else the
+/// first.
 fn write_labels(s: &mut String, labels: &[Label], f: &Frame) {
+    let mut placed: Vec<[f64; 4]> = Vec::new();
     for lab in labels {
         let (px, py) = (f.sx(lab.x), f.sy(lab.y));
         if !(px.is_finite() && py.is_finite()) {
             continue;
         }
+        let w = SMALL_CHAR * lab.text.chars().count() as f64;
+        // (x of the text's start, baseline) relative to the point.
+        let tries = [
+            (6.0, -6.0),
+            (6.0, 15.0),
+            (-6.0 - w, -6.0),
+            (-6.0 - w, 15.0),
+            (6.0, -20.0),
+            (6.0, 29.0),
+            (-6.0 - w, -20.0),
+            (-6.0 - w, 29.0),
+        ];
+        let boxed = |(dx, dy): (f64, f64)| [px + dx, px + dx + w, py + dy - 10.0, py + dy + 3.0];
+        let free = |b: &[f64; 4]| {
+            b[0] >= f.l
+                && b[1] <= f.width - 2.0
+                && b[2] >= f.t
+                && b[3] <= f.b
+                && !placed
+                    .iter()
+                    .any(|q| b[0] < q[1] && q[0] < b[1] && b[2] < q[3] && q[2] < b[3])
+        };
+        let (dx, dy) = tries
+            .iter()
+            .copied()
+            .find(|&t| free(&boxed(t)))
+            .unwrap_or(tries[0]);
+        placed.push(boxed((dx, dy)));
         let _ = writeln!(
             s,
-            r#"<path d="M{:.2},{:.2} L{:.2},{:.2} M{:.2},{:.2} L{:.2},{:.2}" stroke="black" stroke-width="1.5"/><text x="{:.2}" y="{:.2}" font-size="11">{}</text>"#,
+            r#"<path d="M{:.2},{:.2} L{:.2},{:.2} M{:.2},{:.2} L{:.2},{:.2}" stroke="black" stroke-width="1.5"/><text x="{:.2}" y="{:.2}" font-size="11" stroke="white" stroke-width="3" stroke-linejoin="round" paint-order="stroke">{}</text>"#,
             px - 4.0,
             py - 4.0,
             px + 4.0,
@@ -704,8 +737,8 @@ fn write_labels(s: &mut String, labels: &[Label], f: &Frame) {
             py + 4.0,
             px + 4.0,
             py - 4.0,
-            px + 6.0,
-            py - 6.0,
+            px + dx,
+            py + dy,
             esc(&lab.text)
         );
     }
@@ -1115,5 +1148,35 @@ mod tests {
         assert_eq!(min(&t), min(&pts));
         assert_eq!(t.iter().filter(|p| p.1.is_nan()).count(), 1);
         assert!(t.windows(2).all(|w| w[0].0 <= w[1].0));
+    }
+
+    /// Two labels at one point go to different places (the second below the first), on a
+    /// white halo.
+    #[test]
+    fn labels_at_one_point_do_not_cover_each_other() {
+        let mut panel = Panel::new(
+            "t",
+            "x",
+            "y",
+            vec![Series::line("", "black", vec![(0.0, 0.0), (10.0, 10.0)])],
+        );
+        for text in ["first label", "second label"] {
+            panel.labels.push(Label {
+                x: 5.0,
+                y: 5.0,
+                text: text.into(),
+            });
+        }
+        let svg = render(&[panel], 600.0, 400.0);
+        let ys: Vec<f64> = svg
+            .match_indices(r#"font-size="11" stroke="white""#)
+            .map(|(k, _)| {
+                let tag = &svg[svg[..k].rfind("<text").unwrap()..k];
+                let y = tag.split("y=\"").nth(1).unwrap().split('"').next().unwrap();
+                y.parse().unwrap()
+            })
+            .collect();
+        assert_eq!(ys.len(), 2);
+        assert!((ys[1] - ys[0]).abs() >= 13.0, "{ys:?}");
     }
 }
