@@ -458,6 +458,7 @@ fn a_killed_compare_leaves_every_report_file_whole() {
         [
             "README.md",
             "friction.svg",
+            "index.html",
             "kill-big.csv",
             "kill-big.svg",
             "t1-u0.5-rest.csv",
@@ -469,6 +470,9 @@ fn a_killed_compare_leaves_every_report_file_whole() {
     for (n, b) in &first {
         if n.ends_with(".svg") {
             assert!(b.ends_with(b"</svg>\n"), "{n}");
+        }
+        if n.ends_with(".html") {
+            assert!(b.ends_with(b"</html>\n"), "{n}");
         }
     }
     let csv_rows = first
