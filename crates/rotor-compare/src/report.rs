@@ -233,12 +233,21 @@ pub fn scenario_svg(r: &ScenarioResult) -> String {
 /// Line styles of the parameter sets in the friction plot.
 const SET_STYLES: [(&str, Option<&str>); 3] = [
     ("#000000", None),
-    ("#e66101", Some("6 3")),
-    ("#5e3c99", Some("2 2")),
+    ("#D55E00", Some("6 3")),
+    ("#0072B2", Some("2 2")),
 ];
 
 /// The friction curves of both parameter sets (the source's Fig. 2).
 pub fn friction_svg(sets: &[(&str, Params)]) -> String {
+    render(&friction_panels(sets), 900.0, 340.0)
+}
+
+/// The friction figure's data ([`rotor_plot::data_csv`]).
+pub fn friction_csv(sets: &[(&str, Params)]) -> String {
+    rotor_plot::data_csv(&friction_panels(sets))
+}
+
+fn friction_panels<'a>(sets: &[(&'a str, Params)]) -> Vec<Panel<'a>> {
     let mut panels = Vec::new();
     for (disc, name) in [
         (Disc::Upper, "upper disc T_fu"),
@@ -279,7 +288,7 @@ pub fn friction_svg(sets: &[(&str, Params)]) -> String {
             series,
         ));
     }
-    render(&panels, 900.0, 340.0)
+    panels
 }
 
 fn fmt_metrics(st: &Option<SteadyState>) -> String {
@@ -498,6 +507,10 @@ pub fn write_report(
     write_atomic(
         &dir.join("friction.svg"),
         friction_svg(param_sets).as_bytes(),
+    )?;
+    write_atomic(
+        &dir.join("friction.csv"),
+        friction_csv(param_sets).as_bytes(),
     )?;
     for sec in sections {
         md.push('\n');

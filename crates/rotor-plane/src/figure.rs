@@ -19,6 +19,13 @@ impl Plane {
     /// lowest tenth of u, as the Stribeck set's Hopf, grazing and stick limits below 0.25 V),
     /// a second panel shows that strip enlarged.
     pub fn to_svg(&self, title: &str) -> String {
+        let panels = self.panels(title);
+        let heights: Vec<f64> = panels.iter().map(|_| 560.0).collect();
+        render_rows(&panels, 760.0, &heights)
+    }
+
+    /// The figure's panels: the whole window, and the crowded strip enlarged if there is one.
+    fn panels(&self, title: &str) -> Vec<Panel<'_>> {
         let [u_lo, u_hi] = self.u_range;
         let low: Vec<f64> = self
             .points
@@ -33,8 +40,12 @@ impl Plane {
             let zoom = [u_lo, top + 0.5 * (top - u_lo).max(1e-3 * (u_hi - u_lo))];
             panels.push(self.panel(format!("{title}, u ≤ {:.3} V enlarged", zoom[1]), zoom));
         }
-        let heights: Vec<f64> = panels.iter().map(|_| 560.0).collect();
-        render_rows(&panels, 760.0, &heights)
+        panels
+    }
+
+    /// The figure's data ([`rotor_plot::data_csv`]): every drawn point of its panels.
+    pub fn to_csv(&self, title: &str) -> String {
+        rotor_plot::data_csv(&self.panels(title))
     }
 
     /// One panel of the figure over `u ∈ window` (see [`Plane::to_svg`]).

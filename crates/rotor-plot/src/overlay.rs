@@ -28,6 +28,21 @@ pub fn overlay(
     width: f64,
     height: f64,
 ) -> String {
+    render(
+        &[overlay_panel(title, x_label, y_label, layers, labels)],
+        width,
+        height,
+    )
+}
+
+/// The panel [`overlay`] draws (for its data, [`crate::data_csv`]).
+pub fn overlay_panel<'a>(
+    title: &str,
+    x_label: &'a str,
+    y_label: &'a str,
+    layers: Vec<Layer<'a>>,
+    labels: Vec<Label>,
+) -> Panel<'a> {
     let series = layers
         .into_iter()
         .map(|l| Series {
@@ -42,7 +57,7 @@ pub fn overlay(
         .collect();
     let mut panel = Panel::new(title, x_label, y_label, series);
     panel.labels = labels;
-    render(&[panel], width, height)
+    panel
 }
 
 #[cfg(test)]

@@ -98,6 +98,10 @@ pub fn plane_section(
         ));
         sec.files
             .push((format!("{file}.json"), pl.to_json()?.into_bytes()));
+        sec.files.push((
+            format!("{file}.csv"),
+            pl.to_csv(&format!("{name}: ({param}, u)")).into_bytes(),
+        ));
     }
     Ok(sec)
 }

@@ -7,7 +7,7 @@ use std::fmt::Write as _;
 use rotor_bifurcation::{Diagram, EquilibriumKind, PointKind, SpecialPoint};
 use rotor_model::Model;
 use rotor_plot::Label;
-use rotor_plot::overlay::{Layer, overlay};
+use rotor_plot::overlay::Layer;
 use rotor_solvers::SolverKind;
 use serde::Deserialize;
 
@@ -155,9 +155,15 @@ pub fn figure3_section(sets: &[(&str, &str, &Model, &Diagram)]) -> ReportSection
             "\n## Figure 3 by three methods, {name}\n\nSwitch and Moreau–Jean in {:.2} s.\n",
             t0.elapsed().as_secs_f64()
         );
-        let svg = overlay_svg(name, event, &sw.diagram, &mo.diagram);
-        sec.files
-            .push((format!("figure3-{slug}.svg"), svg.into_bytes()));
+        let panel = overlay_panel(name, event, &sw.diagram, &mo.diagram);
+        sec.files.push((
+            format!("figure3-{slug}.svg"),
+            rotor_plot::render(std::slice::from_ref(&panel), 900.0, 520.0).into_bytes(),
+        ));
+        sec.files.push((
+            format!("figure3-{slug}.csv"),
+            rotor_plot::data_csv(std::slice::from_ref(&panel)).into_bytes(),
+        ));
         let md = &mut sec.markdown;
         let _ = write!(
             md,
@@ -269,7 +275,12 @@ fn point_labels(event: &Diagram) -> Vec<Label> {
 /// The overlay of set `name`: the slipping equilibria, and the cycles' ω_l max / min of the
 /// event continuation and of the switch model's (`sw`) and Moreau–Jean's (`mo`) shooting,
 /// with the special points labelled.
-fn overlay_svg(name: &str, event: &Diagram, sw: &Diagram, mo: &Diagram) -> String {
+fn overlay_panel(
+    name: &str,
+    event: &Diagram,
+    sw: &Diagram,
+    mo: &Diagram,
+) -> rotor_plot::Panel<'static> {
     let mut eq: Vec<_> = event
         .equilibria
         .iter()
@@ -277,10 +288,10 @@ fn overlay_svg(name: &str, event: &Diagram, sw: &Diagram, mo: &Diagram) -> Strin
         .map(|e| (e.u, e.omega))
         .collect();
     eq.sort_by(|a, b| a.1.total_cmp(&b.1));
-    overlay(
+    rotor_plot::overlay::overlay_panel(
         &format!("Figure 3 by three methods: {name}"),
         "u [V]",
-        "omega_l max / min [rad/s]",
+        "max and min of ω_{l} [rad/s]",
         vec![
             Layer {
                 label: "equilibria",
@@ -298,21 +309,19 @@ fn overlay_svg(name: &str, event: &Diagram, sw: &Diagram, mo: &Diagram) -> Strin
             },
             Layer {
                 label: "switch model (shooting)",
-                color: "#1f77b4",
+                color: "#D55E00",
                 marker: 3.5,
                 width: 0.0,
                 points: maxmin(sw),
             },
             Layer {
-                label: "Moreau-Jean, h = 1e-3 (shooting)",
-                color: "#d62728",
+                label: "Moreau–Jean, h = 1e-3 (shooting)",
+                color: "#0072B2",
                 marker: 2.0,
                 width: 0.0,
                 points: maxmin(mo),
             },
         ],
         point_labels(event),
-        900.0,
-        520.0,
     )
 }
