@@ -1,8 +1,8 @@
 //! The time scales of a parameter set: how fast the vector field can change, from the
 //! parameters alone. The adaptive solvers bound their steps by a multiple of the friction
 //! scales `τ_fric` (each with its own multiple and tolerance law; docs/methods.md, "Steps
-//! tied to the model's scales"): on every parameter set measured they are the shortest, and
-//! the only ones a step-size controller cannot see coming.
+//! tied to the model's scales"): they are the shortest on Table 1, the Stribeck set and 999
+//! of 1001 random sets measured, and the only ones a step-size controller cannot see coming.
 
 use crate::dynamics::{Disc, Model};
 
