@@ -300,6 +300,44 @@ impl Friction {
         da + self.viscous() + self.dlevel_ext(s * w)
     }
 
+    /// The velocity scale of the law's level, in rad/s: the width over which the level
+    /// changes by a fraction O(1) of its amplitude, or `None` for a law without one.
+    ///
+    /// * Exponential family: `min_i 2/w_i` over the terms with `T_i ≠ 0`
+    ///   (`tanh(w_i|ω|/2)` goes from 0 to tanh 1 ≈ 0.76 over `|ω| = 2/w_i`);
+    /// * Stribeck family: `ω_s/max(1, δ)` if `T_s ≠ T_c` (the fall `e^{−(|ω|/ω_s)^δ}` takes
+    ///   place around `ω_s`, over a width that narrows as `1/δ` for `δ > 1`);
+    /// * upper disc (eq. (4)): none; its law is linear in ω on each side of 0.
+    pub fn velocity_scale(&self) -> Option<f64> {
+        match self.family {
+            Family::Upper => None,
+            Family::Exponential => [(self.t_1, self.w_1), (self.t_2, self.w_2)]
+                .into_iter()
+                .filter(|&(t, w)| t != 0.0 && w > 0.0)
+                .map(|(_, w)| 2.0 / w)
+                .reduce(f64::min),
+            Family::Stribeck => (self.t_s != self.t_c).then(|| self.omega_s / self.delta.max(1.0)),
+        }
+    }
+
+    /// The torque scale of the law's level, in N m: its value at rest plus the amplitudes of
+    /// its velocity-dependent terms, `T_s + |T_1| + |T_2|` (exponential), `T_s + |T_s − T_c|`
+    /// (Stribeck), `|ΔT_s| + T_s` (upper disc). A spring torque balanced against the law at
+    /// one velocity and the law at another differ by at most about this much, so `T/J` is the
+    /// scale of the disc's acceleration while it slips across the law's velocity scale.
+    pub fn torque_scale(&self) -> f64 {
+        match self.family {
+            Family::Upper => self.dt_s.abs() + self.t_s.abs(),
+            Family::Exponential => self.t_s.abs() + self.t_1.abs() + self.t_2.abs(),
+            Family::Stribeck => self.t_s.abs() + (self.t_s - self.t_c).abs(),
+        }
+    }
+
+    /// The largest viscous coefficient on either side of ω = 0, `b + |Δb|` (N m s/rad).
+    pub fn viscous_bound(&self) -> f64 {
+        self.b.abs() + self.db.abs()
+    }
+
     /// The stick interval `[T_f(0⁻), T_f(0⁺)] = a(0) + N(0)·[−1, 1]`.
     pub fn static_interval(&self) -> (f64, f64) {
         let a0 = self.offset(0.0, 1.0);

@@ -17,6 +17,7 @@ pub mod friction;
 pub mod lagrangian;
 pub mod num;
 pub mod params;
+pub mod scales;
 
 pub use dynamics::{ALPHA, Disc, DiscMode, Mode, Model, OMEGA_L, OMEGA_U, State};
 pub use equilibrium::{SlipEquilibrium, StuckSet};
@@ -25,3 +26,4 @@ pub use friction::Friction;
 pub use lagrangian::{Coords, Lagrangian};
 pub use num::{Num, Rounding, round_sig};
 pub use params::{LowerFriction, Params, ParamsError, UpperFriction};
+pub use scales::TimeScales;

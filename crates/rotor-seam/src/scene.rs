@@ -360,6 +360,11 @@ pub struct Stats {
     /// Skips of [`Output::Metrics`] undone because the return after them did not confirm
     /// them: each cost a cycle, and the periods were integrated after all.
     pub undone_skips: u64,
+    /// Steps rejected after they were accepted, because the exact state re-taken to an event
+    /// in them differed from their dense output by more than the event solver's defect limit
+    /// (also counted in `rejected`).
+    #[serde(default)]
+    pub defect_rejections: u64,
 }
 
 impl std::ops::AddAssign for Stats {
@@ -376,6 +381,7 @@ impl std::ops::AddAssign for Stats {
         self.inexact_steps += o.inexact_steps;
         self.skipped_periods += o.skipped_periods;
         self.undone_skips += o.undone_skips;
+        self.defect_rejections += o.defect_rejections;
     }
 }
 

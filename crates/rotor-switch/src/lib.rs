@@ -53,4 +53,4 @@
 pub mod dopri5;
 mod switch;
 
-pub use switch::{Region, SwitchOptions, SwitchSolver};
+pub use switch::{Region, SwitchOptions, SwitchSolver, step_bound};

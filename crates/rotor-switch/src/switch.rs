@@ -14,6 +14,19 @@ use crate::dopri5::{Dopri5, Dopri5Error, Dopri5Options};
 /// resolved (10: one decade of margin).
 const EXTREMUM_RESOLUTION: f64 = 10.0;
 
+/// The step bound tied to the friction laws' scales, `k·(tol/1e-10)^{1/5}·min_d τ_fric,d`
+/// with `τ_fric,d = v_d J_d/T_d` of [`rotor_model::TimeScales`] (docs/methods.md, "Steps tied
+/// to the model's scales"): the time a disc accelerating at its scale takes to cross its
+/// friction law's velocity scale. A step much longer than the one that resolves the field on
+/// that scale (∝ τ·tol^{1/5} for DOPRI5) can cross the law's steep part near rest before the
+/// controller sees it. k = 8, as for the event solver; at the comparisons' tol 1e-10 the
+/// default h_max = 0.1 s is shorter on almost every parameter set (measured: +0.2 % field
+/// evaluations over 1000 random sets, `rotor-solvers/examples/step_scales.rs`).
+pub fn step_bound(model: &Model, tol: f64, k: f64) -> f64 {
+    let s = model.time_scales();
+    k * (tol / 1e-10).powf(1.0 / 5.0) * s.friction[0].min(s.friction[1])
+}
+
 /// Settings of the switch-model solver.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct SwitchOptions {
@@ -33,6 +46,10 @@ pub struct SwitchOptions {
     pub max_steps: u64,
     /// Largest step, in s; also bounds the gap between guard samples (≤ h_max/`guard_samples`).
     pub h_max: f64,
+    /// The step bound's multiple `k` at tolerance 1e-10: the step is at most
+    /// `min(h_max, k·(tol/1e-10)^{1/5}·τ_fric)` ([`step_bound`],
+    /// [`rotor_model::Model::time_scales`]). ∞ turns the bound off.
+    pub h_scale: f64,
     /// Number of equal sub-intervals of each step on which guards are sampled (≥ 1), so that
     /// a guard that dips below 0 and back inside one step is still seen.
     pub guard_samples: usize,
@@ -52,6 +69,7 @@ impl Default for SwitchOptions {
             eta: 1e-10,
             max_steps: 20_000_000,
             h_max: 0.1,
+            h_scale: 8.0,
             guard_samples: 5,
             zeno_count: 1000,
             zeno_window: 1e-9,
@@ -696,6 +714,9 @@ impl SwitchOptions {
         if self.h_max.is_nan() || self.h_max <= 0.0 {
             return bad("h_max", self.h_max, "must be positive");
         }
+        if self.h_scale.is_nan() || self.h_scale <= 0.0 {
+            return bad("h_scale", self.h_scale, "must be positive");
+        }
         if self.zeno_window.is_nan() || self.zeno_window < 0.0 {
             return bad("zeno_window", self.zeno_window, "must be >= 0");
         }
@@ -767,7 +788,7 @@ impl Solver for SwitchSolver {
             rtol: tol,
             atol: tol,
             h0: None,
-            h_max: o.h_max,
+            h_max: o.h_max.min(step_bound(model, tol, o.h_scale)),
             max_steps: o.max_steps,
             ..Dopri5Options::default()
         };
