@@ -457,6 +457,7 @@ fn a_killed_compare_leaves_every_report_file_whole() {
         names,
         [
             "README.md",
+            "friction.csv",
             "friction.svg",
             "index.html",
             "kill-big.csv",
