@@ -224,7 +224,7 @@ pub(crate) fn sweep_flagged(e: rotor_jobs::sweep::SweepError) -> anyhow::Error {
     }
 }
 
-/// The largest |u| [V] taken without a warning. Every special point of both parameter
+/// The largest |u| \[V\] taken without a warning. Every special point of both parameter
 /// sets lies below 5 V (the last, Table 1's fold E, at 4.84 V) and the bifurcation
 /// diagrams span 0 to 7 V; above that the rotor only settles to a faster slipping
 /// equilibrium, its speed growing as k_m u / (b_u + b_l) (about 1.8 rad/s per volt for

@@ -131,7 +131,7 @@ impl ScaleBound {
     }
 }
 
-/// The bound of [`ScaleBound`] with both discs slipping,
+/// The friction-scale step bound (the integrator's `ScaleBound`) with both discs slipping,
 /// `k·(tol/1e-10)^{1/8}·min(τ_fric,u, τ_fric,l)`.
 pub fn step_bound(model: &Model, tol: f64, k: f64) -> f64 {
     let s = model.time_scales();
@@ -139,7 +139,7 @@ pub fn step_bound(model: &Model, tol: f64, k: f64) -> f64 {
 }
 
 /// The largest defect, in tolerances, between a step's dense output and the exact RK state
-/// re-taken to an event in it ([`Integrator::defect`]) that lets the step stand. Measured (a
+/// re-taken to an event in it (`Integrator::defect`) that lets the step stand. Measured (a
 /// temporary log of every event's defect) over the metrics-only stress scene on 100 random
 /// parameter sets at tol 1e-10 (`rotor-solvers/examples/step_scales.rs`): 9168 events on
 /// steps under 0.25 s, median 0.03, 99.9th percentile and largest 4.35 (short steps whose
