@@ -317,41 +317,13 @@ mod tests {
             stick_time: 1.0,
         };
         metrics_of_a_cycle(&cycle).unwrap();
-        let with = |f: &dyn Fn(&mut [f64; 6])| {
-            let SteadyState::LimitCycle {
-                period,
-                omega_l_max,
-                omega_l_min,
-                omega_u_max,
-                omega_u_min,
-                stick_time,
-            } = cycle
-            else {
-                unreachable!()
-            };
-            let mut v = [
-                period,
-                omega_l_max,
-                omega_l_min,
-                omega_u_max,
-                omega_u_min,
-                stick_time,
-            ];
-            f(&mut v);
-            SteadyState::LimitCycle {
-                period: v[0],
-                omega_l_max: v[1],
-                omega_l_min: v[2],
-                omega_u_max: v[3],
-                omega_u_min: v[4],
-                stick_time: v[5],
-            }
-        };
+        // The cycle with one metric replaced.
+        let with = |name: &str, value: f64| cycle.map(|n, v| if n == name { value } else { v });
         for bad in [
-            with(&|v| v[0] = 0.0),
-            with(&|v| v[1] = 1e-7),
-            with(&|v| v[3] = 1.0),
-            with(&|v| v[5] = 5.0),
+            with("period", 0.0),
+            with("omega_l_max", 1e-7),
+            with("omega_u_max", 1.0),
+            with("stick_time", 5.0),
         ] {
             assert!(is_refuted(metrics_of_a_cycle(&bad), "cycle"), "{bad:?}");
         }
