@@ -515,11 +515,8 @@ fn gate_value(
                     .iter()
                     .any(|e| matches!(e.kind, EventKind::StickStart(_)))
             });
-            let eta = if s.kind == SolverKind::SWITCH && sticks {
-                rotor_switch::SwitchOptions::default().eta
-            } else {
-                0.0
-            };
+            // a solver that holds a stuck disc in a band of its own adds that band
+            let eta = if sticks { s.kind.info().stuck_band } else { 0.0 };
             Some(4.0 * phase.max(1.0) * (s.accuracy.tol() + tol_ref) + eta)
         }
         Gate::Trapezoid => {
