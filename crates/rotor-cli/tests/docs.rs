@@ -1,5 +1,6 @@
 //! The documentation's commands, run as they stand: the README's quick CLI block from an
-//! empty directory, and BENCHMARK.md's job file against what `rotor job` prints.
+//! empty directory, its long block (`minutes`) too when `ROTOR_README_LONG=1` (CI's long
+//! step, `.ci/run`), and BENCHMARK.md's job file against what `rotor job` prints.
 
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -100,6 +101,181 @@ fn readme_quick_commands_run_from_an_empty_directory() {
         }
     }
     std::fs::remove_dir_all(&dir).ok();
+}
+
+/// The `rotor ...` lines of a marked block, split from their comments.
+fn rotor_lines<'a>(block: &[&'a str]) -> Vec<(&'a str, &'a str)> {
+    block
+        .iter()
+        .map(|l| split_comment(l))
+        .filter(|(c, _)| c.starts_with("rotor "))
+        .collect()
+}
+
+/// The value of `--flag VALUE` in a command line (the README's long commands quote no path).
+fn flag_value<'a>(cmd: &'a str, flag: &str) -> Option<&'a str> {
+    let mut words = cmd.split_whitespace();
+    words.find(|w| *w == flag)?;
+    words.next()
+}
+
+/// The README's long block (`cli-long`): every `rotor ...` line of it is marked `minutes`,
+/// and every line of the README marked `minutes` that runs `rotor` is in it (so that CI's
+/// long step runs them all). With `ROTOR_README_LONG=1` (CI's long step, `.ci/run`) each runs
+/// as it stands, with `rotor` on the PATH and the suite taken from the binary, from an empty
+/// directory of its own, `/path/to/minimal.py` being the checkout's
+/// `bench/clients/minimal.py`; it must exit 0, write the files it names (`--json` a
+/// benchmark report of every scene the command covers, each with points of the three
+/// solvers; `--svg` an SVG), and its table must name every scene and client. Under
+/// `ROTOR_REQUIRE_PEERS=1` (as in CI, which installs them) every peer must have run. Without
+/// `ROTOR_README_LONG=1` the test says on stderr that it skipped them, in `cargo test`'s own
+/// output (not the captured test output, which a passing test hides).
+#[test]
+fn readme_long_commands_run_in_ci_long_step() {
+    let readme = std::fs::read_to_string(root().join("README.md")).unwrap();
+    let block = marked(&readme, "cli-long");
+    let commands = rotor_lines(&block);
+    assert!(!commands.is_empty(), "no command in the cli-long block");
+    for (cmd, comment) in &commands {
+        assert!(comment.contains("minutes"), "{cmd}: not marked `minutes`");
+    }
+    let mut in_sh = false;
+    for line in readme.lines() {
+        if line.starts_with("```") {
+            in_sh = line == "```sh";
+            continue;
+        }
+        let (cmd, comment) = split_comment(line);
+        if in_sh && cmd.starts_with("rotor ") && comment.contains("minutes") {
+            assert!(
+                block.contains(&line),
+                "{line}: marked `minutes` but outside the cli-long block (CI's long step would \
+                 not run it)"
+            );
+        }
+    }
+    if std::env::var("ROTOR_README_LONG").as_deref() != Ok("1") {
+        // Straight to the process's stderr: libtest captures `eprintln!` of a passing test.
+        use std::io::Write as _;
+        let _ = writeln!(
+            std::io::stderr(),
+            "readme_long_commands_run_in_ci_long_step: skipped the README's {} commands marked \
+             `minutes` ({}); ROTOR_README_LONG=1 runs them (CI's long step, .ci/run)",
+            commands.len(),
+            commands
+                .iter()
+                .map(|(c, _)| *c)
+                .collect::<Vec<_>>()
+                .join("; ")
+        );
+        return;
+    }
+    let minimal = root()
+        .join("bench/clients/minimal.py")
+        .canonicalize()
+        .unwrap();
+    let bin = Path::new(env!("CARGO_BIN_EXE_rotor")).parent().unwrap();
+    let path = format!(
+        "{}:{}",
+        bin.display(),
+        std::env::var("PATH").unwrap_or_default()
+    );
+    let require_peers = std::env::var("ROTOR_REQUIRE_PEERS").as_deref() == Ok("1");
+    let suite_dir = root().join("fixtures/scenarios");
+    for (cmd, _) in &commands {
+        let run = cmd.replace("/path/to/minimal.py", &minimal.display().to_string());
+        assert!(!run.contains("/path/to/"), "{cmd}: a placeholder path left");
+        let dir = rotor_testkit::tmp_dir("rotor-cli-readme-long");
+        let t0 = std::time::Instant::now();
+        let o = Command::new("sh")
+            .args(["-c", &run])
+            .current_dir(&dir)
+            .env("PATH", &path)
+            .env("ROTORBENCH_SUITE", "embedded")
+            .env("ROTORBENCH_CACHE", dir.join(".cache"))
+            .env_remove("ROTORBENCH_FIXTURES")
+            .output()
+            .unwrap();
+        let stderr = String::from_utf8_lossy(&o.stderr);
+        assert!(o.status.success(), "{cmd}: exit {:?}: {stderr}", o.status);
+        // Its wall time, for whoever updates the README's stated one (never asserted).
+        use std::io::Write as _;
+        let _ = writeln!(
+            std::io::stderr(),
+            "{cmd}: {:.0} s wall",
+            t0.elapsed().as_secs_f64()
+        );
+        let table = String::from_utf8(o.stdout).unwrap();
+        // The scenes the command covers: the tier it names, else the whole suite.
+        let tier = flag_value(cmd, "--tier").map(|t| rotor_bench::Tier::parse(t).unwrap());
+        let scenes: Vec<String> = rotor_bench::suite(&suite_dir, tier)
+            .unwrap()
+            .iter()
+            .map(|s| {
+                s.scenario
+                    .file_stem()
+                    .unwrap()
+                    .to_string_lossy()
+                    .into_owned()
+            })
+            .collect();
+        for sc in &scenes {
+            assert!(table.contains(sc.as_str()), "{cmd}: {sc} not in its table");
+        }
+        // `--external NAME=COMMAND`: the client's name.
+        let externals: Vec<&str> = cmd
+            .split(" --external ")
+            .skip(1)
+            .filter_map(|rest| rest.split('=').next())
+            .collect();
+        for name in &externals {
+            assert!(
+                table.contains(name),
+                "{cmd}: client {name} not in its table"
+            );
+        }
+        if let Some(svg) = flag_value(cmd, "--svg") {
+            let text = std::fs::read_to_string(dir.join(svg)).unwrap();
+            assert!(
+                text.contains("<svg") && text.trim_end().ends_with("</svg>"),
+                "{cmd}: {svg} is not a whole SVG"
+            );
+        }
+        if let Some(json) = flag_value(cmd, "--json") {
+            let text = std::fs::read_to_string(dir.join(json)).unwrap();
+            let report: rotor_bench::BenchReport = serde_json::from_str(&text)
+                .unwrap_or_else(|e| panic!("{cmd}: {json} is not a benchmark report: {e}"));
+            let names: Vec<&str> = report.scenes.iter().map(|s| s.name.as_str()).collect();
+            assert_eq!(names.len(), scenes.len(), "{cmd}: {names:?}");
+            for sc in &report.scenes {
+                assert!(
+                    scenes.contains(&sc.name),
+                    "{cmd}: {} not asked for",
+                    sc.name
+                );
+                for k in rotor_solvers::SOLVERS {
+                    assert!(
+                        sc.points.iter().any(|p| p.solver == k),
+                        "{cmd}: {}: no point of {}",
+                        sc.name,
+                        k.name()
+                    );
+                }
+            }
+            if require_peers {
+                for c in report.clients.iter().filter(|c| c.peer) {
+                    assert_eq!(
+                        c.status,
+                        rotor_bench::ClientStatus::Ran,
+                        "{cmd}: peer {} did not run: {:?}",
+                        c.name,
+                        c.reason
+                    );
+                }
+            }
+        }
+        std::fs::remove_dir_all(&dir).ok();
+    }
 }
 
 /// BENCHMARK.md's example job file is what `rotor job` prints for the command above it,

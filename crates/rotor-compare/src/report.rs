@@ -109,9 +109,15 @@ fn label(kind: SolverKind, sc: &Scenario) -> String {
     kind.label_at(solver_setting(kind, sc))
 }
 
-/// Per-scenario CSV: `t` and ω_u, ω_l of each solver on the comparison grid, each value to
-/// 12 significant digits (far below every gate's tolerance, so the committed report moves
-/// only where an answer does).
+/// The per-solver columns of [`scenario_csv`], in the state's order (x = [α, ω_u, ω_l]).
+const CSV_QUANTITIES: [&str; 3] = ["alpha", "omega_u", "omega_l"];
+
+/// Per-scenario CSV, the data of [`scenario_svg`]'s figure: `t`, then for each solver that
+/// finished, in the figure's order (the reference first), `alpha_<solver>` (α = θ_u − θ_l,
+/// rad), `omega_u_<solver>` and `omega_l_<solver>` (rad/s) on the comparison grid. The
+/// figure's difference panels are |x_solver − x_reference| of these columns. Each value to 12
+/// significant digits (far below every gate's tolerance, so the committed report moves only
+/// where an answer does); `t` to the grid's decimals.
 pub fn scenario_csv(r: &ScenarioResult) -> String {
     let kinds: Vec<SolverKind> = r
         .runs
@@ -122,8 +128,9 @@ pub fn scenario_csv(r: &ScenarioResult) -> String {
     let mut w = csv::Writer::from_writer(Vec::new());
     let mut header = vec!["t".to_string()];
     for k in &kinds {
-        header.push(format!("omega_u_{}", k.name()));
-        header.push(format!("omega_l_{}", k.name()));
+        for q in CSV_QUANTITIES {
+            header.push(format!("{q}_{}", k.name()));
+        }
     }
     // Writing to memory cannot fail.
     w.write_record(&header).expect("in memory");
@@ -133,15 +140,17 @@ pub fn scenario_csv(r: &ScenarioResult) -> String {
         .min()
         .unwrap_or(0);
     let digits = rotor_grade::trace::time_digits(r.scenario.compare.dt);
-    let mut row: Vec<f64> = Vec::with_capacity(1 + 2 * kinds.len());
+    let mut row: Vec<f64> = Vec::with_capacity(1 + CSV_QUANTITIES.len() * kinds.len());
     for i in 0..n {
         row.clear();
         let t = r.traj(kinds[0]).map_or(0.0, |tr| tr.samples[i].t);
         row.push(rotor_grade::trace::round_to(t, digits));
         for k in &kinds {
             let x = r.traj(*k).map(|tr| tr.samples[i].x).unwrap_or_default();
-            row.push(round_sig(x[1], 12, Rounding::Decimal { floor: 0.0 }));
-            row.push(round_sig(x[2], 12, Rounding::Decimal { floor: 0.0 }));
+            // The state's order is the columns' order: α, ω_u, ω_l.
+            for v in [x[0], x[1], x[2]] {
+                row.push(round_sig(v, 12, Rounding::Decimal { floor: 0.0 }));
+            }
         }
         w.serialize(&row).expect("in memory");
     }
@@ -470,7 +479,7 @@ pub fn write_report(
          solvers.\n\n\
          | scenario | pair | quantity | key | difference | tolerance | margin | |\n|---|---|---|---|---|---|---|---|\n",
     );
-    // Each scenario's trace and figure, rendered side by side (44 MB of CSV for the fixtures:
+    // Each scenario's trace and figure, rendered side by side (66 MB of CSV for the fixtures:
     // the main job's last step, which would otherwise leave a core idle).
     let rendered: Vec<(String, String)> = {
         use rayon::prelude::*;
@@ -619,5 +628,61 @@ mod tests {
             .collect();
         assert_eq!(names, vec![std::ffi::OsString::from("a.csv")]);
         std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    /// The trace figure's data carries what the figure draws: `t`, then α, ω_u and ω_l of
+    /// each solver, the reference first, one row per grid sample; each value is the run's
+    /// state rounded to 12 significant digits (the report's rule), so that a reader who
+    /// redraws the figure from the CSV draws the same curves, α included.
+    #[test]
+    fn the_trace_csv_holds_alpha_and_both_speeds_of_every_solver() {
+        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("../../fixtures/scenarios/t1-u1.5-rest.toml");
+        let mut sc = rotor_solvers::load_scenario(&path).unwrap();
+        // Two seconds: the lower disc's first stick and slip, a few hundred samples; no
+        // steady window (it lies past 2 s, and the CSV holds no metrics).
+        sc.t_end = 2.0;
+        sc.compare.steady_from = None;
+        let r = rotor_solvers::run::run_scenario(&sc);
+        let csv = scenario_csv(&r);
+        let mut lines = csv.lines();
+        assert_eq!(
+            lines.next().unwrap(),
+            "t,alpha_event,omega_u_event,omega_l_event,alpha_switch,omega_u_switch,\
+             omega_l_switch,alpha_moreau,omega_u_moreau,omega_l_moreau"
+        );
+        let rows: Vec<Vec<f64>> = lines
+            .map(|l| l.split(',').map(|v| v.parse().unwrap()).collect())
+            .collect();
+        let kinds = [SolverKind::EVENT, SolverKind::SWITCH, SolverKind::MOREAU];
+        let samples = &r.traj(kinds[0]).unwrap().samples;
+        assert_eq!(rows.len(), samples.len());
+        assert_eq!(rows.len(), 201, "0, 0.01, ..., 2 s");
+        let round = |v: f64| round_sig(v, 12, Rounding::Decimal { floor: 0.0 });
+        let mut alpha_moves = false;
+        for (i, row) in rows.iter().enumerate() {
+            assert_eq!(row.len(), 1 + 3 * kinds.len());
+            // The scenario's grid is 0.01 s; `t` is written to its two decimals (a double
+            // nearest k/100, within 1e-15 of i·0.01).
+            assert!(
+                (row[0] - i as f64 * 0.01).abs() < 1e-15,
+                "row {i}: t = {}",
+                row[0]
+            );
+            for (j, k) in kinds.iter().enumerate() {
+                let x = r.traj(*k).unwrap().samples[i].x;
+                for q in 0..3 {
+                    assert_eq!(
+                        row[1 + 3 * j + q],
+                        round(x[q]),
+                        "row {i}, {}, column {q}",
+                        k.name()
+                    );
+                }
+            }
+            alpha_moves |= row[1] != 0.0;
+        }
+        // The spring winds up from rest: α is a column of data, not of zeros.
+        assert!(alpha_moves);
     }
 }

@@ -44,7 +44,7 @@ fn snapshots_of_metrics_and_counters() {
         insta::assert_yaml_snapshot!(r.scenario.name.clone(), snapshot(r));
     }
     // Every stored snapshot belongs to a fixture scenario: a renamed or deleted scenario
-    // must take its snapshot with it (CI also runs `cargo insta test --unreferenced=reject`).
+    // must take its snapshot with it (CI also rejects any snapshot no test reads: .ci/snapshots).
     let names: Vec<String> = results.iter().map(|r| r.scenario.name.clone()).collect();
     let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/snapshots");
     for entry in std::fs::read_dir(&dir).unwrap() {

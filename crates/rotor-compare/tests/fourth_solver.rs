@@ -291,13 +291,13 @@ fn a_fourth_solver_needs_its_crate_one_entry_and_its_tolerances() {
     let snap = snapshot(&r);
     assert_eq!(snap.solvers.len(), 4);
     assert!(snap.differences.contains_key("event-euler"));
-    assert!(scenario_csv(&r).starts_with("t,omega_u_event,omega_l_event,omega_u_switch"));
+    assert!(scenario_csv(&r).starts_with("t,alpha_event,omega_u_event,omega_l_event,alpha_switch"));
     assert!(
         scenario_csv(&r)
             .lines()
             .next()
             .unwrap()
-            .ends_with(",omega_u_euler,omega_l_euler")
+            .ends_with(",alpha_euler,omega_u_euler,omega_l_euler")
     );
     // Its figure: α, ω_u and ω_l overlaid over the whole run, each with a panel of every
     // solver's difference from the reference under it; the fourth solver in all six legends.
