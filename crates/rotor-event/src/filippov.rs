@@ -50,6 +50,12 @@ pub struct EventOptions {
     /// less than `ε·k·(tol/1e-10)^{1/8}·v` (the integrator's `ScaleBound`). 0 by default: the
     /// bound everywhere; [`LIFT_FRACTION`] is the measured candidate.
     pub lift: f64,
+    /// `M` of the step bound's lift at the solver's resolution: the bound does not cap a step
+    /// over which the slipping disc's velocity, predicted as for `lift`, moves by less than
+    /// `M·tol·(1 + |ω|)`, motion the solver does not resolve (extrema closer than
+    /// `EXTREMUM_RESOLUTION` = 10 tolerances are not reported). 0 by default (off);
+    /// [`LIFT_RESOLUTION`] = 10 is the measured candidate.
+    pub lift_resolution: f64,
     /// The largest defect, in tolerances, between a step's dense output and the exact state
     /// re-taken to an event in it that lets the step stand; a larger one rejects the step
     /// ([`DEFECT_LIMIT`] by default, ∞ turns the check off).
@@ -78,6 +84,7 @@ impl Default for EventOptions {
             // Off until the fixtures' cross-solver gates and snapshots are re-measured with it
             // (docs/methods.md §1a, "The lift").
             lift: 0.0,
+            lift_resolution: 0.0,
             defect_limit: DEFECT_LIMIT,
             max_steps: 50_000_000,
             zeno_count: 64,
@@ -93,7 +100,7 @@ impl Default for EventOptions {
 ///
 /// ```text
 /// h ≤ max(h_d, t_lift,d),   h_d = k·(tol/1e-10)^{1/8}·τ_fric,d,   τ_fric,d = v_d J_d/T_d,
-/// t_lift,d:  |ω̇_d|·t + ½|ω̈_d|·t² = ε·k·(tol/1e-10)^{1/8}·v_d
+/// t_lift,d:  |ω̇_d|·t + ½|ω̈_d|·t² = max(ε·k·(tol/1e-10)^{1/8}·v_d, M·tol·(1 + |ω_d|))
 /// ```
 ///
 /// ([`rotor_model::TimeScales`]; `ω̇, ω̈` at the step's start, `ω̈ = ((∂f/∂x)·f)_d`). `h_d` is
@@ -132,6 +139,9 @@ pub(crate) struct ScaleBound {
     /// The velocity change `ε·k·(tol/1e-10)^{1/8}·v_d` below which the bound is lifted (0:
     /// never).
     lift: [f64; 2],
+    /// `M·tol`: the bound is also lifted where the velocity moves by less than
+    /// `M·tol·(1 + |ω_d|)` (0: never).
+    resolution: f64,
 }
 
 /// The measured ε of the step bound's lift (`EventOptions::lift`, off by default): the bound
@@ -139,6 +149,12 @@ pub(crate) struct ScaleBound {
 /// it move at its acceleration scale, `k·(tol/1e-10)^{1/8}·v`. Measured (docs/methods.md
 /// §1a, "The lift").
 pub const LIFT_FRACTION: f64 = 1e-5;
+
+/// The measured `M` of the lift at the solver's resolution (`EventOptions::lift_resolution`,
+/// off by default): the bound is lifted where the slipping disc's velocity moves by less than
+/// `M·tol·(1 + |ω|)` over the step, the resolution below which extrema are not reported
+/// (`EXTREMUM_RESOLUTION`). Measured (docs/methods.md §1a, "The lift").
+pub const LIFT_RESOLUTION: f64 = EXTREMUM_RESOLUTION;
 
 /// The first time `t > 0` at which `|ω̇|·t + ½|ω̈|·t² = dv` (`dv > 0`): the velocity of a
 /// disc starting with these rates cannot have moved by `dv` sooner if they stay below them
@@ -156,7 +172,7 @@ pub(crate) fn excursion_time(dv: f64, rate: f64, accel: f64) -> f64 {
 }
 
 impl ScaleBound {
-    pub(crate) fn new(model: &Model, tol: f64, k: f64, lift: f64) -> ScaleBound {
+    pub(crate) fn new(model: &Model, tol: f64, k: f64, lift: f64, resolution: f64) -> ScaleBound {
         let k = k * (tol / 1e-10).powf(1.0 / 8.0);
         let s = model.time_scales();
         ScaleBound {
@@ -165,16 +181,19 @@ impl ScaleBound {
                 let dv = lift * k * v;
                 if dv.is_finite() { dv } else { 0.0 }
             }),
+            resolution: resolution * tol,
         }
     }
 
     /// The bound in `mode` at the state `x` with the field `f` there, for a step the
     /// controller would make `h` long: the shortest over the slipping discs of
-    /// `max(h_d, t_lift,d)` ([`excursion_time`]). `jac` gives `∂f/∂x` at x; it is called only
+    /// `max(h_d, t_lift,d)` ([`excursion_time`]), the lift's velocity change being
+    /// `max(ε·k·(tol/1e-10)^{1/8}·v_d, M·tol·(1 + |ω_d|))`. `jac` gives `∂f/∂x` at x; it is called only
     /// if some `h_d` is shorter than `h`.
     pub(crate) fn at(
         &self,
         mode: Mode,
+        x: &State,
         f: &State,
         h: f64,
         jac: impl FnOnce() -> Matrix3<f64>,
@@ -187,11 +206,12 @@ impl ScaleBound {
                 continue;
             }
             let mut h_d = self.per_disc[i];
-            if h_d < h && self.lift[i] > 0.0 {
+            let k = d.index();
+            let dv = self.lift[i].max(self.resolution * (1.0 + x[k].abs()));
+            if h_d < h && dv > 0.0 {
                 let a =
                     *accel.get_or_insert_with(|| jac.take().map_or(State::zeros(), |j| j() * f));
-                let k = d.index();
-                h_d = h_d.max(excursion_time(self.lift[i], f[k], a[k]));
+                h_d = h_d.max(excursion_time(dv, f[k], a[k]));
             }
             bound = bound.min(h_d);
         }
@@ -386,7 +406,7 @@ impl<'a> Integrator<'a> {
             section: None,
             extra_evals: Cell::new(0),
             delivered: 0,
-            scale_bound: ScaleBound::new(model, tol, opts.h_scale, opts.lift),
+            scale_bound: ScaleBound::new(model, tol, opts.h_scale, opts.lift, opts.lift_resolution),
             stick_intervals: Disc::BOTH.map(|d| model.friction(d).static_interval()),
         }
     }
@@ -834,7 +854,7 @@ impl<'a> Integrator<'a> {
         let (model, u) = (self.model, self.u);
         let bound = self
             .scale_bound
-            .at(c.mode, &c.f0, c.h, || model.jacobian(&c.x, u, c.mode));
+            .at(c.mode, &c.x, &c.f0, c.h, || model.jacobian(&c.x, u, c.mode));
         let mut h = c.h.min(bound);
         let mut last = false;
         if c.t + 1.01 * h >= t_end {
@@ -1375,8 +1395,8 @@ mod tests {
 
     /// The bound at x for a step the controller would make `h` long.
     fn bound_at(m: &Model, u: f64, tol: f64, x: &State, h: f64) -> f64 {
-        let b = ScaleBound::new(m, tol, 8.0, LIFT_FRACTION);
-        b.at(SLIP, &m.rhs(x, u, SLIP), h, || m.jacobian(x, u, SLIP))
+        let b = ScaleBound::new(m, tol, 8.0, LIFT_FRACTION, 0.0);
+        b.at(SLIP, x, &m.rhs(x, u, SLIP), h, || m.jacobian(x, u, SLIP))
     }
 
     /// Where the misjudged step started: the lower disc at 4.09 rad/s, braking at 10 rad/s²
@@ -1412,6 +1432,19 @@ mod tests {
         let off = x + State::new(0.0, 0.0, 1e-3);
         assert_eq!(bound_at(&m, u, tol, &off, 1.0), fixed);
         assert!((fixed - 0.20).abs() < 0.005, "{fixed}");
+        // The lift at the resolution alone (M = 10: 1.2e-8 rad/s here) does the same.
+        let f = |x: &State| m.rhs(x, u, SLIP);
+        let res = ScaleBound::new(&m, tol, 8.0, 0.0, LIFT_RESOLUTION);
+        let at = |x: &State| res.at(SLIP, x, &f(x), 1.0, || m.jacobian(x, u, SLIP));
+        assert!(at(&x) >= 1.0);
+        assert_eq!(at(&off), fixed);
+        // Off by default: the bound everywhere.
+        let d = EventOptions::default();
+        let none = ScaleBound::new(&m, tol, 8.0, d.lift, d.lift_resolution);
+        assert_eq!(
+            none.at(SLIP, &x, &f(&x), 1.0, || m.jacobian(&x, u, SLIP)),
+            fixed
+        );
     }
 
     /// `excursion_time` bounds the velocity change of a harmonic oscillation ω = A cos(Ωt + φ)

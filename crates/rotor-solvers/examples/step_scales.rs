@@ -119,15 +119,22 @@ fn event(k: f64) -> Box<dyn Solver> {
         .ok()
         .and_then(|v| v.parse().ok())
         .unwrap_or(EventOptions::default().lift);
-    event_with(k, lift)
+    // STEP_SCALES_LIFT_RES=M lifts it at M·tol·(1 + |ω|) too (EventOptions::lift_resolution).
+    let resolution = std::env::var("STEP_SCALES_LIFT_RES")
+        .ok()
+        .and_then(|v| v.parse().ok())
+        .unwrap_or(EventOptions::default().lift_resolution);
+    event_with(k, lift, resolution)
 }
 
-/// The event solver with the bound's multiple k and its lift's ε (0: the bound everywhere).
-fn event_with(k: f64, lift: f64) -> Box<dyn Solver> {
+/// The event solver with the bound's multiple k and its lift's ε and M (0, 0: the bound
+/// everywhere).
+fn event_with(k: f64, lift: f64, lift_resolution: f64) -> Box<dyn Solver> {
     Box::new(EventSolver {
         options: EventOptions {
             h_scale: k,
             lift,
+            lift_resolution,
             // STEP_SCALES_DEFECT=inf turns the defect check at events off.
             defect_limit: std::env::var("STEP_SCALES_DEFECT")
                 .ok()
@@ -203,7 +210,7 @@ fn main() {
             metrics_from: Some(50.0),
         };
         // The reference keeps the bound everywhere, whatever the variant measured.
-        let reference = event_with(2.0, 0.0)
+        let reference = event_with(2.0, 0.0, 0.0)
             .simulate(
                 &m,
                 &Scene {
