@@ -13,7 +13,7 @@ mod solver;
 pub mod steady;
 mod tableau;
 
-pub use filippov::{DEFECT_LIMIT, EventOptions, step_bound};
+pub use filippov::{DEFECT_LIMIT, EventOptions, LIFT_FRACTION, LIFT_RESOLUTION, step_bound};
 pub use flow::{FlowEnd, StopAt, flow};
 pub use solver::EventSolver;
 pub use steady::{Method, Steady, SteadyOptions, steady_state};
