@@ -126,6 +126,7 @@ pub(crate) fn load(
     let scenario = rotor_solvers::load_scenario(&spec.scenario)?;
     let base = Scene {
         u: scenario.u,
+        input: None,
         x0: scenario.x0,
         t_end: spec.t_end,
         accuracy: Accuracy::Tol(opts.reference_tol),

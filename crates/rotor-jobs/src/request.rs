@@ -144,6 +144,7 @@ impl Request<'_> {
         };
         Ok(Scene {
             u: self.u,
+            input: None,
             x0: State::new(a, wu, wl),
             t_end,
             accuracy,
