@@ -203,3 +203,79 @@ fn a_scenario_file_takes_an_input_file_or_inline_rows() {
     ]);
     refused(&o, "decreasing row", &["input[1].t = 0", "decreases"]);
 }
+
+/// A scenario with a time-varying input: `rotor job` writes `"u": null` and the rows as
+/// `"input"`, `rotor reference` writes its reference, and `rotor check` grades a trace
+/// against it like any other: the event solver's own trace passes at the strict gate, and
+/// the trace of the constant 1.5 V run (no step) fails.
+#[test]
+fn job_reference_and_check_take_a_scene_with_an_input() {
+    let dir = tmp_dir("rotor-cli-input");
+    let text = local_scenario()
+        .replace("name = \"t1-u1.5-rest\"", "name = \"t1-step\"")
+        .replace("\nu = 1.5 ", "\ninput = [[20.0, 1.5], [20.0, 2.5]] ")
+        .replace("t_end = 200.0", "t_end = 60.0")
+        .replace("steady_from = 100.0", "steady_from = 30.0")
+        .replace("transient = [0.0, 20.0]", "transient = [0.0, 30.0]");
+    // The suite's layout: scenarios/ beside reference/, where `check` looks.
+    let scenarios = dir.join("scenarios");
+    std::fs::create_dir_all(&scenarios).unwrap();
+    let f = write_scenario(&scenarios, text.as_bytes());
+    let s = f.to_str().unwrap();
+    let o = rotor(&["job", s, "--tol", "1e-8"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let job: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert_eq!(job["u"], serde_json::Value::Null);
+    assert_eq!(job["input"], serde_json::json!([[20.0, 1.5], [20.0, 2.5]]));
+    let refdir = dir.join("reference");
+    let o = rotor(&[
+        "reference",
+        "--scenario",
+        s,
+        "--out",
+        refdir.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let graded = |args: &[&str]| {
+        let csv = dir.join("trace.csv");
+        let mut all = vec!["simulate", s];
+        all.extend_from_slice(args);
+        all.extend_from_slice(&["--csv", csv.to_str().unwrap()]);
+        let o = rotor(&all);
+        assert!(o.status.success(), "{}", stderr(&o));
+        Command::new(env!("CARGO_BIN_EXE_rotor"))
+            .args([
+                "check",
+                s,
+                "--trace",
+                csv.to_str().unwrap(),
+                "--gate",
+                "strict",
+            ])
+            .current_dir(&dir)
+            .output()
+            .unwrap()
+    };
+    let own = graded(&["--solver", "event"]);
+    assert_eq!(own.status.code(), Some(0), "{}", stderr(&own));
+    // The same run without the step: a constant scenario's trace against the step's
+    // reference.
+    let constant = text.replace("\ninput = [[20.0, 1.5], [20.0, 2.5]] ", "\nu = 1.5 ");
+    std::fs::write(scenarios.join("c.toml"), constant).unwrap();
+    let csv = dir.join("c.csv");
+    let o = rotor(&[
+        "simulate",
+        scenarios.join("c.toml").to_str().unwrap(),
+        "--solver",
+        "event",
+        "--csv",
+        csv.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let o = Command::new(env!("CARGO_BIN_EXE_rotor"))
+        .args(["check", s, "--trace", csv.to_str().unwrap()])
+        .current_dir(&dir)
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
+}

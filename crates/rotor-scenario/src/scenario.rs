@@ -121,6 +121,12 @@ impl Scenario {
         }
     }
 
+    /// The input over the steady-state window: `u`, or a time-varying input's value after
+    /// its last breakpoint (which a scenario with `compare.steady_from` puts before it).
+    pub fn steady_u(&self) -> f64 {
+        self.input.as_ref().map_or(self.u, |i| i.at(self.t_end))
+    }
+
     /// Reads and validates a scenario file and the parameter file it names.
     pub fn from_file(path: &Path) -> Result<Scenario, ScenarioError> {
         let bytes = read_small(path).map_err(|e| ScenarioError::Io {
@@ -164,6 +170,22 @@ impl Scenario {
         check_run(&raw, bad)?;
         let x0 = initial_state(&raw, &model, bad)?;
         raw.compare.check(raw.t_end, bad)?;
+        // The steady window of a time-varying input lies after its last breakpoint: a steady
+        // state is that of a constant input.
+        if let (Some(i), Some(from)) = (&input, raw.compare.steady_from)
+            && let Some(&(last, _)) = i.rows().last()
+            && last > from
+        {
+            return Err(bad.at(
+                "compare.steady_from",
+                Num(from).to_string(),
+                &format!(
+                    "lies before the input's last breakpoint (t = {}): the steady window needs \
+                     a constant input",
+                    Num(last)
+                ),
+            ));
+        }
         let mut tolerance = BTreeMap::new();
         for (pair, raw_tol) in &raw.tolerance {
             tolerance.insert(pair.clone(), check_pair(pair, raw_tol, &raw.compare, bad)?);
