@@ -1090,7 +1090,7 @@ fn an_installed_rotor_grades_by_name_from_an_empty_directory() {
         serde_json::from_str(&std::fs::read_to_string(dir.join("list.json")).unwrap()).unwrap();
     assert_eq!(json["benchmark"], version);
     let scenes = json["scenarios"].as_array().unwrap();
-    assert_eq!(scenes.len(), 22);
+    assert_eq!(scenes.len(), 23);
     let tier = |n: &str| {
         scenes.iter().find(|s| s["name"] == n).unwrap()["tier"]
             .as_str()
