@@ -14,6 +14,8 @@ from scipy.integrate import solve_ivp
 
 job = json.load(open(sys.argv[1]))
 P, u, tol = job["params"], job["u"], job["tol"] or 1e-8
+if job.get("input") is not None or u is None:
+    sys.exit("this client takes a constant u only (the job's input changes in time)")
 eps = float(os.environ.get("TANH_EPS", "1e-3"))
 up, lo = P["upper"], P["lower"]
 Ju, Jl, km, k = P["j_u"], P["j_l"], P["k_m"], P["k_theta"]

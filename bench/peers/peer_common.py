@@ -31,6 +31,11 @@ def read_job(argv):
         if key not in job:
             print(f"{argv[1]}: the job has no {key!r}", file=sys.stderr)
             sys.exit(2)
+    if job.get("input") is not None or job["u"] is None:
+        # An input that changes in time (BENCHMARK.md): these peers take a constant u only.
+        print(f"{argv[1]}: the job's input changes in time; this peer takes a constant u only",
+              file=sys.stderr)
+        sys.exit(2)
     for key in ("t_end", "dt"):
         if not (math.isfinite(job[key]) and job[key] > 0.0):
             print(f"{argv[1]}: {key} = {job[key]} must be positive", file=sys.stderr)

@@ -356,7 +356,7 @@ fn grade(l: &Loaded, job: &Job) -> Result<Grade, Failure> {
     };
     let exit = StickExit {
         model: &sc.model,
-        u: sc.u,
+        u: sc.steady_u(),
     };
     let steady = grid_metrics(&trace.samples, l.spec.metrics_from, exit).ok();
     let metrics = SteadyRef::of(steady.as_ref());

@@ -126,6 +126,7 @@ pub(crate) fn load(
     let scenario = rotor_solvers::load_scenario(&spec.scenario)?;
     let base = Scene {
         u: scenario.u,
+        input: scenario.input.clone(),
         x0: scenario.x0,
         t_end: spec.t_end,
         accuracy: Accuracy::Tol(opts.reference_tol),
@@ -183,7 +184,7 @@ pub(crate) fn load(
     let view_ref = Reference::in_memory(&view_sc, &tr, opts.reference_tol);
     let exit = StickExit {
         model: &scenario.model,
-        u: scenario.u,
+        u: scenario.steady_u(),
     };
     // The reference's steady state read off its grid as a trace's is.
     let grid_steady =

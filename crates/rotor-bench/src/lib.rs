@@ -419,6 +419,7 @@ pub fn scene_of(spec: &SceneSpec) -> Result<(Model, Scene), BenchError> {
         sc.model,
         Scene {
             u: sc.u,
+            input: sc.input.clone(),
             x0: sc.x0,
             t_end: spec.t_end,
             output: Output::Grid { dt: spec.dt },

@@ -21,6 +21,7 @@ use allocation_counter::measure;
 fn scene(t_end: f64, metrics: bool) -> Scene {
     Scene {
         u: 1.5,
+        input: None,
         x0: State::zeros(),
         t_end,
         // Moreau–Jean takes the default step, 1e-3.

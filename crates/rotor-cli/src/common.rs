@@ -13,7 +13,7 @@ use crate::out;
 pub(crate) struct Common {
     /// A scenario file, or a name in fixtures/scenarios (`t1-u1.5-rest`): its u, x0 and
     /// parameter set (and, for `simulate`, its horizon and grid, so that `rotor check` takes
-    /// the trace). Without it, --u is required.
+    /// the trace). Without it, --u or --input is required.
     #[arg(value_name = "SCENARIO")]
     pub(crate) scenario: Option<PathBuf>,
     /// Solver: switch, event or moreau.
@@ -24,10 +24,15 @@ pub(crate) struct Common {
     #[arg(
         long,
         allow_hyphen_values = true,
-        required_unless_present = "scenario",
+        required_unless_present_any = ["scenario", "input"],
         conflicts_with = "scenario"
     )]
     pub(crate) u: Option<f64>,
+    /// A motor input that changes in time, instead of --u: a CSV with header `t,u` (s, V),
+    /// rows in non-decreasing t; u is linear between rows, constant before the first and
+    /// after the last, and two rows at one t are a step (the second value holds from it).
+    #[arg(long, value_name = "FILE", conflicts_with_all = ["u", "scenario"])]
+    pub(crate) input: Option<PathBuf>,
     /// Parameter file, or the name of one in fixtures/params (`stribeck`; default: the
     /// source's Table 1).
     #[arg(long, conflicts_with = "scenario")]
@@ -263,6 +268,8 @@ pub(crate) fn implausible_u(u: f64, model: &Model) -> Option<String> {
 /// flags'. The scenario, if any, comes back for its horizon and grid.
 pub(crate) struct Start {
     pub(crate) u: f64,
+    /// A time-varying input (`--input`, or the scenario's `input`).
+    pub(crate) input: Option<rotor_seam::Input>,
     pub(crate) x0: State,
     pub(crate) model: Model,
     pub(crate) scenario: Option<rotor_scenario::Scenario>,
@@ -275,6 +282,7 @@ pub(crate) fn start(common: &Common) -> Result<Start> {
             let sc = rotor_solvers::load_scenario(&fixture_path("SCENARIO", p, "scenarios")?)?;
             Start {
                 u: sc.u,
+                input: sc.input.clone(),
                 x0: sc.x0,
                 model: sc.model,
                 scenario: Some(sc),
@@ -283,15 +291,26 @@ pub(crate) fn start(common: &Common) -> Result<Start> {
         None => Start {
             // clap requires --u without a scenario.
             u: common.u.unwrap_or(f64::NAN),
+            input: common.input.as_deref().map(read_input).transpose()?,
             x0: parse_x0(common.x0.as_deref())?,
             model: load_model(common.params.as_deref())?,
             scenario: None,
         },
     };
-    if let Some(w) = implausible_u(s.u, &s.model) {
+    let u_max = s.input.as_ref().map_or(s.u, |i| i.max_abs());
+    if let Some(w) = implausible_u(u_max, &s.model) {
         eprintln!("warning: {w}");
     }
     Ok(s)
+}
+
+/// `--input FILE`: the input table, read and checked (exit 2 naming the file, the row and
+/// the bad value).
+pub(crate) fn read_input(path: &Path) -> Result<rotor_seam::Input> {
+    let text = std::fs::read_to_string(path)
+        .map_err(|e| unusable(format_args!("--input {}: cannot read: {e}", path.display())))?;
+    rotor_seam::Input::from_csv(&text, &path.display().to_string())
+        .map_err(|e| unusable(format_args!("--input: {e}")))
 }
 
 /// The checked request of `simulate` and `steady` (the same checks and words as the Python
@@ -304,6 +323,7 @@ pub(crate) fn request<'a>(
     let req = rotor_jobs::request::Request {
         solver: &common.solver,
         u: start.u,
+        input: start.input.clone(),
         x0: [x[0], x[1], x[2]],
         tol: common.tol,
         h: common.h,

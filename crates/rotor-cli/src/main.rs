@@ -126,7 +126,38 @@ impl Command {
     }
 }
 
+/// The commands that need a constant input (their answers are steady states of a
+/// time-invariant system): `--input` given to one of them is refused, naming it, before
+/// clap would report only a missing required argument.
+const CONSTANT_INPUT_ONLY: [&str; 3] = ["bifurcation", "bifurcation2", "sweep"];
+
+/// The refusal of `--input` for a [`CONSTANT_INPUT_ONLY`] command in `args` (the program's
+/// arguments after its name), if any.
+fn refused_input(args: &[String]) -> Option<String> {
+    let cmd = args.iter().find(|a| !a.starts_with('-'))?;
+    if !CONSTANT_INPUT_ONLY.contains(&cmd.as_str()) {
+        return None;
+    }
+    let given = args
+        .iter()
+        .any(|a| a == "--input" || a.starts_with("--input="));
+    given.then(|| {
+        format!(
+            "--input: {cmd} needs a constant input (its answers are steady states of a \
+             time-invariant system); `rotor simulate --input` runs a time-varying one"
+        )
+    })
+}
+
 fn main() -> ExitCode {
+    let args: Vec<String> = std::env::args_os()
+        .skip(1)
+        .map(|a| a.to_string_lossy().into_owned())
+        .collect();
+    if let Some(msg) = refused_input(&args) {
+        eprintln!("error: {msg}");
+        return ExitCode::from(2);
+    }
     let cli = Cli::parse();
     // `rotor --threads N` is the main job's; a subcommand takes its own after its name.
     if cli.threads.is_some()

@@ -1090,7 +1090,7 @@ fn an_installed_rotor_grades_by_name_from_an_empty_directory() {
         serde_json::from_str(&std::fs::read_to_string(dir.join("list.json")).unwrap()).unwrap();
     assert_eq!(json["benchmark"], version);
     let scenes = json["scenarios"].as_array().unwrap();
-    assert_eq!(scenes.len(), 22);
+    assert_eq!(scenes.len(), 23);
     let tier = |n: &str| {
         scenes.iter().find(|s| s["name"] == n).unwrap()["tier"]
             .as_str()
@@ -1550,6 +1550,7 @@ fn event_conventions_of_benchmark_md_are_the_graders() {
     let req = rotor_jobs::request::Request {
         solver: "event",
         u: 1.5,
+        input: None,
         x0: [0.0, -1.0, 0.0],
         tol: None,
         h: None,

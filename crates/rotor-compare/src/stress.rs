@@ -462,6 +462,7 @@ fn scene_of(case: &StressCase, s: &Setting, u: f64, x0: State) -> Scene {
     };
     Scene {
         u,
+        input: None,
         x0,
         t_end: case.t_end,
         // A step longer than the horizon is cut to it.

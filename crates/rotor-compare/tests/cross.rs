@@ -12,7 +12,7 @@ fn run(kind: SolverKind, setting: f64, scene: &Scene) -> Trajectory {
             &Model::table1(),
             &Scene {
                 accuracy: kind.accuracy(setting),
-                ..*scene
+                ..scene.clone()
             },
         )
         .unwrap()
@@ -57,7 +57,7 @@ fn a_reversal_without_sticking_matches_the_event_solver() {
                     &Model::table1(),
                     &Scene {
                         accuracy: Accuracy::Tol(1e-10),
-                        ..scene
+                        ..scene.clone()
                     },
                 )
                 .unwrap(),
@@ -123,7 +123,7 @@ fn grid_samples_between_steps_match_the_event_solver() {
             setting,
             &Scene {
                 output: Output::Steps,
-                ..scene
+                ..scene.clone()
             },
         );
         let step_times: Vec<f64> = steps.samples.iter().map(|s| s.t).collect();

@@ -40,6 +40,7 @@ fn no_solver_reports_turns_below_its_resolution() {
         };
         let s = Scene {
             u,
+            input: None,
             x0: State::zeros(),
             t_end: 200.0,
             accuracy,

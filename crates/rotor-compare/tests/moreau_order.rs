@@ -27,6 +27,7 @@ const HS: [f64; 5] = [1e-2, 3e-3, 1e-3, 3e-4, 1e-4];
 fn scene(accuracy: Accuracy) -> Scene {
     Scene {
         u: 1.5,
+        input: None,
         x0: State::zeros(),
         t_end: 60.0,
         accuracy,
@@ -230,6 +231,7 @@ fn moreau_state_and_stick_onsets_converge_at_second_order() {
                 &model,
                 &Scene {
                     u: 1.5,
+                    input: None,
                     x0: State::zeros(),
                     t_end,
                     accuracy: Accuracy::Tol(tol),
@@ -263,6 +265,7 @@ fn moreau_state_and_stick_onsets_converge_at_second_order() {
                 &model,
                 &Scene {
                     u: 1.5,
+                    input: None,
                     x0: State::zeros(),
                     t_end,
                     accuracy: Accuracy::Step(h),

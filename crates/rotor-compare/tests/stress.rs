@@ -338,6 +338,7 @@ fn energy_run(
     let fixed = kind.is_fixed_step();
     let scene = Scene {
         u,
+        input: None,
         x0,
         t_end: 10.0,
         accuracy: kind.accuracy(if fixed { 1e-4 } else { tol }),
@@ -469,7 +470,7 @@ proptest! {
         let u = 1.5 * fu;
         for kind in SOLVERS {
             // No panic, no NaN.
-            let scene = Scene { u, x0, t_end: 10.0, accuracy: Accuracy::Tol(1e-10),
+            let scene = Scene { u, input: None, x0, t_end: 10.0, accuracy: Accuracy::Tol(1e-10),
                 output: Output::Grid { dt: 0.01 }, metrics_from: Some(5.0) };
             let tr = match kind.solver().simulate(&m, &scene) {
                 Ok(tr) => tr,
@@ -692,7 +693,7 @@ fn stress_random_parameters_metrics_only_matches_the_full_run() {
         |(p, x0, fu)| {
             let m = Model::new(p);
             let u = 1.5 * fu;
-            let scene = Scene { u, x0, t_end: 100.0, accuracy: Accuracy::Tol(1e-10),
+            let scene = Scene { u, input: None, x0, t_end: 100.0, accuracy: Accuracy::Tol(1e-10),
                 output: Output::Events, metrics_from: Some(50.0) };
             // Whether a disc reverses in the metrics window (the event solver's full run).
             let events = SolverKind::EVENT.solver().simulate(&m, &scene)
@@ -701,7 +702,7 @@ fn stress_random_parameters_metrics_only_matches_the_full_run() {
                 .any(|e| e.t >= 50.0 && matches!(e.kind, rotor_seam::EventKind::Reversal(_)));
             let mut skipped = [false; 3];
             for (i, kind) in SOLVERS.into_iter().enumerate() {
-                let run = |output| kind.solver().simulate(&m, &Scene { output, ..scene })
+                let run = |output| kind.solver().simulate(&m, &Scene { output, ..scene.clone() })
                     .map_err(|e| TestCaseError::fail(format!("{} ({output:?}): {e}", kind.name())));
                 let (full, fast) = (run(Output::Final)?, run(Output::Metrics)?);
                 let (a, b) = (full.metrics.unwrap(), fast.metrics.unwrap());
@@ -786,6 +787,7 @@ fn stress_moreau_reports_a_one_step_hold_between_opposite_slips_as_a_reversal() 
     let m = Model::new(p);
     let scene = Scene {
         u: 1.5 * 1.2706457676858947,
+        input: None,
         x0: State::new(-0.614332526354382, 0.9150337225434341, 0.954027712696292),
         t_end: 100.0,
         // Moreau–Jean takes the default step, 1e-3.
@@ -884,6 +886,7 @@ fn stress_an_extremum_of_one_disc_keeps_the_other_discs_stick() {
         let m = Model::new(p);
         let scene = Scene {
             u: 1.5 * fu,
+            input: None,
             x0: State::zeros(),
             t_end: 100.0,
             accuracy: Accuracy::Tol(1e-10),

@@ -30,7 +30,7 @@
 
 use nalgebra::Matrix3;
 use rotor_model::{Disc, DiscMode, Mode, Model, OMEGA_L, State};
-use rotor_seam::{Event, EventKind, SolveError, Stats, check_finite};
+use rotor_seam::{Event, EventKind, Piece, SolveError, Stats, check_finite};
 use std::cell::Cell;
 
 use crate::dop853::{Dense, Dop853};
@@ -375,7 +375,9 @@ impl Recent {
 /// One integration run of the Filippov system.
 pub(crate) struct Integrator<'a> {
     pub model: &'a Model,
-    pub u: f64,
+    /// The input's piece the run is on, `u(t) = u0 + slope·(t − t0)` (a run never crosses
+    /// a breakpoint: the solver restarts it on the next piece there).
+    pub piece: Piece,
     pub opts: EventOptions,
     pub ctl: Dop853,
     pub stats: Stats,
@@ -400,7 +402,7 @@ impl<'a> Integrator<'a> {
         ctl.h_max = opts.h_max;
         Integrator {
             model,
-            u,
+            piece: Piece::constant(u),
             opts,
             ctl,
             stats: Stats::default(),
@@ -413,10 +415,25 @@ impl<'a> Integrator<'a> {
         }
     }
 
+    /// The input at t, `u0 + slope·(t − t0)` on the current piece.
+    #[inline(always)]
+    fn u(&self, t: f64) -> f64 {
+        self.piece.at(t)
+    }
+
     #[inline]
-    fn field(&self, x: &State, mode: Mode) -> State {
+    fn field(&self, t: f64, x: &State, mode: Mode) -> State {
         self.extra_evals.set(self.extra_evals.get() + 1);
-        self.model.rhs(x, self.u, mode)
+        self.model.rhs(x, self.u(t), mode)
+    }
+
+    /// ∂/∂t of a disc's applied torque at fixed state: `k_m·du/dt` on the upper disc (the
+    /// motor's), 0 on the lower.
+    fn torque_drift(&self, d: Disc) -> f64 {
+        match d {
+            Disc::Upper => self.model.params.k_m * self.piece.slope,
+            Disc::Lower => 0.0,
+        }
     }
 
     fn stick_interval(&self, d: Disc) -> (f64, f64) {
@@ -426,8 +443,8 @@ impl<'a> Integrator<'a> {
         }
     }
 
-    /// Value of a guard at state x (in the current mode).
-    fn guard(&self, g: Guard, x: &State, mode: Mode) -> f64 {
+    /// Value of a guard at state x at time t (in the current mode).
+    fn guard(&self, g: Guard, t: f64, x: &State, mode: Mode) -> f64 {
         match g {
             Guard::Velocity(d) => {
                 let s = mode.of(d).branch().unwrap_or(1.0);
@@ -435,21 +452,23 @@ impl<'a> Integrator<'a> {
             }
             Guard::ExitHi(d) => {
                 let (_, hi) = self.stick_interval(d);
-                hi - self.model.applied_torque(d, x, self.u)
+                hi - self.model.applied_torque(d, x, self.u(t))
             }
             Guard::ExitLo(d) => {
                 let (lo, _) = self.stick_interval(d);
-                self.model.applied_torque(d, x, self.u) - lo
+                self.model.applied_torque(d, x, self.u(t)) - lo
             }
             Guard::Extremum(d, _) => {
                 self.extra_evals.set(self.extra_evals.get() + 1);
-                self.model.disc_accel(d, x, self.u, mode.of(d))
+                self.model.disc_accel(d, x, self.u(t), mode.of(d))
             }
             Guard::Section => x[OMEGA_L] - self.section.unwrap_or(0.0),
         }
     }
 
-    /// Time derivative of a guard along the mode's field, given the field `f` at x.
+    /// Time derivative of a guard along the mode's field, given the field `f` at x: the
+    /// rate through the state plus, for a guard holding the input, its rate through u(t)
+    /// (`k_m·du/dt` in the upper disc's applied torque; 0 for a constant input).
     fn guard_rate(&self, g: Guard, x: &State, f: &State, mode: Mode) -> f64 {
         match g {
             Guard::Velocity(d) => mode.of(d).branch().unwrap_or(1.0) * f[d.index()],
@@ -458,7 +477,7 @@ impl<'a> Integrator<'a> {
                 let dt = match d {
                     Disc::Upper => -k,
                     Disc::Lower => k,
-                };
+                } + self.torque_drift(d);
                 if matches!(g, Guard::ExitHi(_)) {
                     -dt
                 } else {
@@ -466,8 +485,13 @@ impl<'a> Integrator<'a> {
                 }
             }
             Guard::Extremum(d, _) => {
-                let j = self.model.jacobian(x, self.u, mode);
-                (j * *f)[d.index()]
+                let j = self.model.jacobian(x, 0.0, mode);
+                let drift = if mode.of(d) == DiscMode::Stick {
+                    0.0
+                } else {
+                    self.torque_drift(d) / self.model.inertia(d)
+                };
+                (j * *f)[d.index()] + drift
             }
             Guard::Section => f[OMEGA_L],
         }
@@ -553,12 +577,12 @@ impl<'a> Integrator<'a> {
         };
         if ga > 0.0 && gb > 0.0 && ra < 0.0 && rb > 0.0 {
             let tm = illinois(&rate, ta, tb, ra, rb);
-            let gm = self.guard(g, &d.eval(tm), mode);
+            let gm = self.guard(g, tm, &d.eval(tm), mode);
             (gm <= 0.0).then_some((ta, tm, ga, g))
         } else if matches!(g, Guard::Velocity(_)) && ga == 0.0 && ra > 0.0 && gb <= 0.0 && rb < 0.0
         {
             let tm = illinois(&rate, ta, tb, ra, rb);
-            let gm = self.guard(g, &d.eval(tm), mode);
+            let gm = self.guard(g, tm, &d.eval(tm), mode);
             (gm > 0.0).then_some((tm, tb, gm, g))
         } else {
             None
@@ -598,7 +622,7 @@ impl<'a> Integrator<'a> {
                 }
             }
             _ => {
-                let f = |t: f64| self.guard(g, &d.eval(t), mode);
+                let f = |t: f64| self.guard(g, t, &d.eval(t), mode);
                 let fb = f(b);
                 let t = if fb == 0.0 {
                     b
@@ -647,22 +671,22 @@ impl<'a> Integrator<'a> {
                 }
             }
         };
-        let value = |g: Guard, x: &State, f: &State| match g {
+        let value = |g: Guard, t: f64, x: &State, f: &State| match g {
             Guard::Extremum(disc, _) => f[disc.index()],
-            _ => self.guard(g, x, mode),
+            _ => self.guard(g, t, x, mode),
         };
         // Sample intervals in time order; the first one where any guard fires holds the
         // earliest event (the earliest root among the guards firing there).
         let (mut ta, mut xa, mut fa_rate) = sample(0);
         let mut ga = [0.0; 8];
         for (j, &g) in gs[..n].iter().enumerate() {
-            ga[j] = value(g, &xa, &fa_rate);
+            ga[j] = value(g, ta, &xa, &fa_rate);
         }
         for i in 1..=m {
             let (tb, xb, fb_rate) = sample(i);
             let mut best: Option<Detected> = None;
             for (j, &g) in gs[..n].iter().enumerate() {
-                let gb = value(g, &xb, &fb_rate);
+                let gb = value(g, tb, &xb, &fb_rate);
                 let hit = Self::fires(g, ga[j], gb)
                     .map(|kind| (ta, tb, ga[j], kind))
                     .or_else(|| {
@@ -716,9 +740,9 @@ impl<'a> Integrator<'a> {
         let mut dt_prev = f64::INFINITY;
         for _ in 0..4 {
             let x = path(t);
-            let f = self.field(&x, mode);
+            let f = self.field(t, &x, mode);
             at = (t, f[i]);
-            let ar = (self.model.jacobian(&x, self.u, mode) * f)[i];
+            let ar = self.guard_rate(Guard::Extremum(disc, is_max), &x, &f, mode);
             if ar == 0.0 || !ar.is_finite() {
                 break;
             }
@@ -741,7 +765,7 @@ impl<'a> Integrator<'a> {
             let a = if t == at.0 && !at.1.is_nan() {
                 at.1
             } else {
-                self.guard(Guard::Extremum(disc, is_max), &path(t), mode)
+                self.guard(Guard::Extremum(disc, is_max), t, &path(t), mode)
             };
             if is_max { a <= 0.0 } else { a >= 0.0 }
         };
@@ -762,11 +786,11 @@ impl<'a> Integrator<'a> {
         t_end: f64,
         sink: &mut impl Sink,
     ) -> Result<RunEnd, SolveError> {
-        let (model, u) = (self.model, self.u);
+        let (model, piece) = (self.model, self.piece);
         let evals = Cell::new(0u64);
-        let field = |y: &State, mode: Mode| {
+        let field = |t: f64, y: &State, mode: Mode| {
             evals.set(evals.get() + 1);
-            model.rhs(y, u, mode)
+            model.rhs(y, piece.at(t), mode)
         };
         let end = self.steps(t_start, x_start, mode_start, t_end, &field, sink);
         self.stats.rhs_evals += evals.get() + self.extra_evals.take();
@@ -780,7 +804,7 @@ impl<'a> Integrator<'a> {
         x_start: State,
         mode: Mode,
         t_end: f64,
-        field: &impl Fn(&State, Mode) -> State,
+        field: &impl Fn(f64, &State, Mode) -> State,
         sink: &mut impl Sink,
     ) -> Result<RunEnd, SolveError> {
         let mut x = x_start;
@@ -797,10 +821,10 @@ impl<'a> Integrator<'a> {
         if let Some(end) = self.settle(t_start, &mut x, &mut mode, [false; 2], &mut recent, sink)? {
             return Ok(end);
         }
-        let f0 = field(&x, mode);
+        let f0 = field(t_start, &x, mode);
         let h = self
             .ctl
-            .initial_step(&mut |_t, y: &State| field(y, mode), t_start, &x, &f0);
+            .initial_step(&mut |t, y: &State| field(t, y, mode), t_start, &x, &f0);
         self.ctl.restart();
         let mut c = Cursor {
             t: t_start,
@@ -813,12 +837,14 @@ impl<'a> Integrator<'a> {
         };
         let mut steps_total = 0u64;
         while c.t < t_end {
-            // Both discs stuck: the state is frozen and the exit guards are constant.
-            if c.mode.upper == DiscMode::Stick
+            // Both discs stuck: the state is frozen and, on a constant piece of the input,
+            // so are the exit guards.
+            if self.piece.slope == 0.0
+                && c.mode.upper == DiscMode::Stick
                 && c.mode.lower == DiscMode::Stick
                 && Disc::BOTH
                     .iter()
-                    .all(|&d| self.model.stick_exit(d, &c.x, self.u).is_none())
+                    .all(|&d| self.model.stick_exit(d, &c.x, self.piece.u0).is_none())
             {
                 let d = frozen_dense(c.t, t_end - c.t, &c.x);
                 sink.step(&d, c.t, t_end, &c.x, c.mode);
@@ -849,7 +875,7 @@ impl<'a> Integrator<'a> {
         &mut self,
         c: &mut Cursor,
         t_end: f64,
-        field: &impl Fn(&State, Mode) -> State,
+        field: &impl Fn(f64, &State, Mode) -> State,
         recent: &mut Recent,
         sink: &mut impl Sink,
     ) -> Result<Option<RunEnd>, SolveError> {
@@ -871,7 +897,7 @@ impl<'a> Integrator<'a> {
             });
         }
         let mode = c.mode;
-        let mut fm = |_t: f64, y: &State| field(y, mode);
+        let mut fm = |t: f64, y: &State| field(t, y, mode);
         let tr = self.ctl.trial(&mut fm, c.t, &c.x, &c.f0, h);
         if !Dop853::acceptable(&tr) {
             self.stats.rejected += 1;
@@ -911,7 +937,7 @@ impl<'a> Integrator<'a> {
                 if let Some(end) = self.switch(c, g, recent, sink)? {
                     return Ok(Some(end));
                 }
-                c.f0 = field(&c.x, c.mode);
+                c.f0 = field(c.t, &c.x, c.mode);
                 self.ctl.restart();
                 c.h = h_next.min(h).max(1e-6 * h_next);
                 Ok(None)
@@ -1012,7 +1038,7 @@ impl<'a> Integrator<'a> {
     /// so that its state lies on the section.
     fn event_state(&self, c: &Cursor, g: Guard, te: f64, t1: f64, y1: &State) -> (f64, State) {
         let mode = c.mode;
-        let mut fm = |_t: f64, y: &State| self.field(y, mode);
+        let mut fm = |t: f64, y: &State| self.field(t, y, mode);
         let Guard::Extremum(disc, is_max) = g else {
             let (t, x, _) = self.refine(c, g, te, t1, y1, &mut fm);
             return (t, x);
@@ -1026,7 +1052,7 @@ impl<'a> Integrator<'a> {
             } else {
                 c.x
             };
-            let f = self.field(&x, mode);
+            let f = self.field(te, &x, mode);
             let path = |t: f64| x + f * (t - te);
             let t = self.polish_extremum(disc, is_max, &path, te, (c.t, t1), mode);
             // At the step's start (no step to bound |ẍ| by) only a polish that stays is small.
@@ -1076,8 +1102,8 @@ impl<'a> Integrator<'a> {
                 c.x
             };
             first.get_or_insert(xe);
-            let fe = self.field(&xe, mode);
-            let gv = self.guard(g, &xe, mode);
+            let fe = self.field(tev, &xe, mode);
+            let gv = self.guard(g, tev, &xe, mode);
             let gr = self.guard_rate(g, &xe, &fe, mode);
             if gr == 0.0 || !gr.is_finite() {
                 break;
@@ -1129,7 +1155,7 @@ impl<'a> Integrator<'a> {
         recent: &mut Recent,
         sink: &mut impl Sink,
     ) -> Result<Option<RunEnd>, SolveError> {
-        let (new_mode, kind) = self.transition(g, &mut c.x, c.mode);
+        let (new_mode, kind) = self.transition(g, c.t, &mut c.x, c.mode);
         if let Some(kind) = kind {
             self.stats.events += 1;
             let ev = Event {
@@ -1188,14 +1214,14 @@ impl<'a> Integrator<'a> {
                 let (Guard::Velocity(d) | Guard::ExitHi(d) | Guard::ExitLo(d)) = g else {
                     continue;
                 };
-                let v = self.guard(g, x, *mode);
+                let v = self.guard(g, t, x, *mode);
                 let out = if v < 0.0 {
                     true
                 } else if v > 0.0 || (matches!(g, Guard::Velocity(_)) && fresh[d as usize]) {
                     false
                 } else {
-                    let f = *f.get_or_insert_with(|| self.field(x, *mode));
-                    self.moves_out(g, x, &f, *mode)
+                    let f = *f.get_or_insert_with(|| self.field(t, x, *mode));
+                    self.moves_out(g, t, x, &f, *mode)
                 };
                 if out {
                     hit = Some((g, d));
@@ -1205,7 +1231,7 @@ impl<'a> Integrator<'a> {
             let Some((g, d)) = hit else {
                 return Ok(None);
             };
-            let (m, kind) = self.transition(g, x, *mode);
+            let (m, kind) = self.transition(g, t, x, *mode);
             let Some(kind) = kind else {
                 // A velocity guard at a grazing contact from the side the applied torque
                 // pushes back to: the disc stays (its velocity is now exactly 0).
@@ -1238,14 +1264,14 @@ impl<'a> Integrator<'a> {
     /// 64 covers the few operations behind each (a located stick exit leaves T_ex within a
     /// few ulps of the edge). The second derivative is the rate along J·f (the guards are
     /// linear in the state: a velocity, or the spring torque).
-    fn moves_out(&self, g: Guard, x: &State, f: &State, mode: Mode) -> bool {
+    fn moves_out(&self, g: Guard, t: f64, x: &State, f: &State, mode: Mode) -> bool {
         const MARGIN: f64 = 64.0 * f64::EPSILON;
         let r = self.guard_rate(g, x, f, mode);
         let noise = match g {
             Guard::Velocity(d) => {
                 let s = mode.of(d).branch().unwrap_or(1.0);
                 let tf = self.model.friction(d).torque(x[d.index()], s);
-                MARGIN * (self.model.applied_torque(d, x, self.u).abs() + tf.abs())
+                MARGIN * (self.model.applied_torque(d, x, self.u(t)).abs() + tf.abs())
                     / self.model.inertia(d)
             }
             _ => MARGIN * self.model.params.k_theta * (x[1].abs() + x[2].abs()),
@@ -1256,19 +1282,20 @@ impl<'a> Integrator<'a> {
         if r > noise {
             return false;
         }
-        let jf = self.model.jacobian(x, self.u, mode) * *f;
+        // (The input's own second derivative is 0 on a piece.)
+        let jf = self.model.jacobian(x, 0.0, mode) * *f;
         self.guard_rate(g, x, &jf, mode) < 0.0
     }
 
     /// The mode after a terminal guard, and the event to report.
-    fn transition(&self, g: Guard, x: &mut State, mode: Mode) -> (Mode, Option<EventKind>) {
+    fn transition(&self, g: Guard, t: f64, x: &mut State, mode: Mode) -> (Mode, Option<EventKind>) {
         let mut m = mode;
         match g {
             Guard::Velocity(d) => {
                 let s = mode.of(d).branch().unwrap_or(1.0);
                 x[d.index()] = 0.0;
                 let fr = self.model.friction(d);
-                let t_ex = self.model.applied_torque(d, x, self.u);
+                let t_ex = self.model.applied_torque(d, x, self.u(t));
                 let (lo, hi) = fr.static_interval();
                 if fr.is_set_valued() && lo <= t_ex && t_ex <= hi {
                     m.set(d, DiscMode::Stick);

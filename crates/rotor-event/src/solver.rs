@@ -1,7 +1,7 @@
 //! The [`Solver`] seam for the event-driven method.
 
 use rotor_model::{Mode, Model, State};
-use rotor_seam::{Event, Integration, Recorder, Scene, SolveError, Solver, Trajectory};
+use rotor_seam::{Event, Input, Integration, Recorder, Scene, SolveError, Solver, Trajectory};
 
 use crate::dop853::Dense;
 use crate::filippov::{EventOptions, Integrator, RunEnd, Sink};
@@ -71,17 +71,35 @@ struct Run<'a> {
     integ: Integrator<'a>,
     t_end: f64,
     at: RunEnd,
+    /// A time-varying input, run one piece at a time (`None`: the constant input).
+    input: Option<&'a Input>,
 }
 
 impl Integration for Run<'_> {
     type Checkpoint = RunEnd;
 
+    /// With a time-varying input, one run per piece: a run ends on the next breakpoint and
+    /// the next starts there on the new piece (its start re-checks the stick conditions at
+    /// the new value, so a step of u that pushes a stuck disc's torque out of its interval
+    /// ends the stick at once).
     fn advance(&mut self, rec: &mut Recorder) -> Result<(), SolveError> {
-        let RunEnd { t, x, mode } = self.at;
-        self.at = self
-            .integ
-            .run(t, x, mode, self.t_end, &mut Recording(rec))?;
-        Ok(())
+        let Some(input) = self.input else {
+            let RunEnd { t, x, mode } = self.at;
+            self.at = self
+                .integ
+                .run(t, x, mode, self.t_end, &mut Recording(rec))?;
+            return Ok(());
+        };
+        loop {
+            let RunEnd { t, x, mode } = self.at;
+            let piece = input.piece(t);
+            let end = piece.end.min(self.t_end);
+            self.integ.piece = piece;
+            self.at = self.integ.run(t, x, mode, end, &mut Recording(rec))?;
+            if self.at.t < end || end >= self.t_end {
+                return Ok(());
+            }
+        }
     }
 
     /// A run stops right after its anchor event, in the mode after it.
@@ -107,17 +125,18 @@ impl Solver for EventSolver {
         scene.validate_for(model)?;
         let tol = scene.tol();
         let mut rec = Recorder::new(scene, scene.x0, tol, self.options.skip_verify);
-        let mut integ = Integrator::new(model, scene.u, tol, self.options);
+        let mut integ = Integrator::new(model, scene.u_at(0.0), tol, self.options);
         integ.extrema = rec.wants_extrema();
         let at = RunEnd {
             t: 0.0,
             x: scene.x0,
-            mode: model.mode_at(&scene.x0, scene.u),
+            mode: model.mode_at(&scene.x0, scene.u_at(0.0)),
         };
         let mut run = Run {
             integ,
             t_end: scene.t_end,
             at,
+            input: scene.input.as_ref().filter(|_| scene.is_time_varying()),
         };
         rec.drive(&mut run)?;
         let RunEnd { t, x, mode } = run.at;

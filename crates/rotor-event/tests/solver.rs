@@ -772,6 +772,7 @@ fn steep_law_set() -> Model {
 fn stick_time(solver: &EventSolver, m: &Model, tol: f64) -> f64 {
     let scene = Scene {
         u: 1.5 * 1.91649573917313,
+        input: None,
         x0: State::zeros(),
         t_end: 100.0,
         accuracy: rotor_seam::Accuracy::Tol(tol),
@@ -850,6 +851,7 @@ fn a_misjudged_step_found_at_an_event_is_redone() {
     });
     let scene = Scene {
         u: 1.248574492243608,
+        input: None,
         x0: State::zeros(),
         t_end: 100.0,
         accuracy: rotor_seam::Accuracy::Tol(1e-10),

@@ -803,7 +803,7 @@ fn grade_steady(
 ) -> Vec<Graded> {
     let exit = StickExit {
         model: &sc.model,
-        u: sc.u,
+        u: sc.steady_u(),
     };
     let mut q = Vec::new();
     let stuck = stuck_threshold(scale[2], level);

@@ -79,7 +79,7 @@ impl Orbit {
     ) -> Result<Orbit, SolveError> {
         let span = period * 1.05;
         let scene = Scene {
-            u: sc.u,
+            u: sc.steady_u(),
             x0: x_start,
             t_end: span,
             output: Output::Grid { dt: ORBIT_DT },

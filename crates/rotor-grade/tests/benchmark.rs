@@ -93,7 +93,7 @@ fn mismatch(fresh: &Reference, old: &Reference) -> Option<String> {
 #[test]
 fn reference_files_match_the_event_solver_within_their_stated_error() {
     let all = scenarios();
-    assert_eq!(all.len(), 22);
+    assert_eq!(all.len(), 23);
     let bad: Vec<String> = all
         .par_iter()
         .filter_map(|sc| {

@@ -9,7 +9,7 @@
 
 use rotor_model::{FieldError, Num, State};
 use rotor_seam::scene::{DEFAULT_STEP, DEFAULT_TOL};
-use rotor_seam::{Accuracy, Output, Scene, Stats};
+use rotor_seam::{Accuracy, Input, Output, Scene, Stats};
 
 use rotor_solvers::{Knob, SolverKind};
 pub use rotor_solvers::{check_number, solver_kind};
@@ -75,8 +75,10 @@ pub struct Request<'a> {
     /// The solver's name as typed (`event`, `switch`, `moreau`); checked by
     /// [`Request::solver_kind`].
     pub solver: &'a str,
-    /// Motor input voltage u \[V\].
+    /// Motor input voltage u \[V\] (unused with `input`).
     pub u: f64,
+    /// A time-varying input u(t) instead of `u` (`--input FILE`, Python's `input=`).
+    pub input: Option<Input>,
     /// Initial state `[α, ω_u, ω_l]` (rad, rad/s, rad/s).
     pub x0: [f64; 3],
     /// Tolerance of the adaptive solvers (relative = absolute), if given.
@@ -112,7 +114,15 @@ impl Request<'_> {
     /// u finite, x0 finite, tol in (0, 1), h in (0, t_end] (the default step shrinks to a
     /// horizon shorter than itself; an explicit h does not).
     pub fn scene(&self, kind: SolverKind, t_end: f64, output: Output) -> Result<Scene, FieldError> {
-        check_number("u", self.u, true, "must be a finite number")?;
+        // A table of one value is the constant input: the same run, bit for bit, as `u`.
+        let (u, input) = match &self.input {
+            None => (self.u, None),
+            Some(i) => match i.constant() {
+                Some(u) => (u, None),
+                None => (i.at(0.0), Some(i.clone())),
+            },
+        };
+        check_number("u", u, true, "must be a finite number")?;
         for (k, v) in self.x0.iter().enumerate() {
             if !v.is_finite() {
                 return Err(FieldError::new(
@@ -143,7 +153,8 @@ impl Request<'_> {
             Knob::Step => Accuracy::Step(h),
         };
         Ok(Scene {
-            u: self.u,
+            u,
+            input,
             x0: State::new(a, wu, wl),
             t_end,
             accuracy,
@@ -160,9 +171,26 @@ impl Request<'_> {
         Ok((kind, self.scene(kind, t_end, Output::Grid { dt })?))
     }
 
+    /// Refuses a time-varying input for `what` (a steady state, a sweep), which assumes a
+    /// time-invariant system: the error names `input`.
+    pub fn constant_input(&self, what: &str) -> Result<(), FieldError> {
+        match &self.input {
+            Some(i) if i.constant().is_none() => Err(FieldError::new(
+                "input",
+                i.to_string(),
+                format!(
+                    "{what} needs a constant input (a steady state of a time-invariant \
+                     system): give u"
+                ),
+            )),
+            _ => Ok(()),
+        }
+    }
+
     /// A steady-state computation ([`rotor_steady::steady`]): the solver, the scene and the options
     /// (the event-driven solver's refinement runs at `tol`).
     pub fn steady(&self) -> Result<(SolverKind, Scene, SteadyOptions), FieldError> {
+        self.constant_input("steady")?;
         let mut opts = SteadyOptions::default();
         if let Some(tol) = self.tol {
             check_number("tol", tol, tol > 0.0 && tol < 1.0, "must lie in (0, 1)")?;
@@ -185,10 +213,32 @@ mod tests {
         Request {
             solver: "event",
             u: 1.5,
+            input: None,
             x0: [0.0; 3],
             tol: None,
             h: None,
         }
+    }
+
+    #[test]
+    fn an_input_table_of_one_value_is_u_and_a_varying_one_is_refused_by_steady() {
+        let flat = Request {
+            input: Some(Input::new(&[[0.0, 2.0], [5.0, 2.0]]).unwrap()),
+            ..req()
+        };
+        let (_, scene) = flat.simulation(10.0, 0.1).unwrap();
+        assert_eq!((scene.u, scene.input), (2.0, None));
+        assert!(flat.steady().is_ok());
+        let step = Request {
+            input: Some(Input::new(&[[5.0, 1.5], [5.0, 2.5]]).unwrap()),
+            ..req()
+        };
+        let (_, scene) = step.simulation(10.0, 0.1).unwrap();
+        assert!(scene.is_time_varying());
+        assert_eq!(scene.u, 1.5, "u is the input at t = 0");
+        let e = step.steady().unwrap_err();
+        assert_eq!(e.field, "input");
+        assert!(e.to_string().contains("constant input"), "{e}");
     }
 
     #[test]

@@ -4,8 +4,8 @@
 
 use rotor_model::{Disc, DiscMode, FieldError, Mode, Model, State};
 use rotor_seam::{
-    Event, EventKind, Integration, Recorder, Scene, SolveError, Solver, Stats, Trajectory,
-    check_finite,
+    Event, EventKind, Input, Integration, Piece, Recorder, Scene, SolveError, Solver, Stats,
+    Trajectory, check_finite,
 };
 
 use crate::stepper::{StepSize, Stepper};
@@ -164,9 +164,15 @@ struct Run<'a> {
     stepper: Stepper,
     /// The step size `h` with its factorisations (every step but the last).
     full: StepSize,
-    u: f64,
+    /// The input's current piece (the constant input: one piece for ever).
+    piece: Piece,
+    /// A time-varying input, stepped one piece at a time (`None`: constant).
+    input: Option<&'a Input>,
     h: f64,
     t_end: f64,
+    /// Where the current piece ends (its next breakpoint, or `t_end`): the last step of the
+    /// piece lands on it, and the step grid restarts there.
+    seg_end: f64,
     theta: f64,
     base: f64,
     k: u64,
@@ -191,18 +197,32 @@ impl Run<'_> {
         self.k += 1;
         let (k, n) = (self.k, self.n);
         let t_next = if k == n {
-            self.t_end
+            self.seg_end
         } else {
             self.base + k as f64 * self.h
         };
         // Every step but the last has size h (t_next − t differs from h by roundings of t
         // only); the last lands on t_end.
-        let out = if k < n {
-            self.stepper
-                .step_with(self.cur.t, &self.cur.x, &self.full)?
-        } else {
-            self.stepper
-                .step(self.cur.t, &self.cur.x, t_next - self.cur.t)?
+        let out = match (self.input.is_some(), k < n) {
+            (false, true) => self
+                .stepper
+                .step_with(self.cur.t, &self.cur.x, &self.full)?,
+            (false, false) => self
+                .stepper
+                .step(self.cur.t, &self.cur.x, t_next - self.cur.t)?,
+            // A time-varying input: the motor torque of this step, from u at its two ends.
+            (true, not_last) => {
+                let f = self
+                    .stepper
+                    .motor_force(self.piece.at(self.cur.t), self.piece.at(t_next));
+                let size = if !not_last {
+                    self.stepper.step_size(self.cur.t, t_next - self.cur.t)?
+                } else {
+                    self.full
+                };
+                self.stepper
+                    .step_with_force(self.cur.t, &self.cur.x, &size, f)?
+            }
         };
         check_finite(t_next, &out.x)?;
         let s = &mut self.stats;
@@ -291,15 +311,15 @@ impl Run<'_> {
     fn exit_time(&self, d: Disc, slip: DiscMode, next: &Point) -> f64 {
         let (model, cur) = (self.model, &self.cur);
         let (lo, hi) = model.friction(d).static_interval();
-        let z = |x: &State| {
-            let ta = model.applied_torque(d, x, self.u);
+        let z = |x: &State, t: f64| {
+            let ta = model.applied_torque(d, x, self.piece.at(t));
             if slip == DiscMode::SlipPos {
                 ta - hi
             } else {
                 lo - ta
             }
         };
-        let (za, zb) = (z(&cur.x), z(&next.x));
+        let (za, zb) = (z(&cur.x, cur.t), z(&next.x, next.t));
         let t0 = self.prev.map_or(cur.t, |p| p.t);
         if zb > za {
             (cur.t - za * (next.t - cur.t) / (zb - za)).clamp(t0, next.t)
@@ -317,9 +337,14 @@ impl Run<'_> {
         let w = cur.x[wi];
         let mut mode = to_mode(&cur.mode);
         mode.set(d, slip);
-        let f = model.rhs(&cur.x, self.u, mode);
+        let f = model.rhs(&cur.x, self.piece.at(cur.t), mode);
         let acc = f[wi];
-        let jerk = (model.jacobian(&cur.x, self.u, mode) * f)[wi];
+        // The input's own rate adds k_m·du/dt / J_u to the upper disc's ω̈.
+        let drift = match d {
+            Disc::Upper => model.params.k_m * self.piece.slope / model.inertia(d),
+            Disc::Lower => 0.0,
+        };
+        let jerk = (model.jacobian(&cur.x, 0.0, mode) * f)[wi] + drift;
         if acc * w < 0.0 {
             let d1 = -w / acc;
             let den = acc + jerk * d1;
@@ -393,11 +418,23 @@ impl Integration for Run<'_> {
                 return Ok(());
             }
         }
-        while self.k < self.n {
-            self.step(rec)?;
-            if rec.halted() {
-                return Ok(());
+        loop {
+            while self.k < self.n {
+                self.step(rec)?;
+                if rec.halted() {
+                    return Ok(());
+                }
             }
+            // A breakpoint of the input: the next piece, and the step grid from there, as a
+            // run started there would step.
+            let Some(input) = self.input.filter(|_| self.seg_end < self.t_end) else {
+                break;
+            };
+            self.piece = input.piece(self.seg_end);
+            self.base = self.seg_end;
+            self.seg_end = self.piece.end.min(self.t_end);
+            self.k = 0;
+            self.n = steps_to(self.seg_end, self.base, self.h) as u64;
         }
         self.pending.release_before(f64::INFINITY, rec);
         Ok(())
@@ -459,7 +496,11 @@ impl Solver for MoreauSolver {
         check_finite(0.0, &scene.x0)?;
         let o = &self.options;
         o.validate()?;
-        let (u, t_end) = (scene.u, scene.t_end);
+        let (u, t_end) = (scene.u_at(0.0), scene.t_end);
+        let input = scene.input.as_ref().filter(|_| scene.is_time_varying());
+        let piece = scene.piece(0.0);
+        let seg_end = piece.end.min(t_end);
+        // (The step count bounds the whole horizon; a piece's count is its share of it.)
         let n = steps_to(t_end, 0.0, h);
         if n.is_nan() || n > o.max_steps as f64 {
             return Err(SolveError::TooManySteps {
@@ -467,7 +508,7 @@ impl Solver for MoreauSolver {
                 max_steps: o.max_steps,
             });
         }
-        let n = n as u64;
+        let n = steps_to(seg_end, 0.0, h) as u64;
         let stepper = Stepper::new(model, u, o);
         let full = stepper.step_size(0.0, h)?;
         // The scheme's error on the fixtures' cycles is second order, ≈ 0.6·h² in the period
@@ -479,9 +520,11 @@ impl Solver for MoreauSolver {
             model,
             stepper,
             full,
-            u,
+            piece,
+            input,
             h,
             t_end,
+            seg_end,
             theta: o.theta,
             base: 0.0,
             k: 0,

@@ -173,6 +173,8 @@ pub struct Stepper {
     c: [f64; 2],
     k: f64,
     f_ext: f64,
+    /// The motor constant k_m: `F_ext = k_m u` for an input other than the stepper's own.
+    k_m: f64,
     law: [Friction; 2],
     db: [f64; 2],
     /// `max(N_i(0), 0)`: the half-width of disc i's stick interval.
@@ -198,6 +200,7 @@ impl Stepper {
             c: [l.c[(0, 0)], l.c[(1, 1)]],
             k: l.k[(0, 0)],
             f_ext: l.f_ext(u)[0],
+            k_m: model.params.k_m,
             law: [*model.friction(Disc::Upper), *model.friction(Disc::Lower)],
             db: [db_u, 0.0],
             n_zero: [Disc::Upper, Disc::Lower].map(|d| model.friction(d).level(0.0).max(0.0)),
@@ -233,14 +236,38 @@ impl Stepper {
         self.step_with(t, x, &self.step_size(t, h)?)
     }
 
-    /// One step from `x` with the precomputed [`StepSize`].
+    /// One step from `x` with the precomputed [`StepSize`], at the stepper's own input.
     pub fn step_with(&self, t: f64, x: &State, size: &StepSize) -> Result<StepOutcome, SolveError> {
+        self.step_with_force(t, x, size, self.f_ext)
+    }
+
+    /// The motor torque of a time-varying input over the step `[t, t + h]`, in the
+    /// θ-method's weighting: `F = k_m·((1 − θ)·u(t) + θ·u(t + h))` (for the input linear in
+    /// the step, as it is between breakpoints, h·F is the θ-rule's quadrature of ∫k_m u dt,
+    /// exact at θ = ½). `u(t)` and `u(t + h)` are the values on the step's own piece.
+    pub fn motor_force(&self, u_start: f64, u_end: f64) -> f64 {
+        if u_start == u_end {
+            self.k_m * u_start
+        } else {
+            self.k_m * ((1.0 - self.theta) * u_start + self.theta * u_end)
+        }
+    }
+
+    /// [`Stepper::step_with`] with the motor torque `f_ext` over the step
+    /// ([`Stepper::motor_force`]) instead of the stepper's constant one.
+    pub fn step_with_force(
+        &self,
+        t: f64,
+        x: &State,
+        size: &StepSize,
+        f_ext: f64,
+    ) -> Result<StepOutcome, SolveError> {
         let th = self.theta;
         let implicit = self.level == FrictionLevel::Implicit;
         let v = Vector2::new(x[1], x[2]);
         let StepSize { h, a, w_inv } = *size;
         let mut n = Counts::default();
-        let st = self.start_terms(x, h, &mut n);
+        let st = self.start_terms(x, h, f_ext, &mut n);
         let ctx = BranchCtx {
             stepper: self,
             ht: h * th,
@@ -299,7 +326,7 @@ impl Stepper {
     /// stick data. The friction of branch `s0 = sign(v_i)` at the start velocity is evaluated
     /// once here and reused by the skip test and by the first Newton iteration (which
     /// linearise at `w = v` on the same branch): one evaluation per disc instead of three.
-    fn start_terms(&self, x: &State, h: f64, n: &mut Counts) -> StartTerms {
+    fn start_terms(&self, x: &State, h: f64, f_ext: f64, n: &mut Counts) -> StartTerms {
         let th = self.theta;
         let implicit = self.level == FrictionLevel::Implicit;
         let v = Vector2::new(x[1], x[2]);
@@ -307,7 +334,7 @@ impl Stepper {
         let kq = self.k * x[0];
         let mut b = Vector2::new(
             (self.j[0] - (1.0 - th) * h * self.c[0]) * v[0] - th * (1.0 - th) * h * h * kv - h * kq
-                + h * self.f_ext,
+                + h * f_ext,
             (self.j[1] - (1.0 - th) * h * self.c[1]) * v[1] + th * (1.0 - th) * h * h * kv + h * kq,
         );
         let mut p_start = [0.0; 2];

@@ -162,8 +162,13 @@ pub struct Job {
     pub scenario: String,
     /// Every field of the parameter file, friction family names included.
     pub params: serde_json::Value,
-    /// Motor input voltage u (V).
-    pub u: f64,
+    /// Motor input voltage u (V); `null` when the scene's input changes in time (`input`).
+    pub u: Option<f64>,
+    /// The input u(t) as rows `[t, u]` (s, V) when it changes in time: linear between rows,
+    /// constant before the first and after the last, two rows at one t a step; each row's
+    /// time is a breakpoint. Absent for a constant input.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub input: Option<Vec<[f64; 2]>>,
     /// Initial state `[α, ω_u, ω_l]` (rad, rad/s, rad/s), at full precision.
     pub x0: [f64; 3],
     /// Horizon (s): the trace covers `[0, t_end]`.
@@ -181,7 +186,7 @@ pub struct Job {
 }
 
 impl Job {
-    /// The job of a scene: the scenario's parameters, u and x0 (absolute), the scene's
+    /// The job of a scene: the scenario's parameters, u (or its input rows) and x0 (absolute), the scene's
     /// horizon and grid, and the client's knob: `tol` set and `h` null, or the reverse.
     pub fn new(
         sc: &rotor_scenario::Scenario,
@@ -196,7 +201,11 @@ impl Job {
             benchmark: rotor_grade::check::BENCHMARK,
             scenario: sc.name.clone(),
             params: serde_json::to_value(sc.model.params).expect("plain numbers and strings"),
-            u: sc.u,
+            u: sc.input.is_none().then_some(sc.u),
+            input: sc
+                .input
+                .as_ref()
+                .map(|i| i.rows().iter().map(|&(t, u)| [t, u]).collect()),
             x0: [sc.x0[0], sc.x0[1], sc.x0[2]],
             t_end,
             dt,

@@ -304,6 +304,14 @@ impl Columns {
     }
 }
 
+/// ``input=``: an (n, 2) array or a list of ``[t, u]`` pairs, the input u(t) in place of
+/// ``u`` (linear between rows, constant outside them, two rows at one t a step); bad rows
+/// raise ValueError naming the row and the value.
+fn input_of(rows: Option<Vec<[f64; 2]>>) -> PyResult<Option<rotor_seam::Input>> {
+    rows.map(|r| rotor_seam::Input::new(&r).map_err(bad))
+        .transpose()
+}
+
 /// Simulates one scene and returns the trajectory on the output grid.
 ///
 /// Returns a dict: numpy float64 arrays ``t``, ``alpha``, ``omega_u``, ``omega_l`` at
@@ -316,12 +324,15 @@ impl Columns {
 /// 1e-3 s). ``params`` is None (Table 1), a parameter file's path or name (``"stribeck"``),
 /// or a dict of its keys (see ``rotorbench.params()``). Bad input raises ValueError naming
 /// the argument and the value; a failed run raises ``rotorbench.SolveError``. The GIL is
-/// released during the run.
+/// released during the run. ``input`` (an (n, 2) array or a list of ``[t, u]`` pairs) is an
+/// input that changes in time, in place of ``u``: linear between rows, constant before the
+/// first and after the last, two rows at one t a step.
 #[pyfunction]
 #[pyo3(
-    signature = (solver="event", u=1.5, params=None, x0=[0.0; 3], t_end=100.0, dt=0.01, tol=None, h=None),
-    text_signature = "(solver='event', u=1.5, params=None, x0=(0.0, 0.0, 0.0), t_end=100.0, dt=0.01, tol=None, h=None)"
+    signature = (solver="event", u=1.5, params=None, x0=[0.0; 3], t_end=100.0, dt=0.01, tol=None, h=None, input=None),
+    text_signature = "(solver='event', u=1.5, params=None, x0=(0.0, 0.0, 0.0), t_end=100.0, dt=0.01, tol=None, h=None, input=None)"
 )]
+#[allow(clippy::too_many_arguments)]
 fn simulate<'py>(
     py: Python<'py>,
     solver: &str,
@@ -332,10 +343,12 @@ fn simulate<'py>(
     dt: f64,
     tol: Option<f64>,
     h: Option<f64>,
+    input: Option<Vec<[f64; 2]>>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let req = Request {
         solver,
         u,
+        input: input_of(input)?,
         x0,
         tol,
         h,
@@ -377,12 +390,15 @@ fn simulate<'py>(
 /// multipliers as ``[re, im]`` pairs of a refined cycle, else None).
 ///
 /// The event-driven solver refines the cycle to a fixed point of its return map at ``tol``;
-/// the others simulate until the metrics stop changing. Arguments as for ``simulate``.
+/// the others simulate until the metrics stop changing. Arguments as for ``simulate``; an
+/// ``input`` that changes in time is refused (ValueError naming ``input``): a steady state
+/// needs a constant input.
 #[pyfunction]
 #[pyo3(
-    signature = (solver="event", u=1.5, params=None, x0=[0.0; 3], tol=None, h=None),
-    text_signature = "(solver='event', u=1.5, params=None, x0=(0.0, 0.0, 0.0), tol=None, h=None)"
+    signature = (solver="event", u=1.5, params=None, x0=[0.0; 3], tol=None, h=None, input=None),
+    text_signature = "(solver='event', u=1.5, params=None, x0=(0.0, 0.0, 0.0), tol=None, h=None, input=None)"
 )]
+#[allow(clippy::too_many_arguments)]
 fn steady<'py>(
     py: Python<'py>,
     solver: &str,
@@ -391,10 +407,12 @@ fn steady<'py>(
     x0: [f64; 3],
     tol: Option<f64>,
     h: Option<f64>,
+    input: Option<Vec<[f64; 2]>>,
 ) -> PyResult<Bound<'py, PyAny>> {
     let req = Request {
         solver,
         u,
+        input: input_of(input)?,
         x0,
         tol,
         h,
@@ -453,6 +471,7 @@ fn sweep<'py>(
         let req = Request {
             solver,
             u,
+            input: None,
             x0,
             tol,
             h,
@@ -658,6 +677,7 @@ fn _solve_seconds(
     let req = Request {
         solver,
         u,
+        input: None,
         x0: [0.0; 3],
         tol,
         h,

@@ -164,7 +164,7 @@ def test_the_package_is_typed_and_documented():
         f = getattr(rotorbench, name)
         assert f.__doc__ and len(f.__doc__) > 80, name
     assert str(inspect.signature(rotorbench.simulate)) == (
-        "(solver='event', u=1.5, params=None, x0=(0.0, 0.0, 0.0), t_end=100.0, dt=0.01, tol=None, h=None)"
+        "(solver='event', u=1.5, params=None, x0=(0.0, 0.0, 0.0), t_end=100.0, dt=0.01, tol=None, h=None, input=None)"
     )
     assert rotorbench.__version__ == "0.1.0"
 

@@ -30,6 +30,7 @@ use serde::Deserialize;
 
 use rotor_model::params::{Params, one_line, read_small, text_of};
 use rotor_model::{FieldError, Model, Num, State};
+use rotor_seam::Input;
 use rotor_seam::scene::{DEFAULT_STEP, MIN_TOL, Output, Scene};
 
 use crate::compare::CompareSpec;
@@ -43,7 +44,10 @@ struct RawScenario {
     #[serde(default)]
     description: Option<String>,
     params: PathBuf,
-    u: f64,
+    #[serde(default)]
+    u: Option<f64>,
+    #[serde(default)]
+    input: Option<RawInput>,
     #[serde(default)]
     x0: Option<[f64; 3]>,
     #[serde(default)]
@@ -57,6 +61,15 @@ struct RawScenario {
     compare: CompareSpec,
     #[serde(default)]
     tolerance: BTreeMap<String, RawPairTolerance>,
+}
+
+/// `input = "NAME.csv"` (a CSV `t,u` relative to the scenario file) or
+/// `input = [[t, u], ...]` (the rows inline).
+#[derive(Debug, Deserialize)]
+#[serde(untagged)]
+enum RawInput {
+    File(PathBuf),
+    Rows(Vec<[f64; 2]>),
 }
 
 /// A loaded, validated scenario.
@@ -73,8 +86,11 @@ pub struct Scenario {
     pub params_path: PathBuf,
     /// The rotor model of that parameter file.
     pub model: Model,
-    /// Motor input voltage u \[V\].
+    /// Motor input voltage u \[V\]; with `input`, its value at t = 0.
     pub u: f64,
+    /// A time-varying input u(t) (`input = "NAME.csv"` or `input = [[t, u], ...]` instead of
+    /// `u`); `None` for a constant one (a table of one value is read as `u`).
+    pub input: Option<Input>,
     /// Initial state `[α, ω_u, ω_l]` (rad, rad/s, rad/s): `x0`, or the slipping equilibrium
     /// at `u` plus `x0_from_equilibrium`, or rest.
     pub x0: State,
@@ -96,12 +112,19 @@ impl Scenario {
     pub fn scene(&self, output: Output) -> Scene {
         Scene {
             u: self.u,
+            input: self.input.clone(),
             x0: self.x0,
             t_end: self.t_end,
             output,
             metrics_from: self.compare.steady_from,
             ..Scene::default()
         }
+    }
+
+    /// The input over the steady-state window: `u`, or a time-varying input's value after
+    /// its last breakpoint (which a scenario with `compare.steady_from` puts before it).
+    pub fn steady_u(&self) -> f64 {
+        self.input.as_ref().map_or(self.u, |i| i.at(self.t_end))
     }
 
     /// Reads and validates a scenario file and the parameter file it names.
@@ -141,9 +164,28 @@ impl Scenario {
             error,
         })?;
         let model = Model::new(params);
+        let (u, input) = check_input(&raw, path, bad)?;
+        let mut raw = raw;
+        raw.u = Some(u);
         check_run(&raw, bad)?;
         let x0 = initial_state(&raw, &model, bad)?;
         raw.compare.check(raw.t_end, bad)?;
+        // The steady window of a time-varying input lies after its last breakpoint: a steady
+        // state is that of a constant input.
+        if let (Some(i), Some(from)) = (&input, raw.compare.steady_from)
+            && let Some(&(last, _)) = i.rows().last()
+            && last > from
+        {
+            return Err(bad.at(
+                "compare.steady_from",
+                Num(from).to_string(),
+                &format!(
+                    "lies before the input's last breakpoint (t = {}): the steady window needs \
+                     a constant input",
+                    Num(last)
+                ),
+            ));
+        }
         let mut tolerance = BTreeMap::new();
         for (pair, raw_tol) in &raw.tolerance {
             tolerance.insert(pair.clone(), check_pair(pair, raw_tol, &raw.compare, bad)?);
@@ -154,7 +196,8 @@ impl Scenario {
             path: path.to_owned(),
             params_path,
             model,
-            u: raw.u,
+            u,
+            input,
             x0,
             t_end: raw.t_end,
             tol: raw.tol,
@@ -255,8 +298,9 @@ fn check_name(name: &str, bad: Bad) -> Result<(), ScenarioError> {
 /// The run settings: `u` finite, `t_end` positive and finite, `tol` in
 /// `[MIN_TOL, 1)`, `h` in `(0, t_end]`, and without `h` a horizon that holds the default step.
 fn check_run(raw: &RawScenario, bad: Bad) -> Result<(), ScenarioError> {
-    if !raw.u.is_finite() {
-        return Err(bad.at("u", Num(raw.u).to_string(), "must be finite"));
+    let u = raw.u.unwrap_or(f64::NAN);
+    if !u.is_finite() {
+        return Err(bad.at("u", Num(u).to_string(), "must be finite"));
     }
     if !(raw.t_end > 0.0 && raw.t_end.is_finite()) {
         return Err(bad.at(
@@ -297,6 +341,59 @@ fn check_run(raw: &RawScenario, bad: Bad) -> Result<(), ScenarioError> {
     Ok(())
 }
 
+/// The input: `u = V`, or `input = "NAME.csv"` (relative to the scenario file) or
+/// `input = [[t, u], ...]`, exactly one of them. Returns u at t = 0 and the input if it
+/// changes in time (a table of one value is the constant u).
+fn check_input(
+    raw: &RawScenario,
+    path: &Path,
+    bad: Bad,
+) -> Result<(f64, Option<Input>), ScenarioError> {
+    let input = match (&raw.u, &raw.input) {
+        (Some(u), None) => return Ok((*u, None)),
+        (None, None) => {
+            return Err(bad.at(
+                "u",
+                "(missing)".into(),
+                "missing field `u`: give u = V, or input = \"NAME.csv\" or [[t, u], ...]",
+            ));
+        }
+        (Some(u), Some(_)) => {
+            return Err(bad.at(
+                "input",
+                "(with u)".into(),
+                &format!("give u = {} or input, not both", Num(*u)),
+            ));
+        }
+        (None, Some(RawInput::Rows(rows))) => {
+            Input::new(rows).map_err(|e| ScenarioError::Invalid {
+                path: path.to_owned(),
+                error: e,
+            })?
+        }
+        (None, Some(RawInput::File(file))) => {
+            let p = path.parent().unwrap_or(Path::new(".")).join(file);
+            let text = std::fs::read_to_string(&p).map_err(|e| {
+                bad.at(
+                    "input",
+                    format!("{:?}", file.display().to_string()),
+                    &format!("cannot read {}: {e}", p.display()),
+                )
+            })?;
+            Input::from_csv(&text, &file.display().to_string()).map_err(|e| {
+                ScenarioError::Invalid {
+                    path: path.to_owned(),
+                    error: e,
+                }
+            })?
+        }
+    };
+    Ok(match input.constant() {
+        Some(u) => (u, None),
+        None => (input.at(0.0), Some(input)),
+    })
+}
+
 /// The initial state: `x0`, or the one slipping equilibrium at `u` plus the offset
 /// `x0_from_equilibrium` (not both), or rest; every component finite.
 fn initial_state(raw: &RawScenario, model: &Model, bad: Bad) -> Result<State, ScenarioError> {
@@ -309,7 +406,7 @@ fn initial_state(raw: &RawScenario, model: &Model, bad: Bad) -> Result<State, Sc
             ));
         }
         (Some(x), None) => State::new(x[0], x[1], x[2]),
-        (None, Some(d)) => from_equilibrium(d, raw.u, model, bad)?,
+        (None, Some(d)) => from_equilibrium(d, raw.u.unwrap_or(f64::NAN), model, bad)?,
         (None, None) => State::zeros(),
     };
     for (i, n) in ["x0[0]", "x0[1]", "x0[2]"].iter().enumerate() {

@@ -156,9 +156,11 @@ pub struct FastForward {
 
 impl FastForward {
     /// For a scene asking [`Output::Metrics`], with the solver's tolerance `tol` (relative =
-    /// absolute); `None` for every other output, which integrates the whole horizon.
+    /// absolute); `None` for every other output, which integrates the whole horizon, and for a
+    /// time-varying input ([`Scene::is_time_varying`]), whose run is not periodic.
     pub fn for_scene(scene: &Scene, tol: f64) -> Option<FastForward> {
-        (scene.output == Output::Metrics)
+        // A time-varying input breaks the premise of a skip: one period is not the next.
+        (scene.output == Output::Metrics && !scene.is_time_varying())
             .then(|| FastForward::new(tol, scene.metrics_start().unwrap_or(0.0), scene.t_end))
     }
 

@@ -12,6 +12,7 @@
 pub mod attractor;
 pub mod event;
 pub mod fast_forward;
+pub mod input;
 pub mod record;
 pub mod scene;
 pub mod steady;
@@ -19,6 +20,7 @@ pub mod steady;
 pub use attractor::Attractor;
 pub use event::{Event, EventKind};
 pub use fast_forward::{FastForward, Verdict};
+pub use input::{Input, Piece};
 pub use record::{Integration, Recorder};
 pub use scene::{
     Accuracy, Output, OutputGrid, Sample, Scene, SolveError, Solver, Stats, Trajectory,

@@ -4,6 +4,7 @@ use serde::Serialize;
 use thiserror::Error;
 
 use crate::event::Event;
+use crate::input::{Input, Piece};
 use crate::steady::SteadyState;
 use rotor_model::FieldError;
 use rotor_model::{Mode, Model, State};
@@ -87,8 +88,11 @@ impl Accuracy {
 /// One simulation request: input, initial state, horizon, accuracy, and what to keep.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Scene {
-    /// Motor input voltage u \[V\].
+    /// Motor input voltage u \[V\], constant over the run (unless `input` is set).
     pub u: f64,
+    /// A motor input that changes in time, u(t) ([`Input`]); when set it replaces `u`, which
+    /// is then unused. `None` (the default) is the constant input `u`.
+    pub input: Option<Input>,
     /// Initial state `[α, ω_u, ω_l]`.
     pub x0: State,
     /// Horizon \[s\]; the run covers `[0, t_end]`.
@@ -106,6 +110,7 @@ impl Default for Scene {
     fn default() -> Self {
         Scene {
             u: 1.5,
+            input: None,
             x0: State::zeros(),
             t_end: 100.0,
             accuracy: Accuracy::Tol(DEFAULT_TOL),
@@ -130,6 +135,37 @@ impl Scene {
             accuracy: Accuracy::Step(h),
             ..Scene::default()
         }
+    }
+
+    /// Whether the input changes in time: an [`Input`] whose rows are not all one value.
+    /// What assumes a time-invariant system (the fast-forward, steady states) is off then.
+    pub fn is_time_varying(&self) -> bool {
+        self.input.as_ref().is_some_and(|i| i.constant().is_none())
+    }
+
+    /// The input u(t) \[V\]: `u`, or the [`Input`]'s value at t.
+    pub fn u_at(&self, t: f64) -> f64 {
+        match &self.input {
+            None => self.u,
+            Some(i) => i.at(t),
+        }
+    }
+
+    /// The linear piece of the input that holds from `t` on ([`Input::piece`]); the constant
+    /// `u` for ever without an [`Input`].
+    pub fn piece(&self, t: f64) -> Piece {
+        match &self.input {
+            None => Piece::constant(self.u),
+            Some(i) => i.piece(t),
+        }
+    }
+
+    /// The first breakpoint of the input after `t` (a row's time), if any before `t_end`.
+    pub fn next_breakpoint(&self, t: f64) -> Option<f64> {
+        self.input
+            .as_ref()
+            .and_then(|i| i.next_breakpoint(t))
+            .filter(|&b| b < self.t_end)
     }
 
     /// The adaptive solvers' tolerance: the scene's, or [`DEFAULT_TOL`] if it sets a step.
@@ -217,6 +253,16 @@ impl Scene {
         self.validate()?;
         if !(model.params.k_m * self.u).is_finite() {
             return Err(FieldError::num("u", self.u, "the motor torque k_m u overflows").into());
+        }
+        if let Some(i) = &self.input
+            && !(model.params.k_m * i.max_abs()).is_finite()
+        {
+            return Err(FieldError::num(
+                "input",
+                i.max_abs(),
+                "the motor torque k_m u overflows at this |u|",
+            )
+            .into());
         }
         if !(model.params.k_theta * self.x0[0]).is_finite() {
             return Err(FieldError::num(

@@ -109,7 +109,7 @@ impl Section {
                 t_end,
                 output: Output::Events,
                 metrics_from: Some(0.5 * t_end),
-                ..*scene
+                ..scene.clone()
             },
         )?;
         for section in [Section::StickExit, Section::LowerMax] {
@@ -315,7 +315,7 @@ impl<'a> Map<'a> {
                 output: Output::Events,
                 // Extrema are reported when metrics are asked.
                 metrics_from: Some(0.0),
-                ..self.scene
+                ..self.scene.clone()
             },
         )?;
         Ok(run

@@ -203,6 +203,7 @@ fn main() {
         friction_shortest += usize::from(ts.shortest() == ts.friction[0].min(ts.friction[1]));
         let scene = Scene {
             u: *u,
+            input: None,
             x0: State::zeros(),
             t_end: 100.0,
             accuracy: Accuracy::Tol(tol),
@@ -215,7 +216,7 @@ fn main() {
                 &m,
                 &Scene {
                     accuracy: Accuracy::Tol(1e-13),
-                    ..scene
+                    ..scene.clone()
                 },
             )
             .map(|r| values(&r.metrics));
@@ -232,7 +233,7 @@ fn main() {
                         &m,
                         &Scene {
                             output: Output::Metrics,
-                            ..scene
+                            ..scene.clone()
                         },
                     ),
                 ) else {

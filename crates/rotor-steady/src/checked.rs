@@ -524,6 +524,7 @@ pub fn checked_or_simulated(
     scene: &Scene,
     opts: &crate::steady::SteadyOptions,
 ) -> Result<SteadyAnswer, SteadyError> {
+    crate::steady::constant_input(scene)?;
     if kind == SolverKind::EVENT {
         return crate::steady::steady(kind, model, scene, opts);
     }

@@ -87,7 +87,7 @@ pub(crate) fn first_crossing(
                 t_end,
                 output: Output::Events,
                 metrics_from: Some(0.0),
-                ..*scene
+                ..scene.clone()
             },
         )
         .map_err(|e| e.to_string())?;
@@ -137,7 +137,7 @@ pub(crate) fn row_of(
                 t_end: 2.0 * orbit.period + skip,
                 output: Output::Final,
                 metrics_from: Some(0.0),
-                ..*scene
+                ..scene.clone()
             },
         )
         .map_err(|e| e.to_string())?;

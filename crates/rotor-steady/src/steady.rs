@@ -233,6 +233,7 @@ pub fn steady(
     scene: &Scene,
     opts: &SteadyOptions,
 ) -> Result<SteadyAnswer, SteadyError> {
+    constant_input(scene)?;
     scene.validate()?;
     let answer = if kind == SolverKind::EVENT {
         refined(model, scene.u, scene.x0, opts)?
@@ -241,6 +242,21 @@ pub fn steady(
     };
     crate::verify::verify(kind, model, scene, &answer)?;
     Ok(answer)
+}
+
+/// Refuses a scene whose input changes in time ([`Scene::is_time_varying`]): a steady state
+/// (an equilibrium or a cycle of the flow, shooting on its return map) is one of a
+/// time-invariant system.
+pub(crate) fn constant_input(scene: &Scene) -> Result<(), SteadyError> {
+    if scene.is_time_varying() {
+        return Err(SolveError::Unsupported {
+            detail: "a steady state needs a constant input: this scene's input changes in time \
+                     (input)"
+                .into(),
+        }
+        .into());
+    }
+    Ok(())
 }
 
 /// How long the run from the start is before shooting starts from its last crossing of the
@@ -254,6 +270,7 @@ pub const SHOOT_RUN: f64 = 300.0;
 /// from the fixed point), the Floquet multipliers `[1, λ, 0]` (a stick phase) or
 /// `[1, λ1, λ2]`, and whether it is stable. An error when the run settles to an equilibrium.
 pub fn shot(kind: SolverKind, model: &Model, scene: &Scene) -> Result<SteadyAnswer, SteadyError> {
+    constant_input(scene)?;
     scene.validate()?;
     let solver = kind.solver();
     let opts = rotor_shoot::ShootOptions::default();
@@ -285,6 +302,7 @@ pub fn simulated(
     scene: &Scene,
     opts: &SteadyOptions,
 ) -> Result<SteadyAnswer, SteadyError> {
+    constant_input(scene)?;
     scene.validate()?;
     let s = settle(kind, model, scene, &opts.settle)?;
     let answer = SteadyAnswer {

@@ -86,7 +86,7 @@ fn on_every_fixture_scene_each_solvers_steady_answer_is_what_its_simulation_sett
     let scenes = fixture_scenes();
     assert!(
         scenes.len() >= 20,
-        "the suite has 22 scenes: {}",
+        "the suite has 23 scenes: {}",
         scenes.len()
     );
     let cases = scenes

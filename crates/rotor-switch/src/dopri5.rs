@@ -334,6 +334,21 @@ impl<const N: usize> Dopri5<N> {
         (c + (db * th1 - b) * th) / self.h_old
     }
 
+    /// Starts again at `(t, y)` toward `t_end` as [`Dopri5::new`] does (the first step from
+    /// the `HINIT` heuristic, the controller history forgotten), keeping the counters: a
+    /// restart at a breakpoint of the input, the same as a fresh run from there.
+    pub fn reinit<F>(&mut self, t: f64, y: SVector<f64, N>, t_end: f64, f: &mut F)
+    where
+        F: FnMut(f64, &SVector<f64, N>) -> SVector<f64, N>,
+    {
+        let c = self.counters;
+        *self = Dopri5::new(self.opts, t, y, t_end, f);
+        self.counters.accepted += c.accepted;
+        self.counters.rejected += c.rejected;
+        self.counters.rhs_evals += c.rhs_evals;
+        self.counters.attempts += c.attempts;
+    }
+
     /// Restarts at `(t, y)` (after an event that changed the vector field): evaluates
     /// `f(t, y)`, keeps the proposed step size, forgets the controller history.
     pub fn restart<F>(&mut self, t: f64, y: SVector<f64, N>, f: &mut F)

@@ -2,8 +2,8 @@
 
 use rotor_model::{Disc, DiscMode, FieldError, Mode, Model, OMEGA_L, OMEGA_U, State};
 use rotor_seam::{
-    Event, EventKind, Integration, Recorder, Scene, SolveError, Solver, Stats, Trajectory,
-    check_finite,
+    Event, EventKind, Input, Integration, Piece, Recorder, Scene, SolveError, Solver, Stats,
+    Trajectory, check_finite,
 };
 
 use crate::dopri5::{Dopri5, Dopri5Error, Dopri5Options};
@@ -156,7 +156,8 @@ enum Guard {
 #[derive(Debug, Clone, Copy)]
 struct Field<'a> {
     model: &'a Model,
-    u: f64,
+    /// The input's piece, `u(t) = u0 + slope·(t − t0)` up to the next breakpoint.
+    piece: Piece,
     eta: f64,
     laws: [Law; 2],
     regions: [Region; 2],
@@ -168,14 +169,17 @@ struct Field<'a> {
 }
 
 impl Field<'_> {
-    fn tex(&self, k: usize, x: &State) -> f64 {
-        self.model.applied_torque(self.laws[k].disc, x, self.u)
+    /// The applied torque on disc k at time t, state x (the input at t on the piece).
+    #[inline]
+    fn tex(&self, k: usize, t: f64, x: &State) -> f64 {
+        self.model
+            .applied_torque(self.laws[k].disc, x, self.piece.at(t))
     }
 
     /// `ω̇_i = (T_ex,i − T_f,i)/J_i` with the region's friction (table in the crate docs).
-    fn accel(&self, k: usize, x: &State) -> f64 {
+    fn accel(&self, k: usize, t: f64, x: &State) -> f64 {
         let l = &self.laws[k];
-        let tex = self.tex(k, x);
+        let tex = self.tex(k, t, x);
         match self.regions[k] {
             Region::Slip(s) => (tex - self.model.friction(l.disc).torque(x[l.idx], s)) / l.j,
             Region::Stick | Region::Edge(_) => 0.0,
@@ -184,8 +188,12 @@ impl Field<'_> {
     }
 
     /// `ẋ = [ω_u − ω_l, ω̇_u, ω̇_l]`.
-    fn rhs(&self, x: &State) -> State {
-        State::new(x[OMEGA_U] - x[OMEGA_L], self.accel(0, x), self.accel(1, x))
+    fn rhs(&self, t: f64, x: &State) -> State {
+        State::new(
+            x[OMEGA_U] - x[OMEGA_L],
+            self.accel(0, t, x),
+            self.accel(1, t, x),
+        )
     }
 
     /// The guards of disc k in its region (at most two).
@@ -200,16 +208,16 @@ impl Field<'_> {
         }
     }
 
-    fn guard_value(&self, k: usize, g: Guard, x: &State) -> f64 {
+    fn guard_value(&self, k: usize, g: Guard, t: f64, x: &State) -> f64 {
         let l = &self.laws[k];
         let w = x[l.idx];
         match g {
             Guard::BandEntry(s) => s * w - self.eta,
             Guard::Zero(s) => s * w,
-            Guard::StickExit(s) => s * (l.bound(s) - self.tex(k, x)),
+            Guard::StickExit(s) => s * (l.bound(s) - self.tex(k, t, x)),
             Guard::TransOut(s) => self.eta - s * w,
-            Guard::Back(s) => s * (self.tex(k, x) - l.bound(s)),
-            Guard::EdgeOut(s) => s * (l.edge_torque(s) - self.tex(k, x)),
+            Guard::Back(s) => s * (self.tex(k, t, x) - l.bound(s)),
+            Guard::EdgeOut(s) => s * (l.edge_torque(s) - self.tex(k, t, x)),
         }
     }
 
@@ -250,11 +258,12 @@ impl Field<'_> {
         }
     }
 
-    /// Initial region of disc k at state x (t = 0); the velocity to set (η = 0 stick: 0).
-    fn initial_region(&self, k: usize, x: &State) -> (Region, Option<f64>) {
+    /// Initial region of disc k at state x at the start time t (0, or a breakpoint of the
+    /// input); the velocity to set (η = 0 stick: 0).
+    fn initial_region(&self, k: usize, t: f64, x: &State) -> (Region, Option<f64>) {
         let l = &self.laws[k];
         let w = x[l.idx];
-        let tex = self.tex(k, x);
+        let tex = self.tex(k, t, x);
         if !l.set_valued {
             let s = if w > 0.0 {
                 1.0
@@ -275,9 +284,15 @@ impl Field<'_> {
 
     /// The switch when guard g of disc k fires at state x: new region, velocity to set (the
     /// band edge `sη` exactly for `Edge`; 0 for stick only when η = 0), event.
-    fn fire(&self, k: usize, g: Guard, x: &State) -> (Region, Option<f64>, Option<EventKind>) {
+    fn fire(
+        &self,
+        k: usize,
+        g: Guard,
+        t: f64,
+        x: &State,
+    ) -> (Region, Option<f64>, Option<EventKind>) {
         let d = self.laws[k].disc;
-        let tex = self.tex(k, x);
+        let tex = self.tex(k, t, x);
         match g {
             Guard::BandEntry(s) => {
                 let (r, w) = self.band_region(k, tex, s);
@@ -454,6 +469,10 @@ struct Run<'a> {
     field: Field<'a>,
     integ: Dopri5<3>,
     t_end: f64,
+    /// Where the current piece of the input ends: its next breakpoint, or `t_end`.
+    seg_end: f64,
+    /// A time-varying input (`None`: the constant input, one piece to `t_end`).
+    input: Option<&'a Input>,
     tol: f64,
     /// Guard samples per step.
     samples: usize,
@@ -470,7 +489,7 @@ impl Run<'_> {
     /// Restarts the integration at `(t, y)` with the current regions' field.
     fn restart(&mut self, t: f64, y: State) {
         let f = self.field;
-        self.integ.restart(t, y, &mut |_t, y: &State| f.rhs(y));
+        self.integ.restart(t, y, &mut |t, y: &State| f.rhs(t, y));
     }
 
     /// One accepted step, up to its first region change: the markers before it, the samples,
@@ -479,10 +498,10 @@ impl Run<'_> {
         let f = self.field;
         let before = *self.integ.y();
         self.integ
-            .step(&mut |_t, y: &State| f.rhs(y), self.t_end)
+            .step(&mut |t, y: &State| f.rhs(t, y), self.seg_end)
             .map_err(|e| {
                 let y = *self.integ.y();
-                if f.rhs(&y).iter().any(|v| !v.is_finite()) {
+                if f.rhs(self.integ.t(), &y).iter().any(|v| !v.is_finite()) {
                     SolveError::NonFinite {
                         t: self.integ.t(),
                         x: [y[0], y[1], y[2]],
@@ -511,7 +530,7 @@ impl Run<'_> {
         } else {
             integ.dense(tr)
         };
-        let (r, w, ev) = f.fire(k, g, &y);
+        let (r, w, ev) = f.fire(k, g, tr, &y);
         if let Some(w) = w {
             y[f.laws[k].idx] = w;
         }
@@ -531,6 +550,41 @@ impl Run<'_> {
         check_finite(tr, &y)
     }
 
+    /// At a breakpoint of the input (the run's step ended on it): the next piece, and a
+    /// restart as at the start of a run, the regions chosen afresh from the state and the new
+    /// value (a stuck disc whose applied torque a step of u put out of its interval leaves
+    /// stick here, reported as a stick exit; one put back into it sticks) and the first step
+    /// from Hairer's heuristic again.
+    fn breakpoint(&mut self, rec: &mut Recorder) -> Result<(), SolveError> {
+        let Some(input) = self.input else {
+            return Ok(());
+        };
+        let t = self.integ.t();
+        let before = self.field.regions;
+        self.field.piece = input.piece(t);
+        self.seg_end = self.field.piece.end.min(self.t_end);
+        let y = self.field.start(t, self.integ.y());
+        for (k, was) in before.into_iter().enumerate() {
+            let d = self.field.laws[k].disc;
+            let is = self.field.regions[k];
+            let kind = match (was, is) {
+                (Region::Stick, Region::Stick) => None,
+                (Region::Stick, _) => Some(EventKind::StickEnd(d)),
+                (_, Region::Stick) => Some(EventKind::StickStart(d)),
+                _ => None,
+            };
+            if let Some(kind) = kind {
+                rec.event(Event { t, x: y, kind });
+            }
+        }
+        // As a fresh run: no extremum remembered.
+        self.last_extremum = [None; 2];
+        let f = self.field;
+        self.integ
+            .reinit(t, y, self.seg_end, &mut |t, y: &State| f.rhs(t, y));
+        check_finite(t, &y)
+    }
+
     /// The earliest guard root on the dense output of `[t0, t1]`: its time, disc and guard.
     fn first_switch(&self, t0: f64, t1: f64) -> Option<(f64, usize, Guard)> {
         let (f, integ, m) = (&self.field, &self.integ, self.samples);
@@ -543,9 +597,9 @@ impl Run<'_> {
             for g in f.guards(k).into_iter().flatten() {
                 let mut vals = [(0.0, 0.0); 17];
                 for (j, t) in sample_times(t0, t1, m).enumerate() {
-                    vals[j] = (t, f.guard_value(k, g, &xs[j]));
+                    vals[j] = (t, f.guard_value(k, g, t, &xs[j]));
                 }
-                let guard = |tt: f64| f.guard_value(k, g, &integ.dense(tt));
+                let guard = |tt: f64| f.guard_value(k, g, tt, &integ.dense(tt));
                 let root =
                     first_crossing(&vals[..=m], guard).or_else(|| self.dip(k, g, &vals[..=m]));
                 if let Some(tr) = root
@@ -587,9 +641,9 @@ impl Run<'_> {
             if prev < 0.0 && cur > 0.0 && vals[j - 1].1 > 0.0 {
                 let (ta, tb) = (vals[j - 1].0, vals[j].0);
                 let (tm, _) = illinois(slope, ta, prev, tb, cur);
-                let gm = f.guard_value(k, g, &integ.dense(tm));
+                let gm = f.guard_value(k, g, tm, &integ.dense(tm));
                 if gm < 0.0 {
-                    let guard = |tt: f64| f.guard_value(k, g, &integ.dense(tt));
+                    let guard = |tt: f64| f.guard_value(k, g, tt, &integ.dense(tt));
                     return Some(illinois(guard, ta, vals[j - 1].1, tm, gm).0);
                 }
             }
@@ -622,7 +676,7 @@ impl Run<'_> {
                     sign * y[l.idx]
                 } else {
                     extra_rhs += 1;
-                    f.accel(k, &y)
+                    f.accel(k, t, &y)
                 }
             };
             let mut prev = (t0, gfun(t0));
@@ -677,6 +731,9 @@ impl Integration for Run<'_> {
             if rec.halted() {
                 break;
             }
+            if self.integ.t() == self.seg_end && self.seg_end < self.t_end {
+                self.breakpoint(rec)?;
+            }
         }
         Ok(())
     }
@@ -727,7 +784,7 @@ impl SwitchOptions {
 impl<'a> Field<'a> {
     /// The field of `model` at input `u` with band `eta`, both discs in `Stick` until
     /// [`Field::start`] sets their regions.
-    fn new(model: &'a Model, u: f64, eta: f64) -> Field<'a> {
+    fn new(model: &'a Model, piece: Piece, eta: f64) -> Field<'a> {
         let law = |disc: Disc| {
             let f = model.friction(disc);
             let (lo, hi) = f.static_interval();
@@ -744,7 +801,7 @@ impl<'a> Field<'a> {
         };
         Field {
             model,
-            u,
+            piece,
             eta,
             laws: [law(Disc::Upper), law(Disc::Lower)],
             regions: [Region::Stick; 2],
@@ -752,12 +809,12 @@ impl<'a> Field<'a> {
         }
     }
 
-    /// Sets the initial regions at `x` and returns the state the run starts from (a velocity
-    /// in the band is kept; with η = 0 a stuck disc's is 0).
-    fn start(&mut self, x: &State) -> State {
+    /// Sets the initial regions at `x` at time `t` and returns the state the run starts from
+    /// (a velocity in the band is kept; with η = 0 a stuck disc's is 0).
+    fn start(&mut self, t: f64, x: &State) -> State {
         let mut x = *x;
         for k in 0..2 {
-            let (r, w) = self.initial_region(k, &x);
+            let (r, w) = self.initial_region(k, t, &x);
             self.regions[k] = r;
             self.from_rest[k] = true;
             if let Some(w) = w {
@@ -779,8 +836,10 @@ impl Solver for SwitchSolver {
         scene.validate_for(model)?;
         let o = self.options;
         o.validate()?;
-        let mut field = Field::new(model, scene.u, o.eta);
-        let x0 = field.start(&scene.x0);
+        let varying = scene.input.as_ref().filter(|_| scene.is_time_varying());
+        let piece = scene.piece(0.0);
+        let mut field = Field::new(model, piece, o.eta);
+        let x0 = field.start(0.0, &scene.x0);
         check_finite(0.0, &x0)?;
         let tol = scene.tol();
         let mut rec = Recorder::new(scene, x0, tol, o.skip_verify);
@@ -792,13 +851,14 @@ impl Solver for SwitchSolver {
             max_steps: o.max_steps,
             ..Dopri5Options::default()
         };
-        let integ = Dopri5::new(dopts, 0.0, x0, scene.t_end, &mut |_t, y: &State| {
-            field.rhs(y)
-        });
+        let seg_end = piece.end.min(scene.t_end);
+        let integ = Dopri5::new(dopts, 0.0, x0, seg_end, &mut |t, y: &State| field.rhs(t, y));
         let mut run = Run {
             field,
             integ,
             t_end: scene.t_end,
+            seg_end,
+            input: varying,
             tol,
             samples: o.guard_samples.clamp(1, 16),
             zeno: Zeno::new(o.zeno_count, o.zeno_window),

@@ -143,7 +143,7 @@ fn scene_of(sc: &Scenario, output: Output) -> Scene {
 #[test]
 fn every_fixture_runs_to_t_end() {
     let files = fixtures();
-    assert_eq!(files.len(), 22);
+    assert_eq!(files.len(), 23);
     let s = SwitchSolver::default();
     // The fixtures the name-matched checks below are written for; each must be met.
     let mut checked = Vec::new();

@@ -105,6 +105,7 @@ fn picard_fallback_converges_to_a_solution_or_is_flagged() {
                 &sc.model,
                 &Scene {
                     u: sc.u,
+                    input: None,
                     x0: sc.x0,
                     t_end: n as f64 * h,
                     accuracy: Accuracy::Step(h),

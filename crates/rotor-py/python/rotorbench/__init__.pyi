@@ -55,8 +55,12 @@ def simulate(
     dt: float = 0.01,
     tol: Optional[float] = None,
     h: Optional[float] = None,
+    input: Optional[Sequence[Sequence[float]]] = None,
 ) -> Simulation:
     """Simulates one scene; the trajectory on the grid 0, dt, ..., t_end.
+
+    ``input``: an (n, 2) array or a list of [t, u] pairs, an input that changes in time in
+    place of ``u`` (linear between rows, constant outside them, two rows at one t a step).
 
     ``tol`` is the adaptive solvers' tolerance (event, switch; default 1e-10), ``h``
     Moreau-Jean's step (default 1e-3 s). Returns numpy arrays t, alpha, omega_u, omega_l, the
@@ -71,8 +75,12 @@ def steady(
     x0: Sequence[float] = (0.0, 0.0, 0.0),
     tol: Optional[float] = None,
     h: Optional[float] = None,
+    input: Optional[Sequence[Sequence[float]]] = None,
 ) -> Dict[str, Any]:
     """The steady state reached from x0 at u, as ``rotor steady`` prints it.
+
+    An ``input`` that changes in time is refused (ValueError naming it): a steady state needs
+    a constant input.
 
     Keys: kind ("equilibrium" or "limit_cycle"), its metrics (omega_u, omega_l; or period,
     omega_l_max, omega_l_min, omega_u_max, omega_u_min, stick_time), method ("refined",
