@@ -517,7 +517,11 @@ fn gate_value(
                     .any(|e| matches!(e.kind, EventKind::StickStart(_)))
             });
             // a solver that holds a stuck disc in a band of its own adds that band
-            let eta = if sticks { s.kind.info().stuck_band } else { 0.0 };
+            let eta = if sticks {
+                s.kind.info().stuck_band
+            } else {
+                0.0
+            };
             Some(4.0 * phase.max(1.0) * (s.accuracy.tol() + tol_ref) + eta)
         }
         Gate::Trapezoid => {

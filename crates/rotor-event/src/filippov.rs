@@ -879,7 +879,7 @@ impl<'a> Integrator<'a> {
         recent: &mut Recent,
         sink: &mut impl Sink,
     ) -> Result<Option<RunEnd>, SolveError> {
-        let (model, u) = (self.model, self.u);
+        let (model, u) = (self.model, self.u(c.t));
         let bound = self
             .scale_bound
             .at(c.mode, &c.x, &c.f0, c.h, || model.jacobian(&c.x, u, c.mode));

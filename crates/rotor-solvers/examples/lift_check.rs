@@ -39,7 +39,7 @@ fn main() {
             &sc.model,
             &Scene {
                 accuracy: Accuracy::Tol(tol),
-                ..scene
+                ..scene.clone()
             },
         )
         .expect("the event solver runs the scene")
