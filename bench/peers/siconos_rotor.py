@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""The rotorbench rotor model in Siconos (MoreauJeanOSI): a peer for `rotor-bench`.
+"""The rotorbench rotor model in Siconos (MoreauJeanOSI): a peer for `rotor_harness::bench`.
 
 The Lagrangian form of section 3 of the source (docs/model.md; rotor-model's
 lagrangian.rs), as a Siconos user would set it up:

@@ -22,7 +22,7 @@ use std::process::{Command, Stdio};
 use std::time::Instant;
 
 use rotor_model::Model;
-use rotor_seam::{Output, Scene, Solver};
+use rotor_model::seam::{Output, Scene, Solver};
 
 fn median(mut v: Vec<f64>) -> f64 {
     v.sort_by(f64::total_cmp);
@@ -59,12 +59,12 @@ fn main() {
     });
     let solve_format = time(n, || {
         let tr = solver.simulate_finite(&model, &scene).unwrap();
-        std::hint::black_box(rotor_grade::trace::write_trace(&tr.samples, 0.01));
+        std::hint::black_box(rotor_harness::grade::trace::write_trace(&tr.samples, 0.01));
     });
     let solve_write = time(n, || {
         let tr = solver.simulate_finite(&model, &scene).unwrap();
-        rotor_compare::report::write_output_with(&csv, |w| {
-            rotor_grade::trace::write_trace_to(w, &tr.samples, 0.01)
+        rotor_harness::compare::report::write_output_with(&csv, |w| {
+            rotor_harness::grade::trace::write_trace_to(w, &tr.samples, 0.01)
         })
         .unwrap();
     });
@@ -109,14 +109,20 @@ fn main() {
     let check_whole = time(n, || {
         run(&["check", s, "--trace", t, "--events", e, "--gate", "strict"])
     });
-    let sc = rotor_solvers::load_scenario(&sc_path).unwrap();
-    let r = rotor_grade::reference::read(&root.join("fixtures/reference"), &sc.name).unwrap();
+    let sc = rotor_analysis::solvers::load_scenario(&sc_path).unwrap();
+    let r =
+        rotor_harness::grade::reference::read(&root.join("fixtures/reference"), &sc.name).unwrap();
     let check_in = time(n, || {
-        let tr = rotor_grade::trace::read_trace(&trace, usize::MAX).unwrap();
-        let ev = rotor_grade::trace::read_events(&events).unwrap();
-        let rep =
-            rotor_grade::check::check(&sc, &r, &tr, Some(&ev), rotor_grade::check::Level::Strict)
-                .unwrap();
+        let tr = rotor_harness::grade::trace::read_trace(&trace, usize::MAX).unwrap();
+        let ev = rotor_harness::grade::trace::read_events(&events).unwrap();
+        let rep = rotor_harness::grade::check::check(
+            &sc,
+            &r,
+            &tr,
+            Some(&ev),
+            rotor_harness::grade::check::Level::Strict,
+        )
+        .unwrap();
         assert!(rep.passed);
     });
     println!("rotor check t1-u1.5-rest --trace (200 s, 20 001 rows) --events --gate strict");

@@ -69,7 +69,7 @@ fn children_cpu() -> Option<f64> {
 fn main() {
     let bin = Path::new(env!("CARGO_BIN_EXE_rotor"));
     let dir = rotor_testkit::tmp_dir("rotor-steady-bench");
-    let h1 = rotor_bifurcation::equilibria::hopf_points(&Model::table1(), 20.0)[0]
+    let h1 = rotor_analysis::bifurcation::equilibria::hopf_points(&Model::table1(), 20.0)[0]
         .equilibrium
         .u;
     let u = format!("{}", h1 + 1e-4);

@@ -4,8 +4,8 @@
 use std::path::{Path, PathBuf};
 
 use anyhow::{Result, anyhow};
+use rotor_analysis::solvers::SolverKind;
 use rotor_model::{Model, Params, State};
-use rotor_solvers::SolverKind;
 
 use crate::out;
 
@@ -75,23 +75,26 @@ pub(crate) fn exit_code(e: &anyhow::Error) -> u8 {
         c.is::<Unusable>()
             || c.is::<rotor_model::ParamsError>()
             || c.is::<rotor_model::FieldError>()
-            || c.is::<rotor_scenario::ScenarioError>()
+            || c.is::<rotor_model::scenario::ScenarioError>()
             || c.is::<rotor_suite::SuiteError>()
             || invalid_scene(c)
             || matches!(
-                c.downcast_ref::<rotor_report::ReportError>(),
-                Some(rotor_report::ReportError::DuplicateName { .. })
+                c.downcast_ref::<rotor_harness::report::ReportError>(),
+                Some(rotor_harness::report::ReportError::DuplicateName { .. })
             )
             || matches!(
-                c.downcast_ref::<rotor_bench::BenchError>(),
-                Some(rotor_bench::BenchError::Options(_) | rotor_bench::BenchError::Scenario(_))
-            )
-            || matches!(
-                c.downcast_ref::<rotor_jobs::sweep::SweepError>(),
+                c.downcast_ref::<rotor_harness::bench::BenchError>(),
                 Some(
-                    rotor_jobs::sweep::SweepError::Arg(_)
-                        | rotor_jobs::sweep::SweepError::File { .. }
-                        | rotor_jobs::sweep::SweepError::Merge(_)
+                    rotor_harness::bench::BenchError::Options(_)
+                        | rotor_harness::bench::BenchError::Scenario(_)
+                )
+            )
+            || matches!(
+                c.downcast_ref::<rotor_harness::jobs::sweep::SweepError>(),
+                Some(
+                    rotor_harness::jobs::sweep::SweepError::Arg(_)
+                        | rotor_harness::jobs::sweep::SweepError::File { .. }
+                        | rotor_harness::jobs::sweep::SweepError::Merge(_)
                 )
             )
     });
@@ -101,20 +104,20 @@ pub(crate) fn exit_code(e: &anyhow::Error) -> u8 {
 /// Whether a solver refused the scene itself (an input it cannot run, as u = 1e308), also
 /// where a steady-state error carries it transparently.
 fn invalid_scene(c: &(dyn std::error::Error + 'static)) -> bool {
-    use rotor_seam::SolveError::InvalidScene;
+    use rotor_model::seam::SolveError::InvalidScene;
     matches!(c.downcast_ref(), Some(InvalidScene(_)))
         || matches!(
             c.downcast_ref(),
-            Some(rotor_steady::SteadyError::Solve(InvalidScene(_)))
+            Some(rotor_analysis::steady::SteadyError::Solve(InvalidScene(_)))
         )
         || matches!(
             c.downcast_ref(),
-            Some(rotor_steady::SettleError::Solve(InvalidScene(_)))
+            Some(rotor_analysis::steady::SettleError::Solve(InvalidScene(_)))
         )
 }
 
 pub(crate) fn kind_by_name(name: &str) -> Result<SolverKind> {
-    rotor_jobs::request::solver_kind(name).map_err(flagged)
+    rotor_harness::jobs::request::solver_kind(name).map_err(flagged)
 }
 
 /// Prints a command's summary: on standard output, unless one of its outputs goes there
@@ -139,16 +142,16 @@ pub(crate) fn load_model(params: Option<&Path>) -> Result<Model> {
 }
 
 /// The file a path argument names: a path, or the name of a file in `fixtures/KIND`
-/// ([`rotor_solvers::fixtures::resolve`]). A name that is neither is an error naming `flag`
+/// ([`rotor_analysis::solvers::fixtures::resolve`]). A name that is neither is an error naming `flag`
 /// and listing the names there.
 pub(crate) fn fixture_path(flag: &str, p: &Path, kind: &str) -> Result<PathBuf> {
     let dir = fixtures_dir()?.join(kind);
-    rotor_solvers::fixtures::resolve(p, Some(&dir)).ok_or_else(|| {
+    rotor_analysis::solvers::fixtures::resolve(p, Some(&dir)).ok_or_else(|| {
         unusable(format_args!(
             "{flag} {}: no such file, nor a name in {} (names: {})",
             p.display(),
             dir.canonicalize().unwrap_or_else(|_| dir.clone()).display(),
-            rotor_solvers::fixtures::names(&dir).join(", ")
+            rotor_analysis::solvers::fixtures::names(&dir).join(", ")
         ))
     })
 }
@@ -177,23 +180,23 @@ pub(crate) fn parse_x0(s: Option<&str>) -> Result<State> {
 }
 
 /// Moreau–Jean steps whose step problem did not converge are answers to distrust: say so.
-pub(crate) fn warn_inexact(stats: &rotor_seam::Stats) {
-    if let Some(w) = rotor_jobs::request::inexact_warning(stats, "--h") {
+pub(crate) fn warn_inexact(stats: &rotor_model::seam::Stats) {
+    if let Some(w) = rotor_harness::jobs::request::inexact_warning(stats, "--h") {
         eprintln!("warning: {w}");
     }
 }
 
 /// `--threads N`: a whole number from 1 (clap's error names the flag and the value).
 pub(crate) fn threads_arg(s: &str) -> Result<usize, String> {
-    rotor_compare::threads::parse_count(s)
+    rotor_harness::compare::threads::parse_count(s)
 }
 
 /// Starts the thread pool of a command that runs in parallel: `--threads`, else
-/// `SLURM_CPUS_PER_TASK`, else the cores available ([`rotor_compare::threads`]). Returns the
+/// `SLURM_CPUS_PER_TASK`, else the cores available ([`rotor_harness::compare::threads`]). Returns the
 /// count in words ("1 thread", "8 threads, from SLURM_CPUS_PER_TASK") for the run's summary.
 pub(crate) fn thread_pool(explicit: Option<usize>) -> Result<String> {
-    use rotor_compare::threads::Source;
-    let (n, src) = rotor_compare::threads::resolve(explicit).map_err(unusable)?;
+    use rotor_harness::compare::threads::Source;
+    let (n, src) = rotor_harness::compare::threads::resolve(explicit).map_err(unusable)?;
     rayon::ThreadPoolBuilder::new()
         .num_threads(n)
         .build_global()
@@ -212,7 +215,7 @@ pub(crate) fn thread_pool(explicit: Option<usize>) -> Result<String> {
 /// Checks a numeric option: finite and in range, else the refusal naming its flag
 /// ([`flagged`]) and the value.
 pub(crate) fn check(field: &str, v: f64, ok: bool, what: &str) -> Result<()> {
-    rotor_jobs::request::check_number(field, v, ok, what).map_err(flagged)
+    rotor_harness::jobs::request::check_number(field, v, ok, what).map_err(flagged)
 }
 
 /// A bad input as the command line spells it: the field as its flag (`t_end` is `--t-end`).
@@ -222,9 +225,9 @@ pub(crate) fn flagged(e: rotor_model::FieldError) -> anyhow::Error {
 
 /// A sweep's error as the command line spells it: a refused argument names its flag
 /// ([`flagged`]); the others keep their sources.
-pub(crate) fn sweep_flagged(e: rotor_jobs::sweep::SweepError) -> anyhow::Error {
+pub(crate) fn sweep_flagged(e: rotor_harness::jobs::sweep::SweepError) -> anyhow::Error {
     match e {
-        rotor_jobs::sweep::SweepError::Arg(f) => flagged(f),
+        rotor_harness::jobs::sweep::SweepError::Arg(f) => flagged(f),
         e => e.into(),
     }
 }
@@ -269,17 +272,18 @@ pub(crate) fn implausible_u(u: f64, model: &Model) -> Option<String> {
 pub(crate) struct Start {
     pub(crate) u: f64,
     /// A time-varying input (`--input`, or the scenario's `input`).
-    pub(crate) input: Option<rotor_seam::Input>,
+    pub(crate) input: Option<rotor_model::seam::Input>,
     pub(crate) x0: State,
     pub(crate) model: Model,
-    pub(crate) scenario: Option<rotor_scenario::Scenario>,
+    pub(crate) scenario: Option<rotor_model::scenario::Scenario>,
 }
 
 /// Loads the start of `simulate` and `steady` ([`Start`]), warning about an implausible u.
 pub(crate) fn start(common: &Common) -> Result<Start> {
     let s = match &common.scenario {
         Some(p) => {
-            let sc = rotor_solvers::load_scenario(&fixture_path("SCENARIO", p, "scenarios")?)?;
+            let sc =
+                rotor_analysis::solvers::load_scenario(&fixture_path("SCENARIO", p, "scenarios")?)?;
             Start {
                 u: sc.u,
                 input: sc.input.clone(),
@@ -306,10 +310,10 @@ pub(crate) fn start(common: &Common) -> Result<Start> {
 
 /// `--input FILE`: the input table, read and checked (exit 2 naming the file, the row and
 /// the bad value).
-pub(crate) fn read_input(path: &Path) -> Result<rotor_seam::Input> {
+pub(crate) fn read_input(path: &Path) -> Result<rotor_model::seam::Input> {
     let text = std::fs::read_to_string(path)
         .map_err(|e| unusable(format_args!("--input {}: cannot read: {e}", path.display())))?;
-    rotor_seam::Input::from_csv(&text, &path.display().to_string())
+    rotor_model::seam::Input::from_csv(&text, &path.display().to_string())
         .map_err(|e| unusable(format_args!("--input: {e}")))
 }
 
@@ -318,9 +322,9 @@ pub(crate) fn read_input(path: &Path) -> Result<rotor_seam::Input> {
 pub(crate) fn request<'a>(
     common: &'a Common,
     start: &Start,
-) -> Result<rotor_jobs::request::Request<'a>> {
+) -> Result<rotor_harness::jobs::request::Request<'a>> {
     let x = start.x0;
-    let req = rotor_jobs::request::Request {
+    let req = rotor_harness::jobs::request::Request {
         solver: &common.solver,
         u: start.u,
         input: start.input.clone(),

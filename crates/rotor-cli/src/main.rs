@@ -1,6 +1,6 @@
 //! `rotor`: the command-line front end (its contract: docs/design.md, "The CLI"). Each
 //! command is a module of [`cmd`] (its flags and its `run`); what they share is in
-//! [`common`]; the main job's report is assembled by the `rotor-report` crate.
+//! [`common`]; the main job's report is assembled by the `rotor_harness::report` crate.
 
 use std::path::Path;
 use std::process::ExitCode;

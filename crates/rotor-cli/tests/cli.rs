@@ -149,7 +149,9 @@ fn steady_refuses_what_the_solver_cannot_resolve() {
 /// the bench's (`benches/steady.rs`).
 #[test]
 fn steady_default_confirms_the_slow_cycle_next_to_h1() {
-    let h1 = rotor_bifurcation::equilibria::hopf_points(&rotor_model::Model::table1(), 20.0)[0]
+    let h1 =
+        rotor_analysis::bifurcation::equilibria::hopf_points(&rotor_model::Model::table1(), 20.0)
+            [0]
         .equilibrium
         .u;
     let u = format!("{}", h1 + 1e-4);
@@ -209,7 +211,7 @@ fn bifurcation_writes_the_contract_json_and_a_figure() {
         }
     }
     // Table 1 between 0 and 1 V: the supercritical Hopf point (0.3835 V) and the grazing
-    // point (0.6031 V) lie in the window; their values are tested in rotor-bifurcation.
+    // point (0.6031 V) lie in the window; their values are tested in rotor_analysis::bifurcation.
     let kinds: Vec<&str> = v["points"]
         .as_array()
         .unwrap()
@@ -954,13 +956,13 @@ fn without_timings(v: &serde_json::Value, timing: bool) -> serde_json::Value {
 fn job_prints_the_job_file_with_x0_at_full_precision() {
     let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
     let path = root.join("fixtures/scenarios/t1-u2.5-eq-pert.toml");
-    let sc = rotor_solvers::load_scenario(&path).unwrap();
+    let sc = rotor_analysis::solvers::load_scenario(&path).unwrap();
     let json = |o: std::process::Output| -> serde_json::Value {
         assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
         serde_json::from_slice(&o.stdout).unwrap()
     };
     let by_name = json(rotor(&["job", "t1-u2.5-eq-pert", "--h", "1e-3"]));
-    assert_eq!(by_name["benchmark"], rotor_grade::check::BENCHMARK);
+    assert_eq!(by_name["benchmark"], rotor_harness::grade::check::BENCHMARK);
     assert_eq!(by_name["scenario"], "t1-u2.5-eq-pert");
     assert_eq!(by_name["h"], 1e-3);
     assert!(by_name["tol"].is_null());
@@ -1299,7 +1301,8 @@ fn reference_writes_to_the_current_directory_or_out_never_the_checkout() {
 fn simulate_a_scenario_runs_its_horizon_and_check_accepts_the_trace() {
     let fixtures = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../fixtures");
     let sc =
-        rotor_scenario::Scenario::from_file(&fixtures.join("scenarios/t1-u1.5-rest.toml")).unwrap();
+        rotor_model::scenario::Scenario::from_file(&fixtures.join("scenarios/t1-u1.5-rest.toml"))
+            .unwrap();
     let dir = rotor_testkit::tmp_dir("rotor-cli-sim-scenario");
     let csv = dir.join("my.csv");
     let csv = csv.to_str().unwrap();
@@ -1547,7 +1550,7 @@ fn event_conventions_of_benchmark_md_are_the_graders() {
         );
     }
     // A smooth upper disc crossing 0: from ω_u = −1 rad/s at 1.5 V it turns forward.
-    let req = rotor_jobs::request::Request {
+    let req = rotor_harness::jobs::request::Request {
         solver: "event",
         u: 1.5,
         input: None,
@@ -1558,7 +1561,8 @@ fn event_conventions_of_benchmark_md_are_the_graders() {
     let (kind, scene) = req.simulation(5.0, 0.01).unwrap();
     let model = rotor_model::Model::new(rotor_model::Params::table1());
     let traj = kind.solver().simulate_finite(&model, &scene).unwrap();
-    let written = String::from_utf8(rotor_grade::trace::write_events(&traj.events)).unwrap();
+    let written =
+        String::from_utf8(rotor_harness::grade::trace::write_events(&traj.events)).unwrap();
     assert!(
         written.lines().any(|l| l.ends_with(",upper,reversal")),
         "{written}"

@@ -207,8 +207,8 @@ fn readme_long_commands_run_in_ci_long_step() {
         );
         let table = String::from_utf8(o.stdout).unwrap();
         // The scenes the command covers: the tier it names, else the whole suite.
-        let tier = flag_value(cmd, "--tier").map(|t| rotor_bench::Tier::parse(t).unwrap());
-        let scenes: Vec<String> = rotor_bench::suite(&suite_dir, tier)
+        let tier = flag_value(cmd, "--tier").map(|t| rotor_harness::bench::Tier::parse(t).unwrap());
+        let scenes: Vec<String> = rotor_harness::bench::suite(&suite_dir, tier)
             .unwrap()
             .iter()
             .map(|s| {
@@ -243,7 +243,7 @@ fn readme_long_commands_run_in_ci_long_step() {
         }
         if let Some(json) = flag_value(cmd, "--json") {
             let text = std::fs::read_to_string(dir.join(json)).unwrap();
-            let report: rotor_bench::BenchReport = serde_json::from_str(&text)
+            let report: rotor_harness::bench::BenchReport = serde_json::from_str(&text)
                 .unwrap_or_else(|e| panic!("{cmd}: {json} is not a benchmark report: {e}"));
             let names: Vec<&str> = report.scenes.iter().map(|s| s.name.as_str()).collect();
             assert_eq!(names.len(), scenes.len(), "{cmd}: {names:?}");
@@ -253,7 +253,7 @@ fn readme_long_commands_run_in_ci_long_step() {
                     "{cmd}: {} not asked for",
                     sc.name
                 );
-                for k in rotor_solvers::SOLVERS {
+                for k in rotor_analysis::solvers::SOLVERS {
                     assert!(
                         sc.points.iter().any(|p| p.solver == k),
                         "{cmd}: {}: no point of {}",
@@ -266,7 +266,7 @@ fn readme_long_commands_run_in_ci_long_step() {
                 for c in report.clients.iter().filter(|c| c.peer) {
                     assert_eq!(
                         c.status,
-                        rotor_bench::ClientStatus::Ran,
+                        rotor_harness::bench::ClientStatus::Ran,
                         "{cmd}: peer {} did not run: {:?}",
                         c.name,
                         c.reason

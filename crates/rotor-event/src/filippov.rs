@@ -29,8 +29,8 @@
 //! polished once more from there. A section crossing is refined as a terminal root.
 
 use nalgebra::Matrix3;
+use rotor_model::seam::{Event, EventKind, Piece, SolveError, Stats, check_finite};
 use rotor_model::{Disc, DiscMode, Mode, Model, OMEGA_L, State};
-use rotor_seam::{Event, EventKind, Piece, SolveError, Stats, check_finite};
 use std::cell::Cell;
 
 use crate::dop853::{Dense, Dop853};
@@ -70,8 +70,8 @@ pub struct EventOptions {
     pub zeno_window: f64,
     /// Sample intervals per step for guard detection (at most 64).
     pub guard_samples: usize,
-    /// [`rotor_seam::Output::Metrics`]: how close, in tolerances, the first return after
-    /// skipped periods must come to the return before them ([`rotor_seam::FastForward`]);
+    /// [`rotor_model::seam::Output::Metrics`]: how close, in tolerances, the first return after
+    /// skipped periods must come to the return before them ([`rotor_model::seam::FastForward`]);
     /// 0 rejects every skip (a check of the undo).
     pub skip_verify: f64,
 }
@@ -90,7 +90,7 @@ impl Default for EventOptions {
             zeno_count: 64,
             zeno_window: 1e-9,
             guard_samples: 4,
-            skip_verify: rotor_seam::fast_forward::VERIFY_TOLERANCES,
+            skip_verify: rotor_model::seam::fast_forward::VERIFY_TOLERANCES,
         }
     }
 }
@@ -116,7 +116,7 @@ impl Default for EventOptions {
 /// accepted at 0.4 of the tolerance with a true error of 1e4 tolerances. A DOP853 step that
 /// resolves a field varying on τ to a tolerance tol is ∝ τ·tol^{1/8}, so a fixed multiple of
 /// it costs a fixed fraction at every tolerance. k = 8 measured (docs/methods.md, "Steps tied
-/// to the model's scales"; `rotor-solvers/examples/step_scales.rs`): over 1000 random sets at
+/// to the model's scales"; `rotor_analysis::solvers/examples/step_scales.rs`): over 1000 random sets at
 /// tol 1e-10 it brought the limit cycles whose metrics erred by more than 100 tolerances from
 /// 25 to 2, for 14 % more field evaluations.
 ///
@@ -231,7 +231,7 @@ pub fn step_bound(model: &Model, tol: f64, k: f64) -> f64 {
 /// The largest defect, in tolerances, between a step's dense output and the exact RK state
 /// re-taken to an event in it (`Integrator::defect`) that lets the step stand. Measured (a
 /// temporary log of every event's defect) over the metrics-only stress scene on 100 random
-/// parameter sets at tol 1e-10 (`rotor-solvers/examples/step_scales.rs`): 9168 events on
+/// parameter sets at tol 1e-10 (`rotor_analysis::solvers/examples/step_scales.rs`): 9168 events on
 /// steps under 0.25 s, median 0.03, 99.9th percentile and largest 4.35 (short steps whose
 /// error estimate was 0.31); on the 0.7–1 s steps that the step bound now forbids, up to 180.
 /// 10 lies above every trusted step. With the step bound on, the check fired 194 times in the

@@ -1,7 +1,7 @@
 //! The flow of the Filippov system as a function, for shooting and continuation.
 
+use rotor_model::seam::{Event, EventKind, SolveError, Stats};
 use rotor_model::{Disc, Mode, Model, State};
-use rotor_seam::{Event, EventKind, SolveError, Stats};
 
 use crate::filippov::{EventOptions, Integrator, Sink};
 

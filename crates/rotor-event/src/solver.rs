@@ -1,7 +1,9 @@
 //! The [`Solver`] seam for the event-driven method.
 
+use rotor_model::seam::{
+    Event, Input, Integration, Recorder, Scene, SolveError, Solver, Trajectory,
+};
 use rotor_model::{Mode, Model, State};
-use rotor_seam::{Event, Input, Integration, Recorder, Scene, SolveError, Solver, Trajectory};
 
 use crate::dop853::Dense;
 use crate::filippov::{EventOptions, Integrator, RunEnd, Sink};
@@ -12,13 +14,13 @@ use crate::filippov::{EventOptions, Integrator, RunEnd, Sink};
 ///
 /// A run through the [`Solver`] seam: Table 1's rotor at u = 1.5 V from rest settles on the
 /// stick-slip limit cycle of the source's Fig. 4 (period 4.5778 s, the lower disc stuck
-/// 0.87 s of it). [`Output::Metrics`](rotor_seam::Output::Metrics) keeps only the
+/// 0.87 s of it). [`Output::Metrics`](rotor_model::seam::Output::Metrics) keeps only the
 /// steady-state metrics, read off the cycles after `metrics_from`.
 ///
 /// ```
 /// use rotor_event::EventSolver;
 /// use rotor_model::{Model, State};
-/// use rotor_seam::{Accuracy, Output, Scene, Solver, SteadyState};
+/// use rotor_model::seam::{Accuracy, Output, Scene, Solver, SteadyState};
 ///
 /// let model = Model::table1();
 /// let scene = Scene {
@@ -40,7 +42,7 @@ use crate::filippov::{EventOptions, Integrator, RunEnd, Sink};
 /// assert!((period - 4.57776).abs() < 1e-4, "period {period} s");
 /// assert_eq!(omega_l_min, 0.0, "the lower disc sticks exactly");
 /// assert!((stick_time - 0.8708).abs() < 1e-3, "stuck {stick_time} s per period");
-/// # Ok::<(), rotor_seam::SolveError>(())
+/// # Ok::<(), rotor_model::seam::SolveError>(())
 /// ```
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
 pub struct EventSolver {

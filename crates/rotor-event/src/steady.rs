@@ -24,8 +24,8 @@
 //! finds only an unstable cycle, the settled run's own last cycle is the answer
 //! ([`Method::Settled`]).
 
+use rotor_model::seam::{Event, EventKind, MetricsAccumulator, SolveError, SteadyState};
 use rotor_model::{Disc, DiscMode, Mode, Model, SlipEquilibrium, State};
-use rotor_seam::{Event, EventKind, MetricsAccumulator, SolveError, SteadyState};
 
 use nalgebra::Complex;
 

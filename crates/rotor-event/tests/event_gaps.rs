@@ -5,8 +5,8 @@
 use std::path::Path;
 
 use rotor_event::{EventOptions, EventSolver, StopAt, flow};
+use rotor_model::seam::{EventKind, Output, Scene, Solver};
 use rotor_model::{Disc, DiscMode, LowerFriction, Mode, Model, Params, State, UpperFriction};
-use rotor_seam::{EventKind, Output, Scene, Solver};
 
 fn fixtures() -> std::path::PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../../fixtures")
@@ -17,7 +17,7 @@ fn stribeck() -> Model {
 }
 
 /// The mode switches among a run's events (extrema left out).
-fn switches(events: &[rotor_seam::Event]) -> Vec<rotor_seam::Event> {
+fn switches(events: &[rotor_model::seam::Event]) -> Vec<rotor_model::seam::Event> {
     events
         .iter()
         .filter(|e| !matches!(e.kind, EventKind::Max(_) | EventKind::Min(_)))

@@ -5,9 +5,9 @@ use std::path::Path;
 
 use nalgebra::{Matrix3, Vector3};
 use rotor_event::{EventOptions, EventSolver, SteadyOptions, steady_state};
+use rotor_model::scenario::Scenario;
+use rotor_model::seam::{EventKind, Output, Scene, SolveError, Solver, SteadyState};
 use rotor_model::{Disc, LowerFriction, Model, Params, State};
-use rotor_scenario::Scenario;
-use rotor_seam::{EventKind, Output, Scene, SolveError, Solver, SteadyState};
 
 fn fixtures() -> std::path::PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../../fixtures")
@@ -60,7 +60,7 @@ fn frictionless_levels_match_matrix_exponential() {
     }
 }
 
-fn t1_events(u: f64, t_end: f64, tol: f64) -> Vec<rotor_seam::Event> {
+fn t1_events(u: f64, t_end: f64, tol: f64) -> Vec<rotor_model::seam::Event> {
     let s = Scene {
         u,
         t_end,
@@ -509,7 +509,7 @@ fn sampling(n: usize) -> EventSolver {
 }
 
 /// The mode switches among a run's events (extrema left out).
-fn switches(events: &[rotor_seam::Event]) -> Vec<rotor_seam::Event> {
+fn switches(events: &[rotor_model::seam::Event]) -> Vec<rotor_model::seam::Event> {
     events
         .iter()
         .filter(|e| !matches!(e.kind, EventKind::Max(_) | EventKind::Min(_)))
@@ -680,7 +680,7 @@ fn steady_state_accepts_only_a_stable_cycle_near_a_fold() {
 #[test]
 fn steady_state_next_to_a_hopf_point_answers_the_focus() {
     let m = Model::table1();
-    let hopf = 0.383_547_060_287_328_4; // Table 1's first Hopf point (rotor-bifurcation)
+    let hopf = 0.383_547_060_287_328_4; // Table 1's first Hopf point (rotor_analysis::bifurcation)
     let u = hopf - 1e-6;
     let st = steady_state(
         &m,
@@ -729,10 +729,8 @@ fn a_start_on_the_stick_edge_with_rising_torque_leaves_at_once() {
     let on = run(edge);
     let past = run(edge * (1.0 + 1e-14));
     assert!(
-        on.events
-            .first()
-            .is_some_and(|e| e.t == 0.0
-                && e.kind == rotor_seam::EventKind::StickEnd(rotor_model::Disc::Lower)),
+        on.events.first().is_some_and(|e| e.t == 0.0
+            && e.kind == rotor_model::seam::EventKind::StickEnd(rotor_model::Disc::Lower)),
         "{:?}",
         on.events.first()
     );
@@ -775,7 +773,7 @@ fn stick_time(solver: &EventSolver, m: &Model, tol: f64) -> f64 {
         input: None,
         x0: State::zeros(),
         t_end: 100.0,
-        accuracy: rotor_seam::Accuracy::Tol(tol),
+        accuracy: rotor_model::seam::Accuracy::Tol(tol),
         output: Output::Final,
         metrics_from: Some(50.0),
     };
@@ -823,7 +821,7 @@ fn steps_tied_to_the_friction_scale_keep_the_stick_time() {
 }
 
 /// The defect check at events: with the step bound off, a random parameter set (drawn by
-/// `rotor-solvers/examples/step_scales.rs`, seed 4, set 2) has steps of up to 1 s that end in a
+/// `rotor_analysis::solvers/examples/step_scales.rs`, seed 4, set 2) has steps of up to 1 s that end in a
 /// stick event, where the exact state re-taken to the event differs from the dense output by
 /// 29 and 33 tolerances (> DEFECT_LIMIT = 10). The check rejects and redoes those steps, and the redone run keeps the
 /// steady metrics of tol 1e-13.
@@ -854,7 +852,7 @@ fn a_misjudged_step_found_at_an_event_is_redone() {
         input: None,
         x0: State::zeros(),
         t_end: 100.0,
-        accuracy: rotor_seam::Accuracy::Tol(1e-10),
+        accuracy: rotor_model::seam::Accuracy::Tol(1e-10),
         output: Output::Final,
         metrics_from: Some(50.0),
     };
@@ -882,7 +880,7 @@ fn a_misjudged_step_found_at_an_event_is_redone() {
     .simulate(
         &m,
         &Scene {
-            accuracy: rotor_seam::Accuracy::Tol(1e-13),
+            accuracy: rotor_model::seam::Accuracy::Tol(1e-13),
             ..scene
         },
     )

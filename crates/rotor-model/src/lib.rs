@@ -5,10 +5,13 @@
 //!
 //! This crate is the physics only: parameters, friction laws, the vector field per mode, its
 //! Jacobians, the equilibria and the Lagrangian form. What a solver is asked and what it
-//! returns (the solver seam) is the crate `rotor-seam`, built on this one. Neither holds
+//! returns (the solver seam) is the module `rotor_model::seam`, built on this one. Neither holds
 //! integration code.
 
 #![warn(missing_docs)]
+
+pub mod scenario;
+pub mod seam;
 
 pub mod dynamics;
 pub mod equilibrium;

@@ -1,6 +1,6 @@
 //! Bad parameter files: every kind of bad input is an error, never a panic, and its message
 //! is one line that names the file, the field and the offending value. (Bad scenario files
-//! are rotor-scenario's tests/bad_input.rs; bad scenes, rotor-seam's.)
+//! are rotor_model::scenario's tests/bad_input.rs; bad scenes, rotor_model::seam's.)
 //!
 //! Each case is a mutation of a real fixture file, written to a temporary directory and read
 //! back through `from_file`, so that the path in the message is the path of the file. The

@@ -1,7 +1,7 @@
 //! Malformed and random parameter files: mutations of the real ones
 //! ([`rotor_testkit::mutate`]). Reading a mutant never panics; it gives either an admissible
 //! parameter set or an error whose message is one line and names the file. (Scenario files
-//! are fuzzed in rotor-scenario's tests/fuzz_files.rs.)
+//! are fuzzed in rotor_model::scenario's tests/fuzz_files.rs.)
 //!
 //! "Admissible" is checked independently of the loader: parameters pass `Params::validate`.
 

@@ -1,7 +1,7 @@
 //! Counts steps whose one-step problem was not solved exactly (Picard fallback without
 //! convergence) per fixture and step size.
+use rotor_model::scenario::Scenario;
 use rotor_moreau::{MoreauOptions, Stepper};
-use rotor_scenario::Scenario;
 
 fn main() {
     let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../fixtures/scenarios");

@@ -70,8 +70,8 @@
 //! `v_free,i` satisfy `|v_free,i| > 2 Σ_j |W_ij| P_j` (W = M̂⁻¹, P_j the cone bounds), no
 //! admissible impulse can bring a velocity to zero: the slip mode `sign(v)` is taken,
 //! Newton runs in that mode only, and its result is checked against the sign conditions
-//! (a failed check falls back to the enumeration). Counted in [`rotor_seam::Stats::lcp_skipped`]
-//! (vs [`rotor_seam::Stats::lcp_solves`]).
+//! (a failed check falls back to the enumeration). Counted in [`rotor_model::seam::Stats::lcp_skipped`]
+//! (vs [`rotor_model::seam::Stats::lcp_solves`]).
 //!
 //! # Order
 //!
@@ -86,7 +86,7 @@
 //! within the step, or holds it at rest for one step (reported as a Reversal, see below).
 //! The measured orders and constants (of the cycle metrics, and at the state level: the
 //! trace's L∞ error over a cycle and the stick onsets, all second order), and the cost per
-//! step, are in `reports/measurements.md` (measured by `rotor-compare/tests/moreau_order.rs`
+//! step, are in `reports/measurements.md` (measured by `rotor_harness::compare/tests/moreau_order.rs`
 //! and the stress case "far from rest").
 //!
 //! **Very large steps.** Up to h = 0.25 s every step problem of the fixtures is solved
@@ -96,7 +96,7 @@
 //! that does not converge takes its last (bounded) iterate ([`StepOutcome::exact`] =
 //! `false`): 29 of 6100 steps over all fixtures at h = 0.5 (`cargo run --release -p
 //! rotor-moreau --example exactness`). The state stays bounded at any h. Such a step is not
-//! hidden: it is counted in [`rotor_seam::Stats::inexact_steps`], which the CLI and the
+//! hidden: it is counted in [`rotor_model::seam::Stats::inexact_steps`], which the CLI and the
 //! Python module turn into a warning. `tests/integration/fallback.rs` checks at h = 0.5 on
 //! every fixture that each step the fallback solved satisfies the step problem (its residual
 //! computed independently of the stepper) and that each other step is flagged and counted.
@@ -125,7 +125,7 @@
 //!   discrete velocity increments while slipping; vertex of the parabola through the three
 //!   step values.
 //!
-//! Events are fed in time order to a [`rotor_seam::MetricsAccumulator`] when metrics are asked.
+//! Events are fed in time order to a [`rotor_model::seam::MetricsAccumulator`] when metrics are asked.
 
 #![warn(missing_docs)]
 
@@ -169,8 +169,8 @@ pub struct MoreauOptions {
     pub newton_estimate_stop: bool,
     /// Maximum number of steps of one run (default 1e9).
     pub max_steps: u64,
-    /// [`rotor_seam::Output::Metrics`]: how close, in units of h², the first return after skipped
-    /// periods must come to the return before them ([`rotor_seam::FastForward`]); 0 rejects
+    /// [`rotor_model::seam::Output::Metrics`]: how close, in units of h², the first return after skipped
+    /// periods must come to the return before them ([`rotor_model::seam::FastForward`]); 0 rejects
     /// every skip (a check of the undo).
     pub skip_verify: f64,
 }
@@ -184,12 +184,12 @@ impl Default for MoreauOptions {
             max_newton: 50,
             newton_estimate_stop: true,
             max_steps: 1_000_000_000,
-            skip_verify: rotor_seam::fast_forward::VERIFY_TOLERANCES,
+            skip_verify: rotor_model::seam::fast_forward::VERIFY_TOLERANCES,
         }
     }
 }
 
-/// The Moreau–Jean solver; step size [`Scene::step`](rotor_seam::Scene::step).
+/// The Moreau–Jean solver; step size [`Scene::step`](rotor_model::seam::Scene::step).
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct MoreauSolver {
     /// θ, the friction level, Newton's limits and the step limit.

@@ -2,11 +2,11 @@
 //! ends (stick onsets and exits, reversals, extrema), released in time order to the
 //! [`Recorder`], which keeps what the scene asks for and drives the metrics-only skip.
 
-use rotor_model::{Disc, DiscMode, FieldError, Mode, Model, State};
-use rotor_seam::{
+use rotor_model::seam::{
     Event, EventKind, Input, Integration, Piece, Recorder, Scene, SolveError, Solver, Stats,
     Trajectory, check_finite,
 };
+use rotor_model::{Disc, DiscMode, FieldError, Mode, Model, State};
 
 use crate::stepper::{StepSize, Stepper};
 use crate::{MoreauOptions, MoreauSolver};

@@ -21,8 +21,8 @@
 //! quadratic once the mode is settled.
 
 use nalgebra::{Matrix2, Vector2};
+use rotor_model::seam::SolveError;
 use rotor_model::{Disc, DiscMode, Friction, Model, State};
-use rotor_seam::SolveError;
 
 use crate::onestep::{Branch, OneStepProblem, OneStepSolution, StickData};
 use crate::{FrictionLevel, MoreauOptions};

@@ -1,9 +1,9 @@
 //! `rotorbench._rotorbench`: the native module of the Python package (docs/python.md).
 //!
 //! A thin layer. Every check, run and answer belongs to the Rust crates: the inputs go through
-//! [`rotor_jobs::request`] (the checks and the words of the command line), the runs through
-//! the solvers, [`rotor_steady::steady`], [`rotor_bifurcation::diagram`] and
-//! [`rotor_grade::check::grade`]. This file converts arguments and results, releases the GIL
+//! [`rotor_harness::jobs::request`] (the checks and the words of the command line), the runs through
+//! the solvers, [`rotor_analysis::steady::steady`], [`rotor_analysis::bifurcation::diagram`] and
+//! [`rotor_harness::grade::check::grade`]. This file converts arguments and results, releases the GIL
 //! around every run, and maps errors to exceptions:
 //!
 //! * bad input → `ValueError` (a wrong type → `TypeError`), naming the argument or field and
@@ -21,13 +21,13 @@ use pyo3::exceptions::{PyOSError, PyRuntimeError, PyTypeError, PyUserWarning, Py
 use pyo3::prelude::*;
 use pyo3::types::{PyBool, PyDict, PyList, PyString};
 use rayon::prelude::*;
-use rotor_bifurcation::{BifError, DiagramOptions};
-use rotor_grade::check::{GradeError, Level};
-use rotor_grade::trace::{EventsFile, Trace, disc_name, event_row, round_to, time_digits};
-use rotor_jobs::request::Request;
+use rotor_analysis::bifurcation::{BifError, DiagramOptions};
+use rotor_harness::grade::check::{GradeError, Level};
+use rotor_harness::grade::trace::{EventsFile, Trace, disc_name, event_row, round_to, time_digits};
+use rotor_harness::jobs::request::Request;
 use rotor_model::{FieldError, Model, Params};
-use rotor_seam::Stats;
-use rotor_steady::{SettleError, SteadyAnswer, SteadyError};
+use rotor_model::seam::Stats;
+use rotor_analysis::steady::{SettleError, SteadyAnswer, SteadyError};
 
 pyo3::create_exception!(
     rotorbench,
@@ -80,9 +80,9 @@ fn solve_error(py: Python<'_>, message: String, t: Option<f64>, state: Option<[f
     err
 }
 
-fn from_solve(py: Python<'_>, e: rotor_seam::SolveError) -> PyErr {
+fn from_solve(py: Python<'_>, e: rotor_model::seam::SolveError) -> PyErr {
     match e {
-        rotor_seam::SolveError::InvalidScene(_) => value_error(e),
+        rotor_model::seam::SolveError::InvalidScene(_) => value_error(e),
         _ => solve_error(py, e.to_string(), e.time(), e.state()),
     }
 }
@@ -107,9 +107,9 @@ fn from_bif(py: Python<'_>, e: BifError) -> PyErr {
 }
 
 fn from_grade(e: GradeError) -> PyErr {
-    use rotor_grade::reference::ReferenceError;
+    use rotor_harness::grade::reference::ReferenceError;
     match e {
-        GradeError::Scenario(rotor_scenario::ScenarioError::Io { .. })
+        GradeError::Scenario(rotor_model::scenario::ScenarioError::Io { .. })
         | GradeError::Reference(ReferenceError::File { .. }) => PyOSError::new_err(e.to_string()),
         _ => value_error(e),
     }
@@ -128,7 +128,7 @@ fn warn_ignored(py: Python<'_>, req: &Request<'_>) -> PyResult<()> {
 }
 
 fn warn_inexact(py: Python<'_>, stats: &Stats) -> PyResult<()> {
-    match rotor_jobs::request::inexact_warning(stats, "h") {
+    match rotor_harness::jobs::request::inexact_warning(stats, "h") {
         Some(w) => warn(py, &w),
         None => Ok(()),
     }
@@ -143,7 +143,7 @@ fn fixtures() -> Option<PathBuf> {
 }
 
 /// A file argument: a path, or the name of a file of `fixtures/<kind>/` (without `.toml`;
-/// [`rotor_solvers::fixtures::resolve`]), else a `ValueError` naming the argument and what
+/// [`rotor_analysis::solvers::fixtures::resolve`]), else a `ValueError` naming the argument and what
 /// was looked for.
 fn resolve(arg: &str, value: &Bound<'_, PyAny>, kind: &str) -> PyResult<PathBuf> {
     let path: PathBuf = value.extract().map_err(|_| {
@@ -153,13 +153,13 @@ fn resolve(arg: &str, value: &Bound<'_, PyAny>, kind: &str) -> PyResult<PathBuf>
         ))
     })?;
     let dir = fixtures().map(|f| f.join(kind));
-    if let Some(p) = rotor_solvers::fixtures::resolve(&path, dir.as_deref()) {
+    if let Some(p) = rotor_analysis::solvers::fixtures::resolve(&path, dir.as_deref()) {
         return Ok(p);
     }
     let name = path.to_string_lossy().into_owned();
     let known = dir
         .as_deref()
-        .map(|d| rotor_solvers::fixtures::names(d).join(", "));
+        .map(|d| rotor_analysis::solvers::fixtures::names(d).join(", "));
     Err(PyValueError::new_err(match known {
         Some(known) => format!(
             "{arg} = {name:?}: no such file, nor a name in {} (names: {known})",
@@ -278,7 +278,7 @@ struct Columns {
 impl Columns {
     /// The samples as `rotor simulate` writes them: times rounded to the grid's decimals
     /// ([`time_digits`]), states as computed; the mode switches as in an events file.
-    fn of(tr: rotor_seam::Trajectory, dt: f64) -> Columns {
+    fn of(tr: rotor_model::seam::Trajectory, dt: f64) -> Columns {
         let digits = time_digits(dt);
         let n = tr.samples.len();
         let mut c = Columns {
@@ -307,8 +307,8 @@ impl Columns {
 /// ``input=``: an (n, 2) array or a list of ``[t, u]`` pairs, the input u(t) in place of
 /// ``u`` (linear between rows, constant outside them, two rows at one t a step); bad rows
 /// raise ValueError naming the row and the value.
-fn input_of(rows: Option<Vec<[f64; 2]>>) -> PyResult<Option<rotor_seam::Input>> {
-    rows.map(|r| rotor_seam::Input::new(&r).map_err(bad))
+fn input_of(rows: Option<Vec<[f64; 2]>>) -> PyResult<Option<rotor_model::seam::Input>> {
+    rows.map(|r| rotor_model::seam::Input::new(&r).map_err(bad))
         .transpose()
 }
 
@@ -422,7 +422,7 @@ fn steady<'py>(
     warn_ignored(py, &req)?;
     let answer = detached(py, move || {
         // As `rotor steady` without --method: checked shooting, else simulation.
-        rotor_steady::checked::checked_or_simulated(kind, &model, &scene, &opts)
+        rotor_analysis::steady::checked::checked_or_simulated(kind, &model, &scene, &opts)
     })?
     .map_err(|e| from_steady(py, e))?;
     warn_inexact(py, &answer.stats)?;
@@ -456,11 +456,11 @@ fn sweep<'py>(
         .map(|n| {
             usize::try_from(n)
                 .map_err(|_| "expected at least 1 thread".to_owned())
-                .and_then(rotor_compare::threads::check_count)
+                .and_then(rotor_harness::compare::threads::check_count)
                 .map_err(|why| PyValueError::new_err(format!("threads = {n}: {why}")))
         })
         .transpose()?;
-    let (n, _) = rotor_compare::threads::resolve(explicit).map_err(PyValueError::new_err)?;
+    let (n, _) = rotor_harness::compare::threads::resolve(explicit).map_err(PyValueError::new_err)?;
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(n)
         .build()
@@ -489,7 +489,7 @@ fn sweep<'py>(
         pool.install(|| {
             jobs.par_iter()
                 .map(|(kind, scene, opts)| {
-                    rotor_steady::checked::checked_or_simulated(*kind, &model, scene, opts)
+                    rotor_analysis::steady::checked::checked_or_simulated(*kind, &model, scene, opts)
                 })
                 .collect()
         })
@@ -543,7 +543,7 @@ fn bifurcation<'py>(
     u_max: f64,
     solver: &str,
 ) -> PyResult<Bound<'py, PyAny>> {
-    let kind = rotor_jobs::request::solver_kind(solver).map_err(bad)?;
+    let kind = rotor_harness::jobs::request::solver_kind(solver).map_err(bad)?;
     let model = Model::new(params_of(params)?);
     let opts = DiagramOptions {
         u_min,
@@ -552,8 +552,8 @@ fn bifurcation<'py>(
     };
     opts.validate().map_err(|e| from_bif(py, e))?;
     let d = detached(py, move || {
-        let d = rotor_bifurcation::diagram(&model, &opts)?;
-        let by = rotor_steady::by_solver::by_solver(kind, &model, &d);
+        let d = rotor_analysis::bifurcation::diagram(&model, &opts)?;
+        let by = rotor_analysis::steady::by_solver::by_solver(kind, &model, &d);
         by.diagram.check_finite()?;
         Ok::<_, BifError>(by)
     })?
@@ -624,7 +624,7 @@ fn check<'py>(
         Trace::from_columns([&cols[0], &cols[1], &cols[2], &cols[3]]).map_err(value_error)?;
     let events = events.filter(|e| !e.is_none()).map(events_of).transpose()?;
     let report = detached(py, move || {
-        rotor_grade::check::grade(&path, &trace, events.as_ref(), level)
+        rotor_harness::grade::check::grade(&path, &trace, events.as_ref(), level)
     })?
     .map_err(from_grade)?;
     to_py(py, &report)
@@ -645,7 +645,7 @@ fn params<'py>(py: Python<'py>, source: Option<&Bound<'py, PyAny>>) -> PyResult<
 #[pyfunction]
 fn scenario<'py>(py: Python<'py>, source: &Bound<'py, PyAny>) -> PyResult<Bound<'py, PyDict>> {
     let path = resolve("scenario", source, "scenarios")?;
-    let sc = rotor_solvers::load_scenario(&path).map_err(value_error)?;
+    let sc = rotor_analysis::solvers::load_scenario(&path).map_err(value_error)?;
     let d = PyDict::new(py);
     d.set_item("name", &sc.name)?;
     d.set_item("description", &sc.description)?;
@@ -694,7 +694,7 @@ fn _solve_seconds(
                 drop(tr);
                 Ok(s)
             })
-            .collect::<Result<Vec<f64>, rotor_seam::SolveError>>()
+            .collect::<Result<Vec<f64>, rotor_model::seam::SolveError>>()
     })?
     .map_err(|e| from_solve(py, e))
 }

@@ -10,8 +10,8 @@ use std::path::Path;
 use std::time::Instant;
 
 use rotor_model::Model;
-use rotor_scenario::Scenario;
-use rotor_seam::{Output, Scene, Solver};
+use rotor_model::scenario::Scenario;
+use rotor_model::seam::{Output, Scene, Solver};
 use rotor_switch::{SwitchOptions, SwitchSolver};
 
 fn main() {

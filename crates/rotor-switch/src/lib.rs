@@ -22,7 +22,7 @@
 //!   the metrics converge to the Filippov solution at first order in η (period ≈ 0.07·η
 //!   relative on Table 1 and the Stribeck set at 1.5 V). A stuck disc's reported ω is its
 //!   value in the band, `|ω| ≤ η`; the default η = 1e-10 keeps it 10× below the 1e-9 rad/s
-//!   at which `rotor-grade`'s grade counts a sample as stuck.
+//!   at which `rotor_harness::grade`'s grade counts a sample as stuck.
 //! * **Breaking away is no reversal.** The stuck velocity may lie just below 0 (a disc that
 //!   came in through `Trans`), so on a forward stick exit ω can cross 0 inside the band. A
 //!   `Trans` region that began at rest (a stick exit, or a run that starts in the band)

@@ -1,10 +1,10 @@
 //! The switch-model field, its guards, and the event-located integration loop.
 
-use rotor_model::{Disc, DiscMode, FieldError, Mode, Model, OMEGA_L, OMEGA_U, State};
-use rotor_seam::{
+use rotor_model::seam::{
     Event, EventKind, Input, Integration, Piece, Recorder, Scene, SolveError, Solver, Stats,
     Trajectory, check_finite,
 };
+use rotor_model::{Disc, DiscMode, FieldError, Mode, Model, OMEGA_L, OMEGA_U, State};
 
 use crate::dopri5::{Dopri5, Dopri5Error, Dopri5Options};
 
@@ -21,7 +21,7 @@ const EXTREMUM_RESOLUTION: f64 = 10.0;
 /// that scale (∝ τ·tol^{1/5} for DOPRI5) can cross the law's steep part near rest before the
 /// controller sees it. k = 8, as for the event solver; at the comparisons' tol 1e-10 the
 /// default h_max = 0.1 s is shorter on almost every parameter set (measured: +0.2 % field
-/// evaluations over 1000 random sets, `rotor-solvers/examples/step_scales.rs`).
+/// evaluations over 1000 random sets, `rotor_analysis::solvers/examples/step_scales.rs`).
 pub fn step_bound(model: &Model, tol: f64, k: f64) -> f64 {
     let s = model.time_scales();
     k * (tol / 1e-10).powf(1.0 / 5.0) * s.friction[0].min(s.friction[1])
@@ -57,8 +57,8 @@ pub struct SwitchOptions {
     pub zeno_count: u32,
     /// Zeno guard window, in s.
     pub zeno_window: f64,
-    /// [`rotor_seam::Output::Metrics`]: how close, in tolerances, the first return after
-    /// skipped periods must come to the return before them ([`rotor_seam::FastForward`]);
+    /// [`rotor_model::seam::Output::Metrics`]: how close, in tolerances, the first return after
+    /// skipped periods must come to the return before them ([`rotor_model::seam::FastForward`]);
     /// 0 rejects every skip (a check of the undo).
     pub skip_verify: f64,
 }
@@ -73,7 +73,7 @@ impl Default for SwitchOptions {
             guard_samples: 5,
             zeno_count: 1000,
             zeno_window: 1e-9,
-            skip_verify: rotor_seam::fast_forward::VERIFY_TOLERANCES,
+            skip_verify: rotor_model::seam::fast_forward::VERIFY_TOLERANCES,
         }
     }
 }

@@ -1,8 +1,8 @@
 //! A time-varying input u(t): every row's time is a step end, and a step of u from rest
 //! starts the motion at the step.
 
+use rotor_model::seam::{Accuracy, Input, Output, Scene, Solver};
 use rotor_model::{Model, State};
-use rotor_seam::{Accuracy, Input, Output, Scene, Solver};
 
 /// No step straddles a breakpoint: with a ramp that has kinks at t = 10 s and 30 s and a
 /// step at 35 s, both times are step ends exactly.

@@ -2,11 +2,11 @@
 
 use std::path::{Path, PathBuf};
 
-use rotor_model::{Disc, Model, OMEGA_L, OMEGA_U};
-use rotor_scenario::Scenario;
-use rotor_seam::{
+use rotor_model::scenario::Scenario;
+use rotor_model::seam::{
     Accuracy, EventKind, Output, OutputGrid, Scene, SolveError, Solver, SteadyState, Trajectory,
 };
+use rotor_model::{Disc, Model, OMEGA_L, OMEGA_U};
 use rotor_switch::{SwitchOptions, SwitchSolver};
 
 fn solver(eta: f64) -> SwitchSolver {
@@ -318,7 +318,7 @@ fn output_levels_are_honoured() {
     assert_eq!(g.peek(), None);
     assert_eq!(grid.x_final, fin.x_final);
     // The last grid sample is t_end, where the last step ends: the same state. (Samples
-    // between steps are checked against the event-driven solver in rotor-compare's cross.rs.)
+    // between steps are checked against the event-driven solver in rotor_harness::compare's cross.rs.)
     assert_eq!(
         grid.samples.last().unwrap().x,
         steps.samples.last().unwrap().x

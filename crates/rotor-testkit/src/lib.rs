@@ -1,4 +1,4 @@
-//! Test support for the bad-input tests of `rotor-model` and `rotor-scenario` (through
+//! Test support for the bad-input tests of `rotor-model` and `rotor_model::scenario` (through
 //! `from_file`) and `rotor-cli` (through the `rotor` binary).
 //!
 //! They test the same bad files; this crate holds them once, so that the library and the
@@ -126,7 +126,7 @@ pub fn short_horizon_scenario() -> String {
 }
 
 /// Scenario files that load but name a solver pair the runner does not have: a misspelt pair
-/// would leave that pair ungated. The loaders that know the solvers (rotor-solvers', the
+/// would leave that pair ungated. The loaders that know the solvers (rotor_analysis::solvers', the
 /// CLI's) refuse them.
 pub fn bad_pair_cases() -> Vec<BadFile> {
     vec![edited(

@@ -1,5 +1,5 @@
 //! Edits of fixture files for the fuzz tests of the parameter reader (rotor-model) and the
-//! scenario reader (rotor-scenario): deleted, duplicated and swapped lines, swapped values,
+//! scenario reader (rotor_model::scenario): deleted, duplicated and swapped lines, swapped values,
 //! random TOML values, random bytes, truncation.
 
 use proptest::prelude::*;

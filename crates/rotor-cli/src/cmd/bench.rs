@@ -114,9 +114,9 @@ pub(crate) fn bench(
     clients: BenchClients,
 ) -> Result<()> {
     let mut opts = if quick {
-        rotor_bench::BenchOptions::quick()
+        rotor_harness::bench::BenchOptions::quick()
     } else {
-        rotor_bench::BenchOptions::default()
+        rotor_harness::bench::BenchOptions::default()
     };
     if no_peers {
         opts.peers.scipy = false;
@@ -132,7 +132,7 @@ pub(crate) fn bench(
     opts.timeout = clients.timeout;
     for e in clients.external {
         opts.clients.push(
-            rotor_bench::ClientSpec::parse(e, clients.fixed_step)
+            rotor_harness::bench::ClientSpec::parse(e, clients.fixed_step)
                 .map_err(crate::common::flagged)?,
         );
     }
@@ -143,7 +143,7 @@ pub(crate) fn bench(
     }
     let tier = clients
         .tier
-        .map(rotor_bench::Tier::parse)
+        .map(rotor_harness::bench::Tier::parse)
         .transpose()
         .map_err(crate::common::unusable)?;
     if !clients.scenarios.is_empty() {
@@ -152,13 +152,13 @@ pub(crate) fn bench(
             .iter()
             .map(|p| fixture_path("--scenario", p, "scenarios"))
             .collect::<Result<Vec<_>>>()?;
-        opts.scenes = rotor_bench::select(&paths, tier)?;
+        opts.scenes = rotor_harness::bench::select(&paths, tier)?;
     } else if !quick {
-        opts.scenes = rotor_bench::suite(&fixtures_dir()?.join("scenarios"), tier)?;
+        opts.scenes = rotor_harness::bench::suite(&fixtures_dir()?.join("scenarios"), tier)?;
     }
     opts.shard = clients
         .shard
-        .map(rotor_jobs::sweep::Shard::parse)
+        .map(rotor_harness::jobs::sweep::Shard::parse)
         .transpose()
         .map_err(crate::common::sweep_flagged)?;
     opts.keep = clients.keep.map(Path::to_path_buf);
@@ -172,7 +172,7 @@ pub(crate) fn bench(
     // the elapsed time, so a run of minutes shows that it moves.
     let spinner = crate::common::progress_spinner("bench");
     let mut steps = 0usize;
-    let report = rotor_bench::run(&opts, |m| {
+    let report = rotor_harness::bench::run(&opts, |m| {
         steps += 1;
         if spinner.is_hidden() {
             eprintln!("{m}");
@@ -190,7 +190,7 @@ pub(crate) fn bench(
     let unsolved: Vec<String> = report
         .clients
         .iter()
-        .filter(|c| !c.peer && c.status != rotor_bench::ClientStatus::Ran)
+        .filter(|c| !c.peer && c.status != rotor_harness::bench::ClientStatus::Ran)
         .map(|c| {
             format!(
                 "{} ({})",
@@ -215,10 +215,10 @@ pub(crate) fn bench(
 /// What a bench will run, said before it starts: scenes, graded runs per scene (each
 /// setting of each ladder, then timed again when fast), and the measured length of the
 /// longest form.
-fn plan(opts: &rotor_bench::BenchOptions) -> String {
+fn plan(opts: &rotor_harness::bench::BenchOptions) -> String {
     let scenes = opts
         .shard
-        .unwrap_or(rotor_jobs::sweep::Shard::ALL)
+        .unwrap_or(rotor_harness::jobs::sweep::Shard::ALL)
         .count(opts.scenes.len().max(1));
     let ours: usize = opts.ladders.iter().map(|(_, l)| l.len()).sum();
     let clients: usize = opts

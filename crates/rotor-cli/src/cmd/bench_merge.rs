@@ -17,16 +17,17 @@ pub(crate) fn bench_merge(
         .map(|p| {
             let text = std::fs::read_to_string(p)
                 .with_context(|| format!("--merge {}: cannot read", p.display()))?;
-            let r: rotor_bench::BenchReport = serde_json::from_str(&text).with_context(|| {
-                format!(
-                    "--merge {}: not a report of rotor bench --json",
-                    p.display()
-                )
-            })?;
+            let r: rotor_harness::bench::BenchReport =
+                serde_json::from_str(&text).with_context(|| {
+                    format!(
+                        "--merge {}: not a report of rotor bench --json",
+                        p.display()
+                    )
+                })?;
             Ok((p.display().to_string(), r))
         })
         .collect::<Result<Vec<_>>>()?;
-    let report = rotor_bench::merge(&reports)?;
+    let report = rotor_harness::bench::merge(&reports)?;
     write_bench(&report, outputs)?;
     write_results(&report, results)
 }

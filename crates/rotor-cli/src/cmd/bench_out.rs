@@ -9,10 +9,10 @@ use crate::common::say;
 
 /// Prints a benchmark report's table and writes its files.
 pub(crate) fn write_bench(
-    report: &rotor_bench::BenchReport,
+    report: &rotor_harness::bench::BenchReport,
     [json, svg, csv]: [Option<&Path>; 3],
 ) -> Result<()> {
-    use rotor_compare::report::write_output;
+    use rotor_harness::compare::report::write_output;
     say(&report.table(), [json, svg, csv])?;
     for (path, text) in [
         (json, report.to_json()?),
@@ -32,8 +32,8 @@ pub(crate) fn write_bench(
 
 /// Beside the summary figure `<stem>.svg`: every scene's figure `<stem>-<scene>.svg`, each
 /// figure's data `<stem>-<name>.csv`, and the page `<stem>.html` that shows them all.
-fn write_figures(report: &rotor_bench::BenchReport, svg: &Path) -> Result<()> {
-    use rotor_compare::report::write_output;
+fn write_figures(report: &rotor_harness::bench::BenchReport, svg: &Path) -> Result<()> {
+    use rotor_harness::compare::report::write_output;
     let stem = svg
         .file_stem()
         .map(|s| s.to_string_lossy().into_owned())
@@ -53,13 +53,19 @@ fn write_figures(report: &rotor_bench::BenchReport, svg: &Path) -> Result<()> {
 }
 
 /// `--results FILE`: the published-results page.
-pub(crate) fn write_results(report: &rotor_bench::BenchReport, path: Option<&Path>) -> Result<()> {
+pub(crate) fn write_results(
+    report: &rotor_harness::bench::BenchReport,
+    path: Option<&Path>,
+) -> Result<()> {
     if let Some(path) = path {
         // The command that wrote it, as given (`just bench` runs the whole suite's).
         let args: Vec<String> = std::env::args().skip(1).collect();
         let command = format!("rotor {}", args.join(" "));
-        rotor_compare::report::write_output(path, report.to_results_md(&command)?.as_bytes())
-            .with_context(|| format!("--results {}: cannot write", path.display()))?;
+        rotor_harness::compare::report::write_output(
+            path,
+            report.to_results_md(&command)?.as_bytes(),
+        )
+        .with_context(|| format!("--results {}: cannot write", path.display()))?;
     }
     Ok(())
 }

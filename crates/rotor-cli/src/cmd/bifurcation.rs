@@ -57,9 +57,9 @@ pub(crate) fn bifurcation(
     svg: Option<&Path>,
     csv: Option<&Path>,
 ) -> Result<()> {
-    use rotor_compare::report::write_output;
+    use rotor_harness::compare::report::write_output;
     let model = load_model(params)?;
-    let opts = rotor_bifurcation::DiagramOptions {
+    let opts = rotor_analysis::bifurcation::DiagramOptions {
         u_min,
         u_max,
         ..Default::default()
@@ -73,9 +73,9 @@ pub(crate) fn bifurcation(
                 .replace("u_max", "--u-max")
         ))
     })?;
-    let kind = rotor_jobs::request::solver_kind(solver).map_err(crate::common::flagged)?;
-    let event = rotor_bifurcation::diagram(&model, &opts)?;
-    let by = rotor_steady::by_solver::by_solver(kind, &model, &event);
+    let kind = rotor_harness::jobs::request::solver_kind(solver).map_err(crate::common::flagged)?;
+    let event = rotor_analysis::bifurcation::diagram(&model, &opts)?;
+    let by = rotor_analysis::steady::by_solver::by_solver(kind, &model, &event);
     let d = &by.diagram;
     d.check_finite()?;
     let mut text = serde_json::to_string_pretty(&by)?;

@@ -51,14 +51,14 @@ pub(crate) fn bifurcation2(
     json: &Path,
     svg: Option<&Path>,
 ) -> Result<()> {
-    use rotor_compare::report::write_output;
+    use rotor_harness::compare::report::write_output;
     let base = load_model(params)?.params;
-    let opts = rotor_plane::PlaneOptions {
+    let opts = rotor_analysis::plane::PlaneOptions {
         u_min,
         u_max,
-        ..rotor_plane::PlaneOptions::new(param, p_min, p_max)
+        ..rotor_analysis::plane::PlaneOptions::new(param, p_min, p_max)
     };
-    rotor_plane::validate(&base, &opts).map_err(|e| {
+    rotor_analysis::plane::validate(&base, &opts).map_err(|e| {
         crate::common::unusable(format_args!(
             "{}",
             e.to_string()
@@ -75,7 +75,7 @@ pub(crate) fn bifurcation2(
     );
     let spinner = crate::common::progress_spinner("curves");
     let t0 = std::time::Instant::now();
-    let plane = rotor_plane::plane(&base, &opts);
+    let plane = rotor_analysis::plane::plane(&base, &opts);
     spinner.finish_and_clear();
     let plane = plane?;
     let secs = t0.elapsed().as_secs_f64();

@@ -4,8 +4,8 @@ use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 use anyhow::{Context, Result};
-use rotor_grade::check::{CheckError, Level, check};
-use rotor_grade::reference;
+use rotor_harness::grade::check::{CheckError, Level, check};
+use rotor_harness::grade::reference;
 
 #[derive(clap::Args, Debug)]
 pub struct Args {
@@ -77,19 +77,23 @@ fn verdict(
     .map_err(crate::common::flagged)?;
     // The scenario and its reference first: the trace is read up to one row past their grid.
     let scenario = crate::common::fixture_path("scenario", scenario, "scenarios")?;
-    let sc = rotor_solvers::load_scenario(&scenario)?;
+    let sc = rotor_analysis::solvers::load_scenario(&scenario)?;
     let r = reference::read(&reference::dir_for(&scenario), &sc.name)?;
-    let t = rotor_grade::trace::read_trace(trace, r.samples.len() + 1).map_err(CheckError::from)?;
+    let t = rotor_harness::grade::trace::read_trace(trace, r.samples.len() + 1)
+        .map_err(CheckError::from)?;
     let ev = events
-        .map(rotor_grade::trace::read_events)
+        .map(rotor_harness::grade::trace::read_events)
         .transpose()
         .map_err(CheckError::from)?;
     let report = check(&sc, &r, &t, ev.as_ref(), level)?;
     if let Some(path) = json {
         let text = serde_json::to_string_pretty(&report)? + "\n";
         // A closed pipe on `--json -` does not hide the verdict's exit status.
-        crate::out::closed_is_fine(rotor_compare::report::write_output(path, text.as_bytes()))
-            .with_context(|| format!("{}: cannot write", path.display()))?;
+        crate::out::closed_is_fine(rotor_harness::compare::report::write_output(
+            path,
+            text.as_bytes(),
+        ))
+        .with_context(|| format!("{}: cannot write", path.display()))?;
     }
     let table = report.table();
     if json.is_some_and(|p| p.as_os_str() == "-") {

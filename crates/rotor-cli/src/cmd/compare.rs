@@ -1,12 +1,12 @@
 //! `rotor compare`, and the main job (`rotor` alone): the scenarios through every solver,
-//! gated, and the report written ([`rotor_report`]).
+//! gated, and the report written ([`rotor_harness::report`]).
 
 use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result, bail};
 
 use rotor_model::Params;
-use rotor_seam::SteadyState;
+use rotor_model::seam::SteadyState;
 
 use crate::common::{fixture_path, fixtures_dir, progress_bar, thread_pool, threads_arg};
 use crate::out;
@@ -43,7 +43,7 @@ pub(crate) fn compare(
 ) -> Result<()> {
     let files = if files.is_empty() {
         let dir = fixtures_dir()?.join("scenarios");
-        rotor_scenario::Scenario::list_dir(&dir)
+        rotor_model::scenario::Scenario::list_dir(&dir)
             .with_context(|| format!("{}: cannot list scenarios", dir.display()))?
     } else {
         files
@@ -53,17 +53,17 @@ pub(crate) fn compare(
     };
     let scenarios = files
         .iter()
-        .map(|f| rotor_solvers::load_scenario(f))
+        .map(|f| rotor_analysis::solvers::load_scenario(f))
         .collect::<Result<Vec<_>, _>>()?;
     // Report files are named after the scenarios: two of one name would overwrite each other.
-    rotor_report::check_names(&scenarios)?;
+    rotor_harness::report::check_names(&scenarios)?;
     let stribeck = Params::from_file(&fixtures_dir()?.join("params/stribeck.toml"))?;
     let threads = thread_pool(threads)?;
     eprintln!(
         "{} scenarios x {} solvers ({} runs){} on {threads}",
         scenarios.len(),
-        rotor_solvers::SOLVERS.len(),
-        scenarios.len() * rotor_solvers::SOLVERS.len(),
+        rotor_analysis::solvers::SOLVERS.len(),
+        scenarios.len() * rotor_analysis::solvers::SOLVERS.len(),
         if main_job {
             ", then both bifurcation diagrams, the plane, the probes and the stress table \
              (about 11 s on 2 idle cores)"
@@ -73,11 +73,11 @@ pub(crate) fn compare(
     );
     let t0 = std::time::Instant::now();
     let bar = progress_bar(scenarios.len() as u64, "scenarios");
-    let sets = rotor_report::param_sets(stribeck);
-    let compared = rotor_report::run(&scenarios, &sets, main_job, &|| bar.inc(1))?;
+    let sets = rotor_harness::report::param_sets(stribeck);
+    let compared = rotor_harness::report::run(&scenarios, &sets, main_job, &|| bar.inc(1))?;
     bar.finish_and_clear();
     let wall = t0.elapsed().as_secs_f64();
-    let fails = rotor_report::write(report, &compared, stribeck)?;
+    let fails = rotor_harness::report::write(report, &compared, stribeck)?;
     let (results, sections) = (&compared.results, &compared.sections);
     out::line(format_args!(
         "{:<18} {:<7} {:<12} {:>10} {:>12} {:>9}",
@@ -110,7 +110,7 @@ pub(crate) fn compare(
     out::line(format_args!(
         "{} scenarios, {} solvers, {:.2} s wall; report in {}",
         results.len(),
-        rotor_solvers::SOLVERS.len(),
+        rotor_analysis::solvers::SOLVERS.len(),
         wall,
         report.display()
     ))?;

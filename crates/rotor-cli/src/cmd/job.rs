@@ -63,7 +63,7 @@ pub(crate) fn job(
         }
     }
     let path = fixture_path("scenario", scenario, "scenarios")?;
-    let job = rotor_bench::job_for_scenario(
+    let job = rotor_harness::bench::job_for_scenario(
         &path,
         fixed_step,
         setting,

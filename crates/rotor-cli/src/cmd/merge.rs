@@ -21,8 +21,8 @@ pub(crate) fn merge(shards: &[PathBuf], csv: &Path) -> Result<()> {
     if shards.is_empty() {
         crate::common::refuse!("merge: no shard files given");
     }
-    let merged = rotor_jobs::sweep::merge(shards)?;
-    rotor_compare::report::write_output_with(csv, |w| merged.write_to(w))
+    let merged = rotor_harness::jobs::sweep::merge(shards)?;
+    rotor_harness::compare::report::write_output_with(csv, |w| merged.write_to(w))
         .with_context(|| format!("{}: cannot write", csv.display()))?;
     Ok(())
 }

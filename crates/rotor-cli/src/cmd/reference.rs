@@ -4,7 +4,7 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result};
 use rayon::prelude::*;
-use rotor_grade::reference;
+use rotor_harness::grade::reference;
 
 use crate::common::{fixture_path, fixtures_dir, progress_bar, thread_pool, threads_arg};
 
@@ -27,7 +27,7 @@ pub struct Args {
 pub fn run(a: &Args) -> Result<()> {
     let files = if a.scenario.is_empty() {
         let dir = fixtures_dir()?.join("scenarios");
-        rotor_scenario::Scenario::list_dir(&dir)
+        rotor_model::scenario::Scenario::list_dir(&dir)
             .with_context(|| format!("{}: cannot list scenarios", dir.display()))?
     } else {
         a.scenario
@@ -51,7 +51,7 @@ pub fn run(a: &Args) -> Result<()> {
 pub fn write_reference(files: &[PathBuf], out: &Path) -> Result<()> {
     let scenarios = files
         .iter()
-        .map(|f| rotor_solvers::load_scenario(f))
+        .map(|f| rotor_analysis::solvers::load_scenario(f))
         .collect::<Result<Vec<_>, _>>()?;
     std::fs::create_dir_all(out).with_context(|| format!("{}: cannot create", out.display()))?;
     let bar = progress_bar(scenarios.len() as u64, "scenarios");
@@ -70,7 +70,7 @@ pub fn write_reference(files: &[PathBuf], out: &Path) -> Result<()> {
             .iter()
             .zip(reference::to_files(r))
         {
-            rotor_compare::report::write_atomic(path, &bytes)
+            rotor_harness::compare::report::write_atomic(path, &bytes)
                 .with_context(|| format!("{}: cannot write", path.display()))?;
         }
         let worst = |n: &str| r.error(n);

@@ -4,7 +4,7 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result};
 use rotor_model::Disc;
-use rotor_scenario::Scenario;
+use rotor_model::scenario::Scenario;
 use serde::Serialize;
 
 /// A scene's tier: `table1` when only the lower disc has static friction (what a solver that
@@ -62,7 +62,7 @@ pub fn scenarios(json: Option<&Path>) -> Result<()> {
         .with_context(|| format!("{}: cannot list the scenarios", dir.display()))?;
     let scenarios = files
         .iter()
-        .map(|f| rotor_solvers::load_scenario(f))
+        .map(|f| rotor_analysis::solvers::load_scenario(f))
         .collect::<Result<Vec<_>, _>>()?;
     let rows: Vec<Row> = scenarios
         .iter()
@@ -102,7 +102,7 @@ pub fn scenarios(json: Option<&Path>) -> Result<()> {
         };
         let mut s = serde_json::to_string_pretty(&listing)?;
         s.push('\n');
-        rotor_compare::report::write_output(path, s.as_bytes())
+        rotor_harness::compare::report::write_output(path, s.as_bytes())
             .with_context(|| format!("--json {}: cannot write", path.display()))?;
     }
     Ok(())

@@ -76,8 +76,8 @@ pub(crate) fn simulate(
         .simulate_finite(&start.model, &scene)
         .with_context(|| format!("solver {}", solver.name()))?;
     warn_inexact(&traj.stats);
-    rotor_compare::report::write_output_with(csv_path, |w| {
-        rotor_grade::trace::write_trace_to(w, &traj.samples, dt)
+    rotor_harness::compare::report::write_output_with(csv_path, |w| {
+        rotor_harness::grade::trace::write_trace_to(w, &traj.samples, dt)
     })
     .with_context(|| format!("{}: cannot write", csv_path.display()))?;
     Ok(())

@@ -70,9 +70,11 @@ pub(crate) fn steady(common: &Common, method: Option<&str>) -> Result<()> {
         .map_err(crate::common::flagged)?;
     let model = start.model;
     let answer = match how {
-        How::Shoot => rotor_steady::shot(kind, &model, &scene),
-        How::Simulate => rotor_steady::simulated(kind, &model, &scene, &opts),
-        How::Checked => rotor_steady::checked::checked_or_simulated(kind, &model, &scene, &opts),
+        How::Shoot => rotor_analysis::steady::shot(kind, &model, &scene),
+        How::Simulate => rotor_analysis::steady::simulated(kind, &model, &scene, &opts),
+        How::Checked => {
+            rotor_analysis::steady::checked::checked_or_simulated(kind, &model, &scene, &opts)
+        }
     }
     .with_context(|| format!("solver {}", kind.name()))?;
     warn_inexact(&answer.stats);
@@ -80,6 +82,6 @@ pub(crate) fn steady(common: &Common, method: Option<&str>) -> Result<()> {
     Ok(())
 }
 
-pub(crate) fn steady_json(st: &rotor_steady::SteadyAnswer) -> String {
+pub(crate) fn steady_json(st: &rotor_analysis::steady::SteadyAnswer) -> String {
     serde_json::to_string(st).expect("plain floats and strings serialize")
 }

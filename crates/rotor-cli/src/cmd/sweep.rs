@@ -71,7 +71,7 @@ pub(crate) fn sweep(
     csv: &Path,
 ) -> Result<()> {
     use rayon::prelude::*;
-    use rotor_jobs::sweep::{Axis, Shard, Sweep, SweepStart, run};
+    use rotor_harness::jobs::sweep::{Axis, Shard, Sweep, SweepStart, run};
     let base = load_model(params)?.params;
     let (name, range) = param.split_once('=').ok_or_else(|| {
         crate::common::unusable(format_args!("--param {param:?}: expected NAME=A:B:N"))

@@ -2,9 +2,9 @@
 //! very large h): it converges to a solution of the step problem, or the step is flagged.
 
 use nalgebra::{Matrix2, Vector2};
+use rotor_model::seam::{Accuracy, Output, Scene, Solver};
 use rotor_model::{Disc, Model};
 use rotor_moreau::{MoreauOptions, MoreauSolver, StepOutcome, Stepper};
-use rotor_seam::{Accuracy, Output, Scene, Solver};
 
 use crate::scenarios;
 

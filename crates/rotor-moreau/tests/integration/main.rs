@@ -5,8 +5,8 @@ mod output;
 mod properties;
 mod scenarios;
 
+use rotor_model::scenario::Scenario;
 use rotor_model::{Model, Params};
-use rotor_scenario::Scenario;
 use std::path::{Path, PathBuf};
 
 /// The fixture directory of the workspace.

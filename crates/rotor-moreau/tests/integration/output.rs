@@ -1,8 +1,8 @@
 //! The scene's output levels, events, metrics and errors.
 
+use rotor_model::seam::{Accuracy, EventKind, Output, OutputGrid, Scene, SolveError, Solver};
 use rotor_model::{Disc, Model, OMEGA_U, State};
 use rotor_moreau::{MoreauOptions, MoreauSolver, Stepper};
-use rotor_seam::{Accuracy, EventKind, Output, OutputGrid, Scene, SolveError, Solver};
 
 fn base() -> Scene {
     Scene {

@@ -1,12 +1,12 @@
 //! Every fixture runs; large steps stay bounded; stuck equilibria stay exactly stuck.
 
 use rotor_model::State;
+use rotor_model::seam::{Accuracy, Output, Scene, Solver};
 use rotor_moreau::MoreauSolver;
-use rotor_seam::{Accuracy, Output, Scene, Solver};
 
 use crate::scenarios;
 
-fn scene(sc: &rotor_scenario::Scenario, h: f64, output: Output) -> Scene {
+fn scene(sc: &rotor_model::scenario::Scenario, h: f64, output: Output) -> Scene {
     Scene {
         accuracy: Accuracy::Step(h),
         ..sc.scene(output)

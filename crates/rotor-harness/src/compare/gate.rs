@@ -1,0 +1,760 @@
+//! Agreement gates between two solvers' results on one scenario.
+//!
+//! (a) the transient window, sample by sample on the common grid: max and RMS of the
+//! difference in ω_u and ω_l; (b) the steady state: kind, and each metric within its own
+//! tolerance, one key per metric (period, each extreme of ω_l and ω_u, and each of the
+//! equilibrium's ω_u, ω_l and α relative with `steady_abs` as a floor, a stuck disc's
+//! velocity beyond the solvers' stuck bands only, the stick time in seconds); (c) events: lower-disc stick onsets and exits in
+//! the transient window matched one to one within `event_time`; (d) the whole run
+//! ([`crate::compare::whole`]): every mode switch and ω_l maximum over `[0, t_end]` matched one to one
+//! within `whole_event_time`, and every sample of α, ω_u and ω_l, phase-aligned by the matched
+//! events, within `whole_alpha`, `whole_omega_u` and `whole_omega_l`. (d) is measured for
+//! every pair of solvers (`switch-moreau` too: [`rotor_analysis::solvers::all_pairs`]), (a)–(c) for the
+//! reference's pairs.
+//! Every comparison is written `!(diff <= tol)` so that a NaN fails.
+
+use rotor_model::Disc;
+use rotor_model::scenario::PairTolerance;
+use rotor_model::seam::{EventKind, SteadyState, Trajectory};
+
+use rotor_analysis::solvers::registry::{SolverKind, all_pairs, pair_name, pairs};
+use rotor_analysis::solvers::run::ScenarioResult;
+use rotor_model::Model;
+
+use crate::compare::whole::whole_run;
+
+/// A measured difference with its gate.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct Measured {
+    /// What was compared, as the report names it (`transient max abs d_omega`,
+    /// `steady period`, `steady kind (limit_cycle vs equilibrium)`, ...).
+    pub quantity: String,
+    /// The scenario file's key that states `tol` (`tolerance.<pair>.<key>`); `None` for the
+    /// checks that no key states (steady states of different kinds, or missing).
+    pub key: Option<&'static str>,
+    /// The difference: rad/s for the transient, s for event and stick times, relative for
+    /// the relative steady metrics; NaN or ∞ where nothing could be compared.
+    pub diff: f64,
+    /// Its tolerance, in the same unit.
+    pub tol: f64,
+}
+
+impl Measured {
+    /// Whether `diff ≤ tol` (false for a NaN difference).
+    pub fn passes(&self) -> bool {
+        self.diff <= self.tol
+    }
+}
+
+/// A failed gate: which quantity, the measured difference and the tolerance.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Failure {
+    /// The scenario's name.
+    pub scenario: String,
+    /// The solver pair (`event-switch`).
+    pub pair: String,
+    /// The quantity ([`Measured::quantity`]), or what went wrong when nothing was measured.
+    pub quantity: String,
+    /// The measured difference; not finite when nothing could be measured.
+    pub diff: f64,
+    /// The tolerance it exceeds.
+    pub tol: f64,
+}
+
+impl std::fmt::Display for Failure {
+    /// A measured difference over its tolerance, or, where nothing could be measured (a run
+    /// that failed, steady states of different kinds: `diff` not finite), what went wrong.
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        if self.diff.is_finite() {
+            write!(
+                f,
+                "{}: {}: {} differs by {:.3e} > tolerance {:.3e}",
+                self.scenario, self.pair, self.quantity, self.diff, self.tol
+            )
+        } else {
+            write!(f, "{}: {}: {}", self.scenario, self.pair, self.quantity)
+        }
+    }
+}
+
+/// All measurements of one pair on one scenario.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct GateResult {
+    /// The solver pair (`event-switch`).
+    pub pair: String,
+    /// Every quantity gated, passing or not.
+    pub measured: Vec<Measured>,
+}
+
+impl GateResult {
+    /// The measurements that fail, as failures of `scenario`.
+    pub fn failures(&self, scenario: &str) -> Vec<Failure> {
+        self.measured
+            .iter()
+            .filter(|m| !m.passes())
+            .map(|m| Failure {
+                scenario: scenario.to_owned(),
+                pair: self.pair.clone(),
+                quantity: m.quantity.clone(),
+                diff: m.diff,
+                tol: m.tol,
+            })
+            .collect()
+    }
+}
+
+/// Compares two trajectories of the same scenario under a pair's tolerances.
+/// `transient` is the sample-by-sample window; quantities without a tolerance are skipped.
+/// `stuck_band` is the sum of the two solvers' [`SolverInfo::stuck_band`]s
+/// ([`steady_differences`]).
+///
+/// [`SolverInfo::stuck_band`]: rotor_analysis::solvers::SolverInfo::stuck_band
+pub fn check_pair(
+    pair: &str,
+    a: &Trajectory,
+    b: &Trajectory,
+    transient: Option<[f64; 2]>,
+    tol: &PairTolerance,
+    stuck_band: f64,
+) -> GateResult {
+    let mut m = Vec::new();
+    if let Some([t0, t1]) = transient {
+        let mut max: f64 = 0.0;
+        let mut sq = 0.0;
+        let mut n = 0usize;
+        let mut count_mismatch = a.samples.len() != b.samples.len();
+        for (sa, sb) in a.samples.iter().zip(&b.samples) {
+            if sa.t != sb.t {
+                count_mismatch = true;
+                break;
+            }
+            if sa.t < t0 || sa.t > t1 {
+                continue;
+            }
+            for i in [1, 2] {
+                let d = (sa.x[i] - sb.x[i]).abs();
+                // NaN propagates into max through this form.
+                max = if d > max || d.is_nan() { d } else { max };
+                sq += d * d;
+                n += 1;
+            }
+        }
+        // No sample in the window (or grids that differ): nothing was compared, which must
+        // not read as agreement.
+        if count_mismatch || n == 0 {
+            max = f64::NAN;
+        }
+        let rms = if n > 0 {
+            (sq / n as f64).sqrt()
+        } else {
+            f64::NAN
+        };
+        if let Some(t) = tol.transient_max {
+            m.push(Measured {
+                quantity: "transient max abs d_omega".into(),
+                key: Some("transient_max"),
+                diff: max,
+                tol: t,
+            });
+        }
+        if let Some(t) = tol.transient_rms {
+            m.push(Measured {
+                quantity: "transient rms d_omega".into(),
+                key: Some("transient_rms"),
+                diff: rms,
+                tol: t,
+            });
+        }
+        if let Some(t) = tol.event_time {
+            let pick = |tr: &Trajectory| -> Vec<(f64, EventKind)> {
+                tr.events
+                    .iter()
+                    .filter(|e| {
+                        e.t >= t0
+                            && e.t <= t1
+                            && matches!(
+                                e.kind,
+                                EventKind::StickStart(Disc::Lower)
+                                    | EventKind::StickEnd(Disc::Lower)
+                            )
+                    })
+                    .map(|e| (e.t, e.kind))
+                    .collect()
+            };
+            let (ea, eb) = (pick(a), pick(b));
+            let diff = if ea.len() != eb.len() || ea.iter().zip(&eb).any(|(x, y)| x.1 != y.1) {
+                f64::INFINITY
+            } else {
+                ea.iter()
+                    .zip(&eb)
+                    .map(|(x, y)| (x.0 - y.0).abs())
+                    .fold(0.0, f64::max)
+            };
+            m.push(Measured {
+                quantity: format!("stick event times ({} vs {} events)", ea.len(), eb.len()),
+                key: Some("event_time"),
+                diff,
+                tol: t,
+            });
+        }
+    }
+    if tol.gates_steady() {
+        let floor = tol.steady_abs.unwrap_or(0.0);
+        let (Some(sa), Some(sb)) = (a.metrics, b.metrics) else {
+            // A gated steady state that a solver did not deliver fails the gate.
+            let which = |tr: &Trajectory| if tr.metrics.is_some() { "yes" } else { "none" };
+            m.push(Measured {
+                quantity: format!("steady metrics ({} vs {})", which(a), which(b)),
+                key: None,
+                diff: f64::NAN,
+                tol: 0.0,
+            });
+            return GateResult {
+                pair: pair.to_owned(),
+                measured: m,
+            };
+        };
+        if sa.kind() != sb.kind() {
+            m.push(Measured {
+                quantity: format!("steady kind ({} vs {})", sa.kind(), sb.kind()),
+                key: None,
+                diff: f64::INFINITY,
+                tol: 0.0,
+            });
+        } else {
+            m.extend(steady_differences(&sa, &sb, tol, floor, stuck_band));
+        }
+    }
+    GateResult {
+        pair: pair.to_owned(),
+        measured: m,
+    }
+}
+
+/// The whole-run gates of a pair ([`crate::compare::whole`]): the matched events' times and the
+/// phase-aligned samples of α, ω_u and ω_l over `[0, t_end]`, each against its key. A key
+/// that the table does not state is measured against 0 and fails: every pair must gate the
+/// whole run.
+pub fn check_whole(
+    model: &Model,
+    u: f64,
+    a: &Trajectory,
+    b: &Trajectory,
+    tol: &PairTolerance,
+    stuck_band: f64,
+) -> Vec<Measured> {
+    let w = whole_run(model, u, a, b, stuck_band);
+    let events = if w.event_time.is_finite() {
+        format!("whole event times ({} matched)", w.events)
+    } else {
+        "whole event times (sequences differ)".to_owned()
+    };
+    [
+        (
+            "whole alpha (phase-aligned)".to_owned(),
+            "whole_alpha",
+            w.aligned[0],
+        ),
+        (
+            "whole omega_u (phase-aligned)".to_owned(),
+            "whole_omega_u",
+            w.aligned[1],
+        ),
+        (
+            "whole omega_l (phase-aligned)".to_owned(),
+            "whole_omega_l",
+            w.aligned[2],
+        ),
+        (events, "whole_event_time", w.event_time),
+    ]
+    .into_iter()
+    .map(|(quantity, key, diff)| match tol.get(key) {
+        Some(t) => Measured {
+            quantity,
+            key: Some(key),
+            diff,
+            tol: t,
+        },
+        None => Measured {
+            quantity: format!("{quantity} (no {key} stated)"),
+            key: Some(key),
+            diff: f64::INFINITY,
+            tol: 0.0,
+        },
+    })
+    .collect()
+}
+
+/// The steady metrics of two results of the same kind, each against its own tolerance
+/// ([`PairTolerance::for_metric`]). A relative difference is scaled so that `diff ≤ tol` ⇔
+/// `|va − vb| ≤ max(tol·max(|va|, |vb|), floor)`; `stick_time` is absolute. A metric whose
+/// tolerance the file does not state is measured against 0 and fails: the file must gate
+/// every metric of the steady state it reaches.
+///
+/// A disc at rest at an equilibrium: where one solver reports its velocity (`omega_u`,
+/// `omega_l`) as 0 exactly and the other within `stuck_band` of 0 (the two solvers'
+/// [`SolverInfo::stuck_band`]s summed: the switch model holds a stuck disc at the velocity it
+/// entered its band with, |ω| ≤ η), only the part of the difference beyond the band counts
+/// ([`beyond_stuck_band`]). Relative to a value that is 0 by construction, the band itself
+/// would read as a difference of 100 %, which no gate could tell from a real one.
+///
+/// [`SolverInfo::stuck_band`]: rotor_analysis::solvers::SolverInfo::stuck_band
+pub fn steady_differences(
+    sa: &SteadyState,
+    sb: &SteadyState,
+    tol: &PairTolerance,
+    floor: f64,
+    stuck_band: f64,
+) -> Vec<Measured> {
+    sa.values()
+        .into_iter()
+        .zip(sb.values())
+        .map(|((name, va), (_, vb))| {
+            let (q, t) = tol
+                .for_metric(name)
+                .expect("every metric of SteadyState::values has a quantity");
+            let t = t.unwrap_or(0.0);
+            let d = beyond_stuck_band(name, va, vb, stuck_band);
+            let diff = if !q.relative {
+                d
+            } else {
+                let scale = va
+                    .abs()
+                    .max(vb.abs())
+                    .max(if t > 0.0 { floor / t } else { 0.0 });
+                if scale > 0.0 { d / scale } else { d }
+            };
+            let missing = if tol.get(q.key).is_none() {
+                format!(" (no {} stated)", q.key)
+            } else {
+                String::new()
+            };
+            Measured {
+                quantity: format!("steady {name}{missing}"),
+                key: Some(q.key),
+                diff: if missing.is_empty() {
+                    diff
+                } else {
+                    f64::INFINITY
+                },
+                tol: t,
+            }
+        })
+        .collect()
+}
+
+/// The band within which a pair's stuck velocities are no difference: the sum of the two
+/// solvers' [`SolverInfo::stuck_band`]s (see [`steady_differences`]).
+///
+/// [`SolverInfo::stuck_band`]: rotor_analysis::solvers::SolverInfo::stuck_band
+pub fn stuck_band(a: SolverKind, b: SolverKind) -> f64 {
+    a.info().stuck_band + b.info().stuck_band
+}
+
+/// `|va − vb|`, less `stuck_band` (not below 0) where `name` is an equilibrium's disc
+/// velocity (`omega_u`, `omega_l`) that one of the two reports as 0 exactly: a stuck disc
+/// that the other solver holds inside its band (see [`steady_differences`]). A NaN stays NaN.
+pub fn beyond_stuck_band(name: &str, va: f64, vb: f64, stuck_band: f64) -> f64 {
+    let d = (va - vb).abs();
+    let stuck = matches!(name, "omega_u" | "omega_l") && (va == 0.0 || vb == 0.0);
+    if stuck && d <= stuck_band {
+        0.0
+    } else if stuck {
+        d - stuck_band
+    } else {
+        d
+    }
+}
+
+/// The steady metrics of a trajectory, if computed.
+pub fn metrics(tr: &Trajectory) -> Option<SteadyState> {
+    tr.metrics
+}
+
+/// Gates every pair of one scenario. A solver error, or a pair without a tolerance in the
+/// scenario file, is a failure too.
+pub fn gate_scenario(r: &ScenarioResult) -> (Vec<GateResult>, Vec<Failure>) {
+    let sc = &r.scenario;
+    let mut gates = Vec::new();
+    let mut fails = Vec::new();
+    for run in &r.runs {
+        if let Err(e) = &run.result {
+            fails.push(Failure {
+                scenario: sc.name.clone(),
+                pair: run.kind.name().into(),
+                quantity: format!("run failed: {e}"),
+                diff: f64::INFINITY,
+                tol: 0.0,
+            });
+        }
+    }
+    let kinds: Vec<SolverKind> = r.runs.iter().map(|run| run.kind).collect();
+    let reference = pairs(&kinds);
+    for (a, b) in all_pairs(&kinds) {
+        let pair = pair_name(a, b);
+        let Some(tol) = sc.tolerance.get(&pair) else {
+            fails.push(Failure {
+                scenario: sc.name.clone(),
+                pair: pair.clone(),
+                quantity: "no [tolerance] stated for this pair in the scenario file".into(),
+                diff: f64::INFINITY,
+                tol: 0.0,
+            });
+            continue;
+        };
+        let (Some(ta), Some(tb)) = (r.traj(a), r.traj(b)) else {
+            continue;
+        };
+        let band = stuck_band(a, b);
+        let mut g = if reference.contains(&(a, b)) {
+            check_pair(&pair, ta, tb, sc.compare.transient, tol, band)
+        } else {
+            GateResult {
+                pair: pair.clone(),
+                measured: Vec::new(),
+            }
+        };
+        g.measured
+            .extend(check_whole(&sc.model, sc.u, ta, tb, tol, band));
+        fails.extend(g.failures(&sc.name));
+        gates.push(g);
+    }
+    (gates, fails)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use rotor_model::seam::{Sample, Stats};
+    use rotor_model::{DiscMode, Mode, State};
+
+    /// A trajectory with samples every 0.01 s on [0, 1] and the given metrics.
+    fn traj(metrics: Option<SteadyState>) -> Trajectory {
+        let samples = (0..=100)
+            .map(|k| {
+                let t = k as f64 * 0.01;
+                Sample {
+                    t,
+                    x: State::new(0.0, 1.0, t.sin()),
+                }
+            })
+            .collect();
+        Trajectory {
+            samples,
+            events: Vec::new(),
+            t_final: 1.0,
+            x_final: State::zeros(),
+            mode_final: Mode {
+                upper: DiscMode::SlipPos,
+                lower: DiscMode::SlipPos,
+            },
+            metrics,
+            stats: Stats::default(),
+        }
+    }
+
+    const EQ: SteadyState = SteadyState::Equilibrium {
+        omega_u: 1.0,
+        omega_l: 1.0,
+        alpha: 0.1,
+    };
+
+    /// Gates for synthetic data: identical inputs differ by exactly 0, the perturbation below
+    /// is 1e-6, so any gate between the two tells them apart; 1e-9 is one.
+    fn tol() -> PairTolerance {
+        PairTolerance {
+            transient_max: Some(1e-9),
+            equilibrium_omega_u_rel: Some(1e-9),
+            equilibrium_omega_l_rel: Some(1e-9),
+            equilibrium_alpha_rel: Some(1e-9),
+            ..PairTolerance::default()
+        }
+    }
+
+    #[test]
+    fn identical_results_pass_and_a_difference_fails() {
+        let a = traj(Some(EQ));
+        let g = check_pair("p", &a, &a, Some([0.0, 1.0]), &tol(), 0.0);
+        // Both the window and the metrics were measured, and passed.
+        assert_eq!(g.measured.len(), 1 + EQ.values().len());
+        assert!(g.failures("s").is_empty());
+        let mut b = a.clone();
+        b.samples[50].x[2] += 1e-6;
+        let f = check_pair("p", &a, &b, Some([0.0, 1.0]), &tol(), 0.0).failures("s");
+        assert_eq!(f.len(), 1, "{f:?}");
+        assert!(f[0].quantity.contains("transient max"));
+    }
+
+    #[test]
+    fn a_window_without_samples_fails_rather_than_passing_empty() {
+        let a = traj(Some(EQ));
+        // Between grid points 0.50 and 0.51: no sample to compare.
+        let f = check_pair("p", &a, &a, Some([0.501, 0.509]), &tol(), 0.0).failures("s");
+        assert!(
+            f.iter().any(|f| f.quantity.contains("transient max")),
+            "{f:?}"
+        );
+    }
+
+    const CYCLE: SteadyState = SteadyState::LimitCycle {
+        period: 4.5,
+        omega_l_max: 6.3,
+        omega_l_min: 0.0,
+        omega_u_max: 2.7,
+        omega_u_min: 2.5,
+        stick_time: 0.87,
+    };
+
+    /// Each steady metric is gated by its own tolerance: a shift of twice a metric's gate
+    /// fails exactly that metric, a shift of half of it passes, and a metric whose kind has
+    /// no tolerance in the file fails.
+    #[test]
+    fn each_steady_metric_has_its_own_gate() {
+        let tol = PairTolerance {
+            period_rel: Some(1e-10),
+            omega_l_max_rel: Some(1e-9),
+            omega_l_min: Some(3e-9),
+            omega_u_max_rel: Some(1e-11),
+            omega_u_min_rel: Some(3e-11),
+            stick_time: Some(1e-8),
+            steady_abs: Some(1e-12),
+            ..PairTolerance::default()
+        };
+        let a = traj(Some(CYCLE));
+        assert!(
+            check_pair("p", &a, &a, None, &tol, 0.0)
+                .failures("s")
+                .is_empty()
+        );
+        type Shift = fn(&mut SteadyState, f64);
+        let shifts: [(&str, Shift, f64); 6] = [
+            (
+                "period",
+                |m, f| {
+                    if let SteadyState::LimitCycle { period, .. } = m {
+                        *period *= 1.0 + f
+                    }
+                },
+                1e-10,
+            ),
+            (
+                "omega_l_max",
+                |m, f| {
+                    if let SteadyState::LimitCycle { omega_l_max, .. } = m {
+                        *omega_l_max *= 1.0 + f
+                    }
+                },
+                1e-9,
+            ),
+            (
+                "omega_l_min",
+                |m, f| {
+                    if let SteadyState::LimitCycle { omega_l_min, .. } = m {
+                        *omega_l_min += f
+                    }
+                },
+                3e-9,
+            ),
+            (
+                "omega_u_max",
+                |m, f| {
+                    if let SteadyState::LimitCycle { omega_u_max, .. } = m {
+                        *omega_u_max *= 1.0 + f
+                    }
+                },
+                1e-11,
+            ),
+            // Its own gate, 3x omega_u_max's: 1.5e-11 passes here and would fail there.
+            (
+                "omega_u_min",
+                |m, f| {
+                    if let SteadyState::LimitCycle { omega_u_min, .. } = m {
+                        *omega_u_min *= 1.0 + f
+                    }
+                },
+                3e-11,
+            ),
+            (
+                "stick_time",
+                |m, f| {
+                    if let SteadyState::LimitCycle { stick_time, .. } = m {
+                        *stick_time += f
+                    }
+                },
+                1e-8,
+            ),
+        ];
+        for (name, shift, gate) in shifts {
+            for (factor, fails) in [(2.0, true), (0.5, false)] {
+                let mut b = a.clone();
+                shift(b.metrics.as_mut().unwrap(), factor * gate);
+                let f = check_pair("p", &a, &b, None, &tol, 0.0).failures("s");
+                // ω_l's minimum is gated absolutely (rad/s) by its own 3e-9, not through
+                // the relative gates' floor: 6e-9 fails and 1.5e-9 passes.
+                assert_eq!(!f.is_empty(), fails, "{name} x{factor}: {f:?}");
+                if fails {
+                    assert!(
+                        f.len() == 1 && f[0].quantity == format!("steady {name}"),
+                        "{f:?}"
+                    );
+                }
+            }
+        }
+        // An equilibrium gated with cycle tolerances only: its metrics are not gated, so fail.
+        let e = traj(Some(EQ));
+        let f = check_pair("p", &e, &e, None, &tol, 0.0).failures("s");
+        assert_eq!(f.len(), 3, "{f:?}");
+        assert!(
+            f[0].quantity.contains("no equilibrium_omega_u_rel stated"),
+            "{f:?}"
+        );
+    }
+
+    /// A stuck disc: the reference at rest (ω = 0), the other solver inside its stuck band.
+    /// Within the band its velocity passes a gate of 0; beyond it, the excess fails, and only
+    /// that quantity. A slipping equilibrium (neither at 0) is compared as before, band or not.
+    #[test]
+    fn a_stuck_disc_inside_the_band_agrees_and_the_excess_fails() {
+        let tol = PairTolerance {
+            equilibrium_omega_u_rel: Some(0.0),
+            equilibrium_omega_l_rel: Some(0.0),
+            equilibrium_alpha_rel: Some(1e-9),
+            steady_abs: Some(1e-12),
+            ..PairTolerance::default()
+        };
+        let eq = |w_u: f64, w_l: f64| {
+            traj(Some(SteadyState::Equilibrium {
+                omega_u: w_u,
+                omega_l: w_l,
+                alpha: -0.08,
+            }))
+        };
+        let fails = |a: &Trajectory, b: &Trajectory, band: f64| -> Vec<String> {
+            check_pair("p", a, b, None, &tol, band)
+                .failures("s")
+                .into_iter()
+                .map(|f| f.quantity)
+                .collect()
+        };
+        let rest = eq(0.0, 0.0);
+        let eta = 1e-10;
+        // Held at 0.99999 η and −η: inside the band.
+        assert!(fails(&rest, &eq(0.99999 * eta, -eta), eta).is_empty());
+        // Without the band the same is a 100 % difference.
+        assert_eq!(fails(&rest, &eq(0.99999 * eta, -eta), 0.0).len(), 2);
+        // 1.01 η: the excess fails, in ω_l alone.
+        assert_eq!(
+            fails(&rest, &eq(eta, 1.01 * eta), eta),
+            ["steady omega_l".to_owned()]
+        );
+        // A slipping equilibrium is not stuck: 1e-11 apart fails a gate of 0 whatever the
+        // band.
+        assert_eq!(fails(&eq(2.0, 2.0), &eq(2.0, 2.0 + 1e-11), eta).len(), 1);
+        assert!((beyond_stuck_band("omega_l", 0.0, 3e-10, eta) - 2e-10).abs() < 1e-25);
+        assert_eq!(beyond_stuck_band("alpha", 0.0, 3e-10, eta), 3e-10);
+        assert!(beyond_stuck_band("omega_u", 0.0, f64::NAN, eta).is_nan());
+    }
+
+    /// The transient gates: max, RMS, and the stick event times (count and kind too).
+    #[test]
+    fn transient_and_event_gates_each_fail_their_negative_control() {
+        let tol = PairTolerance {
+            transient_max: Some(1e-6),
+            transient_rms: Some(1e-7),
+            event_time: Some(1e-5),
+            ..PairTolerance::default()
+        };
+        let mut a = traj(None);
+        let ev = |t: f64, kind| rotor_model::seam::Event {
+            t,
+            x: State::zeros(),
+            kind,
+        };
+        a.events = vec![
+            ev(0.2, EventKind::StickStart(Disc::Lower)),
+            ev(0.4, EventKind::StickEnd(Disc::Lower)),
+        ];
+        assert!(
+            check_pair("p", &a, &a, Some([0.0, 1.0]), &tol, 0.0)
+                .failures("s")
+                .is_empty()
+        );
+        let fails = |b: &Trajectory| {
+            check_pair("p", &a, b, Some([0.0, 1.0]), &tol, 0.0)
+                .failures("s")
+                .into_iter()
+                .map(|f| f.quantity)
+                .collect::<Vec<_>>()
+        };
+        // One sample off by 2e-6: the max fails; the RMS over 202 values is 1.4e-7 and fails too.
+        let mut b = a.clone();
+        b.samples[10].x[1] += 2e-6;
+        assert_eq!(fails(&b).len(), 2, "{:?}", fails(&b));
+        // Every sample off by 2e-7: max passes, RMS fails.
+        let mut b = a.clone();
+        b.samples.iter_mut().for_each(|s| s.x[2] += 2e-7);
+        assert_eq!(fails(&b), vec!["transient rms d_omega"]);
+        // An event 2e-5 s late; one missing; one of another kind.
+        let mut b = a.clone();
+        b.events[1].t += 2e-5;
+        assert!(
+            fails(&b)[0].starts_with("stick event times"),
+            "{:?}",
+            fails(&b)
+        );
+        let mut b = a.clone();
+        b.events.pop();
+        assert!(fails(&b)[0].contains("(2 vs 1 events)"), "{:?}", fails(&b));
+        let mut b = a.clone();
+        b.events[1].kind = EventKind::StickStart(Disc::Lower);
+        assert!(
+            fails(&b)[0].starts_with("stick event times"),
+            "{:?}",
+            fails(&b)
+        );
+        // Half the gate passes.
+        let mut b = a.clone();
+        b.events[1].t += 5e-6;
+        b.samples[10].x[1] += 5e-7;
+        assert!(fails(&b).is_empty(), "{:?}", fails(&b));
+    }
+
+    /// A gate of 0 is exact agreement: any difference fails it.
+    #[test]
+    fn a_zero_gate_demands_exact_agreement() {
+        let tol = PairTolerance {
+            transient_max: Some(0.0),
+            equilibrium_omega_u_rel: Some(0.0),
+            equilibrium_omega_l_rel: Some(0.0),
+            equilibrium_alpha_rel: Some(0.0),
+            ..PairTolerance::default()
+        };
+        let a = traj(Some(EQ));
+        assert!(
+            check_pair("p", &a, &a, Some([0.0, 1.0]), &tol, 0.0)
+                .failures("s")
+                .is_empty()
+        );
+        let mut b = a.clone();
+        // Sample 0 has ω_l = sin 0 = 0, so 1e-300 is representable there.
+        b.samples[0].x[2] += 1e-300;
+        assert_eq!(
+            check_pair("p", &a, &b, Some([0.0, 1.0]), &tol, 0.0)
+                .failures("s")
+                .len(),
+            1
+        );
+    }
+
+    #[test]
+    fn gated_metrics_missing_on_one_side_fail() {
+        let (a, b) = (traj(Some(EQ)), traj(None));
+        for (x, y) in [(&a, &b), (&b, &a), (&b, &b)] {
+            let f = check_pair("p", x, y, None, &tol(), 0.0).failures("s");
+            assert!(
+                f.len() == 1 && f[0].quantity.contains("steady metrics"),
+                "{f:?}"
+            );
+        }
+    }
+}

@@ -1,0 +1,477 @@
+//! Steady-state metrics, accumulated from a run's events in O(1) memory.
+//!
+//! Solvers push their located events into a [`MetricsAccumulator`] (stick onsets and exits,
+//! and the extrema of ω_u and ω_l, located between steps). A cycle is the interval between two
+//! successive *anchors*: exits of the lower disc from stick when the orbit sticks, maxima of
+//! ω_l otherwise. The metrics of the last complete cycle are reported.
+
+use serde::{Deserialize, Serialize};
+
+use crate::seam::event::{Event, EventKind};
+use crate::{Disc, OMEGA_L, OMEGA_U, State};
+
+/// The steady state as `rotor steady` prints it (docs/design.md, "The CLI"), and as the
+/// reference data stores and reads it back.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "kind", rename_all = "snake_case")]
+pub enum SteadyState {
+    /// An equilibrium (rad, rad/s): a run's final state when read off a run
+    /// ([`MetricsAccumulator::finish`]), or the solved equilibrium.
+    Equilibrium {
+        /// ω_u [rad/s] (equal to ω_l at an equilibrium, up to how the run approached it).
+        omega_u: f64,
+        /// ω_l [rad/s]; exactly 0 when the lower disc is stuck.
+        omega_l: f64,
+        /// α \[rad\]: the spring's twist.
+        alpha: f64,
+    },
+    /// A periodic orbit: period \[s\], extremes [rad/s], time per period with ω_l = 0 \[s\].
+    LimitCycle {
+        /// Period \[s\]: time between the last two anchors (lower-disc stick exits when the
+        /// orbit sticks, ω_l maxima otherwise).
+        period: f64,
+        /// Largest ω_l over the last cycle [rad/s].
+        omega_l_max: f64,
+        /// Smallest ω_l over the last cycle [rad/s] (0 on a stick-slip cycle).
+        omega_l_min: f64,
+        /// Largest ω_u over the last cycle [rad/s].
+        omega_u_max: f64,
+        /// Smallest ω_u over the last cycle [rad/s].
+        omega_u_min: f64,
+        /// Time the lower disc spends stuck per period \[s\] (0 on a slipping cycle).
+        stick_time: f64,
+    },
+}
+
+impl SteadyState {
+    /// The metrics as named values, in a fixed order (for comparisons and reports): the
+    /// order of [`SteadyState::map`]'s calls.
+    pub fn values(&self) -> Vec<(&'static str, f64)> {
+        let mut out = Vec::with_capacity(6);
+        self.map(|name, v| {
+            out.push((name, v));
+            v
+        });
+        out
+    }
+
+    /// The same steady state with every metric `v` named `name` replaced by `f(name, v)`,
+    /// called once per metric in the order of the fields.
+    pub fn map(self, mut f: impl FnMut(&'static str, f64) -> f64) -> SteadyState {
+        match self {
+            SteadyState::Equilibrium {
+                omega_u,
+                omega_l,
+                alpha,
+            } => SteadyState::Equilibrium {
+                omega_u: f("omega_u", omega_u),
+                omega_l: f("omega_l", omega_l),
+                alpha: f("alpha", alpha),
+            },
+            SteadyState::LimitCycle {
+                period,
+                omega_l_max,
+                omega_l_min,
+                omega_u_max,
+                omega_u_min,
+                stick_time,
+            } => SteadyState::LimitCycle {
+                period: f("period", period),
+                omega_l_max: f("omega_l_max", omega_l_max),
+                omega_l_min: f("omega_l_min", omega_l_min),
+                omega_u_max: f("omega_u_max", omega_u_max),
+                omega_u_min: f("omega_u_min", omega_u_min),
+                stick_time: f("stick_time", stick_time),
+            },
+        }
+    }
+
+    /// Both discs at rest with the lower one stuck: an equilibrium with ω_l = 0 exactly.
+    /// Every solver sets a stuck disc's velocity to 0 exactly, and at an equilibrium
+    /// α̇ = ω_u − ω_l = 0, so ω_u is 0 as well, up to how the run approached rest: an upper
+    /// disc with only viscous friction (Table 1) never sticks, and its velocity decays to the
+    /// rounding of α (1e-16 rad/s after 1500 s, 1e-10 in a Moreau–Jean run), never to 0.
+    pub fn is_stuck(&self) -> bool {
+        matches!(self, SteadyState::Equilibrium { omega_l, .. } if *omega_l == 0.0)
+    }
+
+    /// An equilibrium or a limit cycle.
+    pub fn kind(&self) -> SteadyKind {
+        match self {
+            SteadyState::Equilibrium { .. } => SteadyKind::Equilibrium,
+            SteadyState::LimitCycle { .. } => SteadyKind::LimitCycle,
+        }
+    }
+}
+
+/// What a steady state is (`"equilibrium"` or `"limit_cycle"` in JSON and reports).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum SteadyKind {
+    /// A rest point: [`SteadyState::Equilibrium`].
+    Equilibrium,
+    /// A periodic orbit: [`SteadyState::LimitCycle`].
+    LimitCycle,
+}
+
+impl SteadyKind {
+    /// `"equilibrium"` or `"limit_cycle"`.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            SteadyKind::Equilibrium => "equilibrium",
+            SteadyKind::LimitCycle => "limit_cycle",
+        }
+    }
+}
+
+impl std::fmt::Display for SteadyKind {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.as_str())
+    }
+}
+
+/// Summary of one cycle between two anchors.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct Cycle {
+    start: f64,
+    end: f64,
+    wl_max: f64,
+    wl_min: f64,
+    wu_max: f64,
+    wu_min: f64,
+    stick: f64,
+}
+
+/// One anchor stream (stick exits, or ω_l maxima) with the cycle in progress.
+#[derive(Debug, Clone, Copy)]
+struct Stream {
+    open: Option<Cycle>,
+    last: [Option<Cycle>; 2],
+    count: u64,
+}
+
+impl Stream {
+    const fn new() -> Stream {
+        Stream {
+            open: None,
+            last: [None, None],
+            count: 0,
+        }
+    }
+
+    fn anchor(&mut self, t: f64, x: &State) {
+        if let Some(mut c) = self.open.take() {
+            c.end = t;
+            c.include(x);
+            self.last = [Some(c), self.last[0]];
+            self.count += 1;
+        }
+        let mut c = Cycle {
+            start: t,
+            end: t,
+            wl_max: f64::NEG_INFINITY,
+            wl_min: f64::INFINITY,
+            wu_max: f64::NEG_INFINITY,
+            wu_min: f64::INFINITY,
+            stick: 0.0,
+        };
+        c.include(x);
+        self.open = Some(c);
+    }
+}
+
+impl Cycle {
+    fn include(&mut self, x: &State) {
+        self.wl_max = self.wl_max.max(x[OMEGA_L]);
+        self.wl_min = self.wl_min.min(x[OMEGA_L]);
+        self.wu_max = self.wu_max.max(x[OMEGA_U]);
+        self.wu_min = self.wu_min.min(x[OMEGA_U]);
+    }
+}
+
+/// Accumulates steady-state metrics from events, in constant memory.
+#[derive(Debug, Clone, Copy)]
+pub struct MetricsAccumulator {
+    t_from: f64,
+    stick_exits: Stream,
+    maxima: Stream,
+    /// Start of the lower disc's current stick phase (if stuck).
+    stick_since: Option<f64>,
+}
+
+/// Amplitude of ω_l [rad/s] below which an oscillation counts as an equilibrium: far below
+/// any cycle of the source's diagram (the smallest slipping cycles near the Hopf point that
+/// matter have amplitudes ≥ 1e-3) and far above what solver noise at an equilibrium gives.
+pub const EQUILIBRIUM_AMPLITUDE: f64 = 1e-6;
+
+impl MetricsAccumulator {
+    /// Metrics over events at `t ≥ t_from`.
+    pub fn new(t_from: f64) -> MetricsAccumulator {
+        MetricsAccumulator {
+            t_from,
+            stick_exits: Stream::new(),
+            maxima: Stream::new(),
+            stick_since: None,
+        }
+    }
+
+    /// Feeds one event (in time order).
+    pub fn push(&mut self, e: &Event) {
+        if e.t < self.t_from {
+            return;
+        }
+        for s in [&mut self.stick_exits, &mut self.maxima] {
+            if let Some(c) = s.open.as_mut() {
+                c.include(&e.x);
+            }
+        }
+        match e.kind {
+            EventKind::StickStart(Disc::Lower) => self.stick_since = Some(e.t),
+            EventKind::StickEnd(Disc::Lower) => {
+                if let Some(t0) = self.stick_since.take() {
+                    for s in [&mut self.stick_exits, &mut self.maxima] {
+                        if let Some(c) = s.open.as_mut() {
+                            c.stick += e.t - t0.max(c.start);
+                        }
+                    }
+                }
+                self.stick_exits.anchor(e.t, &e.x);
+            }
+            EventKind::Max(Disc::Lower) => self.maxima.anchor(e.t, &e.x),
+            _ => {}
+        }
+    }
+
+    /// The run skips `dt` (whole periods) right after `anchor`, the event pushed last, and
+    /// continues from its state ([`crate::seam::FastForward`]): the cycles kept so far and the one in
+    /// progress move by `dt`. An anchor before the window opens the window at its new time.
+    pub fn fast_forward(&mut self, anchor: &Event, dt: f64) {
+        if anchor.t < self.t_from {
+            self.push(&Event {
+                t: anchor.t + dt,
+                ..*anchor
+            });
+            return;
+        }
+        for s in [&mut self.stick_exits, &mut self.maxima] {
+            for c in s.open.iter_mut().chain(s.last.iter_mut().flatten()) {
+                c.start += dt;
+                c.end += dt;
+            }
+        }
+        if let Some(t) = self.stick_since.as_mut() {
+            *t += dt;
+        }
+    }
+
+    /// The cycles the metrics are read from: between stick exits if the lower disc sticks,
+    /// else between ω_l maxima.
+    fn stream(&self) -> &Stream {
+        if self.stick_exits.count >= 1 {
+            &self.stick_exits
+        } else {
+            &self.maxima
+        }
+    }
+
+    /// The steady state after a run ending at `(t, x)`: the last complete cycle if the orbit
+    /// still oscillates with amplitude above [`EQUILIBRIUM_AMPLITUDE`], else the final state.
+    pub fn finish(&self, x_final: &State) -> SteadyState {
+        match self.stream().last[0] {
+            Some(c) if c.wl_max - c.wl_min > EQUILIBRIUM_AMPLITUDE => SteadyState::LimitCycle {
+                period: c.end - c.start,
+                omega_l_max: c.wl_max,
+                omega_l_min: c.wl_min,
+                omega_u_max: c.wu_max,
+                omega_u_min: c.wu_min,
+                stick_time: c.stick,
+            },
+            _ => SteadyState::Equilibrium {
+                omega_u: x_final[OMEGA_U],
+                omega_l: x_final[OMEGA_L],
+                alpha: x_final[0],
+            },
+        }
+    }
+
+    /// Relative change of the ω_l amplitude (max − min) between the last two complete cycles,
+    /// if two exist: a focus decaying near a Hopf point keeps its period but not its amplitude.
+    pub fn amplitude_drift(&self) -> Option<f64> {
+        let [Some(a), Some(b)] = self.stream().last else {
+            return None;
+        };
+        let (ra, rb) = (a.wl_max - a.wl_min, b.wl_max - b.wl_min);
+        Some((ra - rb).abs() / ra.abs().max(rb.abs()).max(EQUILIBRIUM_AMPLITUDE))
+    }
+
+    /// Relative change of the period between the last two complete cycles (a convergence
+    /// indicator), if two exist.
+    pub fn period_drift(&self) -> Option<f64> {
+        let [Some(a), Some(b)] = self.stream().last else {
+            return None;
+        };
+        let (ta, tb) = (a.end - a.start, b.end - b.start);
+        Some(((ta - tb) / ta).abs())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn ev(t: f64, x: [f64; 3], kind: EventKind) -> Event {
+        Event {
+            t,
+            x: State::new(x[0], x[1], x[2]),
+            kind,
+        }
+    }
+
+    #[test]
+    fn values_name_every_field_once_in_field_order() {
+        let eq = SteadyState::Equilibrium {
+            omega_u: 1.0,
+            omega_l: 2.0,
+            alpha: 3.0,
+        };
+        assert_eq!(
+            eq.values(),
+            [("omega_u", 1.0), ("omega_l", 2.0), ("alpha", 3.0)]
+        );
+        let lc = SteadyState::LimitCycle {
+            period: 1.0,
+            omega_l_max: 2.0,
+            omega_l_min: 3.0,
+            omega_u_max: 4.0,
+            omega_u_min: 5.0,
+            stick_time: 6.0,
+        };
+        let names = [
+            "period",
+            "omega_l_max",
+            "omega_l_min",
+            "omega_u_max",
+            "omega_u_min",
+            "stick_time",
+        ];
+        let expected: Vec<_> = names
+            .into_iter()
+            .zip(1..)
+            .map(|(n, k)| (n, f64::from(k)))
+            .collect();
+        assert_eq!(lc.values(), expected);
+        // map hands each metric to f under its own name and puts the result back there.
+        assert_eq!(lc.map(|_, v| 10.0 * v).values()[5], ("stick_time", 60.0));
+    }
+
+    #[test]
+    fn stick_slip_cycle_from_events() {
+        let mut m = MetricsAccumulator::new(1.0);
+        let l = Disc::Lower;
+        let evs = [
+            ev(0.5, [0.0, 1.0, 0.0], EventKind::StickEnd(l)), // before t_from: ignored
+            ev(2.0, [2.2, 1.0, 0.0], EventKind::StickEnd(l)),
+            ev(3.0, [1.0, 1.1, 3.0], EventKind::Max(l)),
+            ev(4.0, [1.0, 0.9, 0.0], EventKind::StickStart(l)),
+            ev(5.0, [2.2, 1.0, 0.0], EventKind::StickEnd(l)),
+            ev(6.0, [1.0, 1.1, 3.0], EventKind::Max(l)),
+            ev(7.5, [1.0, 0.9, 0.0], EventKind::StickStart(l)),
+            ev(8.0, [2.2, 1.0, 0.0], EventKind::StickEnd(l)),
+        ];
+        for e in &evs {
+            m.push(e);
+        }
+        let SteadyState::LimitCycle {
+            period,
+            omega_l_max,
+            omega_l_min,
+            omega_u_max,
+            omega_u_min,
+            stick_time,
+        } = m.finish(&State::zeros())
+        else {
+            panic!("expected a cycle")
+        };
+        assert_eq!(period, 3.0);
+        assert_eq!(stick_time, 0.5);
+        assert_eq!((omega_l_max, omega_l_min), (3.0, 0.0));
+        assert_eq!((omega_u_max, omega_u_min), (1.1, 0.9));
+        assert_eq!(m.period_drift(), Some(0.0));
+        assert_eq!(m.amplitude_drift(), Some(0.0));
+    }
+
+    /// A decaying focus: the same period, the ω_l amplitude halving from cycle to cycle
+    /// (cycles between maxima, no stick).
+    #[test]
+    fn amplitude_drift_sees_a_decay_the_period_does_not() {
+        let mut m = MetricsAccumulator::new(0.0);
+        let l = Disc::Lower;
+        for (t, kind, w) in [
+            (0.0, EventKind::Max(l), 5.0),
+            (2.0, EventKind::Min(l), 1.0),
+            (4.0, EventKind::Max(l), 4.0),
+            (6.0, EventKind::Min(l), 2.0),
+            (8.0, EventKind::Max(l), 3.5),
+        ] {
+            m.push(&ev(t, [0.0, 1.0, w], kind));
+        }
+        // Amplitudes 5 − 1 = 4 and 4 − 2 = 2 (each cycle's extremes include its end points).
+        assert_eq!(m.period_drift(), Some(0.0));
+        assert_eq!(m.amplitude_drift(), Some(0.5));
+    }
+
+    /// Skipping whole periods after an anchor gives the metrics of the full run, whether the
+    /// anchor lies in the window or before it.
+    #[test]
+    fn fast_forward_keeps_the_metrics_of_the_skipped_run() {
+        let l = Disc::Lower;
+        // A stick-slip cycle of period 3: exit, max, stick onset.
+        let cycle = |k: f64| {
+            [
+                ev(3.0 * k, [2.2, 1.0, 0.0], EventKind::StickEnd(l)),
+                ev(3.0 * k + 1.0, [1.0, 1.1, 3.0], EventKind::Max(l)),
+                ev(3.0 * k + 2.5, [1.0, 0.9, 0.0], EventKind::StickStart(l)),
+            ]
+        };
+        for t_from in [1.0, 20.0] {
+            let mut full = MetricsAccumulator::new(t_from);
+            for k in 0..12 {
+                cycle(k as f64).iter().for_each(|e| full.push(e));
+            }
+            full.push(&cycle(12.0)[0]);
+            // Skip cycles 3..=9 right after the exit at t = 9.
+            let mut skip = MetricsAccumulator::new(t_from);
+            for k in 0..3 {
+                cycle(k as f64).iter().for_each(|e| skip.push(e));
+            }
+            let anchor = cycle(3.0)[0];
+            skip.push(&anchor);
+            skip.fast_forward(&anchor, 21.0);
+            for e in &cycle(10.0)[1..] {
+                skip.push(e);
+            }
+            cycle(11.0).iter().for_each(|e| skip.push(e));
+            skip.push(&cycle(12.0)[0]);
+            let x = State::zeros();
+            assert_eq!(skip.finish(&x), full.finish(&x), "t_from = {t_from}");
+            assert!(
+                matches!(full.finish(&x), SteadyState::LimitCycle { period, stick_time, .. }
+                if period == 3.0 && stick_time == 0.5)
+            );
+        }
+    }
+
+    #[test]
+    fn no_events_is_an_equilibrium() {
+        let m = MetricsAccumulator::new(0.0);
+        let x = State::new(1.0, 2.0, 2.0);
+        assert_eq!(
+            m.finish(&x),
+            SteadyState::Equilibrium {
+                omega_u: 2.0,
+                omega_l: 2.0,
+                alpha: 1.0
+            }
+        );
+    }
+}
