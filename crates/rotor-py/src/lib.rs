@@ -22,12 +22,12 @@ use pyo3::prelude::*;
 use pyo3::types::{PyBool, PyDict, PyList, PyString};
 use rayon::prelude::*;
 use rotor_analysis::bifurcation::{BifError, DiagramOptions};
+use rotor_analysis::steady::{SettleError, SteadyAnswer, SteadyError};
 use rotor_harness::grade::check::{GradeError, Level};
 use rotor_harness::grade::trace::{EventsFile, Trace, disc_name, event_row, round_to, time_digits};
 use rotor_harness::jobs::request::Request;
-use rotor_model::{FieldError, Model, Params};
 use rotor_model::seam::Stats;
-use rotor_analysis::steady::{SettleError, SteadyAnswer, SteadyError};
+use rotor_model::{FieldError, Model, Params};
 
 pyo3::create_exception!(
     rotorbench,
@@ -460,7 +460,8 @@ fn sweep<'py>(
                 .map_err(|why| PyValueError::new_err(format!("threads = {n}: {why}")))
         })
         .transpose()?;
-    let (n, _) = rotor_harness::compare::threads::resolve(explicit).map_err(PyValueError::new_err)?;
+    let (n, _) =
+        rotor_harness::compare::threads::resolve(explicit).map_err(PyValueError::new_err)?;
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(n)
         .build()
@@ -489,7 +490,9 @@ fn sweep<'py>(
         pool.install(|| {
             jobs.par_iter()
                 .map(|(kind, scene, opts)| {
-                    rotor_analysis::steady::checked::checked_or_simulated(*kind, &model, scene, opts)
+                    rotor_analysis::steady::checked::checked_or_simulated(
+                        *kind, &model, scene, opts,
+                    )
                 })
                 .collect()
         })
