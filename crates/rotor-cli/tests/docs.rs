@@ -103,6 +103,66 @@ fn readme_quick_commands_run_from_an_empty_directory() {
     std::fs::remove_dir_all(&dir).ok();
 }
 
+/// The README's example of an input that changes in time (`cli-input`) runs as it stands,
+/// every line in order (the `printf` that writes the input too), from an empty directory as
+/// the quick block does, and its run is the stepped one: the trace covers the horizon on the
+/// 0.01 s grid, and ω_u, which settles at 1.5 V, rises after the step at 60 s.
+#[test]
+fn readme_input_example_runs_from_an_empty_directory() {
+    let readme = std::fs::read_to_string(root().join("README.md")).unwrap();
+    let block = marked(&readme, "cli-input");
+    let lines: Vec<&str> = block
+        .iter()
+        .map(|l| split_comment(l).0)
+        .filter(|c| !c.is_empty() && !c.starts_with("```"))
+        .collect();
+    assert_eq!(lines.len(), 2, "{lines:?}");
+    assert!(lines[1].contains("--input"), "{lines:?}");
+    let dir = rotor_testkit::tmp_dir("rotor-cli-readme-input");
+    let bin = Path::new(env!("CARGO_BIN_EXE_rotor")).parent().unwrap();
+    let path = format!(
+        "{}:{}",
+        bin.display(),
+        std::env::var("PATH").unwrap_or_default()
+    );
+    for cmd in &lines {
+        let o = Command::new("sh")
+            .args(["-c", cmd])
+            .current_dir(&dir)
+            .env("PATH", &path)
+            .env("ROTORBENCH_SUITE", "embedded")
+            .env("ROTORBENCH_CACHE", dir.join(".cache"))
+            .env_remove("ROTORBENCH_FIXTURES")
+            .output()
+            .unwrap();
+        assert!(
+            o.status.success(),
+            "{cmd}: exit {:?}: {}",
+            o.status,
+            String::from_utf8_lossy(&o.stderr)
+        );
+    }
+    let csv = std::fs::read_to_string(dir.join("step-run.csv")).unwrap();
+    let mut rows = csv.lines();
+    assert_eq!(rows.next(), Some("t,alpha,omega_u,omega_l"));
+    let rows: Vec<Vec<f64>> = rows
+        .map(|r| r.split(',').map(|v| v.parse().unwrap()).collect())
+        .collect();
+    // 0, 0.01, ..., 120
+    assert_eq!(rows.len(), 12001);
+    assert_eq!(rows.last().unwrap()[0], 120.0);
+    // ω_u at 59 s is on the 1.5 V cycle (its values stay below the 2.5 V run's), and the
+    // largest ω_u after the step exceeds every ω_u of the 50..60 s window: the input rose.
+    let max_between = |a: f64, b: f64| {
+        rows.iter()
+            .filter(|r| r[0] >= a && r[0] < b)
+            .map(|r| r[2])
+            .fold(f64::MIN, f64::max)
+    };
+    assert!(max_between(60.0, 120.0) > max_between(50.0, 60.0) + 0.1);
+    std::fs::remove_dir_all(&dir).ok();
+}
+
 /// The `rotor ...` lines of a marked block, split from their comments.
 fn rotor_lines<'a>(block: &[&'a str]) -> Vec<(&'a str, &'a str)> {
     block
