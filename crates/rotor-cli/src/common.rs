@@ -242,8 +242,9 @@ pub(crate) fn sweep_flagged(e: rotor_harness::jobs::sweep::SweepError) -> anyhow
 pub(crate) const U_PLAUSIBLE: f64 = 10.0;
 
 /// A warning for an input far outside what the model describes ([`U_PLAUSIBLE`]), with
-/// the slipping speed it would give; `None` for a plausible one.
-pub(crate) fn implausible_u(u: f64, model: &Model) -> Option<String> {
+/// the slipping speed it would give; `None` for a plausible one. `source` names where u came
+/// from as the user wrote it (`--u`, `--input FILE`, the scenario).
+pub(crate) fn implausible_u(u: f64, model: &Model, source: &str) -> Option<String> {
     if !u.is_finite() || u.abs() <= U_PLAUSIBLE {
         return None;
     }
@@ -260,7 +261,7 @@ pub(crate) fn implausible_u(u: f64, model: &Model) -> Option<String> {
         format!("{u}")
     };
     Some(format!(
-        "--u {shown}: far outside the few volts the model describes (every special point of \
+        "{source} {shown}: far outside the few volts the model describes (every special point of \
          both parameter sets lies below 5 V, the bifurcation diagrams span 0 to 7 V; above \
          {U_PLAUSIBLE} V only a faster slipping equilibrium remains): the discs would slip at \
          about {omega:.2e} rad/s. Millivolts or a missing decimal point?"
@@ -302,7 +303,12 @@ pub(crate) fn start(common: &Common) -> Result<Start> {
         },
     };
     let u_max = s.input.as_ref().map_or(s.u, |i| i.max_abs());
-    if let Some(w) = implausible_u(u_max, &s.model) {
+    let source = match (&common.scenario, &common.input) {
+        (Some(p), _) => format!("scenario {}: u reaches", p.display()),
+        (None, Some(f)) => format!("--input {}: u reaches", f.display()),
+        (None, None) => "--u".to_owned(),
+    };
+    if let Some(w) = implausible_u(u_max, &s.model, &source) {
         eprintln!("warning: {w}");
     }
     Ok(s)

@@ -1101,6 +1101,15 @@ fn an_installed_rotor_grades_by_name_from_an_empty_directory() {
     };
     assert_eq!(tier("t1-u1.5-rest"), "table1");
     assert_eq!(tier("st-u1.5-rest"), "full");
+    // A constant input is `u`; one that changes in time is `"u": null` and its rows, as in
+    // the job file.
+    let scene = |n: &str| scenes.iter().find(|s| s["name"] == n).unwrap().clone();
+    assert_eq!(scene("t1-u1.5-rest")["u"], 1.5);
+    assert!(scene("t1-u1.5-rest").get("input").is_none());
+    let step = scene("t1-u1.5-step2.5");
+    assert!(step["u"].is_null(), "{step}");
+    assert_eq!(step["input"], serde_json::json!([[60.0, 1.5], [60.0, 2.5]]));
+    assert!(list.contains("u(t)"), "{list}");
     let job: serde_json::Value =
         serde_json::from_str(&ok(&run(&["job", "t1-u1.5-rest", "--h", "1e-3"]))).unwrap();
     assert_eq!(job["benchmark"], version);
@@ -1376,6 +1385,31 @@ fn implausible_inputs_are_warned_about_or_refused() {
     let p = rotor_model::Params::table1();
     let omega = p.k_m * 1e6 / (p.upper.b + p.lower.viscous());
     assert!(err.contains(&format!("{omega:.2e}")), "{err}");
+    // An input file names itself, and the largest |u| it reaches.
+    let dir = rotor_testkit::tmp_dir("rotor-cli-implausible-input");
+    let input = dir.join("ramp.csv");
+    std::fs::write(&input, "t,u\n0,1.5\n1,2e4\n").unwrap();
+    let o = rotor(&[
+        "simulate",
+        "--solver",
+        "event",
+        "--input",
+        input.to_str().unwrap(),
+        "--t-end",
+        "0.1",
+        "--csv",
+        "-",
+    ]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(o.status.success(), "{err}");
+    assert!(
+        err.starts_with(&format!(
+            "warning: --input {}: u reaches 20000:",
+            input.display()
+        )),
+        "{err}"
+    );
+    std::fs::remove_dir_all(&dir).ok();
     // The README's inputs draw none.
     for u in ["1.5", "-6", "10"] {
         let o = rotor(&["steady", "--solver", "switch", "--u", u]);

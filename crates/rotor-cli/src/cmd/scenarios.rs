@@ -33,7 +33,12 @@ struct Row<'a> {
     name: &'a str,
     tier: &'static str,
     description: &'a str,
-    u: f64,
+    /// The constant input \[V\], or null for an input that changes in time (as in the job
+    /// file).
+    u: Option<f64>,
+    /// The rows `[t, u]` of an input that changes in time.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    input: Option<Vec<[f64; 2]>>,
     t_end: f64,
 }
 
@@ -70,7 +75,11 @@ pub fn scenarios(json: Option<&Path>) -> Result<()> {
             name: &sc.name,
             tier: tier(sc),
             description: &sc.description,
-            u: sc.u,
+            u: sc.input.is_none().then_some(sc.u),
+            input: sc
+                .input
+                .as_ref()
+                .map(|i| i.rows().iter().map(|&(t, u)| [t, u]).collect()),
             t_end: sc.t_end,
         })
         .collect();
@@ -88,7 +97,12 @@ pub fn scenarios(json: Option<&Path>) -> Result<()> {
     for r in &rows {
         text.push_str(&format!(
             "{:<18} {:<7} {:>5} {:>6}  {}\n",
-            r.name, r.tier, r.u, r.t_end, r.description
+            r.name,
+            r.tier,
+            // an input that changes in time: its description says how
+            r.u.map_or("u(t)".to_owned(), |u| u.to_string()),
+            r.t_end,
+            r.description
         ));
     }
     crate::common::say(&text, [json])?;
