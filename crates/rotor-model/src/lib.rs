@@ -10,6 +10,7 @@
 
 #![warn(missing_docs)]
 
+pub mod chain;
 pub mod scenario;
 pub mod seam;
 
@@ -22,6 +23,7 @@ pub mod num;
 pub mod params;
 pub mod scales;
 
+pub use chain::{ChainModel, ChainParams};
 pub use dynamics::{ALPHA, Disc, DiscMode, Mode, Model, OMEGA_L, OMEGA_U, State};
 pub use equilibrium::{SlipEquilibrium, StuckSet};
 pub use field::FieldError;

@@ -52,6 +52,18 @@ pub enum ParamsError {
     /// A value set by name (not read from a file) is unknown or out of its range.
     #[error(transparent)]
     Value(FieldError),
+    /// A value of one disc of a chain is out of its admissible range:
+    /// `chain3.toml: disc 3: friction.t_s = -1: static level must be >= 0`.
+    #[error("{}: disc {disc}: {error}", shown(.path))]
+    Disc {
+        /// The file.
+        path: PathBuf,
+        /// The disc's number, from 1 (the driven disc).
+        disc: usize,
+        /// The field (`j`, `k`, `c`, `friction.t_s`), its value and why it is refused (boxed:
+        /// every error of the crate carries this enum, and this variant would widen it).
+        error: Box<FieldError>,
+    },
     /// A value is out of its admissible range.
     #[error("{}: {error}", shown(.path))]
     Invalid {
@@ -236,13 +248,18 @@ impl Params {
         Params::from_toml_str(&text, path)
     }
 
-    /// Parses and validates parameter TOML; `path` is only used in messages.
+    /// Parses and validates parameter TOML; `path` is only used in messages. A file in chain
+    /// form (`[[disc]]` tables, [`crate::chain`]) is read as a chain and taken if it has the
+    /// rig's shape; any other chain is refused, saying what makes it one.
     pub fn from_toml_str(text: &str, path: &Path) -> Result<Params, ParamsError> {
         if text.trim().is_empty() {
             return Err(ParamsError::Parse {
                 path: path.to_owned(),
                 message: "the file is empty".into(),
             });
+        }
+        if crate::ChainParams::is_chain_form(text) {
+            return crate::ChainParams::from_toml_str(text, path)?.into_rig(path);
         }
         let raw: RawParams = toml::from_str(text).map_err(|e| ParamsError::Parse {
             path: path.to_owned(),
@@ -252,9 +269,13 @@ impl Params {
     }
 
     /// Validates parameters given as a table of the file's keys (the Python package's dict);
-    /// `origin` names them in messages.
+    /// `origin` names them in messages. A table in chain form is taken as
+    /// [`Params::from_toml_str`] takes a file in it.
     pub fn from_table(table: toml::Table, origin: &Path) -> Result<Params, ParamsError> {
         use serde::Deserialize;
+        if table.contains_key("disc") {
+            return crate::ChainParams::from_table(table, origin)?.into_rig(origin);
+        }
         let raw =
             RawParams::deserialize(toml::Value::Table(table)).map_err(|e| ParamsError::Parse {
                 path: origin.to_owned(),
@@ -457,154 +478,183 @@ impl Params {
     /// Checks that every value is finite and in its admissible range; the error names the
     /// first violation (its field as a dotted path, `lower.t_s`).
     pub fn validate(&self) -> Result<(), FieldError> {
-        let mut fields: Vec<(&str, f64)> = vec![
+        let mut fields: Vec<(String, f64)> = [
             ("j_u", self.j_u),
             ("k_m", self.k_m),
             ("k_theta", self.k_theta),
             ("j_l", self.j_l),
-            ("upper.t_s", self.upper.t_s),
-            ("upper.dt_s", self.upper.dt_s),
-            ("upper.b", self.upper.b),
-            ("upper.db", self.upper.db),
-        ];
-        match self.lower {
-            LowerFriction::Exponential {
-                t_s,
-                t_1,
-                t_2,
-                w_1,
-                w_2,
-                b,
-            } => fields.extend([
-                ("lower.t_s", t_s),
-                ("lower.t_1", t_1),
-                ("lower.t_2", t_2),
-                ("lower.w_1", w_1),
-                ("lower.w_2", w_2),
-                ("lower.b", b),
-            ]),
-            LowerFriction::Stribeck {
-                t_s,
-                t_c,
-                omega_s,
-                delta,
-                b,
-            } => fields.extend([
-                ("lower.t_s", t_s),
-                ("lower.t_c", t_c),
-                ("lower.omega_s", omega_s),
-                ("lower.delta", delta),
-                ("lower.b", b),
-            ]),
-        }
-        let err = |f: &str, v: f64, r: &str| Err(FieldError::num(f, v, r));
-        for (f, v) in &fields {
-            if !v.is_finite() {
-                return err(f, *v, "must be a finite number");
-            }
-        }
+        ]
+        .map(|(f, v)| (f.to_owned(), v))
+        .into();
+        fields.extend(upper_fields(&self.upper, "upper."));
+        fields.extend(lower_fields(&self.lower, "lower."));
+        check_finite(&fields)?;
         for (f, v) in [
             ("j_u", self.j_u),
             ("j_l", self.j_l),
             ("k_theta", self.k_theta),
         ] {
             if v <= 0.0 {
-                return err(f, v, "must be positive");
+                return Err(FieldError::num(f, v, "must be positive"));
             }
         }
         if self.k_m == 0.0 {
-            return err("k_m", self.k_m, "must be non-zero");
+            return Err(FieldError::num("k_m", self.k_m, "must be non-zero"));
         }
-        if self.upper.t_s < 0.0 {
-            return err("upper.t_s", self.upper.t_s, "static level must be >= 0");
-        }
-        if self.upper.dt_s.abs() > self.upper.t_s {
-            return err(
-                "upper.dt_s",
-                self.upper.dt_s,
-                "|dt_s| must not exceed t_s (T_cu(0+) and T_cu(0-) must be >= 0)",
-            );
-        }
-        if self.upper.b < 0.0 {
-            return err("upper.b", self.upper.b, "viscous coefficient must be >= 0");
-        }
-        if self.upper.db.abs() > self.upper.b {
-            return err(
-                "upper.db",
-                self.upper.db,
-                "|db| must not exceed b (both viscous slopes must be >= 0)",
-            );
-        }
-        match self.lower {
-            LowerFriction::Exponential {
-                t_s,
-                t_1,
-                t_2,
-                w_1,
-                w_2,
-                b,
-            } => {
-                if t_s < 0.0 {
-                    return err("lower.t_s", t_s, "static level must be >= 0");
-                }
-                if w_1 <= 0.0 {
-                    return err("lower.w_1", w_1, "must be positive");
-                }
-                if w_2 <= 0.0 {
-                    return err("lower.w_2", w_2, "must be positive");
-                }
-                if b < 0.0 {
-                    return err("lower.b", b, "viscous coefficient must be >= 0");
-                }
-                // t_1 and t_2 may be negative (Table 1's t_2 is), but not so negative that
-                // the friction drives the disc: T_cl(ω) >= 0 for every slip velocity.
-                let (w, tc) = exponential_law_minimum(t_s, t_1, t_2, w_1, w_2, b);
-                if tc < 0.0 {
-                    let (f, v) = if t_1 * (0.5 * w_1 * w).tanh() <= t_2 * (0.5 * w_2 * w).tanh() {
-                        ("lower.t_1", t_1)
-                    } else {
-                        ("lower.t_2", t_2)
-                    };
-                    return err(
-                        f,
-                        v,
-                        &format!(
-                            "makes the lower friction law negative, T_cl = {tc:.3e} N m at \
-                             |ω| = {w:.3e} rad/s (friction must oppose the motion)"
-                        ),
-                    );
-                }
-            }
-            LowerFriction::Stribeck {
-                t_s,
-                t_c,
-                omega_s,
-                delta,
-                b,
-            } => {
-                if t_s < 0.0 {
-                    return err("lower.t_s", t_s, "static level must be >= 0");
-                }
-                if t_c < 0.0 {
-                    return err("lower.t_c", t_c, "Coulomb level must be >= 0");
-                }
-                if omega_s <= 0.0 {
-                    return err(
-                        "lower.omega_s",
-                        omega_s,
-                        "Stribeck velocity must be positive",
-                    );
-                }
-                if delta <= 0.0 {
-                    return err("lower.delta", delta, "Stribeck exponent must be positive");
-                }
-                if b < 0.0 {
-                    return err("lower.b", b, "viscous coefficient must be >= 0");
-                }
-            }
-        }
-        Ok(())
+        check_upper(&self.upper, "upper.")?;
+        check_lower(&self.lower, "lower.", "lower")
     }
+}
+
+/// The first of `fields` that is not a finite number, as an error.
+pub(crate) fn check_finite(fields: &[(String, f64)]) -> Result<(), FieldError> {
+    match fields.iter().find(|(_, v)| !v.is_finite()) {
+        Some((f, v)) => Err(FieldError::num(f.as_str(), *v, "must be a finite number")),
+        None => Ok(()),
+    }
+}
+
+/// The upper law's fields, named `{prefix}t_s`, ..., in file order.
+pub(crate) fn upper_fields(u: &UpperFriction, prefix: &str) -> Vec<(String, f64)> {
+    [("t_s", u.t_s), ("dt_s", u.dt_s), ("b", u.b), ("db", u.db)]
+        .map(|(f, v)| (format!("{prefix}{f}"), v))
+        .into()
+}
+
+/// A lower law's fields, named `{prefix}t_s`, ..., in file order.
+pub(crate) fn lower_fields(l: &LowerFriction, prefix: &str) -> Vec<(String, f64)> {
+    let named: Vec<(&str, f64)> = match *l {
+        LowerFriction::Exponential {
+            t_s,
+            t_1,
+            t_2,
+            w_1,
+            w_2,
+            b,
+        } => vec![
+            ("t_s", t_s),
+            ("t_1", t_1),
+            ("t_2", t_2),
+            ("w_1", w_1),
+            ("w_2", w_2),
+            ("b", b),
+        ],
+        LowerFriction::Stribeck {
+            t_s,
+            t_c,
+            omega_s,
+            delta,
+            b,
+        } => vec![
+            ("t_s", t_s),
+            ("t_c", t_c),
+            ("omega_s", omega_s),
+            ("delta", delta),
+            ("b", b),
+        ],
+    };
+    named
+        .into_iter()
+        .map(|(f, v)| (format!("{prefix}{f}"), v))
+        .collect()
+}
+
+/// The upper law's ranges (eq. (4): levels and slopes >= 0 on both sides); fields named
+/// `{prefix}t_s`, ...
+pub(crate) fn check_upper(u: &UpperFriction, prefix: &str) -> Result<(), FieldError> {
+    let err = |f: &str, v: f64, r: &str| Err(FieldError::num(format!("{prefix}{f}"), v, r));
+    if u.t_s < 0.0 {
+        return err("t_s", u.t_s, "static level must be >= 0");
+    }
+    if u.dt_s.abs() > u.t_s {
+        return err(
+            "dt_s",
+            u.dt_s,
+            "|dt_s| must not exceed t_s (T_cu(0+) and T_cu(0-) must be >= 0)",
+        );
+    }
+    if u.b < 0.0 {
+        return err("b", u.b, "viscous coefficient must be >= 0");
+    }
+    if u.db.abs() > u.b {
+        return err(
+            "db",
+            u.db,
+            "|db| must not exceed b (both viscous slopes must be >= 0)",
+        );
+    }
+    Ok(())
+}
+
+/// A lower law's ranges; fields named `{prefix}t_s`, ...; `law` names the law in a message
+/// (`"lower"`: "makes the lower friction law negative").
+pub(crate) fn check_lower(l: &LowerFriction, prefix: &str, law: &str) -> Result<(), FieldError> {
+    let err = |f: &str, v: f64, r: &str| Err(FieldError::num(format!("{prefix}{f}"), v, r));
+    match *l {
+        LowerFriction::Exponential {
+            t_s,
+            t_1,
+            t_2,
+            w_1,
+            w_2,
+            b,
+        } => {
+            if t_s < 0.0 {
+                return err("t_s", t_s, "static level must be >= 0");
+            }
+            if w_1 <= 0.0 {
+                return err("w_1", w_1, "must be positive");
+            }
+            if w_2 <= 0.0 {
+                return err("w_2", w_2, "must be positive");
+            }
+            if b < 0.0 {
+                return err("b", b, "viscous coefficient must be >= 0");
+            }
+            // t_1 and t_2 may be negative (Table 1's t_2 is), but not so negative that
+            // the friction drives the disc: T_cl(ω) >= 0 for every slip velocity.
+            let (w, tc) = exponential_law_minimum(t_s, t_1, t_2, w_1, w_2, b);
+            if tc < 0.0 {
+                let (f, v) = if t_1 * (0.5 * w_1 * w).tanh() <= t_2 * (0.5 * w_2 * w).tanh() {
+                    ("t_1", t_1)
+                } else {
+                    ("t_2", t_2)
+                };
+                return err(
+                    f,
+                    v,
+                    &format!(
+                        "makes the {law} friction law negative, T_cl = {tc:.3e} N m at \
+                         |ω| = {w:.3e} rad/s (friction must oppose the motion)"
+                    ),
+                );
+            }
+        }
+        LowerFriction::Stribeck {
+            t_s,
+            t_c,
+            omega_s,
+            delta,
+            b,
+        } => {
+            if t_s < 0.0 {
+                return err("t_s", t_s, "static level must be >= 0");
+            }
+            if t_c < 0.0 {
+                return err("t_c", t_c, "Coulomb level must be >= 0");
+            }
+            if omega_s <= 0.0 {
+                return err("omega_s", omega_s, "Stribeck velocity must be positive");
+            }
+            if delta <= 0.0 {
+                return err("delta", delta, "Stribeck exponent must be positive");
+            }
+            if b < 0.0 {
+                return err("b", b, "viscous coefficient must be >= 0");
+            }
+        }
+    }
+    Ok(())
 }
 
 /// The smallest value of the exponential law for slip, `min_{ω>0} T_cl(ω)` with

@@ -205,7 +205,8 @@ fn raw(name: &str, contents: impl Into<Vec<u8>>, needles: &[&'static str]) -> Ba
 
 /// Bad parameter files: mutations of [`TABLE1`] and [`STRIBECK`] (unknown, missing and
 /// mistyped keys, non-finite and out-of-range values, an unknown family) and empty, binary
-/// and control-character files. Each is a whole parameter file, to be loaded on its own.
+/// and control-character files; chains in chain form the solvers refuse ([`CHAIN3`]). Each is a
+/// whole parameter file, to be loaded on its own.
 pub fn bad_params_cases() -> Vec<BadFile> {
     let t1 = |from: &str, to: &str, needles: &[&'static str]| {
         edited("table1", TABLE1, from, to, needles)
@@ -380,8 +381,41 @@ pub fn bad_params_cases() -> Vec<BadFile> {
             &["\\u{7}"],
         ),
         too_large(),
+        // Chain form: a chain the solvers do not take yet, and a bad value of one disc.
+        raw("a chain of three discs", CHAIN3, &["a chain with 3 discs"]),
+        edited(
+            "chain3",
+            CHAIN3,
+            "t_s = 0.2,",
+            "t_s = -1,",
+            &["disc 3: friction.t_s = -1: static level must be >= 0"],
+        ),
+        edited(
+            "chain3",
+            CHAIN3,
+            "j = 0.4765",
+            "j = 0.4765\nk = 1.0",
+            &["disc 1: k = 1", "no disc above"],
+        ),
     ]
 }
+
+/// A chain of three discs in chain form: Table 1's rig with a Stribeck disc below it.
+pub const CHAIN3: &str = r#"name = "chain3"
+k_m = 3.9950
+[[disc]]
+j = 0.4765
+friction = { family = "upper", t_s = 0.0, dt_s = 0.0, b = 2.2247, db = 0.0 }
+[[disc]]
+j = 0.0326
+k = 0.0727
+friction = { family = "exponential", t_s = 0.1642, t_1 = 0.0603, t_2 = -0.2267, w_1 = 5.7468, w_2 = 0.2941, b = 0.0109 }
+[[disc]]
+j = 0.0326
+k = 0.0727
+c = 0.001
+friction = { family = "stribeck", t_s = 0.2, t_c = 0.1, omega_s = 1.5, delta = 2.0, b = 0.01 }
+"#;
 
 /// 2 MiB of comment lines: valid TOML, but no parameter or scenario file is that large, and
 /// the readers refuse it (at 1 MiB) before reading on.
