@@ -74,6 +74,11 @@ pub struct SolverInfo {
     /// velocities are no difference within the sum of their bands
     /// (`rotor_harness::compare::gate::steady_differences`).
     pub stuck_band: f64,
+    /// The relative agreement asked of its steady answers (`rotor steady` at its comparison
+    /// setting) with the attractors of the continuation, away from special points: its
+    /// accuracy on steady metrics with a margin, well below the distance to the nearest other
+    /// cycle (`rotor_analysis::steady::probes`, where each value's origin is given).
+    pub steady_agreement: f64,
     /// A solver with its default options.
     pub make: fn() -> Box<dyn Solver>,
 }
@@ -96,6 +101,7 @@ pub static EVENT: SolverInfo = SolverInfo {
         width: 2.5,
     },
     stuck_band: 0.0,
+    steady_agreement: 1e-6,
     make: || Box::new(rotor_event::EventSolver::default()),
 };
 
@@ -114,6 +120,7 @@ pub static SWITCH: SolverInfo = SolverInfo {
     },
     // SwitchOptions::default().eta (a unit test holds them equal).
     stuck_band: 1e-10,
+    steady_agreement: 1e-5,
     make: || Box::new(rotor_switch::SwitchSolver::default()),
 };
 
@@ -133,6 +140,7 @@ pub static MOREAU: SolverInfo = SolverInfo {
         width: 1.5,
     },
     stuck_band: 0.0,
+    steady_agreement: 1e-4,
     make: || Box::new(rotor_moreau::MoreauSolver::default()),
 };
 

@@ -267,10 +267,11 @@ fn hopf_start(cont: &Continuer, omega_h: f64, u_h: f64, u: f64) -> Option<[f64; 
     Some([y[1], y[2]])
 }
 
-/// Relative agreement asked of an answer with an attractor of the continuation, per solver:
-/// its accuracy on steady metrics away from special points with a margin, and well below the
-/// distance to the nearest other cycle in every probe (the unstable cycle 2e-4 V below the
-/// fold E of Table 1 differs from the stable one by 2.4e-3 in max ω_l).
+/// Relative agreement asked of an answer with an attractor of the continuation, per solver
+/// ([`crate::solvers::SolverInfo::steady_agreement`]): its accuracy on steady metrics away
+/// from special points with a margin, and well below the distance to the nearest other cycle
+/// in every probe (the unstable cycle 2e-4 V below the fold E of Table 1 differs from the
+/// stable one by 2.4e-3 in max ω_l). The project's solvers:
 ///
 /// * event-driven (tol 1e-12, fixed point to 1e-11) against Newton at 1e-10 on the section:
 ///   1e-6;
@@ -278,13 +279,7 @@ fn hopf_start(cont: &Continuer, omega_h: f64, u_h: f64, u: f64) -> Option<[f64; 
 /// * Moreau–Jean (h 1e-3; its cycle-to-cycle jitter is 2.5e-7 and its O(h²) error grows
 ///   as 1/(1 − μ) near a fold): 1e-4.
 pub fn agreement(kind: SolverKind) -> f64 {
-    if kind == SolverKind::EVENT {
-        1e-6
-    } else if kind.is_fixed_step() {
-        1e-4
-    } else {
-        1e-5
-    }
+    kind.info().steady_agreement
 }
 
 /// A solver's answer to one probe, judged.
@@ -630,7 +625,14 @@ fn method_name(m: crate::steady::compute::SteadyMethod) -> &'static str {
 /// and Moreau–Jean's from rest at ±1e-3 V (its other probes cost most of a minute: a
 /// transient too slow to settle is followed up to 20 000 s, 2·10⁷ steps).
 pub fn selection(d: &Diagram, full: bool) -> Vec<Probe> {
-    probes(d, &crate::solvers::SOLVERS)
+    selection_for(d, full, &crate::solvers::SOLVERS)
+}
+
+/// [`selection`] for any list of solvers: a solver that is not the project's (a fourth one,
+/// as `tests/fourth_solver.rs` adds) gets the same probes without an edit here; a fixed-step
+/// one the fast form's subset, as Moreau–Jean.
+pub fn selection_for(d: &Diagram, full: bool, kinds: &[SolverKind]) -> Vec<Probe> {
+    probes(d, kinds)
         .into_iter()
         .filter(|p| {
             full || !p.kind.is_fixed_step() || (p.start == Start::Rest && p.offset.abs() == 1e-3)

@@ -32,7 +32,7 @@ use rotor_model::seam::{
 };
 use rotor_model::{Disc, LowerFriction, Model, OMEGA_L, Params, State, UpperFriction};
 
-use rotor_analysis::solvers::registry::{SOLVERS, SolverKind};
+use rotor_analysis::solvers::registry::{Knob, SOLVERS, SolverKind};
 
 /// The event-driven reference's tolerance (as in the comparison, `run.rs`).
 pub const REFERENCE_TOL: f64 = 1e-12;
@@ -796,8 +796,53 @@ const LADDER: [(f64, f64, f64); 11] = [
     (1e-13, 4.25e-12, 1.02e-10),
 ];
 
-/// The stress cases; `full` adds the long horizon and the whole ladders.
+/// The stress cases for the project's solvers; `full` adds the long horizon and the whole
+/// ladders.
 pub fn cases(full: bool) -> Vec<StressCase> {
+    cases_for(full, &SOLVERS)
+}
+
+/// The stress cases for any list of solvers. The project's solvers keep their settings and
+/// their gates, measured or derived per case (rows of a project solver not in `kinds` are
+/// left out; the event-driven reference runs regardless). Every other solver (a fourth one,
+/// as `tests/fourth_solver.rs` adds) gets one row per case at its comparison setting, without
+/// an edit here, gated by what holds for any solver ([`newcomer_gate`]).
+pub fn cases_for(full: bool, kinds: &[SolverKind]) -> Vec<StressCase> {
+    let listed = |k: SolverKind| kinds.iter().any(|o| o.name() == k.name());
+    let project = |k: SolverKind| SOLVERS.iter().any(|o| o.name() == k.name());
+    let mut v = project_cases(full);
+    for case in &mut v {
+        case.settings
+            .retain(|s| s.gate == Gate::Reference || listed(s.kind));
+        for &kind in kinds.iter().filter(|&&k| !project(k)) {
+            case.settings.push(Setting {
+                kind,
+                accuracy: kind.accuracy(kind.info().comparison),
+                gate: newcomer_gate(kind, case.measure),
+            });
+        }
+    }
+    v
+}
+
+/// The gate a solver that is not the project's gets on a case, from what holds for any
+/// solver: the mirror symmetry exactly ([`Gate::Exact`]: the laws are odd, and sign-symmetric
+/// arithmetic keeps it to the bit); a tolerance-controlled solver's a-priori bound
+/// ([`Gate::Adaptive`], with its own stuck band); a fixed-step solver reported, not gated (no
+/// a-priori bound without its order and constant: measure them and give it its gates).
+pub fn newcomer_gate(kind: SolverKind, measure: Measure) -> Gate {
+    match (measure, kind.info().knob) {
+        (Measure::Mirror { .. }, _) => Gate::Exact,
+        (_, Knob::Tolerance) => Gate::Adaptive,
+        (_, Knob::Step) => Gate::Unresolved(
+            "not gated: a fixed-step solver new to the project has no a-priori bound here; \
+             measure its order and constant",
+        ),
+    }
+}
+
+/// The project's stress cases, with each solver's settings and gates.
+fn project_cases(full: bool) -> Vec<StressCase> {
     let t1 = Params::table1();
     let rest = State::zeros();
     let pick = |fast: f64, long: f64| if full { long } else { fast };
