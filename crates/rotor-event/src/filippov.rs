@@ -893,7 +893,7 @@ impl<'a> Integrator<'a> {
             return Err(SolveError::StepSizeUnderflow {
                 t: c.t,
                 h,
-                x: [c.x[0], c.x[1], c.x[2]],
+                x: c.x.as_slice().to_vec(),
             });
         }
         let mode = c.mode;

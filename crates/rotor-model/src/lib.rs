@@ -18,7 +18,7 @@ pub mod dynamics;
 pub mod equilibrium;
 pub mod field;
 pub mod friction;
-pub mod lagrangian;
+pub(crate) mod lagrangian;
 pub mod num;
 pub mod params;
 pub mod scales;

@@ -716,7 +716,7 @@ fn escape_controls(s: &str) -> String {
 pub const MAX_FILE: u64 = 1 << 20;
 
 /// The bytes of the file at `path`, refused once it runs past [`MAX_FILE`] bytes.
-pub fn read_small(path: &Path) -> std::io::Result<Vec<u8>> {
+pub(crate) fn read_small(path: &Path) -> std::io::Result<Vec<u8>> {
     use std::io::Read;
     let mut bytes = Vec::new();
     std::fs::File::open(path)?
@@ -733,7 +733,7 @@ pub fn read_small(path: &Path) -> std::io::Result<Vec<u8>> {
 
 /// The bytes of a file as text, or why it is not a text file: not UTF-8, or it holds a NUL
 /// byte (a binary file that happens to be valid UTF-8). Names the byte offset.
-pub fn text_of(bytes: Vec<u8>) -> Result<String, String> {
+pub(crate) fn text_of(bytes: Vec<u8>) -> Result<String, String> {
     let text = String::from_utf8(bytes).map_err(|e| {
         let at = e.utf8_error().valid_up_to();
         let byte = e.as_bytes()[at];

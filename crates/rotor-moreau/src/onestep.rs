@@ -42,7 +42,8 @@ use nalgebra::{Matrix2, Vector2};
 use rotor_model::DiscMode;
 
 /// The three candidate modes of one contact, in enumeration order.
-pub const DISC_MODES: [DiscMode; 3] = [DiscMode::Stick, DiscMode::SlipPos, DiscMode::SlipNeg];
+pub(crate) const DISC_MODES: [DiscMode; 3] =
+    [DiscMode::Stick, DiscMode::SlipPos, DiscMode::SlipNeg];
 
 /// The friction impulse on one disc along a slip branch, affine in the disc velocity ω:
 /// total (smooth + contact) impulse `c + d·ω`, of which the contact (tangential) impulse is

@@ -70,20 +70,23 @@ fn bad(e: FieldError) -> PyErr {
 }
 
 /// A [`SolveError`] with its `t` and `state` attributes.
-fn solve_error(py: Python<'_>, message: String, t: Option<f64>, state: Option<[f64; 3]>) -> PyErr {
+fn solve_error(py: Python<'_>, message: String, t: Option<f64>, state: Option<Vec<f64>>) -> PyErr {
     let err = SolveError::new_err(message);
     let v = err.value(py);
     // Setting an attribute on a fresh exception instance cannot fail but for lack of
     // memory; then the exception still carries its message.
     let _ = v.setattr("t", t);
-    let _ = v.setattr("state", state.map(|[a, b, c]| (a, b, c)));
+    let _ = v.setattr(
+        "state",
+        state.and_then(|s| pyo3::types::PyTuple::new(py, s).ok()),
+    );
     err
 }
 
 fn from_solve(py: Python<'_>, e: rotor_model::seam::SolveError) -> PyErr {
     match e {
         rotor_model::seam::SolveError::InvalidScene(_) => value_error(e),
-        _ => solve_error(py, e.to_string(), e.time(), e.state()),
+        _ => solve_error(py, e.to_string(), e.time(), e.state().map(<[f64]>::to_vec)),
     }
 }
 
@@ -101,7 +104,9 @@ fn from_bif(py: Python<'_>, e: BifError) -> PyErr {
     match e {
         BifError::InvalidOption(_) => value_error(e),
         BifError::Solve(e) => from_solve(py, e),
-        BifError::Grazing { state, .. } => solve_error(py, e.to_string(), None, Some(state)),
+        BifError::Grazing { state, .. } => {
+            solve_error(py, e.to_string(), None, Some(state.to_vec()))
+        }
         _ => solve_error(py, e.to_string(), None, None),
     }
 }

@@ -457,7 +457,7 @@ fn map_err(e: Dopri5Error, x: &State) -> SolveError {
         Dopri5Error::StepSizeUnderflow { t, h } => SolveError::StepSizeUnderflow {
             t,
             h,
-            x: [x[0], x[1], x[2]],
+            x: x.as_slice().to_vec(),
         },
         Dopri5Error::TooManySteps { t, max_steps } => SolveError::TooManySteps { t, max_steps },
     }
@@ -504,7 +504,7 @@ impl Run<'_> {
                 if f.rhs(self.integ.t(), &y).iter().any(|v| !v.is_finite()) {
                     SolveError::NonFinite {
                         t: self.integ.t(),
-                        x: [y[0], y[1], y[2]],
+                        x: y.as_slice().to_vec(),
                     }
                 } else {
                     map_err(e, &before)

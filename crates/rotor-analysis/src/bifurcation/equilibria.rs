@@ -53,7 +53,7 @@ pub fn omega_reaching(model: &Model, u_target: f64) -> Option<f64> {
 
 /// Sample points of ω > 0 covering the branch up to `omega_max`, dense near 0 (where the
 /// friction varies fastest).
-pub fn omega_grid(omega_max: f64, n: usize) -> Vec<f64> {
+pub(crate) fn omega_grid(omega_max: f64, n: usize) -> Vec<f64> {
     (1..=n)
         .map(|i| {
             let t = i as f64 / n as f64;

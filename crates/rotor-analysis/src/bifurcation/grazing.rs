@@ -50,7 +50,7 @@ pub struct GrazingOrbit {
 const MAX_STEPS: usize = 200_000;
 
 /// The smooth slip–slip flow from `x_g(w)` to the next minimum of ω_l: `(x(t_m), t_m, max ω_l)`.
-pub fn touch_to_min(
+pub(crate) fn touch_to_min(
     model: &Model,
     u: f64,
     w: f64,
@@ -123,44 +123,6 @@ pub fn touch_to_min(
         t += h;
         x = tr.y1;
         f0 = f1;
-        h = h_new;
-    }
-    Err(BifError::NoReturn { u })
-}
-
-/// The smooth flow of one mode (no events: each disc on its branch, the friction continued
-/// across ω = 0) from `x0` for `t_end` seconds.
-pub fn smooth_flow(
-    model: &Model,
-    u: f64,
-    mode: Mode,
-    x0: State,
-    t_end: f64,
-    tol: f64,
-) -> Result<State, BifError> {
-    let mut f = |_t: f64, x: &State| model.rhs(x, u, mode);
-    let mut ctl = Dop853::new(tol, tol);
-    let (mut t, mut x) = (0.0, x0);
-    let mut f0 = f(t, &x);
-    let mut h = ctl.initial_step(&mut f, t, &x, &f0);
-    ctl.restart();
-    for _ in 0..MAX_STEPS {
-        if t >= t_end {
-            return Ok(x);
-        }
-        let hh = h.min(t_end - t);
-        let tr = ctl.trial(&mut f, t, &x, &f0, hh);
-        if !Dop853::acceptable(&tr) {
-            h = ctl.reject(tr.err, hh);
-            if h.is_nan() || h <= 1e-14 {
-                break;
-            }
-            continue;
-        }
-        let h_new = ctl.accept(tr.err, hh);
-        t = if hh == t_end - t { t_end } else { t + hh };
-        x = tr.y1;
-        f0 = f(t, &x);
         h = h_new;
     }
     Err(BifError::NoReturn { u })

@@ -304,7 +304,7 @@ pub fn along(
 
 /// The Floquet multipliers ordered for reporting: the one nearest 1 (the trivial one, up to
 /// the integration error) first, then the others by decreasing modulus.
-pub fn order_multipliers(m: [Complex<f64>; 3]) -> [Complex<f64>; 3] {
+pub(crate) fn order_multipliers(m: [Complex<f64>; 3]) -> [Complex<f64>; 3] {
     let one = Complex::new(1.0, 0.0);
     let mut v = m;
     let k = (0..3)

@@ -41,7 +41,7 @@ pub struct SectionDerivs {
 }
 
 /// Longest time a return may take \[s\] (periods here are a few seconds to a few tens).
-pub const T_RETURN: f64 = 2000.0;
+pub(crate) const T_RETURN: f64 = 2000.0;
 
 /// The shooting setup at one input u.
 #[derive(Debug, Clone, Copy)]

@@ -47,7 +47,7 @@ pub enum ArcEnd {
 }
 
 /// A defining system: `H(y)`.
-pub type System<'a> = dyn Fn(&[f64]) -> Result<Vec<f64>, BifError> + 'a;
+pub(crate) type System<'a> = dyn Fn(&[f64]) -> Result<Vec<f64>, BifError> + 'a;
 
 /// `DH(y)` by forward differences, `(n−1) × n`, in scaled coordinates.
 fn jacobian(

@@ -929,7 +929,7 @@ fn spread(want: &[f64], top: f64, bottom: f64) -> Vec<f64> {
 
 /// Labels closer than `frac` of the spans `(span_x, span_y)` in both coordinates become one,
 /// their texts joined by " / ", at the first one's x and the highest y of the group.
-pub fn merge_close(labels: Vec<Label>, span_x: f64, span_y: f64, frac: f64) -> Vec<Label> {
+pub(crate) fn merge_close(labels: Vec<Label>, span_x: f64, span_y: f64, frac: f64) -> Vec<Label> {
     let mut out: Vec<Label> = Vec::new();
     for lab in labels {
         let near = |c: &&mut Label| {

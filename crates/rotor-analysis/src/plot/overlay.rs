@@ -36,7 +36,7 @@ pub fn overlay(
 }
 
 /// The panel [`overlay`] draws (for its data, [`crate::plot::data_csv`]).
-pub fn overlay_panel<'a>(
+pub(crate) fn overlay_panel<'a>(
     title: &str,
     x_label: &'a str,
     y_label: &'a str,

@@ -268,7 +268,7 @@ pub fn pair_name(a: SolverKind, b: SolverKind) -> String {
 }
 
 /// The pair names of a solver set.
-pub fn pair_names(solvers: &[SolverKind]) -> Vec<String> {
+pub(crate) fn pair_names(solvers: &[SolverKind]) -> Vec<String> {
     pairs(solvers)
         .into_iter()
         .map(|(a, b)| pair_name(a, b))

@@ -14,7 +14,7 @@ use serde::Deserialize;
 use crate::steady::by_solver::{BySolverOptions, by_solver_with};
 
 /// The gates file, embedded (its origins are comments there).
-pub const GATES_TOML: &str = include_str!("../../../../fixtures/gates/bifurcation.toml");
+pub(crate) const GATES_TOML: &str = include_str!("../../../../fixtures/gates/bifurcation.toml");
 
 /// The gate of one special point for each method pair (event vs switch, event vs Moreau–Jean).
 #[derive(Debug, Clone, Deserialize, PartialEq)]
@@ -116,7 +116,7 @@ pub struct ReportSection {
 /// Rows re-shot per solver for the overlay in the report: every 16th (about 30 per set), to
 /// keep the section within its time budget of the main job; the special points are located
 /// whatever the stride.
-pub const REPORT_STRIDE: usize = 16;
+pub(crate) const REPORT_STRIDE: usize = 16;
 
 /// The section: per parameter set `(name, slug, model, event diagram)`, the overlay SVG and
 /// the table of special points by method, with differences and gates.

@@ -494,7 +494,7 @@ pub fn probes(d: &Diagram, solvers: &[SolverKind]) -> Vec<Probe> {
 
 /// Runs one probe: the answer and its verdict against `expected` (the attractors at the
 /// probe's input).
-pub fn run_probe(
+pub(crate) fn run_probe(
     model: &Model,
     probe: &Probe,
     expected: &[Expected],

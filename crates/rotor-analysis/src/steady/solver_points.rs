@@ -39,9 +39,9 @@ use rotor_model::Model;
 use crate::steady::orbit_rows::{BySolverOptions, NotFound, first_crossing, row_of, shoot_opts};
 
 /// The condition of a grazing point located by a solver.
-pub const GRAZING_CONDITION: &str = "min omega_l = 0 of the solver's slipping cycle, root of the quadratic through its last three shots; residual: change of the root from the previous fit [V]";
+pub(crate) const GRAZING_CONDITION: &str = "min omega_l = 0 of the solver's slipping cycle, root of the quadratic through its last three shots; residual: change of the root from the previous fit [V]";
 /// The condition of a smooth fold located by a solver.
-pub const FOLD_CONDITION: &str = "u extremal along the solver's branch (shooting with u free at a fixed section coordinate), parabola vertex; residual: change of the vertex's u in the last refinement [V]";
+pub(crate) const FOLD_CONDITION: &str = "u extremal along the solver's branch (shooting with u free at a fixed section coordinate), parabola vertex; residual: change of the vertex's u in the last refinement [V]";
 
 /// The points one solver located, and those it did not.
 #[derive(Debug, Clone, Default)]

@@ -577,7 +577,7 @@ fn per_step(
 }
 
 /// Why the rest of a tolerance ladder is not run when the client's answer does not move.
-pub const KNOB_IGNORED: &str = "not run: the same answer at four tolerances in a row: the \
+pub(crate) const KNOB_IGNORED: &str = "not run: the same answer at four tolerances in a row: the \
      client ignores tol (a fixed-step client? declare it as NAME:h=COMMAND or --fixed-step NAME)";
 
 /// Whether the last four points of a tolerance ladder are one answer: each placed, with equal

@@ -26,8 +26,8 @@ pub struct SceneReport {
     pub description: String,
     /// Motor input voltage u \[V\].
     pub u: f64,
-    /// Initial state `[α, ω_u, ω_l]` (rad, rad/s, rad/s).
-    pub x0: [f64; 3],
+    /// Initial state (`[α, ω_u, ω_l]` in rad, rad/s, rad/s on the rig; the model's size).
+    pub x0: Vec<f64>,
     /// Horizon of every run (s).
     pub t_end: f64,
     /// Start of the steady-state window `[metrics_from, t_end]` (s).

@@ -67,7 +67,7 @@ pub fn solver(kind: SolverKind) -> Box<dyn Solver> {
 }
 
 /// The scene for one solver at one accuracy setting (its tolerance or its step).
-pub fn scene_at(base: &Scene, kind: SolverKind, setting: f64, output: Output) -> Scene {
+pub(crate) fn scene_at(base: &Scene, kind: SolverKind, setting: f64, output: Output) -> Scene {
     Scene {
         accuracy: kind.accuracy(setting),
         output,
@@ -266,7 +266,7 @@ pub struct Errors {
 }
 
 /// Runs a scene through a solver and measures its errors.
-pub fn run_point(
+pub(crate) fn run_point(
     kind: SolverKind,
     scene: &Scene,
     model: &rotor_model::Model,

@@ -301,7 +301,7 @@ pub fn run(opts: &BenchOptions, mut progress: impl FnMut(&str)) -> Result<BenchR
             tier: Tier::of(&l.scenario).name().to_owned(),
             description: l.scenario.description.clone(),
             u: l.scenario.u,
-            x0: [l.scenario.x0[0], l.scenario.x0[1], l.scenario.x0[2]],
+            x0: l.scenario.x0.as_slice().to_vec(),
             t_end: spec.t_end,
             metrics_from: spec.metrics_from,
             transient: spec.transient,

@@ -105,7 +105,10 @@ impl Profile {
 
 /// The profiles per tier: over every scene (the full tier), and over the table1-tier scenes
 /// alone when the scenes are of both tiers.
-pub fn by_tier(scenes: &[SceneReport], clients: &[ClientReport]) -> (Profile, Option<Profile>) {
+pub(crate) fn by_tier(
+    scenes: &[SceneReport],
+    clients: &[ClientReport],
+) -> (Profile, Option<Profile>) {
     let full = Profile {
         tier: "full".into(),
         ..profile(scenes, clients)

@@ -561,7 +561,7 @@ fn client_table(s: &mut String, p: &ClientReport) {
 /// A time ratio to 3 significant digits (`0.482`, `1.23`, `12.3`, `148`; whole numbers from
 /// 100 up): timings on a shared machine vary by more than that, and a whole number alone
 /// hides a ratio near 1.
-pub fn ratio3(x: f64) -> String {
+pub(crate) fn ratio3(x: f64) -> String {
     if !x.is_finite() || x <= 0.0 {
         return format!("{x}");
     }

@@ -11,7 +11,7 @@ use pulldown_cmark::{Options, Parser, html};
 /// The page for the report whose markdown is `md`, with the scenarios' figures named
 /// `<name>.svg` beside it; `bench` says whether `bench/bench.svg` and `bench/bench.html` are
 /// there.
-pub fn index_html(md: &str, scenarios: &[&str], bench: bool) -> String {
+pub(crate) fn index_html(md: &str, scenarios: &[&str], bench: bool) -> String {
     let mut body = String::new();
     html::push_html(&mut body, Parser::new_ext(md, Options::ENABLE_TABLES));
     let mut page = String::from(

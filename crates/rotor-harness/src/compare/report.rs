@@ -247,12 +247,12 @@ const SET_STYLES: [(&str, Option<&str>); 3] = [
 ];
 
 /// The friction curves of both parameter sets (the source's Fig. 2).
-pub fn friction_svg(sets: &[(&str, Params)]) -> String {
+pub(crate) fn friction_svg(sets: &[(&str, Params)]) -> String {
     render(&friction_panels(sets), 900.0, 340.0)
 }
 
 /// The friction figure's data ([`rotor_analysis::plot::data_csv`]).
-pub fn friction_csv(sets: &[(&str, Params)]) -> String {
+pub(crate) fn friction_csv(sets: &[(&str, Params)]) -> String {
     rotor_analysis::plot::data_csv(&friction_panels(sets))
 }
 
@@ -351,7 +351,7 @@ pub struct Section {
 }
 
 /// The file that holds the run's times beside the report (ignored by git).
-pub const TIMINGS_FILE: &str = "timings.md";
+pub(crate) const TIMINGS_FILE: &str = "timings.md";
 
 /// The report's whole-run section: per scenario and pair of solvers, the differences over
 /// every sample and event of `[0, t_end]` ([`crate::compare::whole`]): the matched events and their

@@ -65,7 +65,7 @@ pub struct Counters {
 }
 
 /// Rounds a counter to 3 significant digits.
-pub fn round_count(n: u64) -> u64 {
+pub(crate) fn round_count(n: u64) -> u64 {
     let mut scale = 1;
     while n / scale >= 1000 {
         scale *= 10;
@@ -110,7 +110,7 @@ pub const MAX_DIGITS: u32 = 12;
 pub const ROUNDING: f64 = 1e-13;
 
 /// A difference to one significant digit, as `4e-11`; `0` below [`ROUNDING`].
-pub fn one_digit(d: f64) -> String {
+pub(crate) fn one_digit(d: f64) -> String {
     if d.is_finite() && d < ROUNDING {
         "0".into()
     } else {
@@ -119,7 +119,7 @@ pub fn one_digit(d: f64) -> String {
 }
 
 /// Rounds `v` to `decimals` decimal places (never −0).
-pub fn round_decimals(v: f64, decimals: u32) -> f64 {
+pub(crate) fn round_decimals(v: f64, decimals: u32) -> f64 {
     if !v.is_finite() {
         return v;
     }
@@ -130,7 +130,7 @@ pub fn round_decimals(v: f64, decimals: u32) -> f64 {
 
 /// Digits a tolerance justifies: `⌊−log10 tol⌋`, at least 1, at most [`MAX_DIGITS`]
 /// (a tolerance of 0, exact agreement, keeps the most).
-pub fn digits_for(tol: f64) -> u32 {
+pub(crate) fn digits_for(tol: f64) -> u32 {
     if tol > 0.0 {
         ((-tol.log10()).floor().max(1.0) as u32).min(MAX_DIGITS)
     } else {

@@ -362,7 +362,7 @@ fn run(kind: SolverKind, model: &Model, scene: &Scene) -> (Outcome, Option<Traje
 
 /// Scaled max difference of two sample lists on the same grid (see the module docs); the
 /// scale is `b`'s. Different grids give ∞; a NaN propagates.
-pub fn scaled_difference(a: &[(f64, State)], b: &[(f64, State)]) -> f64 {
+pub(crate) fn scaled_difference(a: &[(f64, State)], b: &[(f64, State)]) -> f64 {
     if a.len() != b.len() || a.iter().zip(b).any(|(p, q)| p.0 != q.0) {
         return f64::INFINITY;
     }
@@ -423,7 +423,7 @@ pub fn linear_exact(p: &Params, u: f64, x0: &State, times: &[f64]) -> Vec<(f64, 
 }
 
 /// Fastest natural frequency of the linear part, `√(k_θ (1/J_u + 1/J_l))` [rad/s].
-pub fn omega_fast(p: &Params) -> f64 {
+pub(crate) fn omega_fast(p: &Params) -> f64 {
     (p.k_theta * (1.0 / p.j_u + 1.0 / p.j_l)).sqrt()
 }
 
@@ -659,7 +659,7 @@ impl StressRow {
 }
 
 /// The run time of every row, as a Markdown table (for the uncommitted timings file).
-pub fn stress_timings_markdown(rows: &[StressRow]) -> String {
+pub(crate) fn stress_timings_markdown(rows: &[StressRow]) -> String {
     let mut s = String::from("| case | solver | setting | time [ms] |\n|---|---|---|---|\n");
     for r in rows {
         let _ = writeln!(

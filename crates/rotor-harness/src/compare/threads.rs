@@ -62,7 +62,7 @@ pub fn resolve(explicit: Option<usize>) -> Result<(usize, Source), String> {
 }
 
 /// [`resolve`] with the variable's value given (for tests).
-pub fn resolve_with(
+pub(crate) fn resolve_with(
     explicit: Option<usize>,
     slurm: Option<std::ffi::OsString>,
 ) -> Result<(usize, Source), String> {

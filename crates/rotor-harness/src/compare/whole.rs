@@ -161,7 +161,7 @@ pub fn switch_time_difference(a: &Trajectory, b: &Trajectory) -> f64 {
 
 /// The shift Δt(t): linear between matched switches, held before the first and after the
 /// last, 0 without switches.
-pub fn shift_at(shifts: &[(f64, f64)], t: f64) -> f64 {
+pub(crate) fn shift_at(shifts: &[(f64, f64)], t: f64) -> f64 {
     let Some(&(t0, d0)) = shifts.first() else {
         return 0.0;
     };

@@ -367,7 +367,7 @@ pub enum CheckError {
 }
 
 /// Times within this of the grid's are the grid's \[s\].
-pub const TIME_TOL: f64 = 1e-9;
+pub(crate) const TIME_TOL: f64 = 1e-9;
 
 /// Checks that the trace has exactly the reference's grid times.
 fn check_grid(trace: &Trace, reference: &[Sample], dt: f64, t_end: f64) -> Result<(), CheckError> {

@@ -17,7 +17,7 @@ use rotor_model::{Disc, State};
 use thiserror::Error;
 
 /// The header of a trace file.
-pub const TRACE_HEADER: [&str; 4] = ["t", "alpha", "omega_u", "omega_l"];
+pub(crate) const TRACE_HEADER: [&str; 4] = ["t", "alpha", "omega_u", "omega_l"];
 
 /// Decimals that print a grid time `k·dt` without its binary noise: six past the first
 /// significant digit of dt (the grid's times are k·dt within an ulp, so the printed time is
@@ -307,7 +307,7 @@ pub const FULL_DIGITS: u32 = 17;
 
 /// The significant digits a number is written with: the mantissa's digits from the first
 /// nonzero one (`0.00125` has 3, `1.50` has 3, `2.5e-7` has 2, `0` has none).
-pub fn written_digits(field: &str) -> u32 {
+pub(crate) fn written_digits(field: &str) -> u32 {
     let mantissa = field.split(['e', 'E']).next().unwrap_or("");
     let digits = mantissa
         .bytes()
@@ -597,7 +597,7 @@ fn csv_rows(
 }
 
 /// The header of an events file.
-pub const EVENTS_HEADER: [&str; 3] = ["t", "disc", "kind"];
+pub(crate) const EVENTS_HEADER: [&str; 3] = ["t", "disc", "kind"];
 
 /// `upper` or `lower`.
 pub fn disc_name(d: Disc) -> &'static str {

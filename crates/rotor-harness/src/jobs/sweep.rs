@@ -23,10 +23,10 @@ use rotor_model::{FieldError, Model, Params, State};
 use rotor_analysis::solvers::registry::SolverKind;
 
 /// The header of a sweep file.
-pub const HEADER: &str = "u,p,kind,period,omega_l_max,omega_l_min,stick_time";
+pub(crate) const HEADER: &str = "u,p,kind,period,omega_l_max,omega_l_min,stick_time";
 
 /// Largest number of points one process is asked to run: more asks for sharding.
-pub const MAX_POINTS: usize = 10_000_000;
+pub(crate) const MAX_POINTS: usize = 10_000_000;
 
 /// Why a sweep or a merge cannot run.
 #[derive(Debug, thiserror::Error)]
@@ -362,7 +362,7 @@ impl Sweep {
 }
 
 /// The record beside an output file.
-pub fn info_path(out: &Path) -> PathBuf {
+pub(crate) fn info_path(out: &Path) -> PathBuf {
     let mut s = out.as_os_str().to_owned();
     s.push(".shard.json");
     PathBuf::from(s)

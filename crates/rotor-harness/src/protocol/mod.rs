@@ -93,7 +93,7 @@ impl ClientSpec {
 /// Splits a command line into words as a POSIX shell does, without running one: blanks
 /// separate words; `'…'` is literal; `"…"` is literal except `\"`, `\\`, `\$` and `` \` ``;
 /// outside quotes `\` escapes the next character. No expansion of any kind.
-pub fn split_words(s: &str) -> Result<Vec<String>, String> {
+pub(crate) fn split_words(s: &str) -> Result<Vec<String>, String> {
     let mut words = Vec::new();
     let mut cur = String::new();
     let mut in_word = false;
@@ -169,8 +169,9 @@ pub struct Job {
     /// time is a breakpoint. Absent for a constant input.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub input: Option<Vec<[f64; 2]>>,
-    /// Initial state `[α, ω_u, ω_l]` (rad, rad/s, rad/s), at full precision.
-    pub x0: [f64; 3],
+    /// Initial state, at full precision: `[α, ω_u, ω_l]` (rad, rad/s, rad/s) on the rig; its
+    /// length is the model's state size.
+    pub x0: Vec<f64>,
     /// Horizon (s): the trace covers `[0, t_end]`.
     pub t_end: f64,
     /// Grid step of the trace (s): a row at every `k·dt`.
@@ -206,7 +207,7 @@ impl Job {
                 .input
                 .as_ref()
                 .map(|i| i.rows().iter().map(|&(t, u)| [t, u]).collect()),
-            x0: [sc.x0[0], sc.x0[1], sc.x0[2]],
+            x0: sc.x0.as_slice().to_vec(),
             t_end,
             dt,
             tol: (!fixed_step).then_some(setting),
@@ -225,7 +226,7 @@ impl Job {
 
 /// How a client's process ended.
 #[derive(Debug, Clone, PartialEq)]
-pub enum Ended {
+pub(crate) enum Ended {
     /// It exited with this status.
     Exited(ExitStatus),
     /// It ran past the timeout and was killed with its process group.
@@ -234,7 +235,7 @@ pub enum Ended {
 
 /// One run of a client.
 #[derive(Debug, Clone, PartialEq)]
-pub struct RunOutput {
+pub(crate) struct RunOutput {
     /// How the process ended.
     pub ended: Ended,
     /// From the spawn to the exit (or the kill) \[s\].
@@ -309,7 +310,7 @@ pub const SINGLE_THREAD_ENV: [&str; 4] = [
 /// Runs `argv` with the job file's path appended, in its own process group, for at most
 /// `timeout` seconds, with [`SINGLE_THREAD_ENV`] set to 1 where the bench's environment does
 /// not set them. `Err` if it cannot be started.
-pub fn run_client(argv: &[String], job: &Path, timeout: f64) -> Result<RunOutput, String> {
+pub(crate) fn run_client(argv: &[String], job: &Path, timeout: f64) -> Result<RunOutput, String> {
     let mut cmd = Command::new(&argv[0]);
     cmd.args(&argv[1..])
         .arg(job)

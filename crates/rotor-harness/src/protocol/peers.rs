@@ -26,7 +26,7 @@ pub enum Interpreter {
 /// One peer: its name in reports, what runs it, its script and the script's own arguments,
 /// and its knob.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub struct Peer {
+pub(crate) struct Peer {
     /// Its name in the report.
     pub name: &'static str,
     /// What runs its script.
@@ -40,7 +40,7 @@ pub struct Peer {
 }
 
 /// Every peer of the repository, in report order.
-pub const PEERS: [Peer; 6] = [
+pub(crate) const PEERS: [Peer; 6] = [
     Peer {
         name: "scipy",
         interpreter: Interpreter::Python { module: "scipy" },

@@ -489,16 +489,16 @@ pub enum SolveError {
         t: f64,
         /// The step size that fell below a few roundoffs of `t` \[s\].
         h: f64,
-        /// The state `[α, ω_u, ω_l]` at `t`.
-        x: [f64; 3],
+        /// The state at `t` (`[α, ω_u, ω_l]` on the rig; its size is the model's).
+        x: Vec<f64>,
     },
     /// The state became NaN or infinite.
     #[error("non-finite state at t = {t}: {x:?}")]
     NonFinite {
         /// Time at which the state was found non-finite \[s\].
         t: f64,
-        /// That state `[α, ω_u, ω_l]`.
-        x: [f64; 3],
+        /// That state (`[α, ω_u, ω_l]` on the rig; its size is the model's).
+        x: Vec<f64>,
     },
     /// The one-step complementarity problem had no admissible solution.
     #[error("complementarity failure at t = {t}: {detail}")]
@@ -572,9 +572,10 @@ impl SolveError {
         }
     }
 
-    /// The state `[α, ω_u, ω_l]` at which the run failed, where the failure records it.
-    pub fn state(&self) -> Option<[f64; 3]> {
-        match *self {
+    /// The state at which the run failed (`[α, ω_u, ω_l]` on the rig), where the failure
+    /// records it.
+    pub fn state(&self) -> Option<&[f64]> {
+        match self {
             SolveError::StepSizeUnderflow { x, .. } | SolveError::NonFinite { x, .. } => Some(x),
             _ => None,
         }
@@ -615,7 +616,7 @@ pub fn check_finite(t: f64, x: &State) -> Result<(), SolveError> {
     } else {
         Err(SolveError::NonFinite {
             t,
-            x: [x[0], x[1], x[2]],
+            x: x.as_slice().to_vec(),
         })
     }
 }
