@@ -75,7 +75,7 @@ impl<const N: usize> Dense<N> {
     /// (with ds₁/ds = −1), divided by h. At the ends the derivative is the field there, up
     /// to rounding: the interpolant is Hermite at both ends.
     #[inline]
-    pub fn eval_with_rate(&self, t: f64) -> (SVector<f64, N>, SVector<f64, N>) {
+    pub(crate) fn eval_with_rate(&self, t: f64) -> (SVector<f64, N>, SVector<f64, N>) {
         let s = (t - self.t0) / self.h;
         let s1 = 1.0 - s;
         let c = &self.c;

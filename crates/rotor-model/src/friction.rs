@@ -219,7 +219,7 @@ impl Friction {
     }
 
     /// `d level_ext / dx`.
-    pub fn dlevel_ext(&self, x: f64) -> f64 {
+    pub(crate) fn dlevel_ext(&self, x: f64) -> f64 {
         self.level_ext_with_slope(x).1
     }
 
@@ -291,7 +291,7 @@ impl Friction {
 
     /// `dT_f^s/dω`.
     #[inline]
-    pub fn dtorque(&self, w: f64, s: f64) -> f64 {
+    pub(crate) fn dtorque(&self, w: f64, s: f64) -> f64 {
         let da = match self.family {
             Family::Upper => s * self.db,
             _ => 0.0,
@@ -334,7 +334,7 @@ impl Friction {
     }
 
     /// The largest viscous coefficient on either side of ω = 0, `b + |Δb|` (N m s/rad).
-    pub fn viscous_bound(&self) -> f64 {
+    pub(crate) fn viscous_bound(&self) -> f64 {
         self.b.abs() + self.db.abs()
     }
 

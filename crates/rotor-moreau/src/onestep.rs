@@ -120,7 +120,7 @@ impl OneStepProblem {
     /// `None` if the mode's matrix is singular or not positive on its diagonal (no solution
     /// of that mode then exists in the sense of a well-posed branch).
     #[inline]
-    pub fn solve_mode(&self, mode: [DiscMode; 2]) -> Option<OneStepSolution> {
+    pub(crate) fn solve_mode(&self, mode: [DiscMode; 2]) -> Option<OneStepSolution> {
         let mut v = Vector2::zeros();
         let mut r = Vector2::zeros();
         let mut p = Vector2::zeros();

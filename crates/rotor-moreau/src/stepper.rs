@@ -222,7 +222,7 @@ impl Stepper {
 
     /// The step-size dependent data: `M̂` and its inverse (`t` only names the time in the
     /// error). Computed once per run for the constant step.
-    pub fn step_size(&self, t: f64, h: f64) -> Result<StepSize, SolveError> {
+    pub(crate) fn step_size(&self, t: f64, h: f64) -> Result<StepSize, SolveError> {
         let a = self.iteration_matrix(h);
         let w_inv = a.try_inverse().ok_or_else(|| SolveError::Complementarity {
             t,
@@ -255,7 +255,7 @@ impl Stepper {
 
     /// [`Stepper::step_with`] with the motor torque `f_ext` over the step
     /// ([`Stepper::motor_force`]) instead of the stepper's constant one.
-    pub fn step_with_force(
+    pub(crate) fn step_with_force(
         &self,
         t: f64,
         x: &State,
@@ -564,7 +564,12 @@ impl Stepper {
 
     /// Checks a converged solution against the exact (not linearised) Coulomb conditions:
     /// slip s ⇒ `s ω⁺ > 0` and `r = −s P(ω⁺)`; stick ⇒ `ω⁺ = 0` and `|r| ≤ P`.
-    pub fn check_complementarity(&self, sol: &OneStepSolution, p_start: &[f64; 2], h: f64) -> bool {
+    pub(crate) fn check_complementarity(
+        &self,
+        sol: &OneStepSolution,
+        p_start: &[f64; 2],
+        h: f64,
+    ) -> bool {
         (0..2).all(|i| match sol.mode[i].branch() {
             None => sol.v[i] == 0.0 && sol.r[i].abs() <= sol.p[i] * (1.0 + 1e-12) + 1e-15 * h,
             Some(s) => {

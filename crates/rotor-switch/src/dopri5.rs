@@ -295,7 +295,7 @@ impl<const N: usize> Dopri5<N> {
     }
 
     /// Adds RHS evaluations made outside the stepper (event location) to the counters.
-    pub fn count_rhs(&mut self, n: u64) {
+    pub(crate) fn count_rhs(&mut self, n: u64) {
         self.counters.rhs_evals += n;
     }
 
@@ -337,7 +337,7 @@ impl<const N: usize> Dopri5<N> {
     /// Starts again at `(t, y)` toward `t_end` as [`Dopri5::new`] does (the first step from
     /// the `HINIT` heuristic, the controller history forgotten), keeping the counters: a
     /// restart at a breakpoint of the input, the same as a fresh run from there.
-    pub fn reinit<F>(&mut self, t: f64, y: SVector<f64, N>, t_end: f64, f: &mut F)
+    pub(crate) fn reinit<F>(&mut self, t: f64, y: SVector<f64, N>, t_end: f64, f: &mut F)
     where
         F: FnMut(f64, &SVector<f64, N>) -> SVector<f64, N>,
     {

@@ -310,7 +310,7 @@ impl Continuer<'_> {
     }
 
     /// [`Continuer::describe`] from already computed section derivatives.
-    pub fn describe_from(
+    pub(crate) fn describe_from(
         &self,
         u: f64,
         c: f64,
@@ -372,7 +372,7 @@ impl Continuer<'_> {
     /// [`Continuer::describe`] with the multipliers from central differences of the return
     /// maps (step `fd_step`): `[1, λ, 0]` from the stick-exit map for a stick-slip cycle (its
     /// 0 and 1 are structural, not computed), `[1, λ1, λ2]` from the section map otherwise.
-    pub fn describe_fd(&self, u: f64, c: f64, z: [f64; 2]) -> Result<CycleInfo, BifError> {
+    pub(crate) fn describe_fd(&self, u: f64, c: f64, z: [f64; 2]) -> Result<CycleInfo, BifError> {
         let ret = self.sh.section_map(u, c, z)?;
         let (wl_max, wl_min, wu_min, stick_time) = self.metrics(u, c, z, ret.t)?;
         let x0 = State::new(z[0], z[1], c);

@@ -91,7 +91,7 @@ impl Side {
     }
 
     /// `det(I − A) = 1 − s + p`: its sign is `(−1)^σ⁺`.
-    pub fn det_i_minus(&self) -> f64 {
+    pub(crate) fn det_i_minus(&self) -> f64 {
         1.0 - self.trace + self.det
     }
 

@@ -164,7 +164,11 @@ impl Reference {
     /// A reference held in memory only (the benchmark's own reference run on its scene):
     /// the run's grid samples and mode-switch events, and the steady state it reached; no
     /// error is stated.
-    pub fn in_memory(sc: &Scenario, tr: &rotor_model::seam::Trajectory, tol: f64) -> Reference {
+    pub(crate) fn in_memory(
+        sc: &Scenario,
+        tr: &rotor_model::seam::Trajectory,
+        tol: f64,
+    ) -> Reference {
         Reference {
             samples: tr.samples.clone(),
             events: switches(&tr.events),

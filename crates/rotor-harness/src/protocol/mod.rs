@@ -72,7 +72,7 @@ impl ClientSpec {
     }
 
     /// The command as one line, words quoted where needed.
-    pub fn command_line(&self) -> String {
+    pub(crate) fn command_line(&self) -> String {
         self.argv
             .iter()
             .map(|w| {

@@ -158,7 +158,7 @@ impl FastForward {
     /// For a scene asking [`Output::Metrics`], with the solver's tolerance `tol` (relative =
     /// absolute); `None` for every other output, which integrates the whole horizon, and for a
     /// time-varying input ([`Scene::is_time_varying`]), whose run is not periodic.
-    pub fn for_scene(scene: &Scene, tol: f64) -> Option<FastForward> {
+    pub(crate) fn for_scene(scene: &Scene, tol: f64) -> Option<FastForward> {
         // A time-varying input breaks the premise of a skip: one period is not the next.
         (scene.output == Output::Metrics && !scene.is_time_varying())
             .then(|| FastForward::new(tol, scene.metrics_start().unwrap_or(0.0), scene.t_end))
@@ -216,7 +216,7 @@ impl FastForward {
     }
 
     /// Feeds an event (in time order, after the metrics have seen it).
-    pub fn observe(&mut self, e: &Event) -> Verdict {
+    pub(crate) fn observe(&mut self, e: &Event) -> Verdict {
         match self.phase {
             Phase::Done => Verdict::Continue,
             Phase::Verifying { track, sig, t_jump } => {

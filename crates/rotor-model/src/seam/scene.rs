@@ -285,13 +285,13 @@ impl Scene {
     }
 
     /// Whether the event list is kept.
-    pub fn keeps_events(&self) -> bool {
+    pub(crate) fn keeps_events(&self) -> bool {
         !matches!(self.output, Output::Final | Output::Metrics)
     }
 
     /// Start of the metrics window: `metrics_from`, or 0 for [`Output::Metrics`] without it;
     /// `None` if no metrics are asked.
-    pub fn metrics_start(&self) -> Option<f64> {
+    pub(crate) fn metrics_start(&self) -> Option<f64> {
         self.metrics_from
             .or((self.output == Output::Metrics).then_some(0.0))
     }
