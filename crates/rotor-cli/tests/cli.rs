@@ -56,6 +56,56 @@ fn simulate_writes_the_contract_csv() {
 }
 
 /// A flag the solver does not use is a warning on stderr, and the run goes on.
+/// A two-disc parameter file written in chain form is the rig: the same trace, byte for byte,
+/// from every solver; a longer chain is refused by name (exit 2), with no trace written.
+#[test]
+fn a_chain_of_two_in_the_rigs_shape_runs_as_the_rig() {
+    let dir = rotor_testkit::tmp_dir("rotor-cli-chain");
+    let two = rotor_testkit::CHAIN3
+        .split("[[disc]]\nj = 0.0326\nk = 0.0727\nc = 0.001")
+        .next()
+        .unwrap();
+    assert_eq!(two.matches("[[disc]]").count(), 2);
+    let chain2 = dir.join("chain2.toml");
+    std::fs::write(&chain2, two).unwrap();
+    let run = |params: &str, csv: &std::path::Path, solver: &str| {
+        rotor(&[
+            "simulate",
+            "--solver",
+            solver,
+            "--u",
+            "1.5",
+            "--t-end",
+            "5",
+            "--params",
+            params,
+            "--csv",
+            csv.to_str().unwrap(),
+        ])
+    };
+    for solver in ["event", "switch", "moreau"] {
+        let (a, b) = (dir.join("rig.csv"), dir.join("chain.csv"));
+        let o = run("table1", &a, solver);
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        let o = run(chain2.to_str().unwrap(), &b, solver);
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        assert_eq!(
+            std::fs::read(&a).unwrap(),
+            std::fs::read(&b).unwrap(),
+            "{solver}"
+        );
+    }
+    let chain3 = dir.join("chain3.toml");
+    std::fs::write(&chain3, rotor_testkit::CHAIN3).unwrap();
+    let csv = dir.join("three.csv");
+    let o = run(chain3.to_str().unwrap(), &csv, "event");
+    assert_eq!(o.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(err.contains("a chain with 3 discs"), "{err}");
+    assert!(!csv.exists());
+    std::fs::remove_dir_all(&dir).ok();
+}
+
 #[test]
 fn flags_a_solver_ignores_are_warned_about() {
     let dir = rotor_testkit::tmp_dir("rotor-cli-warn");
