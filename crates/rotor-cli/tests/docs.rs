@@ -30,6 +30,27 @@ fn split_comment(line: &str) -> (&str, &str) {
     }
 }
 
+/// Runs one README line with `sh` in `dir`, as a newcomer would: the built `rotor` first on
+/// the PATH, the suite taken from the binary itself (as for an installed `rotor`), a cache of
+/// its own, and no pointer into the checkout.
+fn run_in(dir: &Path, cmd: &str) -> std::process::Output {
+    let bin = Path::new(env!("CARGO_BIN_EXE_rotor")).parent().unwrap();
+    let path = format!(
+        "{}:{}",
+        bin.display(),
+        std::env::var("PATH").unwrap_or_default()
+    );
+    Command::new("sh")
+        .args(["-c", cmd])
+        .current_dir(dir)
+        .env("PATH", &path)
+        .env("ROTORBENCH_SUITE", "embedded")
+        .env("ROTORBENCH_CACHE", dir.join(".cache"))
+        .env_remove("ROTORBENCH_FIXTURES")
+        .output()
+        .unwrap()
+}
+
 /// Every `rotor ...` line of the README's quick block (`cli-quick`) runs, in order, from an
 /// empty directory with `rotor` on the PATH and the suite taken from the binary itself (as
 /// for an installed `rotor`), and exits 0: names, not paths of the checkout, and pairs that
@@ -47,12 +68,6 @@ fn readme_quick_commands_run_from_an_empty_directory() {
         .collect();
     assert!(commands.len() >= 10, "{commands:?}");
     let dir = rotor_testkit::tmp_dir("rotor-cli-readme");
-    let bin = Path::new(env!("CARGO_BIN_EXE_rotor")).parent().unwrap();
-    let path = format!(
-        "{}:{}",
-        bin.display(),
-        std::env::var("PATH").unwrap_or_default()
-    );
     for (cmd, comment) in &commands {
         assert!(
             !comment.contains("minutes"),
@@ -63,15 +78,7 @@ fn readme_quick_commands_run_from_an_empty_directory() {
             comment.contains(" s)") || comment.contains(" s;") || comment.contains(" s,"),
             "{cmd}: its comment gives no time: {comment}"
         );
-        let o = Command::new("sh")
-            .args(["-c", cmd])
-            .current_dir(&dir)
-            .env("PATH", &path)
-            .env("ROTORBENCH_SUITE", "embedded")
-            .env("ROTORBENCH_CACHE", dir.join(".cache"))
-            .env_remove("ROTORBENCH_FIXTURES")
-            .output()
-            .unwrap();
+        let o = run_in(&dir, cmd);
         assert!(
             o.status.success(),
             "{cmd}: exit {:?}: {}",
@@ -119,22 +126,8 @@ fn readme_input_example_runs_from_an_empty_directory() {
     assert_eq!(lines.len(), 2, "{lines:?}");
     assert!(lines[1].contains("--input"), "{lines:?}");
     let dir = rotor_testkit::tmp_dir("rotor-cli-readme-input");
-    let bin = Path::new(env!("CARGO_BIN_EXE_rotor")).parent().unwrap();
-    let path = format!(
-        "{}:{}",
-        bin.display(),
-        std::env::var("PATH").unwrap_or_default()
-    );
     for cmd in &lines {
-        let o = Command::new("sh")
-            .args(["-c", cmd])
-            .current_dir(&dir)
-            .env("PATH", &path)
-            .env("ROTORBENCH_SUITE", "embedded")
-            .env("ROTORBENCH_CACHE", dir.join(".cache"))
-            .env_remove("ROTORBENCH_FIXTURES")
-            .output()
-            .unwrap();
+        let o = run_in(&dir, cmd);
         assert!(
             o.status.success(),
             "{cmd}: exit {:?}: {}",
@@ -234,12 +227,6 @@ fn readme_long_commands_run_in_ci_long_step() {
         .join("bench/clients/minimal.py")
         .canonicalize()
         .unwrap();
-    let bin = Path::new(env!("CARGO_BIN_EXE_rotor")).parent().unwrap();
-    let path = format!(
-        "{}:{}",
-        bin.display(),
-        std::env::var("PATH").unwrap_or_default()
-    );
     let require_peers = std::env::var("ROTOR_REQUIRE_PEERS").as_deref() == Ok("1");
     let suite_dir = root().join("fixtures/scenarios");
     for (cmd, _) in &commands {
@@ -247,15 +234,7 @@ fn readme_long_commands_run_in_ci_long_step() {
         assert!(!run.contains("/path/to/"), "{cmd}: a placeholder path left");
         let dir = rotor_testkit::tmp_dir("rotor-cli-readme-long");
         let t0 = std::time::Instant::now();
-        let o = Command::new("sh")
-            .args(["-c", &run])
-            .current_dir(&dir)
-            .env("PATH", &path)
-            .env("ROTORBENCH_SUITE", "embedded")
-            .env("ROTORBENCH_CACHE", dir.join(".cache"))
-            .env_remove("ROTORBENCH_FIXTURES")
-            .output()
-            .unwrap();
+        let o = run_in(&dir, &run);
         let stderr = String::from_utf8_lossy(&o.stderr);
         assert!(o.status.success(), "{cmd}: exit {:?}: {stderr}", o.status);
         // Its wall time, for whoever updates the README's stated one (never asserted).

@@ -1,6 +1,7 @@
-//! Inputs that change in time, u(t), across the three solvers: a step of u is the
-//! composition of two constant-input runs, a ramp converges at each solver's order, and the
-//! metrics-only fast-forward stays off.
+//! Inputs that change in time, u(t), across the three solvers: every row's time is a step
+//! end, a step of u is the composition of two constant-input runs, a ramp converges at each
+//! solver's order, the metrics-only fast-forward stays off, and a step from rest starts the
+//! motion at the step.
 
 use rotor_analysis::solvers::{SOLVERS, SolverKind};
 use rotor_model::seam::{Accuracy, Input, Output, Scene, Trajectory};
@@ -214,6 +215,40 @@ fn the_fast_forward_is_off_for_a_time_varying_input() {
     }
 }
 
+/// No step straddles a breakpoint: with a ramp that has kinks at t = 10 s and 30 s and a
+/// step at 35 s, every row's time is a step end exactly, in every solver (the adaptive ones
+/// at tol 1e-12, Moreau–Jean at h = 1e-3).
+#[test]
+fn every_breakpoint_is_a_step_end() {
+    let input = Input::new(&[[10.0, 1.5], [30.0, 2.5], [35.0, 2.5], [35.0, 2.0]]).unwrap();
+    for kind in SOLVERS {
+        let scene = Scene {
+            input: Some(input.clone()),
+            t_end: 40.0,
+            accuracy: if kind.is_fixed_step() {
+                Accuracy::Step(1e-3)
+            } else {
+                Accuracy::Tol(1e-12)
+            },
+            output: Output::Steps,
+            ..Scene::default()
+        };
+        let tr = run(kind, &scene);
+        for b in input.breakpoints() {
+            assert!(
+                tr.samples.iter().any(|s| s.t == b),
+                "{}: no step ends on the breakpoint {b}",
+                kind.name()
+            );
+            assert!(
+                !tr.samples.windows(2).any(|w| w[0].t < b && b < w[1].t),
+                "{}: a step straddles the breakpoint {b}",
+                kind.name()
+            );
+        }
+    }
+}
+
 /// A rig at rest that a step of u sets moving starts at the step itself, in every solver
 /// (the stick condition read at the new u).
 #[test]
@@ -236,6 +271,9 @@ fn a_step_from_rest_starts_the_motion_at_the_step() {
                 assert_eq!(s.x, State::zeros(), "{} at {}", kind.name(), s.t);
             }
         }
+        // Already moving one output interval after the step.
+        let after = tr.samples.iter().find(|s| s.t > 1.0).unwrap();
+        assert!(after.x[1] > 0.0, "{}: {:?}", kind.name(), after);
         let last = tr.samples.last().unwrap();
         assert!(last.x[1] > 0.1, "{}: {:?}", kind.name(), last.x);
     }

@@ -1066,6 +1066,8 @@ friction = { family = "stribeck", t_s = 0.2, t_c = 0.1, omega_s = 1.5, delta = 2
         // Its applied torque: k_1 α_1 + c_1 (ω_1 − ω_2) − k_2 α_2 − c_2 (ω_2 − ω_3), with
         // c_1 = 0 (the example's), k_2 = 0.0727, c_2 = 0.015 and ω_2 = 0.
         let want = 0.0727 * 0.4 - 0.0727 * (-0.7) - 0.015 * (0.0 - (-2.1));
+        // The same three products (each ≲ 0.05 N m) summed in another order: rounding ≲ 1e-17;
+        // 1e-15 is 100×.
         assert!((m.applied_torque(1, &x, 1.5) - want).abs() < 1e-15);
     }
 
