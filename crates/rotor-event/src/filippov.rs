@@ -430,17 +430,15 @@ impl<'a> Integrator<'a> {
     /// ∂/∂t of a disc's applied torque at fixed state: `k_m·du/dt` on the upper disc (the
     /// motor's), 0 on the lower.
     fn torque_drift(&self, d: Disc) -> f64 {
-        match d {
-            Disc::Upper => self.model.params.k_m * self.piece.slope,
-            Disc::Lower => 0.0,
+        if d == Disc::UPPER {
+            self.model.params.k_m * self.piece.slope
+        } else {
+            0.0
         }
     }
 
     fn stick_interval(&self, d: Disc) -> (f64, f64) {
-        match d {
-            Disc::Upper => self.stick_intervals[0],
-            Disc::Lower => self.stick_intervals[1],
-        }
+        self.stick_intervals[d.position()]
     }
 
     /// Value of a guard at state x at time t (in the current mode).
@@ -474,10 +472,8 @@ impl<'a> Integrator<'a> {
             Guard::Velocity(d) => mode.of(d).branch().unwrap_or(1.0) * f[d.index()],
             Guard::ExitHi(d) | Guard::ExitLo(d) => {
                 let k = self.model.params.k_theta * f[0];
-                let dt = match d {
-                    Disc::Upper => -k,
-                    Disc::Lower => k,
-                } + self.torque_drift(d);
+                // The spring pulls the upper disc back and the lower one on.
+                let dt = if d == Disc::UPPER { -k } else { k } + self.torque_drift(d);
                 if matches!(g, Guard::ExitHi(_)) {
                     -dt
                 } else {
@@ -840,8 +836,8 @@ impl<'a> Integrator<'a> {
             // Both discs stuck: the state is frozen and, on a constant piece of the input,
             // so are the exit guards.
             if self.piece.slope == 0.0
-                && c.mode.upper == DiscMode::Stick
-                && c.mode.lower == DiscMode::Stick
+                && c.mode.upper() == DiscMode::Stick
+                && c.mode.lower() == DiscMode::Stick
                 && Disc::BOTH
                     .iter()
                     .all(|&d| self.model.stick_exit(d, &c.x, self.piece.u0).is_none())
@@ -986,9 +982,11 @@ impl<'a> Integrator<'a> {
             // exact state.
             if let Guard::Extremum(d, _) = g {
                 let w = dense.eval(te)[d.index()];
-                let resolvable = c.last_extremum[d as usize].replace(w).is_none_or(|w_prev| {
-                    (w - w_prev).abs() > EXTREMUM_RESOLUTION * self.ctl.rtol * (1.0 + w.abs())
-                });
+                let resolvable = c.last_extremum[d.position()]
+                    .replace(w)
+                    .is_none_or(|w_prev| {
+                        (w - w_prev).abs() > EXTREMUM_RESOLUTION * self.ctl.rtol * (1.0 + w.abs())
+                    });
                 if !resolvable {
                     if t_lo >= t1 {
                         break;
@@ -998,7 +996,7 @@ impl<'a> Integrator<'a> {
             }
             let (te, xe) = self.event_state(c, g, te, t1, end.0);
             if let Guard::Extremum(d, _) = g {
-                c.last_extremum[d as usize] = Some(xe[d.index()]);
+                c.last_extremum[d.position()] = Some(xe[d.index()]);
             }
             self.delivered += 1;
             let stop = if g == Guard::Section {
@@ -1007,7 +1005,7 @@ impl<'a> Integrator<'a> {
                 let kind = match g {
                     Guard::Extremum(d, false) => EventKind::Min(d),
                     Guard::Extremum(d, true) => EventKind::Max(d),
-                    _ => EventKind::Max(Disc::Lower),
+                    _ => EventKind::Max(Disc::LOWER),
                 };
                 let ev = Event { t: te, x: xe, kind };
                 self.stats.events += 1;
@@ -1178,7 +1176,7 @@ impl<'a> Integrator<'a> {
         c.last_extremum = [None; 2];
         let mut fresh = [false; 2];
         if let Guard::Velocity(d) | Guard::ExitHi(d) | Guard::ExitLo(d) = g {
-            fresh[d as usize] = true;
+            fresh[d.position()] = true;
         }
         self.settle(c.t, &mut c.x, &mut c.mode, fresh, recent, sink)
     }
@@ -1217,7 +1215,7 @@ impl<'a> Integrator<'a> {
                 let v = self.guard(g, t, x, *mode);
                 let out = if v < 0.0 {
                     true
-                } else if v > 0.0 || (matches!(g, Guard::Velocity(_)) && fresh[d as usize]) {
+                } else if v > 0.0 || (matches!(g, Guard::Velocity(_)) && fresh[d.position()]) {
                     false
                 } else {
                     let f = *f.get_or_insert_with(|| self.field(t, x, *mode));
@@ -1236,11 +1234,11 @@ impl<'a> Integrator<'a> {
                 // A velocity guard at a grazing contact from the side the applied torque
                 // pushes back to: the disc stays (its velocity is now exactly 0).
                 *mode = m;
-                fresh[d as usize] = true;
+                fresh[d.position()] = true;
                 continue;
             };
             *mode = m;
-            fresh[d as usize] = true;
+            fresh[d.position()] = true;
             self.stats.events += 1;
             let ev = Event { t, x: *x, kind };
             sink.event(&ev);
@@ -1417,10 +1415,7 @@ mod tests {
         })
     }
 
-    const SLIP: Mode = Mode {
-        upper: DiscMode::SlipPos,
-        lower: DiscMode::SlipPos,
-    };
+    const SLIP: Mode = Mode::rig(DiscMode::SlipPos, DiscMode::SlipPos);
 
     /// The bound at x for a step the controller would make `h` long.
     fn bound_at(m: &Model, u: f64, tol: f64, x: &State, h: f64) -> f64 {
@@ -1437,7 +1432,7 @@ mod tests {
         let w_l = 4.09;
         // k_θ α − T_f(ω_l) = J_l·ω̇_l with ω̇_l = −10 rad/s².
         let p = m.params;
-        let alpha = (m.friction(Disc::Lower).torque(w_l, 1.0) - 10.0 * p.j_l) / p.k_theta;
+        let alpha = (m.friction(Disc::LOWER).torque(w_l, 1.0) - 10.0 * p.j_l) / p.k_theta;
         let x = State::new(alpha, 2.0, w_l);
         assert!((m.rhs(&x, u, SLIP)[OMEGA_L] + 10.0).abs() < 1e-9);
         let fixed = step_bound(&m, tol, 8.0);

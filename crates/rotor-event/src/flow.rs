@@ -45,7 +45,7 @@ impl Sink for FlowSink {
         self.events.push(*e);
     }
     fn stop_after(&mut self, e: &Event) -> bool {
-        let hit = self.stop == StopAt::LowerStickExit && e.kind == EventKind::StickEnd(Disc::Lower);
+        let hit = self.stop == StopAt::LowerStickExit && e.kind == EventKind::StickEnd(Disc::LOWER);
         self.reached |= hit;
         hit
     }

@@ -111,7 +111,7 @@ struct StopSink {
 
 impl Sink for StopSink {
     fn event(&mut self, e: &Event) {
-        if e.kind == EventKind::StickEnd(Disc::Lower) {
+        if e.kind == EventKind::StickEnd(Disc::LOWER) {
             self.lower_exits += 1;
         }
         if let Some(a) = self.acc.as_mut() {
@@ -119,7 +119,7 @@ impl Sink for StopSink {
         }
     }
     fn stop_after(&mut self, e: &Event) -> bool {
-        self.stop == Stop::LowerStickExit && e.kind == EventKind::StickEnd(Disc::Lower)
+        self.stop == Stop::LowerStickExit && e.kind == EventKind::StickEnd(Disc::LOWER)
     }
     fn section(&mut self, _t: f64, _x: &State) -> bool {
         self.stop == Stop::Section
@@ -164,8 +164,8 @@ impl Flow<'_> {
     fn exit_state(&self, alpha: f64, w: f64, upper: DiscMode) -> (State, Mode) {
         let alpha = exit_alpha(self.model, alpha);
         let x = State::new(alpha, if upper == DiscMode::Stick { 0.0 } else { w }, 0.0);
-        let lower = DiscMode::slip_of(self.model.applied_torque(Disc::Lower, &x, self.u));
-        (x, Mode { upper, lower })
+        let lower = DiscMode::slip_of(self.model.applied_torque(Disc::LOWER, &x, self.u));
+        (x, Mode::rig(upper, lower))
     }
 
     /// Return map at the lower disc's stick exit: ω_u at the next exit (and the mode there).
@@ -205,14 +205,14 @@ impl Flow<'_> {
 /// again at once and leave a few 1e-14 s later: a "return" of zero length, which the secant
 /// method takes for a fixed point.
 pub(crate) fn exit_alpha(model: &Model, alpha: f64) -> f64 {
-    let (lo, hi) = model.friction(Disc::Lower).static_interval();
+    let (lo, hi) = model.friction(Disc::LOWER).static_interval();
     let k = model.params.k_theta;
     let x = |a: f64| State::new(a, 0.0, 0.0);
     let up = k * alpha >= 0.5 * (lo + hi);
     let mut a = if up { hi / k } else { lo / k };
     // The quotient is within an ulp or two of the edge: a few outward steps at most.
     for _ in 0..8 {
-        if model.stick_exit(Disc::Lower, &x(a), 0.0).is_some() {
+        if model.stick_exit(Disc::LOWER, &x(a), 0.0).is_some() {
             break;
         }
         a = if up { a.next_up() } else { a.next_down() };
@@ -441,7 +441,7 @@ struct LastExitSink {
 impl Sink for LastExitSink {
     fn event(&mut self, e: &Event) {
         self.acc.push(e);
-        if e.kind == EventKind::StickEnd(Disc::Lower) {
+        if e.kind == EventKind::StickEnd(Disc::LOWER) {
             let upper = if e.x[1] == 0.0 {
                 DiscMode::Stick
             } else {
@@ -570,7 +570,7 @@ fn refine_stick_slip(
     acc.push(&Event {
         t: 0.0,
         x,
-        kind: EventKind::StickEnd(Disc::Lower),
+        kind: EventKind::StickEnd(Disc::LOWER),
     });
     let (end, sink) = flow.run(x, mode, 1e4, Stop::LowerStickExit, true, None, Some(acc))?;
     Ok(Steady {
@@ -722,19 +722,19 @@ mod tests {
     #[test]
     fn an_exit_starts_on_the_edge_of_the_stick_interval() {
         let m = stribeck();
-        let (lo, hi) = m.friction(Disc::Lower).static_interval();
+        let (lo, hi) = m.friction(Disc::LOWER).static_interval();
         let k = m.params.k_theta;
         let edge = hi / k;
         let ulp = edge.next_up() - edge;
         for located in [edge - 250.0 * ulp, edge + 250.0 * ulp] {
             let a = exit_alpha(&m, located);
             let x = State::new(a, 0.0, 0.0);
-            assert_eq!(m.stick_exit(Disc::Lower, &x, 0.0), Some(DiscMode::SlipPos));
+            assert_eq!(m.stick_exit(Disc::LOWER, &x, 0.0), Some(DiscMode::SlipPos));
             assert!((a - edge).abs() <= 4.0 * ulp, "{a} vs {edge}");
         }
         let a = exit_alpha(&m, lo / k + 1e-13);
         let x = State::new(a, 0.0, 0.0);
-        assert_eq!(m.stick_exit(Disc::Lower, &x, 0.0), Some(DiscMode::SlipNeg));
+        assert_eq!(m.stick_exit(Disc::LOWER, &x, 0.0), Some(DiscMode::SlipNeg));
     }
 
     /// The Stribeck set at 1.5 V from rest: a stick-slip cycle whose period is the one a
@@ -768,7 +768,7 @@ mod tests {
         let exits: Vec<f64> = run
             .events
             .iter()
-            .filter(|e| e.kind == EventKind::StickEnd(Disc::Lower))
+            .filter(|e| e.kind == EventKind::StickEnd(Disc::LOWER))
             .map(|e| e.t)
             .collect();
         let plain = exits[exits.len() - 1] - exits[exits.len() - 2];

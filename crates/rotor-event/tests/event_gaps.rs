@@ -63,7 +63,7 @@ fn a_stick_exit_guard_dipping_inside_one_step_is_found() {
     let u = 0.02;
     let (jj, b, k) = (p.j_u, p.upper.b, p.k_theta);
     let a_star = p.k_m * u / k;
-    let edge = m.friction(Disc::Lower).static_interval().1 / k;
+    let edge = m.friction(Disc::LOWER).static_interval().1 / k;
     // y = α − α*: y'' + (b/J) y' + (k/J) y = 0, y(0) = 0, y'(0) = v.
     let disc = (b * b - 4.0 * jj * k).sqrt();
     let (r1, r2) = ((-b + disc) / (2.0 * jj), (-b - disc) / (2.0 * jj));
@@ -100,7 +100,7 @@ fn a_stick_exit_guard_dipping_inside_one_step_is_found() {
         let first = sw.first().expect("no switch");
         assert_eq!(
             first.kind,
-            EventKind::StickEnd(Disc::Lower),
+            EventKind::StickEnd(Disc::LOWER),
             "{samples} samples: {sw:?}"
         );
         // The event's error in time is the state's error in α over α̇ at the root: the
@@ -131,17 +131,11 @@ fn a_stick_exit_guard_dipping_inside_one_step_is_found() {
 fn a_disc_stuck_on_its_edge_after_a_switch_leaves_at_once() {
     let m = stribeck();
     let u = 0.5;
-    let hi = m.friction(Disc::Lower).static_interval().1;
+    let hi = m.friction(Disc::LOWER).static_interval().1;
     let alpha = exact_edge(hi, m.params.k_theta);
     let x = State::new(alpha, 0.0, 0.0);
-    let stuck = Mode {
-        upper: DiscMode::Stick,
-        lower: DiscMode::Stick,
-    };
-    let slipping = Mode {
-        upper: DiscMode::SlipPos,
-        lower: DiscMode::SlipPos,
-    };
+    let stuck = Mode::rig(DiscMode::Stick, DiscMode::Stick);
+    let slipping = Mode::rig(DiscMode::SlipPos, DiscMode::SlipPos);
     let tol = 1e-12;
     let run = |mode| flow(&m, u, tol, x, mode, 10.0, StopAt::Time).unwrap();
     let a = run(stuck);
@@ -149,8 +143,8 @@ fn a_disc_stuck_on_its_edge_after_a_switch_leaves_at_once() {
     assert_eq!(
         kinds,
         [
-            (0.0, EventKind::StickEnd(Disc::Upper)),
-            (0.0, EventKind::StickEnd(Disc::Lower))
+            (0.0, EventKind::StickEnd(Disc::UPPER)),
+            (0.0, EventKind::StickEnd(Disc::LOWER))
         ]
     );
     let b = run(slipping);
@@ -171,7 +165,7 @@ fn a_disc_stuck_on_its_edge_after_a_switch_leaves_at_once() {
         .unwrap();
     let first = tr.events.first().copied();
     assert!(
-        first.is_some_and(|e| e.t == 0.0 && e.kind == EventKind::StickEnd(Disc::Lower)),
+        first.is_some_and(|e| e.t == 0.0 && e.kind == EventKind::StickEnd(Disc::LOWER)),
         "{first:?}"
     );
     assert_eq!(tr.x_final, b.x);
@@ -227,12 +221,12 @@ fn both_discs_sticking_at_one_instant_both_stick() {
         let t_stick = 2.0 * (1.0 + 2.0 * w0).ln();
         assert_eq!(sw.len(), 2, "ω₀ = {w0}: {sw:?}");
         let mut kinds: Vec<_> = sw.iter().map(|e| e.kind).collect();
-        kinds.sort_by_key(|k| format!("{k:?}"));
+        kinds.sort_by_key(|k| k.disc());
         assert_eq!(
             kinds,
             [
-                EventKind::StickStart(Disc::Lower),
-                EventKind::StickStart(Disc::Upper)
+                EventKind::StickStart(Disc::UPPER),
+                EventKind::StickStart(Disc::LOWER)
             ],
             "ω₀ = {w0}"
         );

@@ -85,11 +85,11 @@ fn stick_events_satisfy_their_conditions_exactly() {
 
 fn stick_events_at(tol: f64) {
     let m = Model::table1();
-    let t_sl = m.friction(Disc::Lower).static_interval().1;
+    let t_sl = m.friction(Disc::LOWER).static_interval().1;
     let evs = t1_events(1.5, 100.0, tol);
     let exits: Vec<_> = evs
         .iter()
-        .filter(|e| e.kind == EventKind::StickEnd(Disc::Lower))
+        .filter(|e| e.kind == EventKind::StickEnd(Disc::LOWER))
         .collect();
     assert!(
         exits.len() > 10,
@@ -108,10 +108,10 @@ fn stick_events_at(tol: f64) {
     }
     for e in evs
         .iter()
-        .filter(|e| e.kind == EventKind::StickStart(Disc::Lower))
+        .filter(|e| e.kind == EventKind::StickStart(Disc::LOWER))
     {
         assert_eq!(e.x[2], 0.0);
-        assert!(m.can_stick(Disc::Lower, &e.x, 1.5));
+        assert!(m.can_stick(Disc::LOWER, &e.x, 1.5));
     }
 }
 
@@ -138,10 +138,10 @@ fn extrema_are_roots_of_the_fields_acceleration() {
             _ => continue,
         };
         n += 1;
-        let mode = rotor_model::Mode {
-            upper: rotor_model::DiscMode::slip_of(e.x[1]),
-            lower: rotor_model::DiscMode::slip_of(e.x[2]),
-        };
+        let mode = rotor_model::Mode::rig(
+            rotor_model::DiscMode::slip_of(e.x[1]),
+            rotor_model::DiscMode::slip_of(e.x[2]),
+        );
         let f = m.rhs(&e.x, u, mode);
         let a = f[d.index()];
         let rate = (m.jacobian(&e.x, u, mode) * f)[d.index()];
@@ -592,10 +592,10 @@ fn a_reversal_whose_excursion_returns_within_one_sample_ends_in_stick() {
     assert_eq!(
         kinds,
         [
-            EventKind::StickEnd(Disc::Lower),
-            EventKind::Reversal(Disc::Lower),
-            EventKind::StickStart(Disc::Lower),
-            EventKind::StickEnd(Disc::Lower),
+            EventKind::StickEnd(Disc::LOWER),
+            EventKind::Reversal(Disc::LOWER),
+            EventKind::StickStart(Disc::LOWER),
+            EventKind::StickEnd(Disc::LOWER),
         ]
     );
     let (rev, stick) = (lower[1], lower[2]);
@@ -710,7 +710,7 @@ fn steady_state_next_to_a_hopf_point_answers_the_focus() {
 #[test]
 fn a_start_on_the_stick_edge_with_rising_torque_leaves_at_once() {
     let m = Model::table1();
-    let t_sl = m.friction(rotor_model::Disc::Lower).static_interval().1;
+    let t_sl = m.friction(rotor_model::Disc::LOWER).static_interval().1;
     let edge = t_sl / m.params.k_theta;
     let run = |alpha: f64| {
         EventSolver::default()
@@ -730,7 +730,7 @@ fn a_start_on_the_stick_edge_with_rising_torque_leaves_at_once() {
     let past = run(edge * (1.0 + 1e-14));
     assert!(
         on.events.first().is_some_and(|e| e.t == 0.0
-            && e.kind == rotor_model::seam::EventKind::StickEnd(rotor_model::Disc::Lower)),
+            && e.kind == rotor_model::seam::EventKind::StickEnd(rotor_model::Disc::LOWER)),
         "{:?}",
         on.events.first()
     );

@@ -36,9 +36,9 @@ fn a_reversal_without_sticking_matches_the_event_solver() {
             .filter(|e| {
                 matches!(
                     e.kind,
-                    EventKind::Reversal(Disc::Lower)
-                        | EventKind::StickStart(Disc::Lower)
-                        | EventKind::StickEnd(Disc::Lower)
+                    EventKind::Reversal(Disc::LOWER)
+                        | EventKind::StickStart(Disc::LOWER)
+                        | EventKind::StickEnd(Disc::LOWER)
                 )
             })
             .map(|e| (e.t, e.kind))
@@ -65,7 +65,7 @@ fn a_reversal_without_sticking_matches_the_event_solver() {
     };
     let event = lower(&run(SolverKind::EVENT, 1e-12, &scene));
     assert_eq!(event.len(), 1, "{event:?}");
-    assert_eq!(event[0].1, EventKind::Reversal(Disc::Lower));
+    assert_eq!(event[0].1, EventKind::Reversal(Disc::LOWER));
     // The default band and a wide one (1e-7, so that the band's shift stands above the
     // integration error) both report the one reversal.
     let default_eta = rotor_switch::SwitchOptions::default().eta;
@@ -74,7 +74,7 @@ fn a_reversal_without_sticking_matches_the_event_solver() {
     for eta in [default_eta, wide] {
         let switch = switch_at(eta);
         assert_eq!(switch.len(), 1, "eta {eta}: {switch:?}");
-        assert_eq!(switch[0].1, EventKind::Reversal(Disc::Lower));
+        assert_eq!(switch[0].1, EventKind::Reversal(Disc::LOWER));
     }
     // The band moves the crossing by at most η/|ω̇_l| (the switch model leaves the smooth law
     // for |ω_l| < η): |ω̇_l| ≈ (0.36 − 0.16)/0.0326 ≈ 6 rad/s² gives 1.7e-8 s at η = 1e-7.
@@ -85,7 +85,7 @@ fn a_reversal_without_sticking_matches_the_event_solver() {
     let x = ev
         .events
         .iter()
-        .find(|e| e.kind == EventKind::Reversal(Disc::Lower))
+        .find(|e| e.kind == EventKind::Reversal(Disc::LOWER))
         .unwrap()
         .x;
     let rate = m.rhs(&x, scene.u, m.mode_at(&x, scene.u))[OMEGA_L].abs();

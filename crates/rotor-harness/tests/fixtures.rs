@@ -247,14 +247,14 @@ fn every_gate_of_every_fixture_fails_its_negative_control() {
                     match tr.events.iter_mut().find(|e| {
                         e.t >= t0
                             && e.t <= t1
-                            && matches!(e.kind, EventKind::StickStart(Disc::Lower))
+                            && matches!(e.kind, EventKind::StickStart(Disc::LOWER))
                     }) {
                         Some(e) => e.t += excess,
                         // No stick event in the window: one that appears must fail.
                         None => tr.events.push(Event {
                             t: 0.5 * (t0 + t1),
                             x: State::zeros(),
-                            kind: EventKind::StickStart(Disc::Lower),
+                            kind: EventKind::StickStart(Disc::LOWER),
                         }),
                     }
                 } else if let Some(rest) = q.strip_prefix("whole ") {
@@ -270,7 +270,7 @@ fn every_gate_of_every_fixture_fails_its_negative_control() {
                             _ => tr.events.push(Event {
                                 t: 0.5 * (t1 + sc.t_end),
                                 x: State::zeros(),
-                                kind: EventKind::StickStart(Disc::Lower),
+                                kind: EventKind::StickStart(Disc::LOWER),
                             }),
                         }
                     } else {

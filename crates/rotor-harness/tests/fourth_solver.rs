@@ -49,10 +49,7 @@ mod euler {
         /// The mode at `x` reached from `prev`, with the band: within it (or across 0) and
         /// inside the stick interval, stuck.
         fn mode_at(&self, prev: &State, x: &mut State) -> Mode {
-            let mut m = Mode {
-                upper: DiscMode::SlipPos,
-                lower: DiscMode::SlipPos,
-            };
+            let mut m = Mode::rig(DiscMode::SlipPos, DiscMode::SlipPos);
             for d in Disc::BOTH {
                 let w = x[d.index()];
                 let f = self.model.friction(d);

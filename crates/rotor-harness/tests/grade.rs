@@ -294,7 +294,7 @@ fn stick_intervals_are_graded_from_the_grid() {
     let ons: Vec<f64> = r
         .events
         .iter()
-        .filter(|e| e.kind == rotor_model::seam::EventKind::StickStart(rotor_model::Disc::Lower))
+        .filter(|e| e.kind == rotor_model::seam::EventKind::StickStart(rotor_model::Disc::LOWER))
         .map(|e| e.t)
         .collect();
     for level in LEVELS {
@@ -365,7 +365,7 @@ fn unsorted_out_of_range_and_unmatched_events() {
         .to_string();
     assert!(m.contains("outside [0, 200]"), "{m}");
     let mut e = ev.clone();
-    e.events[7].kind = rotor_model::seam::EventKind::Reversal(rotor_model::Disc::Lower);
+    e.events[7].kind = rotor_model::seam::EventKind::Reversal(rotor_model::Disc::LOWER);
     let rep = grade(&sc, &r, &t, Some(&e), Level::Loose);
     let q = rep.quantities.iter().find(|q| q.name == "events").unwrap();
     let note = q.note.as_deref().unwrap();

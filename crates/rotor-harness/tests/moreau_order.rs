@@ -188,7 +188,7 @@ const REF_DT: f64 = 1e-4;
 fn onsets(tr: &rotor_model::seam::Trajectory) -> Vec<f64> {
     tr.events
         .iter()
-        .filter(|e| e.kind == EventKind::StickStart(Disc::Lower) && e.t >= 20.0)
+        .filter(|e| e.kind == EventKind::StickStart(Disc::LOWER) && e.t >= 20.0)
         .map(|e| e.t)
         .collect()
 }

@@ -48,13 +48,13 @@ const EQUILIBRIUM_AMPLITUDE: f64 = 1e-6;
 fn steady_of(run: &Run) -> SteadyState {
     let w = &run.window;
     let exits: Vec<usize> = (0..w.len())
-        .filter(|&i| w[i].kind == EventKind::StickEnd(Disc::Lower))
+        .filter(|&i| w[i].kind == EventKind::StickEnd(Disc::LOWER))
         .collect();
     let anchors = if exits.len() >= 2 {
         exits
     } else {
         (0..w.len())
-            .filter(|&i| w[i].kind == EventKind::Max(Disc::Lower))
+            .filter(|&i| w[i].kind == EventKind::Max(Disc::LOWER))
             .collect()
     };
     let equilibrium = || SteadyState::Equilibrium {
@@ -83,8 +83,8 @@ fn steady_of(run: &Run) -> SteadyState {
     let mut since: Option<f64> = None;
     for e in cycle {
         match e.kind {
-            EventKind::StickStart(Disc::Lower) => since = Some(e.t),
-            EventKind::StickEnd(Disc::Lower) => {
+            EventKind::StickStart(Disc::LOWER) => since = Some(e.t),
+            EventKind::StickEnd(Disc::LOWER) => {
                 if let Some(t0) = since.take() {
                     stick += e.t - t0.max(cycle[0].t);
                 }

@@ -400,7 +400,7 @@ fn moreau_share(m: &Model, s: &[(f64, State)]) -> f64 {
     s.windows(2)
         .map(|w| {
             let h = w[1].0 - w[0].0;
-            [(Disc::Upper, OMEGA_U), (Disc::Lower, OMEGA_L)]
+            [(Disc::UPPER, OMEGA_U), (Disc::LOWER, OMEGA_L)]
                 .into_iter()
                 .map(|(d, i)| {
                     let (v0, v1) = (w[0].1[i], w[1].1[i]);
@@ -621,8 +621,8 @@ fn metrics_only_allowed(
 /// `q = h·(T_fl(0⁺) − T_fl(0⁻))/J_l`: the jump of the lower disc's acceleration at a reversal
 /// times the step, the velocity error of the Moreau–Jean step that contains the reversal.
 fn moreau_reversal_quantum(m: &Model, h: f64) -> f64 {
-    let (lo, hi) = m.friction(rotor_model::Disc::Lower).static_interval();
-    h * (hi - lo) / m.inertia(rotor_model::Disc::Lower)
+    let (lo, hi) = m.friction(rotor_model::Disc::LOWER).static_interval();
+    h * (hi - lo) / m.inertia(rotor_model::Disc::LOWER)
 }
 
 /// The stick time per period (the lower disc's, as the metric) that Moreau–Jean at step `h`
@@ -652,15 +652,15 @@ fn moreau_unresolved_slip(
     let mut slip: Option<(f64, f64)> = None;
     for e in events.iter().filter(|e| e.t >= from && e.t <= t_end) {
         match e.kind {
-            EventKind::Reversal(Disc::Lower) | EventKind::StickEnd(Disc::Lower) => {
+            EventKind::Reversal(Disc::LOWER) | EventKind::StickEnd(Disc::LOWER) => {
                 slip = Some((e.t, 0.0));
             }
-            EventKind::Max(Disc::Lower) | EventKind::Min(Disc::Lower) => {
+            EventKind::Max(Disc::LOWER) | EventKind::Min(Disc::LOWER) => {
                 if let Some((_, depth)) = slip.as_mut() {
                     *depth = depth.max(e.x[OMEGA_L].abs());
                 }
             }
-            EventKind::StickStart(Disc::Lower) => {
+            EventKind::StickStart(Disc::LOWER) => {
                 if let Some((t0, depth)) = slip.take()
                     && depth <= quantum
                 {
@@ -800,7 +800,7 @@ fn stress_moreau_reports_a_one_step_hold_between_opposite_slips_as_a_reversal() 
             .iter()
             .filter(|e| {
                 e.t >= 50.0
-                    && e.kind == rotor_model::seam::EventKind::Reversal(rotor_model::Disc::Lower)
+                    && e.kind == rotor_model::seam::EventKind::Reversal(rotor_model::Disc::LOWER)
             })
             .count()
     };
@@ -900,7 +900,7 @@ fn stress_an_extremum_of_one_disc_keeps_the_other_discs_stick() {
                 tr.events
                     .iter()
                     .all(|e| e.kind
-                        != rotor_model::seam::EventKind::Reversal(rotor_model::Disc::Lower)),
+                        != rotor_model::seam::EventKind::Reversal(rotor_model::Disc::LOWER)),
                 "{}: the cycle does not reverse",
                 kind.name()
             );

@@ -24,10 +24,7 @@ const H: f64 = 1e-3;
 const U: f64 = 1.5;
 
 fn vector3(m: &Model) -> f64 {
-    let mode = Mode {
-        upper: DiscMode::SlipPos,
-        lower: DiscMode::SlipPos,
-    };
+    let mode = Mode::rig(DiscMode::SlipPos, DiscMode::SlipPos);
     let f = |x: &State| m.rhs(x, U, mode);
     let mut x = State::new(0.5, 2.0, 1.0);
     for _ in 0..STEPS {
@@ -41,8 +38,8 @@ fn vector3(m: &Model) -> f64 {
 }
 
 fn array(m: &ChainModel) -> f64 {
-    let modes = [DiscMode::SlipPos; 2];
-    let f = |x: &[f64; 3], out: &mut [f64; 3]| m.rhs_into(x, U, &modes, out);
+    let modes = Mode::SLIP;
+    let f = |x: &[f64; 3], out: &mut [f64; 3]| m.rhs_into(x, U, modes, out);
     let mut x = [0.5, 2.0, 1.0];
     let (mut k1, mut k2, mut k3, mut k4, mut y) =
         ([0.0; 3], [0.0; 3], [0.0; 3], [0.0; 3], [0.0; 3]);
@@ -69,9 +66,9 @@ fn array(m: &ChainModel) -> f64 {
 
 fn dvector(m: &ChainModel) -> f64 {
     let n = m.dim();
-    let modes = vec![DiscMode::SlipPos; m.discs()];
+    let modes = Mode::uniform(m.discs(), DiscMode::SlipPos);
     let f = |x: &DVector<f64>, out: &mut DVector<f64>| {
-        m.rhs_into(x.as_slice(), U, &modes, out.as_mut_slice())
+        m.rhs_into(x.as_slice(), U, modes, out.as_mut_slice())
     };
     let mut x = DVector::from_vec(vec![0.5, 2.0, 1.0]);
     let mut k = [(); 4].map(|_| DVector::zeros(n));
@@ -97,10 +94,10 @@ fn dvector(m: &ChainModel) -> f64 {
 
 fn dvector_alloc(m: &ChainModel) -> f64 {
     let n = m.dim();
-    let modes = vec![DiscMode::SlipPos; m.discs()];
+    let modes = Mode::uniform(m.discs(), DiscMode::SlipPos);
     let f = |x: &DVector<f64>| {
         let mut out = DVector::zeros(n);
-        m.rhs_into(x.as_slice(), U, &modes, out.as_mut_slice());
+        m.rhs_into(x.as_slice(), U, modes, out.as_mut_slice());
         out
     };
     let mut x = DVector::from_vec(vec![0.5, 2.0, 1.0]);

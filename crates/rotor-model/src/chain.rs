@@ -30,7 +30,7 @@ use serde::Deserialize;
 use crate::params::{
     ParamsError, check_finite, check_lower, check_upper, lower_fields, one_line, upper_fields,
 };
-use crate::{DiscMode, FieldError, Friction, LowerFriction, Params, UpperFriction};
+use crate::{Disc, DiscMode, FieldError, Friction, LowerFriction, Mode, Params, UpperFriction};
 
 /// The friction law of one disc of a chain, by family as the file names it.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -476,6 +476,13 @@ impl ChainParams {
                 "a chain needs at least 2 discs",
             )));
         }
+        if self.discs.len() > Mode::MAX_DISCS {
+            return Err(ChainFieldError::Chain(FieldError::new(
+                "disc",
+                format!("{} discs", self.discs.len()),
+                format!("a chain holds at most {} discs", Mode::MAX_DISCS),
+            )));
+        }
         if !self.k_m.is_finite() {
             return Err(ChainFieldError::Chain(FieldError::num(
                 "k_m",
@@ -646,10 +653,10 @@ impl ChainModel {
     /// `2N − 1`). A stuck disc's velocity is taken as exactly 0 (whatever `x` holds) and its
     /// acceleration is 0.
     #[inline]
-    pub fn rhs_into(&self, x: &[f64], u: f64, modes: &[DiscMode], out: &mut [f64]) {
+    pub fn rhs_into(&self, x: &[f64], u: f64, mode: Mode, out: &mut [f64]) {
         let n = self.j.len();
         let w = |i: usize| {
-            if modes[i] == DiscMode::Stick {
+            if mode.is_stuck(Disc::at(i)) {
                 0.0
             } else {
                 x[n - 1 + i]
@@ -659,7 +666,7 @@ impl ChainModel {
             *a = w(i) - w(i + 1);
         }
         for i in 0..n {
-            out[n - 1 + i] = match modes[i].branch() {
+            out[n - 1 + i] = match mode.of(Disc::at(i)).branch() {
                 None => 0.0,
                 Some(s) => {
                     (self.torque_with(i, x, u, w) - self.friction[i].torque(x[n - 1 + i], s))
@@ -669,13 +676,14 @@ impl ChainModel {
         }
     }
 
-    /// The Filippov-consistent mode of each disc at a state, into `modes`: slip by the sign of
-    /// its velocity; a disc at ω = 0 sticks if its applied torque is inside its interval,
-    /// else slips toward the exit; a law without an interval slips the way the torque pushes.
-    pub fn mode_at(&self, x: &[f64], u: f64, modes: &mut [DiscMode]) {
-        for (i, m) in modes.iter_mut().enumerate() {
+    /// The Filippov-consistent mode of each disc at a state: slip by the sign of its velocity;
+    /// a disc at ω = 0 sticks if its applied torque is inside its interval, else slips toward
+    /// the exit; a law without an interval slips the way the torque pushes.
+    pub fn mode_at(&self, x: &[f64], u: f64) -> Mode {
+        let mut mode = Mode::SLIP;
+        for i in 0..self.discs() {
             let w = x[self.omega(i)];
-            *m = if w != 0.0 {
+            let m = if w != 0.0 {
                 DiscMode::slip_of(w)
             } else if !self.friction[i].is_set_valued() {
                 let (_, hi) = self.friction[i].static_interval();
@@ -683,16 +691,18 @@ impl ChainModel {
             } else {
                 self.stick_exit(i, x, u).unwrap_or(DiscMode::Stick)
             };
+            mode.set(Disc::at(i), m);
         }
+        mode
     }
 
     /// Analytic Jacobian `∂f_mode/∂x` (`2N − 1` square). A stuck disc's row is 0 and its
     /// velocity enters no other row (it is held at 0).
-    pub fn jacobian(&self, x: &[f64], modes: &[DiscMode]) -> DMatrix<f64> {
+    pub fn jacobian(&self, x: &[f64], mode: Mode) -> DMatrix<f64> {
         let n = self.j.len();
         let dim = self.dim();
         let mut jac = DMatrix::zeros(dim, dim);
-        let slipping = |i: usize| modes[i] != DiscMode::Stick;
+        let slipping = |i: usize| !mode.is_stuck(Disc::at(i));
         for i in 0..n - 1 {
             if slipping(i) {
                 jac[(i, n - 1 + i)] = 1.0;
@@ -702,7 +712,7 @@ impl ChainModel {
             }
         }
         for i in 0..n {
-            let Some(s) = modes[i].branch() else {
+            let Some(s) = mode.of(Disc::at(i)).branch() else {
                 continue;
             };
             let (row, ji) = (n - 1 + i, self.j[i]);
@@ -738,7 +748,7 @@ impl ChainModel {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::{Disc, Mode, Model, State};
+    use crate::{Model, State};
 
     const DESIGN_EXAMPLE: &str = r#"
 name = "chain3"
@@ -790,14 +800,14 @@ friction = { family = "stribeck", t_s = 0.2, t_c = 0.1, omega_s = 1.5, delta = 2
                 for u in [0.0, 0.4, 1.5, 6.0, -2.0] {
                     for upper in modes3() {
                         for lower in modes3() {
-                            let mode = Mode { upper, lower };
+                            let mode = Mode::rig(upper, lower);
                             let mut out = [0.0; 3];
-                            chain.rhs_into(x.as_slice(), u, &[upper, lower], &mut out);
+                            chain.rhs_into(x.as_slice(), u, mode, &mut out);
                             let f = rig.rhs(&x, u, mode);
                             for r in 0..3 {
                                 assert_eq!(out[r].to_bits(), f[r].to_bits(), "{x:?} {u} {mode:?}");
                             }
-                            let jc = chain.jacobian(x.as_slice(), &[upper, lower]);
+                            let jc = chain.jacobian(x.as_slice(), mode);
                             let jr = rig.jacobian(&x, u, mode);
                             for r in 0..3 {
                                 for c in 0..3 {
@@ -817,10 +827,7 @@ friction = { family = "stribeck", t_s = 0.2, t_c = 0.1, omega_s = 1.5, delta = 2
                             rig.stick_exit(d, &x, u)
                         );
                     }
-                    let mut modes = [DiscMode::Stick; 2];
-                    chain.mode_at(x.as_slice(), u, &mut modes);
-                    let m = rig.mode_at(&x, u);
-                    assert_eq!(modes, [m.upper, m.lower]);
+                    assert_eq!(chain.mode_at(x.as_slice(), u), rig.mode_at(&x, u));
                     assert_eq!(chain.energy(x.as_slice()), rig.energy(&x));
                 }
             }
@@ -932,6 +939,16 @@ friction = { family = "stribeck", t_s = 0.2, t_c = 0.1, omega_s = 1.5, delta = 2
             .next();
         let err = chain(one.unwrap()).unwrap_err();
         assert!(err.contains("a chain needs at least 2 discs"), "{err}");
+        // The mode's bit sets hold 128 discs: a chain of 128 is read, one of 129 refused.
+        let tail =
+            "[[disc]]\nj = 0.0326\nk = 0.0727\nfriction = { family = \"viscous\", b = 0.01 }\n";
+        let with = |n: usize| format!("{}{}", one.unwrap(), tail.repeat(n - 1));
+        assert_eq!(chain(&with(Mode::MAX_DISCS)).map(|c| c.len()), Ok(128));
+        let err = chain(&with(Mode::MAX_DISCS + 1)).unwrap_err();
+        assert!(
+            err.contains("disc = 129 discs: a chain holds at most 128 discs"),
+            "{err}"
+        );
         let nan = DESIGN_EXAMPLE.replacen("j = 0.0326", "j = nan", 1);
         assert!(
             chain(&nan)
@@ -959,7 +976,14 @@ friction = { family = "stribeck", t_s = 0.2, t_c = 0.1, omega_s = 1.5, delta = 2
         ChainModel::new(&p)
     }
 
-    fn all_modes(n: usize) -> Vec<Vec<DiscMode>> {
+    fn all_modes(n: usize) -> Vec<Mode> {
+        all_disc_modes(n)
+            .iter()
+            .map(|m| Mode::from_discs(m))
+            .collect()
+    }
+
+    fn all_disc_modes(n: usize) -> Vec<Vec<DiscMode>> {
         let mut out = vec![vec![]];
         for _ in 0..n {
             out = out
@@ -983,15 +1007,15 @@ friction = { family = "stribeck", t_s = 0.2, t_c = 0.1, omega_s = 1.5, delta = 2
         let m = coupled_chain();
         let x = [0.4, -0.7, 1.1, 1.3, 0.6, -2.1, 0.9];
         for modes in all_modes(4) {
-            let jac = m.jacobian(&x, &modes);
+            let jac = m.jacobian(&x, modes);
             for k in 0..7 {
                 let d = 1e-6;
                 let (mut xp, mut xm) = (x, x);
                 xp[k] += d;
                 xm[k] -= d;
                 let (mut fp, mut fm) = ([0.0; 7], [0.0; 7]);
-                m.rhs_into(&xp, 1.5, &modes, &mut fp);
-                m.rhs_into(&xm, 1.5, &modes, &mut fm);
+                m.rhs_into(&xp, 1.5, modes, &mut fp);
+                m.rhs_into(&xm, 1.5, modes, &mut fm);
                 for r in 0..7 {
                     let fd = (fp[r] - fm[r]) / (2.0 * d);
                     // Central differences: O(d²) truncation + ε|f|/d rounding ≈ 1e-8 for
@@ -1015,16 +1039,16 @@ friction = { family = "stribeck", t_s = 0.2, t_c = 0.1, omega_s = 1.5, delta = 2
         for modes in all_modes(n) {
             let mut x: [f64; 7] = [0.4, -0.7, 1.1, 1.3, 0.6, -2.1, 0.9];
             for i in 0..n {
-                if modes[i] == DiscMode::Stick {
+                if modes.is_stuck(Disc::at(i)) {
                     x[n - 1 + i] = 0.0;
-                } else if modes[i].branch() == Some(-1.0) {
+                } else if modes.of(Disc::at(i)).branch() == Some(-1.0) {
                     x[n - 1 + i] = -x[n - 1 + i].abs();
                 } else {
                     x[n - 1 + i] = x[n - 1 + i].abs();
                 }
             }
             let mut f = [0.0; 7];
-            m.rhs_into(&x, u, &modes, &mut f);
+            m.rhs_into(&x, u, modes, &mut f);
             let de: f64 = (0..n)
                 .map(|i| m.j[i] * x[n - 1 + i] * f[n - 1 + i])
                 .sum::<f64>()
@@ -1048,13 +1072,13 @@ friction = { family = "stribeck", t_s = 0.2, t_c = 0.1, omega_s = 1.5, delta = 2
     fn a_stuck_disc_is_held_whatever_the_others_do() {
         let m = coupled_chain();
         let x = [0.4, -0.7, 1.1, 1.3, 0.0, -2.1, 0.9];
-        for modes in all_modes(4).into_iter().filter(|m| m[1] == DiscMode::Stick) {
+        for modes in all_modes(4).into_iter().filter(|m| m.is_stuck(Disc::at(1))) {
             let mut f = [0.0; 7];
-            m.rhs_into(&x, 1.5, &modes, &mut f);
+            m.rhs_into(&x, 1.5, modes, &mut f);
             assert_eq!(f[m.omega(1)], 0.0);
             // α̇_1 = ω_1 − 0, α̇_2 = 0 − ω_3 (or 0 where those discs are stuck too).
             let w = |i: usize| {
-                if modes[i] == DiscMode::Stick {
+                if modes.is_stuck(Disc::at(i)) {
                     0.0
                 } else {
                     x[3 + i]

@@ -29,26 +29,66 @@ pub const OMEGA_U: usize = 1;
 /// Index of ω_l in [`State`].
 pub const OMEGA_L: usize = 2;
 
-/// One of the two discs.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, serde::Serialize)]
-#[serde(rename_all = "lowercase")]
-pub enum Disc {
-    /// The motor-driven disc (J_u, ω_u, friction T_fu, eq. (4)).
-    Upper,
-    /// The disc at the end of the string, loaded by the brake (J_l, ω_l, friction T_fl).
-    Lower,
-}
+/// A disc, by its position in the chain from the top: position 0 is the motor-driven disc,
+/// the last one the bottom. The rig is the chain of two ([`Disc::UPPER`], [`Disc::LOWER`]);
+/// its words `upper` and `lower` are a view of positions 0 and 1 ([`Disc::rig_word`]), and a
+/// chain's discs are numbered from 1 ([`Disc::number`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub struct Disc(u16);
 
 impl Disc {
-    /// Both discs, upper first.
-    pub const BOTH: [Disc; 2] = [Disc::Upper, Disc::Lower];
+    /// The rig's motor-driven disc (J_u, ω_u, friction T_fu, eq. (4)): position 0.
+    pub const UPPER: Disc = Disc(0);
+    /// The rig's disc at the end of the string, loaded by the brake (J_l, ω_l, friction
+    /// T_fl): position 1.
+    pub const LOWER: Disc = Disc(1);
+    /// Both discs of the rig, upper first.
+    pub const BOTH: [Disc; 2] = [Disc::UPPER, Disc::LOWER];
 
-    /// Index of this disc's velocity in [`State`].
-    pub fn index(self) -> usize {
-        match self {
-            Disc::Upper => OMEGA_U,
-            Disc::Lower => OMEGA_L,
+    /// The disc at `position` (0 = the top). Positions beyond [`Mode::MAX_DISCS`] have no
+    /// mode and are refused where a chain is read.
+    pub const fn at(position: usize) -> Disc {
+        Disc(position as u16)
+    }
+
+    /// Position from the top, 0-based.
+    pub const fn position(self) -> usize {
+        self.0 as usize
+    }
+
+    /// The disc's number as a chain file counts it, 1-based.
+    pub const fn number(self) -> usize {
+        self.0 as usize + 1
+    }
+
+    /// The discs `0..n`, top first.
+    pub fn all(n: usize) -> impl DoubleEndedIterator<Item = Disc> + ExactSizeIterator {
+        (0..n).map(Disc::at)
+    }
+
+    /// The rig's word for this disc, `upper` or `lower`; `None` beyond the rig's two.
+    pub const fn rig_word(self) -> Option<&'static str> {
+        match self.0 {
+            0 => Some("upper"),
+            1 => Some("lower"),
+            _ => None,
         }
+    }
+
+    /// The disc's name in a chain of `n` as a person reads it: the rig's word for the two
+    /// discs of the rig (`n = 2`), else `disc <number>`.
+    pub fn name_in(self, n: usize) -> std::borrow::Cow<'static, str> {
+        match self.rig_word() {
+            Some(w) if n == 2 => w.into(),
+            _ => format!("disc {}", self.number()).into(),
+        }
+    }
+
+    /// Index of this disc's velocity in the rig's [`State`] (`ω_u` at 1, `ω_l` at 2): the
+    /// state holds the one twist angle first. In a chain of N the velocities follow its
+    /// N − 1 angles ([`crate::ChainModel::omega`]).
+    pub const fn index(self) -> usize {
+        OMEGA_U + self.0 as usize
     }
 }
 
@@ -84,30 +124,113 @@ impl DiscMode {
     }
 }
 
-/// Friction modes of both discs.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, serde::Serialize)]
+/// The friction modes of the discs, one [`DiscMode`] per disc position.
+///
+/// Held as two bit sets (the stuck discs and the discs slipping backward; every other disc
+/// slips forward), so a mode of any chain up to [`Mode::MAX_DISCS`] discs is `Copy`,
+/// hashable and compared in two instructions, and changing one disc's mode allocates
+/// nothing. A mode does not store the number of discs: positions past a chain's last disc
+/// read as [`DiscMode::SlipPos`] and are never asked.
+#[derive(Clone, Copy, PartialEq, Eq, Hash, Default)]
 pub struct Mode {
-    /// Mode of the upper disc.
-    pub upper: DiscMode,
-    /// Mode of the lower disc.
-    pub lower: DiscMode,
+    stuck: u128,
+    backward: u128,
 }
 
 impl Mode {
+    /// The most discs a mode holds (the width of its bit sets). A chain file with more is
+    /// refused by name.
+    pub const MAX_DISCS: usize = 128;
+
+    /// Every disc slipping forward.
+    pub const SLIP: Mode = Mode {
+        stuck: 0,
+        backward: 0,
+    };
+
+    /// The rig's mode: the upper disc's, then the lower disc's.
+    pub const fn rig(upper: DiscMode, lower: DiscMode) -> Mode {
+        Mode::SLIP.with(Disc::UPPER, upper).with(Disc::LOWER, lower)
+    }
+
+    /// Every one of `n` discs in mode `m`.
+    pub fn uniform(n: usize, m: DiscMode) -> Mode {
+        Disc::all(n).fold(Mode::SLIP, |acc, d| acc.with(d, m))
+    }
+
+    /// The mode of each disc in position order.
+    pub fn from_discs(modes: &[DiscMode]) -> Mode {
+        modes
+            .iter()
+            .enumerate()
+            .fold(Mode::SLIP, |acc, (i, &m)| acc.with(Disc::at(i), m))
+    }
+
     /// Mode of one disc.
-    pub fn of(&self, d: Disc) -> DiscMode {
-        match d {
-            Disc::Upper => self.upper,
-            Disc::Lower => self.lower,
+    #[inline]
+    pub const fn of(&self, d: Disc) -> DiscMode {
+        let bit = 1u128 << d.0;
+        if self.stuck & bit != 0 {
+            DiscMode::Stick
+        } else if self.backward & bit != 0 {
+            DiscMode::SlipNeg
+        } else {
+            DiscMode::SlipPos
+        }
+    }
+
+    /// This mode with one disc's mode replaced.
+    #[inline]
+    pub const fn with(self, d: Disc, m: DiscMode) -> Mode {
+        let bit = 1u128 << d.0;
+        let (stuck, backward) = (self.stuck & !bit, self.backward & !bit);
+        match m {
+            DiscMode::SlipPos => Mode { stuck, backward },
+            DiscMode::SlipNeg => Mode {
+                stuck,
+                backward: backward | bit,
+            },
+            DiscMode::Stick => Mode {
+                stuck: stuck | bit,
+                backward,
+            },
         }
     }
 
     /// Sets the mode of one disc.
+    #[inline]
     pub fn set(&mut self, d: Disc, m: DiscMode) {
-        match d {
-            Disc::Upper => self.upper = m,
-            Disc::Lower => self.lower = m,
-        }
+        *self = self.with(d, m);
+    }
+
+    /// Whether the disc is stuck.
+    #[inline]
+    pub const fn is_stuck(&self, d: Disc) -> bool {
+        self.stuck & (1u128 << d.0) != 0
+    }
+
+    /// Mode of the rig's upper disc.
+    #[inline]
+    pub const fn upper(&self) -> DiscMode {
+        self.of(Disc::UPPER)
+    }
+
+    /// Mode of the rig's lower disc.
+    #[inline]
+    pub const fn lower(&self) -> DiscMode {
+        self.of(Disc::LOWER)
+    }
+}
+
+/// Lists the modes up to the last disc that is not slipping forward (at least the rig's
+/// two): `Mode[SlipPos, Stick]`.
+impl std::fmt::Debug for Mode {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let used = 128 - (self.stuck | self.backward).leading_zeros() as usize;
+        f.write_str("Mode")?;
+        f.debug_list()
+            .entries(Disc::all(used.max(2)).map(|d| self.of(d)))
+            .finish()
     }
 }
 
@@ -138,18 +261,20 @@ impl Model {
     /// Friction law of a disc.
     #[inline]
     pub fn friction(&self, d: Disc) -> &Friction {
-        match d {
-            Disc::Upper => &self.upper,
-            Disc::Lower => &self.lower,
+        if d == Disc::UPPER {
+            &self.upper
+        } else {
+            &self.lower
         }
     }
 
     /// Inertia of a disc.
     #[inline]
     pub fn inertia(&self, d: Disc) -> f64 {
-        match d {
-            Disc::Upper => self.params.j_u,
-            Disc::Lower => self.params.j_l,
+        if d == Disc::UPPER {
+            self.params.j_u
+        } else {
+            self.params.j_l
         }
     }
 
@@ -158,9 +283,10 @@ impl Model {
     #[inline]
     pub fn applied_torque(&self, d: Disc, x: &State, u: f64) -> f64 {
         let spring = self.params.k_theta * x[ALPHA];
-        match d {
-            Disc::Upper => self.params.k_m * u - spring,
-            Disc::Lower => spring,
+        if d == Disc::UPPER {
+            self.params.k_m * u - spring
+        } else {
+            spring
         }
     }
 
@@ -201,20 +327,20 @@ impl Model {
     /// is taken as exactly 0 (whatever is stored in `x`).
     #[inline]
     pub fn rhs(&self, x: &State, u: f64, mode: Mode) -> State {
-        let wu = if mode.upper == DiscMode::Stick {
+        let wu = if mode.is_stuck(Disc::UPPER) {
             0.0
         } else {
             x[OMEGA_U]
         };
-        let wl = if mode.lower == DiscMode::Stick {
+        let wl = if mode.is_stuck(Disc::LOWER) {
             0.0
         } else {
             x[OMEGA_L]
         };
         State::new(
             wu - wl,
-            self.disc_accel(Disc::Upper, x, u, mode.upper),
-            self.disc_accel(Disc::Lower, x, u, mode.lower),
+            self.disc_accel(Disc::UPPER, x, u, mode.upper()),
+            self.disc_accel(Disc::LOWER, x, u, mode.lower()),
         )
     }
 
@@ -222,12 +348,12 @@ impl Model {
     pub fn jacobian(&self, x: &State, _u: f64, mode: Mode) -> Matrix3<f64> {
         let p = &self.params;
         let mut j = Matrix3::zeros();
-        if let Some(s) = mode.upper.branch() {
+        if let Some(s) = mode.upper().branch() {
             j[(ALPHA, OMEGA_U)] = 1.0;
             j[(OMEGA_U, ALPHA)] = -p.k_theta / p.j_u;
             j[(OMEGA_U, OMEGA_U)] = -self.upper.dtorque(x[OMEGA_U], s) / p.j_u;
         }
-        if let Some(s) = mode.lower.branch() {
+        if let Some(s) = mode.lower().branch() {
             j[(ALPHA, OMEGA_L)] = -1.0;
             j[(OMEGA_L, ALPHA)] = p.k_theta / p.j_l;
             j[(OMEGA_L, OMEGA_L)] = -self.lower.dtorque(x[OMEGA_L], s) / p.j_l;
@@ -238,7 +364,7 @@ impl Model {
     /// `∂f_mode/∂u`.
     pub fn d_rhs_du(&self, mode: Mode) -> State {
         let mut v = State::zeros();
-        if mode.upper != DiscMode::Stick {
+        if !mode.is_stuck(Disc::UPPER) {
             v[OMEGA_U] = self.params.k_m / self.params.j_u;
         }
         v
@@ -247,10 +373,7 @@ impl Model {
     /// The Filippov-consistent mode at a state: slip by the sign of each velocity; a disc at
     /// ω = 0 sticks if the applied torque is inside its interval, else slips toward the exit.
     pub fn mode_at(&self, x: &State, u: f64) -> Mode {
-        let mut m = Mode {
-            upper: DiscMode::SlipPos,
-            lower: DiscMode::SlipPos,
-        };
+        let mut m = Mode::SLIP;
         for d in Disc::BOTH {
             let w = x[d.index()];
             let dm = if w != 0.0 {
@@ -318,10 +441,7 @@ mod tests {
                 State::new(2.5, 5.0, 0.0),
             ] {
                 for lower in [DiscMode::SlipPos, DiscMode::SlipNeg, DiscMode::Stick] {
-                    let m = Mode {
-                        upper: DiscMode::SlipPos,
-                        lower,
-                    };
+                    let m = Mode::rig(DiscMode::SlipPos, lower);
                     let (a, b) = (with.rhs(&x, u, m), t1.rhs(&x, u - shift, m));
                     // 1e-14: a few ulps of the O(1) accelerations.
                     assert!(
@@ -345,10 +465,80 @@ mod tests {
         let mut v = Vec::new();
         for upper in ms {
             for lower in ms {
-                v.push(Mode { upper, lower });
+                v.push(Mode::rig(upper, lower));
             }
         }
         v
+    }
+
+    /// A mode holds each disc's mode independently at every position its bit sets have, the
+    /// last change of a disc wins, and the rig's constructor and accessors are the view of
+    /// positions 0 and 1.
+    #[test]
+    fn a_mode_holds_each_discs_mode_independently() {
+        let ms = [DiscMode::SlipPos, DiscMode::SlipNeg, DiscMode::Stick];
+        assert_eq!(Mode::default(), Mode::SLIP);
+        for (k, &a) in ms.iter().enumerate() {
+            for &b in &ms {
+                for far in [2, 63, 64, 127] {
+                    let (d0, d1, dn) = (Disc::UPPER, Disc::LOWER, Disc::at(far));
+                    let mut m = Mode::rig(b, a).with(dn, ms[(k + 1) % 3]);
+                    assert_eq!((m.of(d0), m.of(d1)), (b, a));
+                    assert_eq!((m.upper(), m.lower()), (b, a));
+                    assert_eq!(m.of(dn), ms[(k + 1) % 3]);
+                    assert_eq!(m.is_stuck(dn), ms[(k + 1) % 3] == DiscMode::Stick);
+                    // Every disc's mode can be changed to every other; the rest stay.
+                    for &c in &ms {
+                        m.set(d1, c);
+                        assert_eq!((m.of(d0), m.of(d1), m.of(dn)), (b, c, ms[(k + 1) % 3]));
+                    }
+                    m.set(d1, a);
+                    m.set(dn, DiscMode::SlipPos);
+                    assert_eq!(m, Mode::rig(b, a), "far {far}");
+                }
+            }
+        }
+        let chain = [
+            DiscMode::Stick,
+            DiscMode::SlipPos,
+            DiscMode::SlipNeg,
+            DiscMode::Stick,
+        ];
+        let m = Mode::from_discs(&chain);
+        assert_eq!(Disc::all(4).map(|d| m.of(d)).collect::<Vec<_>>(), chain);
+        assert_eq!(format!("{m:?}"), "Mode[Stick, SlipPos, SlipNeg, Stick]");
+        assert_eq!(format!("{:?}", Mode::SLIP), "Mode[SlipPos, SlipPos]");
+        assert_eq!(
+            Mode::uniform(3, DiscMode::Stick),
+            Mode::from_discs(&[DiscMode::Stick; 3])
+        );
+        assert_eq!(
+            Mode::uniform(Mode::MAX_DISCS, DiscMode::SlipNeg).of(Disc::at(127)),
+            DiscMode::SlipNeg
+        );
+    }
+
+    /// A disc is its position: the rig's two are positions 0 and 1 with their words, a
+    /// chain numbers its discs from 1, and the rig's state holds ω_u, ω_l at 1, 2.
+    #[test]
+    fn a_disc_is_its_position_with_the_rigs_words_as_a_view() {
+        assert_eq!(Disc::BOTH, [Disc::at(0), Disc::at(1)]);
+        assert!(Disc::UPPER < Disc::LOWER);
+        assert_eq!(
+            (Disc::UPPER.index(), Disc::LOWER.index()),
+            (OMEGA_U, OMEGA_L)
+        );
+        assert_eq!(Disc::LOWER.number(), 2);
+        assert_eq!(
+            (Disc::UPPER.name_in(2), Disc::LOWER.name_in(2)),
+            ("upper".into(), "lower".into())
+        );
+        assert_eq!(Disc::LOWER.name_in(3), "disc 2");
+        assert_eq!(Disc::at(2).rig_word(), None);
+        assert_eq!(
+            Disc::all(3).map(Disc::position).collect::<Vec<_>>(),
+            [0, 1, 2]
+        );
     }
 
     #[test]
@@ -392,18 +582,15 @@ mod tests {
     fn stick_holds_velocity_and_uses_equivalent_control() {
         let m = Model::table1();
         let x = State::new(1.0, 0.5, 0.0);
-        let mode = Mode {
-            upper: DiscMode::SlipPos,
-            lower: DiscMode::Stick,
-        };
+        let mode = Mode::rig(DiscMode::SlipPos, DiscMode::Stick);
         let f = m.rhs(&x, 1.5, mode);
         assert_eq!(f[OMEGA_L], 0.0);
         assert_eq!(f[ALPHA], 0.5);
         // Stick persists while |k_θ α| ≤ T_sl = 0.1642: α = 1 gives 0.0727 (inside).
-        assert!(m.can_stick(Disc::Lower, &x, 1.5));
+        assert!(m.can_stick(Disc::LOWER, &x, 1.5));
         let x_out = State::new(3.0, 0.5, 0.0); // k_θ α = 0.218 > T_sl
         assert_eq!(
-            m.stick_exit(Disc::Lower, &x_out, 1.5),
+            m.stick_exit(Disc::LOWER, &x_out, 1.5),
             Some(DiscMode::SlipPos)
         );
     }
@@ -416,8 +603,8 @@ mod tests {
             let mode = m.mode_at(&x, u);
             let p = &m.params;
             let expect = p.k_m * u * x[OMEGA_U]
-                - m.friction(Disc::Upper).curve(x[OMEGA_U]) * x[OMEGA_U]
-                - m.friction(Disc::Lower).curve(x[OMEGA_L]) * x[OMEGA_L];
+                - m.friction(Disc::UPPER).curve(x[OMEGA_U]) * x[OMEGA_U]
+                - m.friction(Disc::LOWER).curve(x[OMEGA_L]) * x[OMEGA_L];
             // Two sums of the same terms (≲ 10): measured ≤ 8.9e-16 (1 ulp of 5.7); 1e-13 ≈ 110×.
             assert_relative_eq!(m.power(&x, u, mode), expect, epsilon = 1e-13);
         }

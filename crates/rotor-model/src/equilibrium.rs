@@ -48,8 +48,8 @@ impl Model {
     /// The slipping branch at velocity ω ≠ 0: `u(ω)`, `α(ω)`.
     pub fn slip_equilibrium_at(&self, omega: f64) -> SlipEquilibrium {
         let s = if omega < 0.0 { -1.0 } else { 1.0 };
-        let tl = self.friction(crate::Disc::Lower).torque(omega, s);
-        let tu = self.friction(crate::Disc::Upper).torque(omega, s);
+        let tl = self.friction(crate::Disc::LOWER).torque(omega, s);
+        let tu = self.friction(crate::Disc::UPPER).torque(omega, s);
         SlipEquilibrium {
             u: (tl + tu) / self.params.k_m,
             omega,
@@ -60,8 +60,8 @@ impl Model {
     /// `du/dω` along the slipping branch.
     pub fn du_domega(&self, omega: f64) -> f64 {
         let s = if omega < 0.0 { -1.0 } else { 1.0 };
-        (self.friction(crate::Disc::Lower).dtorque(omega, s)
-            + self.friction(crate::Disc::Upper).dtorque(omega, s))
+        (self.friction(crate::Disc::LOWER).dtorque(omega, s)
+            + self.friction(crate::Disc::UPPER).dtorque(omega, s))
             / self.params.k_m
     }
 
@@ -89,11 +89,11 @@ impl Model {
             return Vec::new();
         }
         let s = u.signum();
-        let bt = self.friction(crate::Disc::Lower).viscous()
-            + self.friction(crate::Disc::Upper).viscous();
+        let bt = self.friction(crate::Disc::LOWER).viscous()
+            + self.friction(crate::Disc::UPPER).viscous();
         let bound = self.params.upper.t_s.abs()
             + self.params.upper.dt_s.abs()
-            + self.friction(crate::Disc::Lower).level(0.0).abs()
+            + self.friction(crate::Disc::LOWER).level(0.0).abs()
             + match self.params.lower {
                 crate::LowerFriction::Exponential { t_1, t_2, .. } => t_1.abs() + t_2.abs(),
                 crate::LowerFriction::Stribeck { t_c, .. } => t_c.abs(),
@@ -133,7 +133,7 @@ impl Model {
     /// Eigenvalues of the Jacobian at a slipping equilibrium.
     pub fn equilibrium_eigenvalues(&self, e: &SlipEquilibrium) -> [Complex<f64>; 3] {
         let m = DiscMode::slip_of(e.omega);
-        let j = self.jacobian(&e.state(), e.u, Mode { upper: m, lower: m });
+        let j = self.jacobian(&e.state(), e.u, Mode::rig(m, m));
         let ev = j.complex_eigenvalues();
         [ev[0], ev[1], ev[2]]
     }
@@ -162,8 +162,8 @@ impl Model {
     /// The set of equilibria with both discs at rest, if non-empty.
     pub fn stuck_equilibria(&self, u: f64) -> Option<StuckSet> {
         let k = self.params.k_theta;
-        let (ll, lh) = self.friction(crate::Disc::Lower).static_interval();
-        let (ul, uh) = self.friction(crate::Disc::Upper).static_interval();
+        let (ll, lh) = self.friction(crate::Disc::LOWER).static_interval();
+        let (ul, uh) = self.friction(crate::Disc::UPPER).static_interval();
         let km_u = self.params.k_m * u;
         let lo = (ll / k).max((km_u - uh) / k);
         let hi = (lh / k).min((km_u - ul) / k);

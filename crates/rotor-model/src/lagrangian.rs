@@ -44,8 +44,8 @@ impl Lagrangian {
         let p = &model.params;
         let m = Matrix4::from_diagonal(&Vector4::new(p.j_u, p.j_l, 1.0, 1.0));
         let c = Matrix4::from_diagonal(&Vector4::new(
-            model.friction(Disc::Upper).viscous(),
-            model.friction(Disc::Lower).viscous(),
+            model.friction(Disc::UPPER).viscous(),
+            model.friction(Disc::LOWER).viscous(),
             0.0,
             0.0,
         ));
@@ -73,8 +73,8 @@ impl Lagrangian {
 
     /// `F_int(q̇)`, eq. (12): `[ΔT_su + Δb_u|θ̇_u|, 0, N_u, N_l(θ̇_l)]`.
     pub fn f_int(&self, v: &Coords) -> Coords {
-        let up = self.model.friction(Disc::Upper);
-        let lo = self.model.friction(Disc::Lower);
+        let up = self.model.friction(Disc::UPPER);
+        let lo = self.model.friction(Disc::LOWER);
         let s = if v[0] < 0.0 { -1.0 } else { 1.0 };
         Coords::new(up.offset(v[0], s), 0.0, up.level(v[0]), lo.level(v[1]))
     }

@@ -139,10 +139,7 @@ fn quad(p: [&Point; 3], t: f64) -> State {
 }
 
 fn to_mode(m: &[DiscMode; 2]) -> Mode {
-    Mode {
-        upper: m[0],
-        lower: m[1],
-    }
+    Mode::rig(m[0], m[1])
 }
 
 /// What the run goes back to if a jump is undone: the end of the step on which it was
@@ -340,9 +337,11 @@ impl Run<'_> {
         let f = model.rhs(&cur.x, self.piece.at(cur.t), mode);
         let acc = f[wi];
         // The input's own rate adds k_m·du/dt / J_u to the upper disc's ω̈.
-        let drift = match d {
-            Disc::Upper => model.params.k_m * self.piece.slope / model.inertia(d),
-            Disc::Lower => 0.0,
+        // The motor drives the top disc only.
+        let drift = if d == Disc::UPPER {
+            model.params.k_m * self.piece.slope / model.inertia(d)
+        } else {
+            0.0
         };
         let jerk = (model.jacobian(&cur.x, 0.0, mode) * f)[wi] + drift;
         if acc * w < 0.0 {
@@ -532,7 +531,7 @@ impl Solver for MoreauSolver {
             cur: Point {
                 t: 0.0,
                 x: scene.x0,
-                mode: [m0.upper, m0.lower],
+                mode: [m0.upper(), m0.lower()],
             },
             prev: None,
             pending: Pending::new(),
@@ -569,7 +568,7 @@ mod tests {
         Event {
             t,
             x: State::zeros(),
-            kind: EventKind::Max(Disc::Lower),
+            kind: EventKind::Max(Disc::LOWER),
         }
     }
 
@@ -597,8 +596,8 @@ mod tests {
         s.halt = false;
         p.release_before(8.0, &mut s);
         assert_eq!(times(&s, 4), [4.0, 5.0, 6.0, 7.0]);
-        assert!(p.remove(EventKind::Max(Disc::Lower)));
-        assert!(!p.remove(EventKind::Min(Disc::Lower)));
+        assert!(p.remove(EventKind::Max(Disc::LOWER)));
+        assert!(!p.remove(EventKind::Min(Disc::LOWER)));
         p.shift(100.0);
         p.release_before(f64::INFINITY, &mut s);
         // 19 was the latest and was removed; the rest moved by 100 s.

@@ -188,23 +188,23 @@ impl Stepper {
     /// [`rotor_model::Lagrangian`].
     pub fn new(model: &Model, u: f64, options: &MoreauOptions) -> Stepper {
         let l = rotor_model::Lagrangian::new(model);
-        let db_u = model.friction(Disc::Upper).as_upper().map_or(0.0, |p| p.db);
+        let db_u = model.friction(Disc::UPPER).as_upper().map_or(0.0, |p| p.db);
         Stepper {
             theta: options.theta,
             level: options.friction_level,
             max_newton: options.max_newton,
             skip_free: options.skip_free_steps,
             estimate_stop: options.newton_estimate_stop,
-            affine_law: [Disc::Upper, Disc::Lower].map(|d| model.friction(d).as_upper().is_some()),
+            affine_law: [Disc::UPPER, Disc::LOWER].map(|d| model.friction(d).as_upper().is_some()),
             j: [l.m[(0, 0)], l.m[(1, 1)]],
             c: [l.c[(0, 0)], l.c[(1, 1)]],
             k: l.k[(0, 0)],
             f_ext: l.f_ext(u)[0],
             k_m: model.params.k_m,
-            law: [*model.friction(Disc::Upper), *model.friction(Disc::Lower)],
+            law: [*model.friction(Disc::UPPER), *model.friction(Disc::LOWER)],
             db: [db_u, 0.0],
-            n_zero: [Disc::Upper, Disc::Lower].map(|d| model.friction(d).level(0.0).max(0.0)),
-            off_zero: [Disc::Upper, Disc::Lower].map(|d| -model.friction(d).offset(0.0, 1.0)),
+            n_zero: [Disc::UPPER, Disc::LOWER].map(|d| model.friction(d).level(0.0).max(0.0)),
+            off_zero: [Disc::UPPER, Disc::LOWER].map(|d| -model.friction(d).offset(0.0, 1.0)),
         }
     }
 

@@ -276,7 +276,7 @@ struct Columns {
     alpha: Vec<f64>,
     omega_u: Vec<f64>,
     omega_l: Vec<f64>,
-    events: Vec<(f64, &'static str, &'static str)>,
+    events: Vec<(f64, std::borrow::Cow<'static, str>, &'static str)>,
     stats: Stats,
 }
 

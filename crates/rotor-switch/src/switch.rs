@@ -706,7 +706,7 @@ impl Run<'_> {
             let y = self.integ.dense(t);
             if let EventKind::Max(d) | EventKind::Min(d) = kind {
                 let w = y[d.index()];
-                let slot = &mut self.last_extremum[usize::from(d == Disc::Lower)];
+                let slot = &mut self.last_extremum[usize::from(d == Disc::LOWER)];
                 let resolvable = slot.replace(w).is_none_or(|w_prev| {
                     (w - w_prev).abs() > EXTREMUM_RESOLUTION * self.tol * (1.0 + w.abs())
                 });
@@ -803,7 +803,7 @@ impl<'a> Field<'a> {
             model,
             piece,
             eta,
-            laws: [law(Disc::Upper), law(Disc::Lower)],
+            laws: [law(Disc::UPPER), law(Disc::LOWER)],
             regions: [Region::Stick; 2],
             from_rest: [true; 2],
         }
@@ -869,10 +869,10 @@ impl Solver for SwitchSolver {
         let x_final = *run.integ.y();
         check_finite(run.integ.t(), &x_final)?;
         let c = run.integ.counters();
-        let mode = Mode {
-            upper: run.field.regions[0].disc_mode(),
-            lower: run.field.regions[1].disc_mode(),
-        };
+        let mode = Mode::rig(
+            run.field.regions[0].disc_mode(),
+            run.field.regions[1].disc_mode(),
+        );
         let stats = Stats {
             steps: c.accepted,
             rejected: c.rejected,

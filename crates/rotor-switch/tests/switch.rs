@@ -184,7 +184,7 @@ fn every_fixture_runs_to_t_end() {
                 assert!(
                     !t.events
                         .iter()
-                        .any(|e| e.kind == EventKind::StickEnd(Disc::Lower))
+                        .any(|e| e.kind == EventKind::StickEnd(Disc::LOWER))
                 );
                 checked.push(sc.name.clone());
             }
@@ -196,7 +196,7 @@ fn every_fixture_runs_to_t_end() {
                 let first_exit = t
                     .events
                     .iter()
-                    .find(|e| e.kind == EventKind::StickEnd(Disc::Lower))
+                    .find(|e| e.kind == EventKind::StickEnd(Disc::LOWER))
                     .unwrap_or_else(|| panic!("{n}: lower disc never broke away"));
                 assert!(first_exit.t > 0.0 && first_exit.x[OMEGA_L] == 0.0);
                 checked.push(sc.name.clone());
@@ -208,12 +208,12 @@ fn every_fixture_runs_to_t_end() {
         let mut stuck_since = None;
         for e in &t.events {
             match e.kind {
-                EventKind::StickStart(Disc::Lower) => {
+                EventKind::StickStart(Disc::LOWER) => {
                     let w = e.x[OMEGA_L];
                     assert!(w.abs() <= eta, "{} at t = {}: {w:e}", sc.name, e.t);
                     stuck_since = Some((e.t, w));
                 }
-                EventKind::StickEnd(Disc::Lower) => {
+                EventKind::StickEnd(Disc::LOWER) => {
                     if let Some((t0, w)) = stuck_since.take() {
                         for p in t.samples.iter().filter(|p| p.t > t0 && p.t < e.t) {
                             assert_eq!(p.x[OMEGA_L], w, "{} at t = {}", sc.name, p.t);
@@ -227,7 +227,7 @@ fn every_fixture_runs_to_t_end() {
             let onsets: Vec<f64> = t
                 .events
                 .iter()
-                .filter(|e| e.kind == EventKind::StickStart(Disc::Lower))
+                .filter(|e| e.kind == EventKind::StickStart(Disc::LOWER))
                 .map(|e| e.x[OMEGA_L])
                 .collect();
             // Onsets from slip are located at ω_l = η to the event location's time
@@ -340,7 +340,7 @@ fn the_band_moves_a_reversal_without_sticking_by_order_eta() {
     let first_rev = |t: &Trajectory| {
         t.events
             .iter()
-            .find(|e| e.kind == EventKind::Reversal(Disc::Lower))
+            .find(|e| e.kind == EventKind::Reversal(Disc::LOWER))
             .copied()
             .expect("a reversal")
     };
@@ -349,7 +349,7 @@ fn the_band_moves_a_reversal_without_sticking_by_order_eta() {
     assert!(
         !b.events
             .iter()
-            .any(|e| e.kind == EventKind::StickStart(Disc::Lower))
+            .any(|e| e.kind == EventKind::StickStart(Disc::LOWER))
     );
     let (ra, rb) = (first_rev(&a), first_rev(&b));
     // The band changes the crossing by O(η/|ω̇_l|); |ω̇_l| ≈ (0.36 − 0.16)/0.0326 ≈ 6 rad/s²
@@ -428,7 +428,7 @@ fn band_edge_sliver_is_held_not_chattered() {
     let model = Model::table1();
     let p = model.params;
     let eta = 1e-3;
-    let f = model.friction(Disc::Lower);
+    let f = model.friction(Disc::LOWER);
     let (_, hi) = f.static_interval();
     let sliver = f.torque(eta, 1.0) - hi; // ≈ 0.15·η N m for Table 1
     assert!(sliver > 0.0);
@@ -454,7 +454,7 @@ fn band_edge_sliver_is_held_not_chattered() {
             assert!(
                 t.events
                     .iter()
-                    .any(|e| e.kind == EventKind::StickStart(Disc::Lower))
+                    .any(|e| e.kind == EventKind::StickStart(Disc::LOWER))
             );
         } else {
             assert!(t.x_final[OMEGA_L] > eta, "{:?}", t.x_final);
@@ -504,8 +504,8 @@ fn a_grazing_approach_inside_one_sample_interval_still_enters_the_band() {
             },
         );
         let count = |k: EventKind| t.events.iter().filter(|e| e.kind == k).count();
-        let maxima = count(EventKind::Max(Disc::Lower));
-        let sticks = count(EventKind::StickStart(Disc::Lower));
+        let maxima = count(EventKind::Max(Disc::LOWER));
+        let sticks = count(EventKind::StickStart(Disc::LOWER));
         assert!(maxima >= 9, "{u} V: {maxima} maxima of omega_l in 42 s");
         assert!(
             sticks.abs_diff(maxima) <= 1,
@@ -576,7 +576,7 @@ fn a_transition_that_turns_back_between_samples_still_leaves_the_band() {
     let sticks: Vec<f64> = t
         .events
         .iter()
-        .filter(|e| e.kind == EventKind::StickStart(Disc::Lower))
+        .filter(|e| e.kind == EventKind::StickStart(Disc::LOWER))
         .map(|e| e.x[OMEGA_L])
         .collect();
     assert!(!sticks.is_empty(), "no stick of the lower disc");
@@ -611,19 +611,19 @@ fn leaving_stick_from_just_below_zero_is_no_reversal() {
             .filter(|k| {
                 matches!(
                     k,
-                    EventKind::StickEnd(Disc::Lower)
-                        | EventKind::Reversal(Disc::Lower)
-                        | EventKind::StickStart(Disc::Lower)
+                    EventKind::StickEnd(Disc::LOWER)
+                        | EventKind::Reversal(Disc::LOWER)
+                        | EventKind::StickStart(Disc::LOWER)
                 )
             })
             .collect();
         assert_eq!(
             lower.first(),
-            Some(&EventKind::StickEnd(Disc::Lower)),
+            Some(&EventKind::StickEnd(Disc::LOWER)),
             "w = {w:e}: {lower:?}"
         );
         assert!(
-            !lower.contains(&EventKind::Reversal(Disc::Lower)),
+            !lower.contains(&EventKind::Reversal(Disc::LOWER)),
             "w = {w:e}: {lower:?}"
         );
     }

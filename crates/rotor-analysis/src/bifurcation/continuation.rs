@@ -465,10 +465,10 @@ impl Continuer<'_> {
                 detail: "no complex pair at the Hopf point".into(),
             },
         )?;
-        let mode = rotor_model::Mode {
-            upper: rotor_model::DiscMode::SlipPos,
-            lower: rotor_model::DiscMode::SlipPos,
-        };
+        let mode = rotor_model::Mode::rig(
+            rotor_model::DiscMode::SlipPos,
+            rotor_model::DiscMode::SlipPos,
+        );
         let j = m.jacobian(&e.state(), e.u, mode);
         let lam = Complex::new(0.0, pair.im);
         let row = |i: usize| -> [Complex<f64>; 3] {

@@ -128,10 +128,7 @@ pub fn hopf_points(model: &Model, omega_max: f64) -> Vec<HopfPoint> {
 /// 2e-3 of 1 + |ω|: the torque is analytic on the branch). `None` if there is no complex pair.
 pub fn first_lyapunov(model: &Model, omega: f64) -> Option<f64> {
     let e = model.slip_equilibrium_at(omega);
-    let mode = Mode {
-        upper: DiscMode::SlipPos,
-        lower: DiscMode::SlipPos,
-    };
+    let mode = Mode::rig(DiscMode::SlipPos, DiscMode::SlipPos);
     let a = model.jacobian(&e.state(), e.u, mode);
     let beta = complex_pair(model, omega)?.im;
     let c = |v: f64| Complex::new(v, 0.0);
@@ -168,8 +165,8 @@ pub fn first_lyapunov(model: &Model, omega: f64) -> Option<f64> {
             / (2.0 * h3 * h3 * h3);
         (-second / j, -third / j)
     };
-    let (bu, cu) = d(rotor_model::Disc::Upper, model.params.j_u);
-    let (bl, cl) = d(rotor_model::Disc::Lower, model.params.j_l);
+    let (bu, cu) = d(rotor_model::Disc::UPPER, model.params.j_u);
+    let (bl, cl) = d(rotor_model::Disc::LOWER, model.params.j_l);
     let b = |x: &Vector3<Complex<f64>>, y: &Vector3<Complex<f64>>| {
         Vector3::new(c(0.0), x[1] * y[1] * bu, x[2] * y[2] * bl)
     };

@@ -57,13 +57,10 @@ pub(crate) fn touch_to_min(
     tol: f64,
     t_max: f64,
 ) -> Result<(State, f64, f64), BifError> {
-    let t_sl = model.friction(Disc::Lower).static_interval().1;
+    let t_sl = model.friction(Disc::LOWER).static_interval().1;
     let x0 = State::new(t_sl / model.params.k_theta, w, 0.0);
-    let mode = Mode {
-        upper: DiscMode::slip_of(w),
-        lower: DiscMode::SlipPos,
-    };
-    let s_u = mode.upper.branch().unwrap_or(1.0);
+    let mode = Mode::rig(DiscMode::slip_of(w), DiscMode::SlipPos);
+    let s_u = mode.upper().branch().unwrap_or(1.0);
     let mut f = |_t: f64, x: &State| model.rhs(x, u, mode);
     let acc = |x: &State| model.rhs(x, u, mode)[OMEGA_L];
     let mut ctl = Dop853::new(tol, tol);
@@ -138,12 +135,9 @@ pub fn touch_monodromy(
     tol: f64,
 ) -> Result<(nalgebra::Matrix3<f64>, f64), BifError> {
     let (_, period, _) = touch_to_min(model, u, w, tol, crate::bifurcation::periodic::T_RETURN)?;
-    let t_sl = model.friction(Disc::Lower).static_interval().1;
+    let t_sl = model.friction(Disc::LOWER).static_interval().1;
     let x0 = State::new(t_sl / model.params.k_theta, w, 0.0);
-    let mode = Mode {
-        upper: DiscMode::slip_of(w),
-        lower: DiscMode::SlipPos,
-    };
+    let mode = Mode::rig(DiscMode::slip_of(w), DiscMode::SlipPos);
     let var = crate::bifurcation::monodromy::along(model, u, tol, x0, mode, &[], period)?;
     Ok((var.phi, period))
 }

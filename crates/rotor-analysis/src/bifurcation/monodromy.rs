@@ -102,8 +102,11 @@ pub fn surface(model: &Model, kind: EventKind) -> Option<(Vector3<f64>, f64)> {
             n[d.index()] = 1.0;
             Some((n, 0.0))
         }
-        EventKind::StickEnd(Disc::Lower) => Some((Vector3::new(k, 0.0, 0.0), 0.0)),
-        EventKind::StickEnd(Disc::Upper) => Some((Vector3::new(-k, 0.0, 0.0), model.params.k_m)),
+        // The upper disc's applied torque is k_m u − k_θ α, the lower one's k_θ α.
+        EventKind::StickEnd(d) if d == Disc::UPPER => {
+            Some((Vector3::new(-k, 0.0, 0.0), model.params.k_m))
+        }
+        EventKind::StickEnd(_) => Some((Vector3::new(k, 0.0, 0.0), 0.0)),
         EventKind::Max(_) | EventKind::Min(_) => None,
     }
 }

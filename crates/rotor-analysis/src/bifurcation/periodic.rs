@@ -109,7 +109,7 @@ impl Shooter<'_> {
         let stuck = end
             .events
             .iter()
-            .any(|e| e.kind == rotor_model::seam::EventKind::StickStart(Disc::Lower));
+            .any(|e| e.kind == rotor_model::seam::EventKind::StickStart(Disc::LOWER));
         Ok((
             Return {
                 x: end.x,
@@ -164,7 +164,7 @@ impl Shooter<'_> {
 
     /// α at every exit of the lower disc from stick (upward): `k_θ α = T_sl`.
     pub fn exit_alpha(&self) -> f64 {
-        self.model.friction(Disc::Lower).static_interval().1 / self.model.params.k_theta
+        self.model.friction(Disc::LOWER).static_interval().1 / self.model.params.k_theta
     }
 
     /// State and mode just after the lower disc leaves stick with upper velocity `w`.
@@ -176,10 +176,7 @@ impl Shooter<'_> {
         };
         (
             State::new(self.exit_alpha(), w, 0.0),
-            Mode {
-                upper,
-                lower: DiscMode::SlipPos,
-            },
+            Mode::rig(upper, DiscMode::SlipPos),
         )
     }
 

@@ -62,8 +62,8 @@ impl Section {
 
     fn event(self) -> EventKind {
         match self {
-            Section::StickExit => EventKind::StickEnd(Disc::Lower),
-            Section::LowerMax => EventKind::Max(Disc::Lower),
+            Section::StickExit => EventKind::StickEnd(Disc::LOWER),
+            Section::LowerMax => EventKind::Max(Disc::LOWER),
         }
     }
 
@@ -80,13 +80,13 @@ impl Section {
         let k = model.params.k_theta;
         match self {
             Section::StickExit => {
-                let (_, hi) = model.friction(Disc::Lower).static_interval();
+                let (_, hi) = model.friction(Disc::LOWER).static_interval();
                 State::new(hi / k, z[0], 0.0)
             }
             Section::LowerMax => {
                 let w = z[1];
                 let s = if w < 0.0 { -1.0 } else { 1.0 };
-                let t = model.friction(Disc::Lower).torque(w, s);
+                let t = model.friction(Disc::LOWER).torque(w, s);
                 State::new(t / k, z[0], w)
             }
         }

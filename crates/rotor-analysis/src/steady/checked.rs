@@ -181,8 +181,8 @@ impl<'a> Run<'a> {
     /// The returns to `section` after `from` \[s\]: time and section coordinates.
     fn returns(&self, section: Section, from: f64) -> Vec<(f64, Vec<f64>)> {
         let kind = match section {
-            Section::StickExit => EventKind::StickEnd(Disc::Lower),
-            Section::LowerMax => EventKind::Max(Disc::Lower),
+            Section::StickExit => EventKind::StickEnd(Disc::LOWER),
+            Section::LowerMax => EventKind::Max(Disc::LOWER),
         };
         self.events
             .iter()

@@ -92,8 +92,8 @@ pub(crate) fn first_crossing(
         )
         .map_err(|e| e.to_string())?;
     let (kind, pick): (EventKind, fn(&rotor_model::State) -> Vec<f64>) = match section {
-        Section::StickExit => (EventKind::StickEnd(Disc::Lower), |x| vec![x[OMEGA_U]]),
-        Section::LowerMax => (EventKind::Max(Disc::Lower), |x| {
+        Section::StickExit => (EventKind::StickEnd(Disc::LOWER), |x| vec![x[OMEGA_U]]),
+        Section::LowerMax => (EventKind::Max(Disc::LOWER), |x| {
             vec![x[OMEGA_U], x[OMEGA_L]]
         }),
     };

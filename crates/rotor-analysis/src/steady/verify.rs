@@ -78,11 +78,8 @@ pub fn verify(
 }
 
 /// `upper` or `lower`, as in events.
-fn disc_name(d: Disc) -> &'static str {
-    match d {
-        Disc::Upper => "upper",
-        Disc::Lower => "lower",
-    }
+fn disc_name(d: Disc) -> std::borrow::Cow<'static, str> {
+    d.name_in(2)
 }
 
 fn refuted(what: &'static str, detail: String) -> SteadyError {
@@ -93,10 +90,7 @@ fn refuted(what: &'static str, detail: String) -> SteadyError {
 /// set-valued law counting as stuck.
 pub fn equilibrium(model: &Model, u: f64, x: &State, band: f64) -> Result<(), SteadyError> {
     let delta = EQUILIBRIUM_AMPLITUDE;
-    let mut mode = Mode {
-        upper: DiscMode::SlipPos,
-        lower: DiscMode::SlipPos,
-    };
+    let mut mode = Mode::rig(DiscMode::SlipPos, DiscMode::SlipPos);
     let mut stuck = [false; 2];
     for d in Disc::BOTH {
         let w = x[d.index()];
@@ -263,8 +257,8 @@ mod tests {
         // With the upper disc at rest too it is the stuck set's edge: an equilibrium.
         let x = State::new(3.708, 0.0, 0.0);
         let r = equilibrium(&m, 1.5, &x, 0.0);
-        let (lo, hi) = m.friction(Disc::Upper).static_interval();
-        let t = m.applied_torque(Disc::Upper, &x, 1.5);
+        let (lo, hi) = m.friction(Disc::UPPER).static_interval();
+        let t = m.applied_torque(Disc::UPPER, &x, 1.5);
         assert_eq!(r.is_ok(), lo <= t && t <= hi, "{r:?}");
     }
 
@@ -296,12 +290,12 @@ mod tests {
         let set = m.stuck_equilibria(u).expect("Table 1 sticks at 0.02 V");
         let x = State::new(set.alpha_min, 0.0, 0.0);
         equilibrium(&m, u, &x, 0.0).unwrap();
-        let (_, hi) = m.friction(Disc::Lower).static_interval();
+        let (_, hi) = m.friction(Disc::LOWER).static_interval();
         let beyond = State::new((hi + 1e-3) / m.params.k_theta, 0.0, 0.0);
         let r = equilibrium(&m, u, &beyond, 0.0);
         assert!(r.is_err(), "{r:?}");
         let banded = State::new(set.alpha_min, 0.0, 1e-10);
-        if m.friction(Disc::Lower).is_set_valued() {
+        if m.friction(Disc::LOWER).is_set_valued() {
             equilibrium(&m, u, &banded, 1e-10).unwrap();
         }
     }

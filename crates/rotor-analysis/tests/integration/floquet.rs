@@ -79,8 +79,8 @@ fn check_stick_slip_structure(sh: &Shooter, cy: &Cycle) {
     assert_eq!(
         kinds,
         [
-            EventKind::StickStart(Disc::Lower),
-            EventKind::StickEnd(Disc::Lower)
+            EventKind::StickStart(Disc::LOWER),
+            EventKind::StickEnd(Disc::LOWER)
         ]
     );
     // Entering stick: S = I − e₃e₃ᵀ exactly (f⁺ − f⁻ = −f⁻₃e₃ with ω_l = 0 set exactly at

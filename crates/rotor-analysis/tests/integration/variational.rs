@@ -87,7 +87,7 @@ fn reversal_of_the_lower_disc() {
     let m = model("table1");
     let x0 = State::new(-3.0, 1.0, 0.05);
     let mode = m.mode_at(&x0, 1.0);
-    let s = check(&m, 1.0, x0, mode, 0.5, EventKind::Reversal(Disc::Lower));
+    let s = check(&m, 1.0, x0, mode, 0.5, EventKind::Reversal(Disc::LOWER));
     // A genuine jump: f⁺₃ − f⁻₃ = 2T_sl/J_l ≈ 10 rad/s² against f⁻₃ ≈ −12 rad/s², so S
     // differs from I by O(1) (the comparison above fails if S is left out).
     assert!((s - Matrix3::identity()).amax() > 0.1, "{s}");
@@ -102,12 +102,12 @@ fn stick_exit_of_the_upper_disc_moves_with_u() {
     // disc; the stuck start zeroes the ω_u column of X(0).
     let m = model("stribeck");
     let u = 0.5;
-    let (_, hi) = m.friction(Disc::Upper).static_interval();
+    let (_, hi) = m.friction(Disc::UPPER).static_interval();
     let alpha = (m.params.k_m * u - (hi - 0.01)) / m.params.k_theta;
     let x0 = State::new(alpha, 0.0, 1.0);
     let mode = m.mode_at(&x0, u);
-    assert_eq!(mode.upper, rotor_model::DiscMode::Stick);
-    let s = check(&m, u, x0, mode, 0.5, EventKind::StickEnd(Disc::Upper));
+    assert_eq!(mode.upper(), rotor_model::DiscMode::Stick);
+    let s = check(&m, u, x0, mode, 0.5, EventKind::StickEnd(Disc::UPPER));
     // At an exit the applied torque equals the break-away level, which is also the slip
     // branch's torque at ω = 0⁺: f is continuous, so S = I and the u-jump vanishes (to the
     // rounding of the located exit, as for the lower disc).

@@ -10,7 +10,7 @@ use serde::Serialize;
 /// A scene's tier: `table1` when only the lower disc has static friction (what a solver that
 /// treats one switching surface handles), `full` when the upper disc sticks too.
 pub fn tier(sc: &Scenario) -> &'static str {
-    if sc.model.friction(Disc::Upper).is_set_valued() {
+    if sc.model.friction(Disc::UPPER).is_set_valued() {
         "full"
     } else {
         "table1"

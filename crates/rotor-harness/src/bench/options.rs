@@ -35,7 +35,7 @@ impl Tier {
 
     /// The tier of a scenario: `full` when its upper disc's friction is set-valued.
     pub fn of(sc: &rotor_model::scenario::Scenario) -> Tier {
-        if sc.model.friction(rotor_model::Disc::Upper).is_set_valued() {
+        if sc.model.friction(rotor_model::Disc::UPPER).is_set_valued() {
             Tier::Full
         } else {
             Tier::Table1

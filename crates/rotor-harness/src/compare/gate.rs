@@ -174,8 +174,8 @@ pub fn check_pair(
                             && e.t <= t1
                             && matches!(
                                 e.kind,
-                                EventKind::StickStart(Disc::Lower)
-                                    | EventKind::StickEnd(Disc::Lower)
+                                EventKind::StickStart(Disc::LOWER)
+                                    | EventKind::StickEnd(Disc::LOWER)
                             )
                     })
                     .map(|e| (e.t, e.kind))
@@ -444,10 +444,7 @@ mod tests {
             events: Vec::new(),
             t_final: 1.0,
             x_final: State::zeros(),
-            mode_final: Mode {
-                upper: DiscMode::SlipPos,
-                lower: DiscMode::SlipPos,
-            },
+            mode_final: Mode::rig(DiscMode::SlipPos, DiscMode::SlipPos),
             metrics,
             stats: Stats::default(),
         }
@@ -671,8 +668,8 @@ mod tests {
             kind,
         };
         a.events = vec![
-            ev(0.2, EventKind::StickStart(Disc::Lower)),
-            ev(0.4, EventKind::StickEnd(Disc::Lower)),
+            ev(0.2, EventKind::StickStart(Disc::LOWER)),
+            ev(0.4, EventKind::StickEnd(Disc::LOWER)),
         ];
         assert!(
             check_pair("p", &a, &a, Some([0.0, 1.0]), &tol, 0.0)
@@ -706,7 +703,7 @@ mod tests {
         b.events.pop();
         assert!(fails(&b)[0].contains("(2 vs 1 events)"), "{:?}", fails(&b));
         let mut b = a.clone();
-        b.events[1].kind = EventKind::StickStart(Disc::Lower);
+        b.events[1].kind = EventKind::StickStart(Disc::LOWER);
         assert!(
             fails(&b)[0].starts_with("stick event times"),
             "{:?}",

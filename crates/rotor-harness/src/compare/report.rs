@@ -259,8 +259,8 @@ pub(crate) fn friction_csv(sets: &[(&str, Params)]) -> String {
 fn friction_panels<'a>(sets: &[(&'a str, Params)]) -> Vec<Panel<'a>> {
     let mut panels = Vec::new();
     for (disc, name) in [
-        (Disc::Upper, "upper disc T_fu"),
-        (Disc::Lower, "lower disc T_fl"),
+        (Disc::UPPER, "upper disc T_fu"),
+        (Disc::LOWER, "lower disc T_fl"),
     ] {
         let series = sets
             .iter()

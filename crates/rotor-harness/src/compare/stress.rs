@@ -433,7 +433,7 @@ fn periods(events: &[Event], from: f64) -> Vec<(f64, usize)> {
     let mut out = Vec::new();
     let mut last: Option<(f64, usize)> = None;
     for (i, e) in events.iter().enumerate() {
-        if e.t < from || e.kind != EventKind::StickEnd(Disc::Lower) {
+        if e.t < from || e.kind != EventKind::StickEnd(Disc::LOWER) {
             continue;
         }
         if let Some((t0, i0)) = last {
@@ -481,8 +481,8 @@ fn reversal_term(p: &Params, events: &[Event], samples: &[(f64, State)], h: f64)
     let mut sum = 0.0;
     for e in events {
         let (t_s, j, i) = match e.kind {
-            EventKind::Reversal(Disc::Upper) => (p.upper.t_s, p.j_u, 1),
-            EventKind::Reversal(Disc::Lower) => (p.lower.static_level(), p.j_l, OMEGA_L),
+            EventKind::Reversal(Disc::UPPER) => (p.upper.t_s, p.j_u, 1),
+            EventKind::Reversal(Disc::LOWER) => (p.lower.static_level(), p.j_l, OMEGA_L),
             _ => continue,
         };
         sum += 2.0 * h * t_s / (j * scale(i));

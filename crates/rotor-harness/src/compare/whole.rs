@@ -83,7 +83,7 @@ pub fn is_switch(kind: EventKind) -> bool {
 
 /// Whether an event is matched between the two runs: a mode switch or a maximum of ω_l.
 pub fn is_matched(kind: EventKind) -> bool {
-    is_switch(kind) || kind == EventKind::Max(Disc::Lower)
+    is_switch(kind) || kind == EventKind::Max(Disc::LOWER)
 }
 
 /// Whether a matched event anchors the phase: a stick exit (the spring's torque crosses the
@@ -91,7 +91,7 @@ pub fn is_matched(kind: EventKind) -> bool {
 /// maximum of ω_l. A stick onset is not: ω arrives at 0 with ω̇ that may be near 0 (the
 /// Stribeck scenes), and the switch model's band η moves it by η/|ω̇|.
 pub fn is_anchor(kind: EventKind) -> bool {
-    matches!(kind, EventKind::StickEnd(_) | EventKind::Max(Disc::Lower))
+    matches!(kind, EventKind::StickEnd(_) | EventKind::Max(Disc::LOWER))
 }
 
 /// The matched events of two runs as `(t_A, Δt = t_B − t_A, kind)`, in time order: every
@@ -297,10 +297,7 @@ mod tests {
             events,
             t_final: 1.0,
             x_final: State::zeros(),
-            mode_final: Mode {
-                upper: DiscMode::SlipPos,
-                lower: DiscMode::SlipPos,
-            },
+            mode_final: Mode::rig(DiscMode::SlipPos, DiscMode::SlipPos),
             metrics: None,
             stats: Stats::default(),
         }
@@ -320,8 +317,8 @@ mod tests {
     /// they do not, the switches alone; switches that differ are not matched at all.
     #[test]
     fn maxima_are_matched_only_where_both_runs_report_them() {
-        let exit = EventKind::StickEnd(Disc::Lower);
-        let max = EventKind::Max(Disc::Lower);
+        let exit = EventKind::StickEnd(Disc::LOWER);
+        let max = EventKind::Max(Disc::LOWER);
         let a = traj(vec![ev(0.1, exit), ev(0.3, max), ev(0.6, max)]);
         let b = traj(vec![
             ev(0.1 + 1e-6, exit),
@@ -337,14 +334,14 @@ mod tests {
         let m = matched_events(&a, &c).unwrap();
         assert!(!m.maxima && m.events.len() == 1);
         // Another switch: nothing matched, the event gate is infinite.
-        let d = traj(vec![ev(0.1, EventKind::StickStart(Disc::Lower))]);
+        let d = traj(vec![ev(0.1, EventKind::StickStart(Disc::LOWER))]);
         assert!(matched_events(&a, &d).is_none());
         let w = whole_run(&Model::table1(), 1.5, &a, &d, 0.0);
         assert!(w.event_time.is_infinite() && w.events == 0);
         // Upper-disc extrema are not matched (their count depends on the tolerance too).
         let e = traj(vec![
             ev(0.1, exit),
-            ev(0.2, EventKind::Max(Disc::Upper)),
+            ev(0.2, EventKind::Max(Disc::UPPER)),
             ev(0.3, max),
             ev(0.6, max),
         ]);
@@ -367,7 +364,7 @@ mod tests {
     /// out of the aligned comparison; the others are compared.
     #[test]
     fn samples_within_a_shift_of_a_switch_are_excluded() {
-        let start = EventKind::StickStart(Disc::Lower);
+        let start = EventKind::StickStart(Disc::LOWER);
         let a = traj(vec![ev(0.5 - 1e-3, start)]);
         let b = traj(vec![ev(0.5 + 1e-3, start)]);
         let w = whole_run(&Model::table1(), 1.5, &a, &b, 0.0);

@@ -532,7 +532,7 @@ fn sample_differences(trace: &[Sample], reference: &[Sample]) -> [(f64, f64); 3]
 
 /// An event as the files name it: `lower stick_start at 4.7677 s`.
 fn describe(e: &Event) -> String {
-    let (disc, kind) = event_row(e.kind).map_or(("?", "?"), |(d, k)| (disc_name(d), k));
+    let (disc, kind) = event_row(e.kind).map_or(("?".into(), "?"), |(d, k)| (disc_name(d), k));
     format!("{disc} {kind} at {} s", e.t)
 }
 
@@ -591,7 +591,7 @@ fn grade_events(reference: &[Event], trace: &[Event], t_scale: f64, level: Level
     };
     let (reference, trace) = (switches(reference), switches(trace));
     let mut classes: Vec<EventKind> = reference.iter().chain(&trace).map(|e| e.kind).collect();
-    classes.sort_by_key(|k| format!("{k:?}"));
+    classes.sort_by_key(|k| (k.disc(), event_row(*k).map(|(_, name)| name)));
     classes.dedup();
     let (mut worst, mut missing, mut extra) = (0.0f64, Vec::new(), Vec::new());
     for kind in classes {
@@ -679,10 +679,7 @@ fn grade_stick(
     t_scale: f64,
     level: Level,
 ) -> Option<Graded> {
-    let i = match disc {
-        Disc::Upper => 1,
-        Disc::Lower => 2,
-    };
+    let i = disc.index();
     let stuck = stuck_threshold(scale[i], level);
     let name = format!("stick_{}", disc_name(disc));
     let rs = &reference.samples;
@@ -940,7 +937,7 @@ pub fn check(
         Some(f) => q.push(grade_events(&reference.events, &f.events, t_scale, level)),
         None => not_graded.push("events".to_owned()),
     }
-    for disc in [Disc::Lower, Disc::Upper] {
+    for disc in [Disc::LOWER, Disc::UPPER] {
         q.extend(grade_stick(
             disc,
             &trace.samples,

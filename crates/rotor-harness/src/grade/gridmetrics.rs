@@ -204,8 +204,8 @@ fn maxima(s: &[Sample], exit: StickExit, stuck: f64) -> Vec<(usize, f64)> {
         // field, to where ω̇_l turns negative.
         let lower = DiscMode::slip_of(b);
         let from = &s[k - 1];
-        let upper = m.mode_at(&from.x, exit.u).upper;
-        let mode = rotor_model::Mode { upper, lower };
+        let upper = m.mode_at(&from.x, exit.u).upper();
+        let mode = rotor_model::Mode::rig(upper, lower);
         let t = exit.crossing(from, s[k + 1].t, lower, |x| m.rhs(x, exit.u, mode)[OMEGA_L]);
         out.push((if t <= s[k].t { k } else { k + 1 }, t));
     }
@@ -240,8 +240,8 @@ fn extremes(s: &[Sample], i: usize, exit: StickExit, stuck: f64) -> (f64, f64) {
         }
         let from = &s[k - 1];
         let lower = DiscMode::slip_of(from.x[OMEGA_L]);
-        let upper = m.mode_at(&from.x, exit.u).upper;
-        let mode = rotor_model::Mode { upper, lower };
+        let upper = m.mode_at(&from.x, exit.u).upper();
+        let mode = rotor_model::Mode::rig(upper, lower);
         let (_, x) = exit.crossing_state(from, s[k + 1].t, lower, |x| {
             sign * m.rhs(x, exit.u, mode)[i]
         });
@@ -254,8 +254,8 @@ impl StickExit<'_> {
     /// How far the applied torque on the lower disc is outside its stick interval (< 0
     /// inside).
     fn excess(&self, x: &State) -> f64 {
-        let (lo, hi) = self.model.friction(Disc::Lower).static_interval();
-        let t = self.model.applied_torque(Disc::Lower, x, self.u);
+        let (lo, hi) = self.model.friction(Disc::LOWER).static_interval();
+        let t = self.model.applied_torque(Disc::LOWER, x, self.u);
         (t - hi).max(lo - t)
     }
 
@@ -280,8 +280,8 @@ impl StickExit<'_> {
         if lower == DiscMode::Stick {
             x[OMEGA_L] = 0.0;
         }
-        let upper = m.mode_at(&x, self.u).upper;
-        let mode = rotor_model::Mode { upper, lower };
+        let upper = m.mode_at(&x, self.u).upper();
+        let mode = rotor_model::Mode::rig(upper, lower);
         let f = |x: &State| m.rhs(x, self.u, mode);
         let h = (t_max - a.t) / STEPS as f64;
         let mut t = a.t;

@@ -599,12 +599,9 @@ fn csv_rows(
 /// The header of an events file.
 pub(crate) const EVENTS_HEADER: [&str; 3] = ["t", "disc", "kind"];
 
-/// `upper` or `lower`.
-pub fn disc_name(d: Disc) -> &'static str {
-    match d {
-        Disc::Upper => "upper",
-        Disc::Lower => "lower",
-    }
+/// The rig's word for a disc, `upper` or `lower`, as an events file names it.
+pub fn disc_name(d: Disc) -> std::borrow::Cow<'static, str> {
+    d.name_in(2)
 }
 
 /// The disc and the events-file name of a mode-switch event (`None` for extrema, which the
@@ -627,7 +624,7 @@ pub fn write_events(events: &[Event]) -> Vec<u8> {
         if let Some((d, k)) = event_row(e.kind) {
             out.push_str(b.format(e.t));
             out.push(',');
-            out.push_str(disc_name(d));
+            out.push_str(&disc_name(d));
             out.push(',');
             out.push_str(k);
             out.push('\n');
@@ -665,8 +662,8 @@ const KIND_WORDS: &str = "stick_start, stick_end, reversal";
 /// The disc named `word` ([`disc_name`] read back).
 fn disc_of(word: &str) -> Option<Disc> {
     match word {
-        "upper" => Some(Disc::Upper),
-        "lower" => Some(Disc::Lower),
+        "upper" => Some(Disc::UPPER),
+        "lower" => Some(Disc::LOWER),
         _ => None,
     }
 }
@@ -924,10 +921,10 @@ mod tests {
             kind,
         };
         let events = vec![
-            ev(0.5, EventKind::StickStart(Disc::Lower)),
-            ev(0.75, EventKind::Max(Disc::Lower)),
-            ev(1.0 / 3.0, EventKind::StickEnd(Disc::Lower)),
-            ev(2.0, EventKind::Reversal(Disc::Upper)),
+            ev(0.5, EventKind::StickStart(Disc::LOWER)),
+            ev(0.75, EventKind::Max(Disc::LOWER)),
+            ev(1.0 / 3.0, EventKind::StickEnd(Disc::LOWER)),
+            ev(2.0, EventKind::Reversal(Disc::UPPER)),
         ];
         let bytes = write_events(&events);
         let text = String::from_utf8(bytes.clone()).unwrap();
@@ -942,9 +939,9 @@ mod tests {
         assert_eq!(
             kinds,
             [
-                (0.5, EventKind::StickStart(Disc::Lower)),
-                (1.0 / 3.0, EventKind::StickEnd(Disc::Lower)),
-                (2.0, EventKind::Reversal(Disc::Upper)),
+                (0.5, EventKind::StickStart(Disc::LOWER)),
+                (1.0 / 3.0, EventKind::StickEnd(Disc::LOWER)),
+                (2.0, EventKind::Reversal(Disc::UPPER)),
             ]
         );
         assert!(

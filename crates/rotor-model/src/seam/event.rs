@@ -1,12 +1,9 @@
 //! What happened during a run: the events a solver reports.
 
-use serde::Serialize;
-
 use crate::{Disc, State};
 
 /// What happened at an event.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
-#[serde(rename_all = "snake_case")]
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum EventKind {
     /// The disc's velocity reached 0 and it sticks.
     StickStart(Disc),
@@ -22,8 +19,21 @@ pub enum EventKind {
     Min(Disc),
 }
 
+impl EventKind {
+    /// The disc the event happened to.
+    pub fn disc(self) -> Disc {
+        match self {
+            EventKind::StickStart(d)
+            | EventKind::StickEnd(d)
+            | EventKind::Reversal(d)
+            | EventKind::Max(d)
+            | EventKind::Min(d) => d,
+        }
+    }
+}
+
 /// An event with its time and the state there.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Event {
     /// Time of the event \[s\], as the reporting solver located it.
     pub t: f64,

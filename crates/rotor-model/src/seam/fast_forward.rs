@@ -171,8 +171,8 @@ impl FastForward {
             t_from,
             t_end,
             tracks: [
-                Track::new(EventKind::StickEnd(Disc::Lower)),
-                Track::new(EventKind::Max(Disc::Lower)),
+                Track::new(EventKind::StickEnd(Disc::LOWER)),
+                Track::new(EventKind::Max(Disc::LOWER)),
             ],
             phase: Phase::Watching,
             verify: VERIFY_TOLERANCES,
@@ -342,7 +342,7 @@ mod tests {
         Event {
             t,
             x: State::new(2.0, w, 0.0),
-            kind: EventKind::StickEnd(Disc::Lower),
+            kind: EventKind::StickEnd(Disc::LOWER),
         }
     }
 
@@ -360,9 +360,9 @@ mod tests {
     /// the index is into `evs`.
     fn first_jump(ff: &mut FastForward, evs: &[Event]) -> Option<(usize, f64)> {
         evs.iter().enumerate().find_map(|(k, e)| {
-            if e.kind == EventKind::StickEnd(Disc::Lower) {
+            if e.kind == EventKind::StickEnd(Disc::LOWER) {
                 let mut max = *e;
-                (max.t, max.x[2], max.kind) = (e.t - 2.0, 6.0, EventKind::Max(Disc::Lower));
+                (max.t, max.x[2], max.kind) = (e.t - 2.0, 6.0, EventKind::Max(Disc::LOWER));
                 assert_eq!(ff.observe(&max), Verdict::Continue);
             }
             match ff.observe(e) {
@@ -530,8 +530,8 @@ mod tests {
             .flat_map(|k| {
                 let t = 4.0 * k as f64;
                 [
-                    ev(t, 1.0 + a(k), EventKind::Max(Disc::Lower)),
-                    ev(t + 2.0, 1.0 - a(k), EventKind::Min(Disc::Lower)),
+                    ev(t, 1.0 + a(k), EventKind::Max(Disc::LOWER)),
+                    ev(t + 2.0, 1.0 - a(k), EventKind::Min(Disc::LOWER)),
                 ]
             })
             .collect()

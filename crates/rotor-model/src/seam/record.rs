@@ -191,8 +191,8 @@ impl Recorder {
     ///             rec.step(t0, t1, &x(t1), x); // the exact solution is the interpolant
     ///             self.t = t1;
     ///             let kind = match t1.rem_euclid(4.0) {
-    ///                 1.0 => EventKind::Max(Disc::Lower),
-    ///                 3.0 => EventKind::Min(Disc::Lower),
+    ///                 1.0 => EventKind::Max(Disc::LOWER),
+    ///                 3.0 => EventKind::Min(Disc::LOWER),
     ///                 _ => continue,
     ///             };
     ///             rec.event(Event { t: t1, x: x(t1), kind });
@@ -222,7 +222,7 @@ impl Recorder {
     /// let mut rec = Recorder::new(&scene, scene.x0, 1e-10, 3.0);
     /// let mut toy = Toy { t: 0.0, t_end: scene.t_end };
     /// rec.drive(&mut toy)?;
-    /// let slip = Mode { upper: DiscMode::SlipPos, lower: DiscMode::SlipPos };
+    /// let slip = Mode::rig(DiscMode::SlipPos, DiscMode::SlipPos);
     /// let tr = rec.finish(toy.t, x(toy.t), slip, Stats::default());
     ///
     /// assert_eq!(tr.t_final, 100.0);
@@ -350,9 +350,9 @@ mod tests {
                 let te = k + offset;
                 if te <= t1 {
                     let kind = if tri(k) > 0.0 {
-                        EventKind::Max(Disc::Lower)
+                        EventKind::Max(Disc::LOWER)
                     } else {
-                        EventKind::Min(Disc::Lower)
+                        EventKind::Min(Disc::LOWER)
                     };
                     rec.step(self.t, te, &y(te), y);
                     self.steps += 1;
@@ -389,10 +389,7 @@ mod tests {
         }
     }
 
-    const MODE: Mode = Mode {
-        upper: DiscMode::SlipPos,
-        lower: DiscMode::SlipPos,
-    };
+    const MODE: Mode = Mode::rig(DiscMode::SlipPos, DiscMode::SlipPos);
 
     fn run(output: Output, drift: f64, verify: f64) -> (Trajectory, u64) {
         let scene = Scene {

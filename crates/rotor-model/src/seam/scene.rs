@@ -635,14 +635,11 @@ mod tests {
             events: vec![Event {
                 t: 0.5,
                 x,
-                kind: EventKind::StickStart(Disc::Lower),
+                kind: EventKind::StickStart(Disc::LOWER),
             }],
             t_final: 1.0,
             x_final: x,
-            mode_final: Mode {
-                upper: DiscMode::SlipPos,
-                lower: DiscMode::Stick,
-            },
+            mode_final: Mode::rig(DiscMode::SlipPos, DiscMode::Stick),
             metrics: Some(SteadyState::Equilibrium {
                 omega_u: 2.0,
                 omega_l: 3.0,

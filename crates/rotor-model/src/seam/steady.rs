@@ -226,8 +226,8 @@ impl MetricsAccumulator {
             }
         }
         match e.kind {
-            EventKind::StickStart(Disc::Lower) => self.stick_since = Some(e.t),
-            EventKind::StickEnd(Disc::Lower) => {
+            EventKind::StickStart(Disc::LOWER) => self.stick_since = Some(e.t),
+            EventKind::StickEnd(Disc::LOWER) => {
                 if let Some(t0) = self.stick_since.take() {
                     for s in [&mut self.stick_exits, &mut self.maxima] {
                         if let Some(c) = s.open.as_mut() {
@@ -237,7 +237,7 @@ impl MetricsAccumulator {
                 }
                 self.stick_exits.anchor(e.t, &e.x);
             }
-            EventKind::Max(Disc::Lower) => self.maxima.anchor(e.t, &e.x),
+            EventKind::Max(Disc::LOWER) => self.maxima.anchor(e.t, &e.x),
             _ => {}
         }
     }
@@ -367,7 +367,7 @@ mod tests {
     #[test]
     fn stick_slip_cycle_from_events() {
         let mut m = MetricsAccumulator::new(1.0);
-        let l = Disc::Lower;
+        let l = Disc::LOWER;
         let evs = [
             ev(0.5, [0.0, 1.0, 0.0], EventKind::StickEnd(l)), // before t_from: ignored
             ev(2.0, [2.2, 1.0, 0.0], EventKind::StickEnd(l)),
@@ -405,7 +405,7 @@ mod tests {
     #[test]
     fn amplitude_drift_sees_a_decay_the_period_does_not() {
         let mut m = MetricsAccumulator::new(0.0);
-        let l = Disc::Lower;
+        let l = Disc::LOWER;
         for (t, kind, w) in [
             (0.0, EventKind::Max(l), 5.0),
             (2.0, EventKind::Min(l), 1.0),
@@ -424,7 +424,7 @@ mod tests {
     /// anchor lies in the window or before it.
     #[test]
     fn fast_forward_keeps_the_metrics_of_the_skipped_run() {
-        let l = Disc::Lower;
+        let l = Disc::LOWER;
         // A stick-slip cycle of period 3: exit, max, stick onset.
         let cycle = |k: f64| {
             [

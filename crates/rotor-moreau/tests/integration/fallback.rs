@@ -25,7 +25,7 @@ fn step_residual(m: &Model, u: f64, x: &rotor_model::State, h: f64, o: &StepOutc
     let th = 0.5;
     let (mm, c) = (
         Matrix2::new(p.j_u, 0.0, 0.0, p.j_l),
-        Matrix2::new(p.upper.b, 0.0, 0.0, m.friction(Disc::Lower).viscous()),
+        Matrix2::new(p.upper.b, 0.0, 0.0, m.friction(Disc::LOWER).viscous()),
     );
     let k = Matrix2::new(p.k_theta, -p.k_theta, -p.k_theta, p.k_theta);
     let v = Vector2::new(x[1], x[2]);
@@ -33,8 +33,8 @@ fn step_residual(m: &Model, u: f64, x: &rotor_model::State, h: f64, o: &StepOutc
     let sgn = |w: f64| if w < 0.0 { -1.0 } else { 1.0 };
     let g = |w: Vector2<f64>| {
         Vector2::new(
-            smooth_force(m, Disc::Upper, w[0], sgn(w[0])),
-            smooth_force(m, Disc::Lower, w[1], sgn(w[1])),
+            smooth_force(m, Disc::UPPER, w[0], sgn(w[0])),
+            smooth_force(m, Disc::LOWER, w[1], sgn(w[1])),
         )
     };
     let kq = Vector2::new(p.k_theta * x[0], -p.k_theta * x[0]);

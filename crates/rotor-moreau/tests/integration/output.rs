@@ -159,7 +159,7 @@ fn events_are_ordered_and_stick_phases_alternate() {
         .filter(|k| {
             matches!(
                 k,
-                EventKind::StickStart(Disc::Lower) | EventKind::StickEnd(Disc::Lower)
+                EventKind::StickStart(Disc::LOWER) | EventKind::StickEnd(Disc::LOWER)
             )
         })
         .collect();
@@ -167,9 +167,9 @@ fn events_are_ordered_and_stick_phases_alternate() {
     assert!(lower.len() >= 10, "{lower:?}");
     for (i, k) in lower.iter().enumerate() {
         let want = if i % 2 == 0 {
-            EventKind::StickEnd(Disc::Lower)
+            EventKind::StickEnd(Disc::LOWER)
         } else {
-            EventKind::StickStart(Disc::Lower)
+            EventKind::StickStart(Disc::LOWER)
         };
         assert_eq!(*k, want, "event {i}");
     }
@@ -190,7 +190,7 @@ fn events_are_ordered_and_stick_phases_alternate() {
     let maxima: Vec<_> = with_metrics
         .events
         .iter()
-        .filter(|e| e.kind == EventKind::Max(Disc::Lower))
+        .filter(|e| e.kind == EventKind::Max(Disc::LOWER))
         .collect();
     assert!(maxima.len() >= 7, "one per cycle of ~4.6 s");
     assert!(with_metrics.events.windows(2).all(|w| w[0].t <= w[1].t));

@@ -108,8 +108,8 @@ fn stribeck_u005_keeps_both_discs_stuck() {
         for s in &tr.samples {
             assert_eq!(s.x, State::zeros(), "t={}", s.t);
         }
-        assert_eq!(tr.mode_final.upper, rotor_model::DiscMode::Stick);
-        assert_eq!(tr.mode_final.lower, rotor_model::DiscMode::Stick);
+        assert_eq!(tr.mode_final.upper(), rotor_model::DiscMode::Stick);
+        assert_eq!(tr.mode_final.lower(), rotor_model::DiscMode::Stick);
         assert!(tr.events.is_empty());
     }
 }
