@@ -14,7 +14,7 @@
 
 use rotor_event::{EventOptions, EventSolver};
 use rotor_model::seam::{Accuracy, Output, Scene, Solver, SteadyState};
-use rotor_model::{LowerFriction, Model, Params, State, UpperFriction};
+use rotor_model::{LowerFriction, Model, Params, UpperFriction};
 use rotor_switch::{SwitchOptions, SwitchSolver};
 
 /// xorshift64*: a reproducible draw without a dependency.
@@ -204,7 +204,7 @@ fn main() {
         let scene = Scene {
             u: *u,
             input: None,
-            x0: State::zeros(),
+            x0: vec![0.0; 3],
             t_end: 100.0,
             accuracy: Accuracy::Tol(tol),
             output: Output::Final,

@@ -15,9 +15,9 @@ use rotor_analysis::solvers::{SOLVERS, SolverKind};
 use rotor_analysis::steady::checked::checked_or_simulated;
 use rotor_analysis::steady::verify::answer_accuracy;
 use rotor_analysis::steady::{SteadyAnswer, SteadyOptions, simulated};
+use rotor_model::Model;
 use rotor_model::scenario::Scenario;
 use rotor_model::seam::{Scene, SteadyState};
-use rotor_model::{Model, State};
 
 /// `(kind, values)` of an answer: an equilibrium's (α, ω_u, ω_l), a cycle's six metrics.
 fn values(a: &SteadyAnswer) -> (&'static str, Vec<(&'static str, f64)>) {
@@ -95,7 +95,7 @@ fn on_every_fixture_scene_each_solvers_steady_answer_is_what_its_simulation_sett
             SOLVERS.iter().map(|&k| {
                 let scene = Scene {
                     u: s.u,
-                    x0: s.x0,
+                    x0: s.x0.as_slice().to_vec(),
                     ..Scene::default()
                 };
                 (s.name.clone(), k, s.model, scene)
@@ -124,7 +124,7 @@ fn the_stribeck_set_from_rest_every_solver_agrees_with_its_simulation() {
             SOLVERS.iter().map(move |&k| {
                 let scene = Scene {
                     u,
-                    x0: State::zeros(),
+                    x0: vec![0.0; 3],
                     ..Scene::default()
                 };
                 (format!("{u:.1} V"), k, model, scene)

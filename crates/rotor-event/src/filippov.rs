@@ -429,6 +429,7 @@ impl<'a> Integrator<'a> {
 
     /// ∂/∂t of a disc's applied torque at fixed state: `k_m·du/dt` on the upper disc (the
     /// motor's), 0 on the lower.
+    #[inline]
     fn torque_drift(&self, d: Disc) -> f64 {
         if d == Disc::UPPER {
             self.model.params.k_m * self.piece.slope
@@ -437,11 +438,13 @@ impl<'a> Integrator<'a> {
         }
     }
 
+    #[inline]
     fn stick_interval(&self, d: Disc) -> (f64, f64) {
         self.stick_intervals[d.position()]
     }
 
     /// Value of a guard at state x at time t (in the current mode).
+    #[inline(always)]
     fn guard(&self, g: Guard, t: f64, x: &State, mode: Mode) -> f64 {
         match g {
             Guard::Velocity(d) => {
@@ -467,6 +470,7 @@ impl<'a> Integrator<'a> {
     /// Time derivative of a guard along the mode's field, given the field `f` at x: the
     /// rate through the state plus, for a guard holding the input, its rate through u(t)
     /// (`k_m·du/dt` in the upper disc's applied torque; 0 for a constant input).
+    #[inline(always)]
     fn guard_rate(&self, g: Guard, x: &State, f: &State, mode: Mode) -> f64 {
         match g {
             Guard::Velocity(d) => mode.of(d).branch().unwrap_or(1.0) * f[d.index()],

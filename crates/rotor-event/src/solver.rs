@@ -25,7 +25,7 @@ use crate::filippov::{EventOptions, Integrator, RunEnd, Sink};
 /// let model = Model::table1();
 /// let scene = Scene {
 ///     u: 1.5,                // V
-///     x0: State::zeros(),    // [α, ω_u, ω_l]: at rest
+///     x0: vec![0.0; 3],    // [α, ω_u, ω_l]: at rest
 ///     t_end: 60.0,           // s
 ///     accuracy: Accuracy::Tol(1e-10), // relative = absolute
 ///     output: Output::Metrics,
@@ -126,13 +126,14 @@ impl Solver for EventSolver {
     fn simulate(&self, model: &Model, scene: &Scene) -> Result<Trajectory, SolveError> {
         scene.validate_for(model)?;
         let tol = scene.tol();
-        let mut rec = Recorder::new(scene, scene.x0, tol, self.options.skip_verify);
+        let x0 = scene.x0_state()?;
+        let mut rec = Recorder::new(scene, x0, tol, self.options.skip_verify);
         let mut integ = Integrator::new(model, scene.u_at(0.0), tol, self.options);
         integ.extrema = rec.wants_extrema();
         let at = RunEnd {
             t: 0.0,
-            x: scene.x0,
-            mode: model.mode_at(&scene.x0, scene.u_at(0.0)),
+            x: x0,
+            mode: model.mode_at(&x0, scene.u_at(0.0)),
         };
         let mut run = Run {
             integ,

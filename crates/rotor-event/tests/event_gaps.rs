@@ -83,7 +83,7 @@ fn a_stick_exit_guard_dipping_inside_one_step_is_found() {
     let tol = 1e-12;
     let scene = Scene {
         u,
-        x0: State::new(a_star, v, 0.0),
+        x0: vec![a_star, v, 0.0],
         t_end: 3.0,
         output: Output::Events,
         ..Scene::with_tol(tol)
@@ -156,7 +156,7 @@ fn a_disc_stuck_on_its_edge_after_a_switch_leaves_at_once() {
             &m,
             &Scene {
                 u,
-                x0: x,
+                x0: x.as_slice().to_vec(),
                 t_end: 10.0,
                 output: Output::Events,
                 ..Scene::with_tol(tol)
@@ -210,7 +210,7 @@ fn both_discs_sticking_at_one_instant_both_stick() {
                 &m,
                 &Scene {
                     u: 0.5,
-                    x0: State::new(0.5, w0, w0),
+                    x0: vec![0.5, w0, w0],
                     t_end: 20.0,
                     output: Output::Events,
                     ..Scene::with_tol(tol)

@@ -47,7 +47,7 @@ fn frictionless_levels_match_matrix_exponential() {
         let exact = (a * t_end).exp() * (x0 + ainv_b) - ainv_b;
         let s = Scene {
             u,
-            x0,
+            x0: x0.as_slice().to_vec(),
             t_end,
             output: Output::Final,
             ..Scene::with_tol(1e-12)
@@ -325,7 +325,7 @@ fn mirror_symmetry_is_exact() {
     let run = |u: f64, x0: State| {
         let s = Scene {
             u,
-            x0,
+            x0: x0.as_slice().to_vec(),
             t_end: 50.0,
             output: Output::Final,
             ..Scene::default()
@@ -718,7 +718,7 @@ fn a_start_on_the_stick_edge_with_rising_torque_leaves_at_once() {
                 &m,
                 &Scene {
                     u: 4.63,
-                    x0: State::new(alpha, 8.0, 0.0),
+                    x0: vec![alpha, 8.0, 0.0],
                     t_end: 10.0,
                     output: Output::Events,
                     ..Scene::with_tol(1e-12)
@@ -771,7 +771,7 @@ fn stick_time(solver: &EventSolver, m: &Model, tol: f64) -> f64 {
     let scene = Scene {
         u: 1.5 * 1.91649573917313,
         input: None,
-        x0: State::zeros(),
+        x0: vec![0.0; 3],
         t_end: 100.0,
         accuracy: rotor_model::seam::Accuracy::Tol(tol),
         output: Output::Final,
@@ -850,7 +850,7 @@ fn a_misjudged_step_found_at_an_event_is_redone() {
     let scene = Scene {
         u: 1.248574492243608,
         input: None,
-        x0: State::zeros(),
+        x0: vec![0.0; 3],
         t_end: 100.0,
         accuracy: rotor_model::seam::Accuracy::Tol(1e-10),
         output: Output::Final,

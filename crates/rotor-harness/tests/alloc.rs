@@ -11,7 +11,7 @@ use rotor_event::EventSolver;
 use std::path::Path;
 
 use rotor_model::seam::{Accuracy, Output, Scene, Solver};
-use rotor_model::{Model, Params, State};
+use rotor_model::{Model, Params};
 use rotor_moreau::MoreauSolver;
 use rotor_switch::SwitchSolver;
 
@@ -22,7 +22,7 @@ fn scene(t_end: f64, metrics: bool) -> Scene {
     Scene {
         u: 1.5,
         input: None,
-        x0: State::zeros(),
+        x0: vec![0.0; 3],
         t_end,
         // Moreau–Jean takes the default step, 1e-3.
         accuracy: Accuracy::Tol(1e-10),

@@ -1,9 +1,9 @@
 //! Cross-solver checks of single solver features against the event-driven reference (the
 //! solver crates test themselves; what needs a second solver lives here).
 
-use rotor_analysis::solvers::SolverKind;
+use rotor_analysis::solvers::{SOLVERS, SolverKind};
 use rotor_model::seam::{Accuracy, EventKind, Output, Scene, Solver, Trajectory};
-use rotor_model::{Disc, Model, OMEGA_L, State};
+use rotor_model::{Disc, Model, OMEGA_L};
 
 /// `scene` run by `kind` at `setting`, its tolerance or its step.
 fn run(kind: SolverKind, setting: f64, scene: &Scene) -> Trajectory {
@@ -25,7 +25,7 @@ fn run(kind: SolverKind, setting: f64, scene: &Scene) -> Trajectory {
 fn a_reversal_without_sticking_matches_the_event_solver() {
     let scene = Scene {
         u: 1.5,
-        x0: State::new(5.0, 0.0, -1.0),
+        x0: vec![5.0, 0.0, -1.0],
         t_end: 1.0,
         output: Output::Events,
         ..Scene::default()
@@ -159,5 +159,23 @@ fn grid_samples_between_steps_match_the_event_solver() {
             6e-5
         };
         assert!(worst <= gate, "{}: {worst:e} > {gate:e}", kind.name());
+    }
+}
+
+/// The initial state is a list of the model's size: every solver refuses a list of another
+/// size by name (the rig's state has three values), rather than reading past it or padding.
+#[test]
+fn every_solver_refuses_an_initial_state_of_the_wrong_size() {
+    for kind in SOLVERS {
+        for n in [2, 4] {
+            let scene = Scene {
+                x0: vec![0.0; n],
+                accuracy: kind.accuracy(if kind.is_fixed_step() { 1e-3 } else { 1e-8 }),
+                ..Scene::default()
+            };
+            let err = kind.solver().simulate(&Model::table1(), &scene).unwrap_err();
+            let msg = err.to_string();
+            assert!(msg.contains(&format!("x0 = {n} values")), "{}: {msg}", kind.name());
+        }
     }
 }

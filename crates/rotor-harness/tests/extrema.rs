@@ -11,7 +11,7 @@
 
 use rotor_analysis::solvers::{SOLVERS, SolverKind};
 use rotor_model::seam::{Accuracy, EventKind, Output, Scene};
-use rotor_model::{Disc, Model, State};
+use rotor_model::{Disc, Model};
 
 #[test]
 fn no_solver_reports_turns_below_its_resolution() {
@@ -41,7 +41,7 @@ fn no_solver_reports_turns_below_its_resolution() {
         let s = Scene {
             u,
             input: None,
-            x0: State::zeros(),
+            x0: vec![0.0; 3],
             t_end: 200.0,
             accuracy,
             output: Output::Events,

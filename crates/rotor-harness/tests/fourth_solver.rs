@@ -139,19 +139,20 @@ mod euler {
         fn simulate(&self, model: &Model, scene: &Scene) -> Result<Trajectory, SolveError> {
             scene.validate_for(model)?;
             let h = scene.checked_step()?;
+            let start = scene.x0_state()?;
             let mut run = Run {
                 model,
                 u: scene.u,
                 h,
                 t_end: scene.t_end,
                 t: 0.0,
-                x: scene.x0,
-                mode: model.mode_at(&scene.x0, scene.u),
+                x: start,
+                mode: model.mode_at(&start, scene.u),
                 dw: [0.0; 2],
                 steps: 0,
             };
-            let mut x0 = scene.x0;
-            run.mode = run.mode_at(&scene.x0, &mut x0);
+            let mut x0 = start;
+            run.mode = run.mode_at(&start, &mut x0);
             run.x = x0;
             let mut rec = Recorder::new(scene, x0, h, 3.0);
             rec.drive(&mut run)?;

@@ -73,7 +73,7 @@ fn a_step_is_two_constant_runs_composed() {
         let a = run(kind, &first);
         let second = Scene {
             u: 2.5,
-            x0: a.x_final,
+            x0: a.x_final.as_slice().to_vec(),
             t_end: 20.0,
             ..first.clone()
         };
@@ -259,7 +259,7 @@ fn a_step_from_rest_starts_the_motion_at_the_step() {
     for kind in SOLVERS {
         let scene = Scene {
             input: Some(input.clone()),
-            x0: State::zeros(),
+            x0: vec![0.0; 3],
             t_end: 2.0,
             accuracy: accuracy(kind),
             output: Output::Grid { dt: 0.01 },

@@ -18,7 +18,7 @@
 
 use rotor_event::EventSolver;
 use rotor_model::seam::{Accuracy, EventKind, Output, Scene, Solver, SteadyState};
-use rotor_model::{Disc, Model, State};
+use rotor_model::{Disc, Model};
 use rotor_moreau::{FrictionLevel, MoreauOptions, MoreauSolver};
 
 const HS: [f64; 5] = [1e-2, 3e-3, 1e-3, 3e-4, 1e-4];
@@ -28,7 +28,7 @@ fn scene(accuracy: Accuracy) -> Scene {
     Scene {
         u: 1.5,
         input: None,
-        x0: State::zeros(),
+        x0: vec![0.0; 3],
         t_end: 60.0,
         accuracy,
         output: Output::Final,
@@ -232,7 +232,7 @@ fn moreau_state_and_stick_onsets_converge_at_second_order() {
                 &Scene {
                     u: 1.5,
                     input: None,
-                    x0: State::zeros(),
+                    x0: vec![0.0; 3],
                     t_end,
                     accuracy: Accuracy::Tol(tol),
                     output: Output::Grid { dt: REF_DT },
@@ -266,7 +266,7 @@ fn moreau_state_and_stick_onsets_converge_at_second_order() {
                 &Scene {
                     u: 1.5,
                     input: None,
-                    x0: State::zeros(),
+                    x0: vec![0.0; 3],
                     t_end,
                     accuracy: Accuracy::Step(h),
                     output: Output::Steps,

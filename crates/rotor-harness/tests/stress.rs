@@ -339,7 +339,7 @@ fn energy_run(
     let scene = Scene {
         u,
         input: None,
-        x0,
+        x0: x0.as_slice().to_vec(),
         t_end: 10.0,
         accuracy: kind.accuracy(if fixed { 1e-4 } else { tol }),
         output: if fixed {
@@ -470,7 +470,7 @@ proptest! {
         let u = 1.5 * fu;
         for kind in SOLVERS {
             // No panic, no NaN.
-            let scene = Scene { u, input: None, x0, t_end: 10.0, accuracy: Accuracy::Tol(1e-10),
+            let scene = Scene { u, input: None, x0: x0.as_slice().to_vec(), t_end: 10.0, accuracy: Accuracy::Tol(1e-10),
                 output: Output::Grid { dt: 0.01 }, metrics_from: Some(5.0) };
             let tr = match kind.solver().simulate(&m, &scene) {
                 Ok(tr) => tr,
@@ -482,7 +482,7 @@ proptest! {
             // Mirror symmetry: both friction laws are odd here (the generator keeps Table 1's
             // symmetric upper disc), and every solver's arithmetic is sign-symmetric, so the
             // mirrored run is the negated run bit for bit.
-            let mirrored = kind.solver().simulate(&m, &Scene { u: -u, x0: -x0, ..scene })
+            let mirrored = kind.solver().simulate(&m, &Scene { u: -u, x0: (-x0).as_slice().to_vec(), ..scene })
                 .map_err(|e| TestCaseError::fail(format!("{} mirrored: {e}", kind.name())))?;
             let gap = mirror_gap(&tr, &mirrored);
             prop_assert!(gap == 0.0, "{}: x(-u, -x0) + x(u, x0) reaches {gap:e}", kind.name());
@@ -693,7 +693,7 @@ fn stress_random_parameters_metrics_only_matches_the_full_run() {
         |(p, x0, fu)| {
             let m = Model::new(p);
             let u = 1.5 * fu;
-            let scene = Scene { u, input: None, x0, t_end: 100.0, accuracy: Accuracy::Tol(1e-10),
+            let scene = Scene { u, input: None, x0: x0.as_slice().to_vec(), t_end: 100.0, accuracy: Accuracy::Tol(1e-10),
                 output: Output::Events, metrics_from: Some(50.0) };
             // Whether a disc reverses in the metrics window (the event solver's full run).
             let events = SolverKind::EVENT.solver().simulate(&m, &scene)
@@ -788,7 +788,7 @@ fn stress_moreau_reports_a_one_step_hold_between_opposite_slips_as_a_reversal() 
     let scene = Scene {
         u: 1.5 * 1.2706457676858947,
         input: None,
-        x0: State::new(-0.614332526354382, 0.9150337225434341, 0.954027712696292),
+        x0: vec![-0.614332526354382, 0.9150337225434341, 0.954027712696292],
         t_end: 100.0,
         // Moreau–Jean takes the default step, 1e-3.
         accuracy: Accuracy::Tol(1e-10),
@@ -888,7 +888,7 @@ fn stress_an_extremum_of_one_disc_keeps_the_other_discs_stick() {
         let scene = Scene {
             u: 1.5 * fu,
             input: None,
-            x0: State::zeros(),
+            x0: vec![0.0; 3],
             t_end: 100.0,
             accuracy: Accuracy::Tol(1e-10),
             output: Output::Events,

@@ -939,14 +939,14 @@ friction = { family = "stribeck", t_s = 0.2, t_c = 0.1, omega_s = 1.5, delta = 2
             .next();
         let err = chain(one.unwrap()).unwrap_err();
         assert!(err.contains("a chain needs at least 2 discs"), "{err}");
-        // The mode's bit sets hold 128 discs: a chain of 128 is read, one of 129 refused.
+        // The mode's bit sets hold 64 discs: a chain of 64 is read, one of 65 refused.
         let tail =
             "[[disc]]\nj = 0.0326\nk = 0.0727\nfriction = { family = \"viscous\", b = 0.01 }\n";
         let with = |n: usize| format!("{}{}", one.unwrap(), tail.repeat(n - 1));
-        assert_eq!(chain(&with(Mode::MAX_DISCS)).map(|c| c.len()), Ok(128));
+        assert_eq!(chain(&with(Mode::MAX_DISCS)).map(|c| c.len()), Ok(64));
         let err = chain(&with(Mode::MAX_DISCS + 1)).unwrap_err();
         assert!(
-            err.contains("disc = 129 discs: a chain holds at most 128 discs"),
+            err.contains("disc = 65 discs: a chain holds at most 64 discs"),
             "{err}"
         );
         let nan = DESIGN_EXAMPLE.replacen("j = 0.0326", "j = nan", 1);

@@ -133,14 +133,14 @@ impl DiscMode {
 /// read as [`DiscMode::SlipPos`] and are never asked.
 #[derive(Clone, Copy, PartialEq, Eq, Hash, Default)]
 pub struct Mode {
-    stuck: u128,
-    backward: u128,
+    stuck: u64,
+    backward: u64,
 }
 
 impl Mode {
     /// The most discs a mode holds (the width of its bit sets). A chain file with more is
     /// refused by name.
-    pub const MAX_DISCS: usize = 128;
+    pub const MAX_DISCS: usize = 64;
 
     /// Every disc slipping forward.
     pub const SLIP: Mode = Mode {
@@ -169,7 +169,7 @@ impl Mode {
     /// Mode of one disc.
     #[inline]
     pub const fn of(&self, d: Disc) -> DiscMode {
-        let bit = 1u128 << d.0;
+        let bit = 1u64 << d.0;
         if self.stuck & bit != 0 {
             DiscMode::Stick
         } else if self.backward & bit != 0 {
@@ -182,7 +182,7 @@ impl Mode {
     /// This mode with one disc's mode replaced.
     #[inline]
     pub const fn with(self, d: Disc, m: DiscMode) -> Mode {
-        let bit = 1u128 << d.0;
+        let bit = 1u64 << d.0;
         let (stuck, backward) = (self.stuck & !bit, self.backward & !bit);
         match m {
             DiscMode::SlipPos => Mode { stuck, backward },
@@ -206,7 +206,7 @@ impl Mode {
     /// Whether the disc is stuck.
     #[inline]
     pub const fn is_stuck(&self, d: Disc) -> bool {
-        self.stuck & (1u128 << d.0) != 0
+        self.stuck & (1u64 << d.0) != 0
     }
 
     /// Mode of the rig's upper disc.
@@ -226,7 +226,7 @@ impl Mode {
 /// two): `Mode[SlipPos, Stick]`.
 impl std::fmt::Debug for Mode {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        let used = 128 - (self.stuck | self.backward).leading_zeros() as usize;
+        let used = 64 - (self.stuck | self.backward).leading_zeros() as usize;
         f.write_str("Mode")?;
         f.debug_list()
             .entries(Disc::all(used.max(2)).map(|d| self.of(d)))
@@ -480,7 +480,7 @@ mod tests {
         assert_eq!(Mode::default(), Mode::SLIP);
         for (k, &a) in ms.iter().enumerate() {
             for &b in &ms {
-                for far in [2, 63, 64, 127] {
+                for far in [2, 31, 32, 63] {
                     let (d0, d1, dn) = (Disc::UPPER, Disc::LOWER, Disc::at(far));
                     let mut m = Mode::rig(b, a).with(dn, ms[(k + 1) % 3]);
                     assert_eq!((m.of(d0), m.of(d1)), (b, a));
@@ -513,7 +513,7 @@ mod tests {
             Mode::from_discs(&[DiscMode::Stick; 3])
         );
         assert_eq!(
-            Mode::uniform(Mode::MAX_DISCS, DiscMode::SlipNeg).of(Disc::at(127)),
+            Mode::uniform(Mode::MAX_DISCS, DiscMode::SlipNeg).of(Disc::at(63)),
             DiscMode::SlipNeg
         );
     }

@@ -492,7 +492,8 @@ impl Solver for MoreauSolver {
         scene.validate_for(model)?;
         // The scene's step, or the default one from a scene that sets a tolerance.
         let h = scene.checked_step()?;
-        check_finite(0.0, &scene.x0)?;
+        let x0 = scene.x0_state()?;
+        check_finite(0.0, &x0)?;
         let o = &self.options;
         o.validate()?;
         let (u, t_end) = (scene.u_at(0.0), scene.t_end);
@@ -512,9 +513,9 @@ impl Solver for MoreauSolver {
         let full = stepper.step_size(0.0, h)?;
         // The scheme's error on the fixtures' cycles is second order, ≈ 0.6·h² in the period
         // (crate docs), so h² plays the adaptive solvers' tolerance.
-        let mut rec = Recorder::new(scene, scene.x0, h * h, o.skip_verify);
+        let mut rec = Recorder::new(scene, x0, h * h, o.skip_verify);
         rec.reserve(n as usize);
-        let m0 = model.mode_at(&scene.x0, u);
+        let m0 = model.mode_at(&x0, u);
         let mut run = Run {
             model,
             stepper,
@@ -530,7 +531,7 @@ impl Solver for MoreauSolver {
             n,
             cur: Point {
                 t: 0.0,
-                x: scene.x0,
+                x: x0,
                 mode: [m0.upper(), m0.lower()],
             },
             prev: None,

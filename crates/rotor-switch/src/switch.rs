@@ -839,7 +839,7 @@ impl Solver for SwitchSolver {
         let varying = scene.input.as_ref().filter(|_| scene.is_time_varying());
         let piece = scene.piece(0.0);
         let mut field = Field::new(model, piece, o.eta);
-        let x0 = field.start(0.0, &scene.x0);
+        let x0 = field.start(0.0, &scene.x0_state()?);
         check_finite(0.0, &x0)?;
         let tol = scene.tol();
         let mut rec = Recorder::new(scene, x0, tol, o.skip_verify);

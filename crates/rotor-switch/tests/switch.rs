@@ -332,7 +332,7 @@ fn the_band_moves_a_reversal_without_sticking_by_order_eta() {
     let model = Model::table1();
     let scene = Scene {
         u: 1.5,
-        x0: rotor_model::State::new(5.0, 0.0, -1.0),
+        x0: vec![5.0, 0.0, -1.0],
         t_end: 1.0,
         output: Output::Events,
         ..Scene::default()
@@ -438,7 +438,7 @@ fn band_edge_sliver_is_held_not_chattered() {
         let u = (p.k_theta * alpha0 + p.upper.b * w_u) / p.k_m;
         let scene = Scene {
             u,
-            x0: rotor_model::State::new(alpha0, w_u, 1.01 * eta),
+            x0: vec![alpha0, w_u, 1.01 * eta],
             t_end: 0.5,
             output: Output::Steps,
             ..Scene::default()
@@ -496,7 +496,7 @@ fn a_grazing_approach_inside_one_sample_interval_still_enters_the_band() {
             &m,
             &Scene {
                 u,
-                x0: settled.x_final,
+                x0: settled.x_final.as_slice().to_vec(),
                 t_end: 42.0,
                 output: Output::Events,
                 metrics_from: Some(0.0),
@@ -563,11 +563,11 @@ fn a_transition_that_turns_back_between_samples_still_leaves_the_band() {
         &m,
         &Scene {
             u: 1.3365041040337289,
-            x0: rotor_model::State::new(
+            x0: vec![
                 0.8659456400432735,
                 -0.32796852503374785,
                 -0.8366875147756173,
-            ),
+            ],
             t_end: 10.0,
             output: Output::Events,
             ..Scene::default()
@@ -598,7 +598,7 @@ fn leaving_stick_from_just_below_zero_is_no_reversal() {
             u: 1.5,
             // At rest but for a stuck velocity w in the band; T_ex = k_θ α = 0 lies inside
             // the lower disc's stick interval, so it sticks until the spring winds up.
-            x0: rotor_model::State::new(0.0, 0.0, w),
+            x0: vec![0.0, 0.0, w],
             t_end: 3.0,
             output: Output::Events,
             ..Scene::with_tol(1e-10)

@@ -347,7 +347,7 @@ impl Continuer<'_> {
         // maxima), and the first comes within one period.
         let scene = Scene {
             u,
-            x0,
+            x0: x0.as_slice().to_vec(),
             t_end: 2.05 * period,
             output: Output::Final,
             metrics_from: Some(0.0),

@@ -36,7 +36,7 @@ pub struct Region {
 pub fn classify(model: &Model, u: f64, x0: State) -> Option<Attractor> {
     let scene = Scene {
         u,
-        x0,
+        x0: x0.as_slice().to_vec(),
         t_end: 1500.0,
         output: Output::Metrics,
         metrics_from: Some(1000.0),

@@ -105,7 +105,7 @@ impl Section {
         let run = solver.simulate_finite(
             model,
             &Scene {
-                x0,
+                x0: x0.as_slice().to_vec(),
                 t_end,
                 output: Output::Events,
                 metrics_from: Some(0.5 * t_end),
@@ -310,7 +310,7 @@ impl<'a> Map<'a> {
         let run = self.solver.simulate_finite(
             self.model,
             &Scene {
-                x0: self.section.lift(self.model, z),
+                x0: self.section.lift(self.model, z).as_slice().to_vec(),
                 t_end,
                 output: Output::Events,
                 // Extrema are reported when metrics are asked.

@@ -137,17 +137,17 @@ struct Run<'a> {
 
 impl<'a> Run<'a> {
     /// A run of `kind` from the scene's start, nothing simulated yet.
-    fn new(kind: SolverKind, model: &'a Model, scene: &Scene) -> Run<'a> {
-        Run {
+    fn new(kind: SolverKind, model: &'a Model, scene: &Scene) -> Result<Run<'a>, SteadyError> {
+        Ok(Run {
             solver: kind.solver(),
             model,
             scene: scene.clone(),
             events: Vec::new(),
             t: 0.0,
-            x: scene.x0,
+            x: scene.x0_state()?,
             last_metrics: None,
             equilibria: std::cell::OnceCell::new(),
-        }
+        })
     }
 
     /// The slipping equilibria at the scene's input ([`Model::slip_equilibria`]).
@@ -160,7 +160,7 @@ impl<'a> Run<'a> {
         let tr = self.solver.simulate_finite(
             self.model,
             &Scene {
-                x0: self.x,
+                x0: self.x.as_slice().to_vec(),
                 t_end: dt,
                 output: Output::Events,
                 metrics_from: Some(0.5 * dt),
@@ -376,7 +376,7 @@ fn shot_and_checked(
     opts: &CheckOptions,
 ) -> Result<Checked, SteadyError> {
     scene.validate()?;
-    let mut run = Run::new(kind, model, scene);
+    let mut run = Run::new(kind, model, scene)?;
     run.extend(opts.first_run)?;
     // Shooting from the last crossing of the first run's second half.
     let half = 0.5 * run.t;
@@ -422,7 +422,7 @@ fn shot_and_checked(
             kind,
             model,
             &Scene {
-                x0: run.x,
+                x0: run.x.as_slice().to_vec(),
                 ..scene.clone()
             },
             &crate::steady::settle::SettleOptions {
@@ -645,7 +645,7 @@ pub(crate) fn orbit_answer(
     let run = solver.simulate_finite(
         model,
         &Scene {
-            x0: orbit.x,
+            x0: orbit.x.as_slice().to_vec(),
             t_end,
             output: Output::Final,
             metrics_from: Some(0.0),
@@ -705,10 +705,10 @@ mod tests {
             let orbit = shoot(&*solver, &m, &rest, section, &z0, &Default::default()).unwrap();
             // Returns of a run from the perturbed equilibrium to that orbit's section.
             let pert = Scene {
-                x0: m.perturbed_equilibrium(u),
+                x0: m.perturbed_equilibrium(u).as_slice().to_vec(),
                 ..rest.clone()
             };
-            let mut run = Run::new(kind, &m, &pert);
+            let mut run = Run::new(kind, &m, &pert).unwrap();
             run.extend(600.0).unwrap();
             let z: Vec<Vec<f64>> = run.returns(section, 0.0).into_iter().map(|r| r.1).collect();
             assert_eq!(
@@ -737,7 +737,7 @@ mod tests {
         for kind in [SolverKind::SWITCH, SolverKind::MOREAU] {
             let scene = Scene {
                 u,
-                x0: m.perturbed_equilibrium(u),
+                x0: m.perturbed_equilibrium(u).as_slice().to_vec(),
                 ..Scene::default()
             };
             let opts = CheckOptions::default();
@@ -794,7 +794,7 @@ mod tests {
         );
         let scene = Scene {
             u: row.u,
-            x0,
+            x0: x0.as_slice().to_vec(),
             ..Scene::default()
         };
         for kind in [SolverKind::SWITCH, SolverKind::MOREAU] {

@@ -210,7 +210,7 @@ pub enum SteadyError {
 /// use rotor_analysis::steady::{SteadyMethod, steady};
 ///
 /// let model = Model::table1();
-/// let scene = Scene { u: 1.5, x0: State::zeros(), ..Scene::default() };
+/// let scene = Scene { u: 1.5, x0: vec![0.0; 3], ..Scene::default() };
 /// let a = steady(SolverKind::EVENT, &model, &scene, &Default::default())?;
 /// let SteadyState::LimitCycle { period, stick_time, .. } = a.state else { panic!("{a:?}") };
 /// assert!((period - 4.5777579).abs() < 1e-6); // the 1.5 V stick-slip cycle
@@ -236,7 +236,7 @@ pub fn steady(
     constant_input(scene)?;
     scene.validate()?;
     let answer = if kind == SolverKind::EVENT {
-        refined(model, scene.u, scene.x0, opts)?
+        refined(model, scene.u, scene.x0_state()?, opts)?
     } else {
         simulated(kind, model, scene, opts)?
     };
@@ -274,14 +274,15 @@ pub fn shot(kind: SolverKind, model: &Model, scene: &Scene) -> Result<SteadyAnsw
     scene.validate()?;
     let solver = kind.solver();
     let opts = crate::shoot::ShootOptions::default();
-    let (section, z0) = crate::shoot::Section::of_run(&*solver, model, scene, scene.x0, SHOOT_RUN)?;
+    let (section, z0) =
+        crate::shoot::Section::of_run(&*solver, model, scene, scene.x0_state()?, SHOOT_RUN)?;
     let orbit = crate::shoot::shoot(&*solver, model, scene, section, &z0, &opts)?;
     // The metrics of the orbit: its last complete cycle of a run over two periods.
     let t_end = 2.0 * orbit.period + opts.skip;
     let run = solver.simulate_finite(
         model,
         &Scene {
-            x0: orbit.x,
+            x0: orbit.x.as_slice().to_vec(),
             t_end,
             output: rotor_model::seam::Output::Final,
             metrics_from: Some(0.0),

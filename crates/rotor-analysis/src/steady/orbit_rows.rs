@@ -83,7 +83,7 @@ pub(crate) fn first_crossing(
         .simulate_finite(
             model,
             &Scene {
-                x0: rotor_model::State::new(x[0], x[1], x[2]),
+                x0: vec![x[0], x[1], x[2]],
                 t_end,
                 output: Output::Events,
                 metrics_from: Some(0.0),
@@ -133,7 +133,7 @@ pub(crate) fn row_of(
         .simulate_finite(
             model,
             &Scene {
-                x0: orbit.x,
+                x0: orbit.x.as_slice().to_vec(),
                 t_end: 2.0 * orbit.period + skip,
                 output: Output::Final,
                 metrics_from: Some(0.0),

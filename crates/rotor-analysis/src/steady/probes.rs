@@ -502,7 +502,7 @@ pub(crate) fn run_probe(
     let u = probe.u();
     let scene = Scene {
         u,
-        x0: probe.start.state(model, u),
+        x0: probe.start.state(model, u).as_slice().to_vec(),
         ..Scene::default()
     };
     let answer = if probe.kind == SolverKind::EVENT {

@@ -251,14 +251,14 @@ pub fn settle(
     } else {
         opts.rel
     };
-    let mut x = base.x0;
+    let mut x = base.x0_state()?;
     let mut t = 0.0;
     let mut stats = Stats::default();
     let mut prev: Option<SteadyState> = None;
     let mut history = History::new(rel, opts);
     loop {
         let scene = Scene {
-            x0: x,
+            x0: x.as_slice().to_vec(),
             t_end: opts.chunk,
             output: Output::Final,
             metrics_from: Some(0.5 * opts.chunk),
@@ -658,7 +658,9 @@ mod tests {
         let u = hopf(&m, 1) - 1e-3;
         let eq = m.slip_equilibria(u)[0];
         let scene = Scene {
-            x0: eq.state() + State::new(0.0, 0.0, 1e-3),
+            x0: (eq.state() + State::new(0.0, 0.0, 1e-3))
+                .as_slice()
+                .to_vec(),
             ..base(u)
         };
         let opts = SettleOptions::default();

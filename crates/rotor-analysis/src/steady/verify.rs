@@ -197,7 +197,7 @@ fn returns(
     let run = kind.solver().simulate_finite(
         model,
         &Scene {
-            x0: *x,
+            x0: x.as_slice().to_vec(),
             t_end: period,
             output: Output::Final,
             metrics_from: None,

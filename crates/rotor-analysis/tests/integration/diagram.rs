@@ -291,7 +291,7 @@ fn hysteresis_of_a_brute_force_sweep_matches_the_bistable_window() {
     let run = |u: f64, x0: State| {
         let scene = Scene {
             u,
-            x0,
+            x0: x0.as_slice().to_vec(),
             t_end: 300.0,
             output: Output::Final,
             metrics_from: Some(200.0),
@@ -302,7 +302,7 @@ fn hysteresis_of_a_brute_force_sweep_matches_the_bistable_window() {
             .simulate(
                 &m,
                 &Scene {
-                    x0: t1.x_final,
+                    x0: t1.x_final.as_slice().to_vec(),
                     ..scene
                 },
             )

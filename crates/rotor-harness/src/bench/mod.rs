@@ -420,7 +420,7 @@ pub fn scene_of(spec: &SceneSpec) -> Result<(Model, Scene), BenchError> {
         Scene {
             u: sc.u,
             input: sc.input.clone(),
-            x0: sc.x0,
+            x0: sc.x0.as_slice().to_vec(),
             t_end: spec.t_end,
             output: Output::Grid { dt: spec.dt },
             metrics_from: Some(spec.metrics_from),

@@ -463,7 +463,7 @@ fn scene_of(case: &StressCase, s: &Setting, u: f64, x0: State) -> Scene {
     Scene {
         u,
         input: None,
-        x0,
+        x0: x0.as_slice().to_vec(),
         t_end: case.t_end,
         // A step longer than the horizon is cut to it.
         accuracy: match s.accuracy {

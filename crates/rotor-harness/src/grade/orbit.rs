@@ -80,7 +80,7 @@ impl Orbit {
         let span = period * 1.05;
         let scene = Scene {
             u: sc.steady_u(),
-            x0: x_start,
+            x0: x_start.as_slice().to_vec(),
             t_end: span,
             output: Output::Grid { dt: ORBIT_DT },
             metrics_from: None,

@@ -9,7 +9,7 @@
 
 use rotor_model::seam::scene::{DEFAULT_STEP, DEFAULT_TOL};
 use rotor_model::seam::{Accuracy, Input, Output, Scene, Stats};
-use rotor_model::{FieldError, Num, State};
+use rotor_model::{FieldError, Num};
 
 use rotor_analysis::solvers::{Knob, SolverKind};
 pub use rotor_analysis::solvers::{check_number, solver_kind};
@@ -155,7 +155,7 @@ impl Request<'_> {
         Ok(Scene {
             u,
             input,
-            x0: State::new(a, wu, wl),
+            x0: vec![a, wu, wl],
             t_end,
             accuracy,
             output,

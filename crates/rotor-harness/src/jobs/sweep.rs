@@ -270,7 +270,7 @@ impl Sweep {
         };
         let scene = Scene {
             u,
-            x0,
+            x0: x0.as_slice().to_vec(),
             t_end: self.t_end,
             output: Output::Metrics,
             metrics_from: Some(0.5 * self.t_end),

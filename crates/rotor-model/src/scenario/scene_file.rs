@@ -113,7 +113,7 @@ impl Scenario {
         Scene {
             u: self.u,
             input: self.input.clone(),
-            x0: self.x0,
+            x0: self.x0.as_slice().to_vec(),
             t_end: self.t_end,
             output,
             metrics_from: self.compare.steady_from,

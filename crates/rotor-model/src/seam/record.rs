@@ -214,12 +214,12 @@ impl Recorder {
     /// }
     ///
     /// let scene = Scene {
-    ///     x0: x(0.0),
+    ///     x0: x(0.0).as_slice().to_vec(),
     ///     t_end: 100.0,
     ///     output: Output::Metrics,
     ///     ..Scene::default()
     /// };
-    /// let mut rec = Recorder::new(&scene, scene.x0, 1e-10, 3.0);
+    /// let mut rec = Recorder::new(&scene, x(0.0), 1e-10, 3.0);
     /// let mut toy = Toy { t: 0.0, t_end: scene.t_end };
     /// rec.drive(&mut toy)?;
     /// let slip = Mode::rig(DiscMode::SlipPos, DiscMode::SlipPos);
@@ -393,13 +393,13 @@ mod tests {
 
     fn run(output: Output, drift: f64, verify: f64) -> (Trajectory, u64) {
         let scene = Scene {
-            x0: x(0.0),
+            x0: x(0.0).as_slice().to_vec(),
             t_end: 100.0,
             output,
             metrics_from: (output != Output::Metrics).then_some(50.0),
             ..Scene::default()
         };
-        let mut rec = Recorder::new(&scene, scene.x0, 1e-10, verify);
+        let mut rec = Recorder::new(&scene, x(0.0), 1e-10, verify);
         let mut tri = Triangle {
             t: 0.0,
             t_end: 100.0,
@@ -453,14 +453,14 @@ mod tests {
                 output: Output::Final,
                 ..scene
             },
-            scene.x0,
+            x(0.0),
             1e-10,
             3.0,
         );
         rec.count_switch();
         rec.count_switch();
         assert!(!rec.wants_events());
-        let tr = rec.finish(1.0, scene.x0, MODE, Stats::default());
+        let tr = rec.finish(1.0, x(0.0), MODE, Stats::default());
         assert_eq!((tr.stats.events, tr.events.len()), (2, 0));
     }
 

@@ -93,8 +93,9 @@ pub struct Scene {
     /// A motor input that changes in time, u(t) ([`Input`]); when set it replaces `u`, which
     /// is then unused. `None` (the default) is the constant input `u`.
     pub input: Option<Input>,
-    /// Initial state `[α, ω_u, ω_l]`.
-    pub x0: State,
+    /// Initial state, a list of the model's size: `[α, ω_u, ω_l]` for the rig (rad, rad/s,
+    /// rad/s); a solver reads it through [`Scene::x0_state`], which checks the size.
+    pub x0: Vec<f64>,
     /// Horizon \[s\]; the run covers `[0, t_end]`.
     pub t_end: f64,
     /// The tolerance or the step ([`Scene::tol`], [`Scene::step`] read it for a solver).
@@ -111,7 +112,7 @@ impl Default for Scene {
         Scene {
             u: 1.5,
             input: None,
-            x0: State::zeros(),
+            x0: vec![0.0; 3],
             t_end: 100.0,
             accuracy: Accuracy::Tol(DEFAULT_TOL),
             output: Output::Grid { dt: 0.01 },
@@ -199,13 +200,15 @@ impl Scene {
         if !self.u.is_finite() {
             return bad("u", self.u, "must be finite");
         }
-        for (i, name) in ["x0[alpha]", "x0[omega_u]", "x0[omega_l]"]
-            .iter()
-            .enumerate()
-        {
-            if !self.x0[i].is_finite() {
-                return bad(name, self.x0[i], "must be finite");
-            }
+        if let Some(i) = self.x0.iter().position(|v| !v.is_finite()) {
+            // The rig's components by name, a longer state's by index.
+            let name = match (self.x0.len(), i) {
+                (3, 0) => "x0[alpha]".to_owned(),
+                (3, 1) => "x0[omega_u]".to_owned(),
+                (3, 2) => "x0[omega_l]".to_owned(),
+                _ => format!("x0[{i}]"),
+            };
+            return bad(&name, self.x0[i], "must be finite");
         }
         if !(self.t_end > 0.0 && self.t_end.is_finite()) {
             return bad("t_end", self.t_end, "must be positive and finite");
@@ -251,6 +254,7 @@ impl Scene {
     /// time-stepping scheme would then silently stay at rest).
     pub fn validate_for(&self, model: &crate::Model) -> Result<(), SolveError> {
         self.validate()?;
+        self.x0_state()?;
         if !(model.params.k_m * self.u).is_finite() {
             return Err(FieldError::num("u", self.u, "the motor torque k_m u overflows").into());
         }
@@ -273,6 +277,20 @@ impl Scene {
             .into());
         }
         Ok(())
+    }
+
+    /// The initial state as the rig's [`State`]; an error naming `x0` if the list does not
+    /// hold the rig's three values.
+    pub fn x0_state(&self) -> Result<State, SolveError> {
+        if self.x0.len() != 3 {
+            return Err(FieldError::new(
+                "x0",
+                format!("{} values", self.x0.len()),
+                "the rig's state has 3 (alpha, omega_u, omega_l)",
+            )
+            .into());
+        }
+        Ok(State::from_column_slice(&self.x0))
     }
 
     /// Number of grid intervals for `Output::Grid { dt }`: sample times are `k·dt` for
@@ -730,7 +748,7 @@ mod tests {
         let s = Scene::with_step(1000.0);
         assert!(s.validate().unwrap_err().to_string().contains("h = 1000"));
         let s = Scene {
-            x0: State::new(0.0, f64::NAN, 0.0),
+            x0: vec![0.0, f64::NAN, 0.0],
             ..Scene::default()
         };
         assert!(
@@ -739,5 +757,29 @@ mod tests {
                 .to_string()
                 .contains("x0[omega_u] = NaN")
         );
+        // A state of another size: a non-finite value is named by its index, and the rig's
+        // model refuses the size by name.
+        let s = Scene {
+            x0: vec![0.0, 0.0, 0.0, 0.0, f64::INFINITY],
+            ..Scene::default()
+        };
+        assert!(s.validate().unwrap_err().to_string().contains("x0[4] = inf"));
+        let m = crate::Model::table1();
+        for n in [0, 2, 5] {
+            let s = Scene {
+                x0: vec![0.0; n],
+                ..Scene::default()
+            };
+            let err = s.validate_for(&m).unwrap_err().to_string();
+            assert!(
+                err.contains(&format!("x0 = {n} values: the rig's state has 3")),
+                "{err}"
+            );
+        }
+        let s = Scene {
+            x0: vec![0.5, 1.0, -2.0],
+            ..Scene::default()
+        };
+        assert_eq!(s.x0_state().unwrap(), State::new(0.5, 1.0, -2.0));
     }
 }

@@ -106,7 +106,7 @@ fn picard_fallback_converges_to_a_solution_or_is_flagged() {
                 &Scene {
                     u: sc.u,
                     input: None,
-                    x0: sc.x0,
+                    x0: sc.x0.as_slice().to_vec(),
                     t_end: n as f64 * h,
                     accuracy: Accuracy::Step(h),
                     output: Output::Final,

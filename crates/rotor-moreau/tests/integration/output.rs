@@ -1,13 +1,13 @@
 //! The scene's output levels, events, metrics and errors.
 
 use rotor_model::seam::{Accuracy, EventKind, Output, OutputGrid, Scene, SolveError, Solver};
-use rotor_model::{Disc, Model, OMEGA_U, State};
+use rotor_model::{Disc, Model, OMEGA_U};
 use rotor_moreau::{MoreauOptions, MoreauSolver, Stepper};
 
 fn base() -> Scene {
     Scene {
         u: 1.5,
-        x0: State::zeros(),
+        x0: vec![0.0; 3],
         t_end: 1.0,
         output: Output::Final,
         metrics_from: None,
@@ -29,7 +29,7 @@ fn name_is_moreau_and_its_samples_are_the_steppers() {
     let tr = solver.simulate(&Model::table1(), &scene).unwrap();
     let model = Model::table1();
     let st = Stepper::new(&model, scene.u, &MoreauOptions::default());
-    let mut x = scene.x0;
+    let mut x = scene.x0_state().unwrap();
     assert_eq!(tr.samples[0].x, x);
     for (k, s) in tr.samples.iter().enumerate().skip(1) {
         let t0 = tr.samples[k - 1].t;
@@ -239,7 +239,7 @@ fn typed_errors() {
         s.simulate(
             &m,
             &Scene {
-                x0: State::new(0.0, f64::INFINITY, 0.0),
+                x0: vec![0.0, f64::INFINITY, 0.0],
                 ..base()
             }
         ),
