@@ -5,7 +5,7 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{Result, anyhow};
 use rotor_analysis::solvers::SolverKind;
-use rotor_model::{Model, Params, State};
+use rotor_model::{Model, Params};
 
 use crate::out;
 
@@ -156,27 +156,35 @@ pub(crate) fn fixture_path(flag: &str, p: &Path, kind: &str) -> Result<PathBuf> 
     })
 }
 
-pub(crate) fn parse_x0(s: Option<&str>) -> Result<State> {
+/// `--x0`: the initial state as comma-separated numbers, one per component of the model's
+/// state (`names`: the rig's `alpha,omega_u,omega_l`); rest when not given.
+pub(crate) fn parse_x0(s: Option<&str>, names: &[&str]) -> Result<Vec<f64>> {
     let Some(s) = s else {
-        return Ok(State::zeros());
+        return Ok(vec![0.0; names.len()]);
     };
     let parts: Vec<&str> = s.split(',').map(str::trim).collect();
-    if parts.len() != 3 {
+    if parts.len() != names.len() {
+        let count = match names.len() {
+            3 => "three".to_owned(),
+            n => n.to_string(),
+        };
         return Err(unusable(format_args!(
-            "--x0 {s:?}: expected three comma-separated numbers alpha,omega_u,omega_l"
+            "--x0 {s:?}: expected {count} comma-separated numbers {}",
+            names.join(",")
         )));
     }
-    let mut x = State::zeros();
-    for (i, p) in parts.iter().enumerate() {
-        let v: f64 = p
-            .parse()
-            .map_err(|_| unusable(format_args!("--x0 {s:?}: {p:?} is not a number")))?;
-        if !v.is_finite() {
-            return Err(unusable(format_args!("--x0 {s:?}: {p:?} is not finite")));
-        }
-        x[i] = v;
-    }
-    Ok(x)
+    parts
+        .iter()
+        .map(|p| {
+            let v: f64 = p
+                .parse()
+                .map_err(|_| unusable(format_args!("--x0 {s:?}: {p:?} is not a number")))?;
+            if !v.is_finite() {
+                return Err(unusable(format_args!("--x0 {s:?}: {p:?} is not finite")));
+            }
+            Ok(v)
+        })
+        .collect()
 }
 
 /// Moreau–Jean steps whose step problem did not converge are answers to distrust: say so.
@@ -274,7 +282,7 @@ pub(crate) struct Start {
     pub(crate) u: f64,
     /// A time-varying input (`--input`, or the scenario's `input`).
     pub(crate) input: Option<rotor_model::seam::Input>,
-    pub(crate) x0: State,
+    pub(crate) x0: Vec<f64>,
     pub(crate) model: Model,
     pub(crate) scenario: Option<rotor_model::scenario::Scenario>,
 }
@@ -288,19 +296,23 @@ pub(crate) fn start(common: &Common) -> Result<Start> {
             Start {
                 u: sc.u,
                 input: sc.input.clone(),
-                x0: sc.x0,
+                x0: sc.x0.as_slice().to_vec(),
                 model: sc.model,
                 scenario: Some(sc),
             }
         }
-        None => Start {
-            // clap requires --u without a scenario.
-            u: common.u.unwrap_or(f64::NAN),
-            input: common.input.as_deref().map(read_input).transpose()?,
-            x0: parse_x0(common.x0.as_deref())?,
-            model: load_model(common.params.as_deref())?,
-            scenario: None,
-        },
+        None => {
+            let input = common.input.as_deref().map(read_input).transpose()?;
+            let model = load_model(common.params.as_deref())?;
+            Start {
+                // clap requires --u without a scenario.
+                u: common.u.unwrap_or(f64::NAN),
+                input,
+                x0: parse_x0(common.x0.as_deref(), &model.state_names())?,
+                model,
+                scenario: None,
+            }
+        }
     };
     let u_max = s.input.as_ref().map_or(s.u, |i| i.max_abs());
     let source = match (&common.scenario, &common.input) {
@@ -329,12 +341,11 @@ pub(crate) fn request<'a>(
     common: &'a Common,
     start: &Start,
 ) -> Result<rotor_harness::jobs::request::Request<'a>> {
-    let x = start.x0;
     let req = rotor_harness::jobs::request::Request {
         solver: &common.solver,
         u: start.u,
         input: start.input.clone(),
-        x0: [x[0], x[1], x[2]],
+        x0: start.x0.clone(),
         tol: common.tol,
         h: common.h,
     };

@@ -1638,7 +1638,7 @@ fn event_conventions_of_benchmark_md_are_the_graders() {
         solver: "event",
         u: 1.5,
         input: None,
-        x0: [0.0, -1.0, 0.0],
+        x0: vec![0.0, -1.0, 0.0],
         tol: None,
         h: None,
     };

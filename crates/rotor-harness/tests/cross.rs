@@ -173,9 +173,16 @@ fn every_solver_refuses_an_initial_state_of_the_wrong_size() {
                 accuracy: kind.accuracy(if kind.is_fixed_step() { 1e-3 } else { 1e-8 }),
                 ..Scene::default()
             };
-            let err = kind.solver().simulate(&Model::table1(), &scene).unwrap_err();
+            let err = kind
+                .solver()
+                .simulate(&Model::table1(), &scene)
+                .unwrap_err();
             let msg = err.to_string();
-            assert!(msg.contains(&format!("x0 = {n} values")), "{}: {msg}", kind.name());
+            assert!(
+                msg.contains(&format!("x0 = {n} values")),
+                "{}: {msg}",
+                kind.name()
+            );
         }
     }
 }

@@ -546,6 +546,14 @@ impl ChainParams {
     }
 }
 
+/// `alpha_1 … alpha_{n−1}, omega_1 … omega_n`: the state's components of a chain of `n`.
+pub(crate) fn chain_state_names(n: usize) -> Vec<String> {
+    let alphas = (1..n).map(|i| format!("alpha_{i}"));
+    alphas
+        .chain((1..=n).map(|i| format!("omega_{i}")))
+        .collect()
+}
+
 /// The vector field of a chain: [`ChainParams`] with each disc's law built, on states of size
 /// `2N − 1` held in slices.
 #[derive(Debug, Clone, PartialEq)]
@@ -578,6 +586,12 @@ impl ChainModel {
     /// Size of the state, `2N − 1`.
     pub fn dim(&self) -> usize {
         2 * self.j.len() - 1
+    }
+
+    /// The names of the state's components, `alpha_1 … alpha_{N−1}, omega_1 … omega_N`: the
+    /// header of a chain's trace.
+    pub fn state_names(&self) -> Vec<String> {
+        chain_state_names(self.j.len())
     }
 
     /// Index of disc `i`'s velocity ω_i in the state (0-based disc).
@@ -832,6 +846,21 @@ friction = { family = "stribeck", t_s = 0.2, t_c = 0.1, omega_s = 1.5, delta = 2
                 }
             }
         }
+    }
+
+    /// The state's names: the rig's for three values, a chain's numbered ones (the header of
+    /// a chain's trace, DESIGN's contract) for 2N − 1, by index for an even length.
+    #[test]
+    fn state_names_follow_the_states_size() {
+        assert_eq!(crate::state_names(3), ["alpha", "omega_u", "omega_l"]);
+        let three = ChainModel::new(&chain(DESIGN_EXAMPLE).unwrap());
+        let want = ["alpha_1", "alpha_2", "omega_1", "omega_2", "omega_3"];
+        assert_eq!(three.state_names(), want);
+        assert_eq!(crate::state_names(5), want);
+        assert_eq!(crate::state_names(2), ["x[0]", "x[1]"]);
+        let two = ChainModel::new(&ChainParams::from_params(&Params::table1()));
+        assert_eq!(two.state_names(), ["alpha_1", "omega_1", "omega_2"]);
+        assert_eq!(Model::table1().state_names().len(), Model::table1().dim());
     }
 
     /// Today's two-disc files mean the same chain of two, and a chain of two in rig shape

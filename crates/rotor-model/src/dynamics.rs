@@ -28,6 +28,22 @@ pub const ALPHA: usize = 0;
 pub const OMEGA_U: usize = 1;
 /// Index of ω_l in [`State`].
 pub const OMEGA_L: usize = 2;
+/// The rig's state components by name, in [`State`]'s order: the CSV header's columns, the
+/// job file's and `--x0`'s order.
+pub const RIG_STATE_NAMES: [&str; 3] = ["alpha", "omega_u", "omega_l"];
+
+/// The names of a state's components, from its length: the rig's ([`RIG_STATE_NAMES`]) for
+/// three values, a chain's `alpha_1 … alpha_{N−1}, omega_1 … omega_N` for `2N − 1` of them
+/// ([`crate::ChainModel::state_names`]); `x[k]` for a length no chain has.
+pub fn state_names(len: usize) -> Vec<String> {
+    if len == 3 {
+        RIG_STATE_NAMES.map(str::to_owned).to_vec()
+    } else if len % 2 == 1 {
+        crate::chain::chain_state_names(len.div_ceil(2))
+    } else {
+        (0..len).map(|k| format!("x[{k}]")).collect()
+    }
+}
 
 /// A disc, by its position in the chain from the top: position 0 is the motor-driven disc,
 /// the last one the bottom. The rig is the chain of two ([`Disc::UPPER`], [`Disc::LOWER`]);
@@ -251,6 +267,16 @@ impl Model {
             upper: Friction::upper(params.upper),
             lower: Friction::lower(params.lower),
         }
+    }
+
+    /// Size of the state, 3.
+    pub const fn dim(&self) -> usize {
+        3
+    }
+
+    /// The names of the state's components, [`RIG_STATE_NAMES`].
+    pub const fn state_names(&self) -> [&'static str; 3] {
+        RIG_STATE_NAMES
     }
 
     /// The Table 1 model.

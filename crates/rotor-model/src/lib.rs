@@ -24,7 +24,9 @@ pub mod params;
 pub mod scales;
 
 pub use chain::{ChainModel, ChainParams};
-pub use dynamics::{ALPHA, Disc, DiscMode, Mode, Model, OMEGA_L, OMEGA_U, State};
+pub use dynamics::{
+    ALPHA, Disc, DiscMode, Mode, Model, OMEGA_L, OMEGA_U, RIG_STATE_NAMES, State, state_names,
+};
 pub use equilibrium::{SlipEquilibrium, StuckSet};
 pub use field::FieldError;
 pub use friction::Friction;

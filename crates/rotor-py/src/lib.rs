@@ -334,7 +334,7 @@ fn input_of(rows: Option<Vec<[f64; 2]>>) -> PyResult<Option<rotor_model::seam::I
 /// first and after the last, two rows at one t a step.
 #[pyfunction]
 #[pyo3(
-    signature = (solver="event", u=1.5, params=None, x0=[0.0; 3], t_end=100.0, dt=0.01, tol=None, h=None, input=None),
+    signature = (solver="event", u=1.5, params=None, x0=vec![0.0; 3], t_end=100.0, dt=0.01, tol=None, h=None, input=None),
     text_signature = "(solver='event', u=1.5, params=None, x0=(0.0, 0.0, 0.0), t_end=100.0, dt=0.01, tol=None, h=None, input=None)"
 )]
 #[allow(clippy::too_many_arguments)]
@@ -343,7 +343,7 @@ fn simulate<'py>(
     solver: &str,
     u: f64,
     params: Option<&Bound<'py, PyAny>>,
-    x0: [f64; 3],
+    x0: Vec<f64>,
     t_end: f64,
     dt: f64,
     tol: Option<f64>,
@@ -400,7 +400,7 @@ fn simulate<'py>(
 /// needs a constant input.
 #[pyfunction]
 #[pyo3(
-    signature = (solver="event", u=1.5, params=None, x0=[0.0; 3], tol=None, h=None, input=None),
+    signature = (solver="event", u=1.5, params=None, x0=vec![0.0; 3], tol=None, h=None, input=None),
     text_signature = "(solver='event', u=1.5, params=None, x0=(0.0, 0.0, 0.0), tol=None, h=None, input=None)"
 )]
 #[allow(clippy::too_many_arguments)]
@@ -409,7 +409,7 @@ fn steady<'py>(
     solver: &str,
     u: f64,
     params: Option<&Bound<'py, PyAny>>,
-    x0: [f64; 3],
+    x0: Vec<f64>,
     tol: Option<f64>,
     h: Option<f64>,
     input: Option<Vec<[f64; 2]>>,
@@ -443,7 +443,7 @@ fn steady<'py>(
 /// ``steady``.
 #[pyfunction]
 #[pyo3(
-    signature = (u, solver="event", params=None, x0=[0.0; 3], tol=None, h=None, threads=None),
+    signature = (u, solver="event", params=None, x0=vec![0.0; 3], tol=None, h=None, threads=None),
     text_signature = "(u, solver='event', params=None, x0=(0.0, 0.0, 0.0), tol=None, h=None, threads=None)"
 )]
 #[allow(clippy::too_many_arguments)]
@@ -452,7 +452,7 @@ fn sweep<'py>(
     u: PyArrayLike1<'py, f64, AllowTypeChange>,
     solver: &str,
     params: Option<&Bound<'py, PyAny>>,
-    x0: [f64; 3],
+    x0: Vec<f64>,
     tol: Option<f64>,
     h: Option<f64>,
     threads: Option<i64>,
@@ -478,7 +478,7 @@ fn sweep<'py>(
             solver,
             u,
             input: None,
-            x0,
+            x0: x0.clone(),
             tol,
             h,
         };
@@ -686,7 +686,7 @@ fn _solve_seconds(
         solver,
         u,
         input: None,
-        x0: [0.0; 3],
+        x0: vec![0.0; 3],
         tol,
         h,
     };

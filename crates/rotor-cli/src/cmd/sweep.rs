@@ -72,14 +72,18 @@ pub(crate) fn sweep(
 ) -> Result<()> {
     use rayon::prelude::*;
     use rotor_harness::jobs::sweep::{Axis, Shard, Sweep, SweepStart, run};
-    let base = load_model(params)?.params;
+    let model = load_model(params)?;
+    let base = model.params;
     let (name, range) = param.split_once('=').ok_or_else(|| {
         crate::common::unusable(format_args!("--param {param:?}: expected NAME=A:B:N"))
     })?;
     check("t_end", t_end, t_end > 0.0, "must be positive and finite")?;
     let start = match x0 {
         Some("eq") => SweepStart::PerturbedEquilibrium,
-        other => SweepStart::State(parse_x0(other)?),
+        other => SweepStart::State(rotor_model::State::from_column_slice(&parse_x0(
+            other,
+            &model.state_names(),
+        )?)),
     };
     let s = Sweep {
         base,

@@ -110,7 +110,7 @@ fn label(kind: SolverKind, sc: &Scenario) -> String {
 }
 
 /// The per-solver columns of [`scenario_csv`], in the state's order (x = [α, ω_u, ω_l]).
-const CSV_QUANTITIES: [&str; 3] = ["alpha", "omega_u", "omega_l"];
+const CSV_QUANTITIES: [&str; 3] = rotor_model::RIG_STATE_NAMES;
 
 /// Per-scenario CSV, the data of [`scenario_svg`]'s figure: `t`, then for each solver that
 /// finished, in the figure's order (the reference first), `alpha_<solver>` (α = θ_u − θ_l,

@@ -927,7 +927,7 @@ pub fn check(
     let t_scale = time_scale(reference);
     let mut q = Vec::new();
     let d = sample_differences(&trace.samples, &reference.samples);
-    for (i, name) in ["alpha", "omega_u", "omega_l"].into_iter().enumerate() {
+    for (i, name) in rotor_model::RIG_STATE_NAMES.into_iter().enumerate() {
         let mut g = graded(name, d[i].0, scale[i], level);
         g.at = Some(d[i].1);
         q.push(g);

@@ -256,7 +256,7 @@ fn differences(
     reference: &rotor_model::seam::Trajectory,
 ) -> BTreeMap<String, f64> {
     let d = trace_differences(&r.samples, &reference.samples);
-    let mut out: BTreeMap<String, f64> = ["alpha", "omega_u", "omega_l"]
+    let mut out: BTreeMap<String, f64> = rotor_model::RIG_STATE_NAMES
         .iter()
         .zip(d)
         .map(|(n, e)| ((*n).to_owned(), e))
@@ -368,7 +368,7 @@ fn compute_at(sc: &Scenario, tol: f64, check_tol: f64) -> Result<Reference, Refe
     }
     // Trace digits: half a unit of the last digit ≤ a tenth of the smallest relative error
     // of the three components.
-    let rel = ["alpha", "omega_u", "omega_l"]
+    let rel = rotor_model::RIG_STATE_NAMES
         .iter()
         .map(|n| error.get(*n).map_or(f64::INFINITY, |e| e / scale_of(n)))
         .fold(f64::INFINITY, f64::min);

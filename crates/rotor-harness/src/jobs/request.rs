@@ -9,7 +9,7 @@
 
 use rotor_model::seam::scene::{DEFAULT_STEP, DEFAULT_TOL};
 use rotor_model::seam::{Accuracy, Input, Output, Scene, Stats};
-use rotor_model::{FieldError, Num};
+use rotor_model::{FieldError, Num, state_names};
 
 use rotor_analysis::solvers::{Knob, SolverKind};
 pub use rotor_analysis::solvers::{check_number, solver_kind};
@@ -79,8 +79,9 @@ pub struct Request<'a> {
     pub u: f64,
     /// A time-varying input u(t) instead of `u` (`--input FILE`, Python's `input=`).
     pub input: Option<Input>,
-    /// Initial state `[α, ω_u, ω_l]` (rad, rad/s, rad/s).
-    pub x0: [f64; 3],
+    /// Initial state, a list of the model's size: `[α, ω_u, ω_l]` for the rig (rad, rad/s,
+    /// rad/s). Its size is checked against the model where the run starts.
+    pub x0: Vec<f64>,
     /// Tolerance of the adaptive solvers (relative = absolute), if given.
     pub tol: Option<f64>,
     /// Step of Moreau–Jean \[s\], if given.
@@ -123,18 +124,17 @@ impl Request<'_> {
             },
         };
         check_number("u", u, true, "must be a finite number")?;
-        for (k, v) in self.x0.iter().enumerate() {
-            if !v.is_finite() {
-                return Err(FieldError::new(
-                    "x0",
-                    format!("{:?}", self.x0.map(|x| Num(x).to_string())),
-                    format!(
-                        "component {} ({}) is not finite",
-                        k + 1,
-                        ["alpha", "omega_u", "omega_l"][k]
-                    ),
-                ));
-            }
+        if let Some(k) = self.x0.iter().position(|v| !v.is_finite()) {
+            let shown: Vec<String> = self.x0.iter().map(|&x| Num(x).to_string()).collect();
+            return Err(FieldError::new(
+                "x0",
+                format!("{shown:?}"),
+                format!(
+                    "component {} ({}) is not finite",
+                    k + 1,
+                    state_names(self.x0.len())[k]
+                ),
+            ));
         }
         let tol = self.tol.unwrap_or(DEFAULT_TOL);
         check_number("tol", tol, tol > 0.0 && tol < 1.0, "must lie in (0, 1)")?;
@@ -145,7 +145,6 @@ impl Request<'_> {
             h > 0.0 && h <= t_end,
             &format!("must lie in (0, {}] s (the run's horizon)", Num(t_end)),
         )?;
-        let [a, wu, wl] = self.x0;
         // The solver's own setting; the other one was checked all the same, and is ignored
         // (with the warning of [`Request::ignored`]).
         let accuracy = match kind.info().knob {
@@ -155,7 +154,7 @@ impl Request<'_> {
         Ok(Scene {
             u,
             input,
-            x0: vec![a, wu, wl],
+            x0: self.x0.clone(),
             t_end,
             accuracy,
             output,
@@ -214,7 +213,7 @@ mod tests {
             solver: "event",
             u: 1.5,
             input: None,
-            x0: [0.0; 3],
+            x0: vec![0.0; 3],
             tol: None,
             h: None,
         }
@@ -278,7 +277,7 @@ mod tests {
             "h = 20: must lie in (0, 10] s (the run's horizon)"
         );
         let e = Request {
-            x0: [0.0, f64::NAN, 0.0],
+            x0: vec![0.0, f64::NAN, 0.0],
             ..req()
         }
         .simulation(10.0, 0.01)

@@ -763,7 +763,12 @@ mod tests {
             x0: vec![0.0, 0.0, 0.0, 0.0, f64::INFINITY],
             ..Scene::default()
         };
-        assert!(s.validate().unwrap_err().to_string().contains("x0[4] = inf"));
+        assert!(
+            s.validate()
+                .unwrap_err()
+                .to_string()
+                .contains("x0[4] = inf")
+        );
         let m = crate::Model::table1();
         for n in [0, 2, 5] {
             let s = Scene {
