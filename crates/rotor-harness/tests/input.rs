@@ -73,7 +73,7 @@ fn a_step_is_two_constant_runs_composed() {
         let a = run(kind, &first);
         let second = Scene {
             u: 2.5,
-            x0: a.x_final.as_slice().to_vec(),
+            x0: a.x_final.clone(),
             t_end: 20.0,
             ..first.clone()
         };

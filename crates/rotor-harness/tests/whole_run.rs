@@ -196,9 +196,7 @@ impl<const PPB: u32> Solver for LateOffset<PPB> {
                 model,
                 &Scene {
                     u,
-                    x0: out
-                        .as_ref()
-                        .map_or(scene.x0.clone(), |o| o.x_final.as_slice().to_vec()),
+                    x0: out.as_ref().map_or(scene.x0.clone(), |o| o.x_final.clone()),
                     t_end: t1 - t0,
                     // Metrics asked in every part (so that the maxima of ω are reported);
                     // the last part's over the scene's window are the run's.

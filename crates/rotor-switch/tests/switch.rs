@@ -164,7 +164,12 @@ fn every_fixture_runs_to_t_end() {
         assert_eq!(t.samples.last().unwrap().t, sc.t_end);
         assert!(t.samples.iter().all(|p| p.x.iter().all(|v| v.is_finite())));
         assert!(t.x_final.iter().all(|v| v.is_finite()), "{}", sc.name);
-        assert_eq!(t.samples.last().unwrap().x, t.x_final, "{}", sc.name);
+        assert_eq!(
+            t.samples.last().unwrap().x.as_slice(),
+            t.x_final,
+            "{}",
+            sc.name
+        );
         assert!(t.metrics.is_some());
         let eta = s.options.eta;
         match sc.name.as_str() {
@@ -496,7 +501,7 @@ fn a_grazing_approach_inside_one_sample_interval_still_enters_the_band() {
             &m,
             &Scene {
                 u,
-                x0: settled.x_final.as_slice().to_vec(),
+                x0: settled.x_final.clone(),
                 t_end: 42.0,
                 output: Output::Events,
                 metrics_from: Some(0.0),

@@ -168,12 +168,13 @@ impl<'a> Run<'a> {
             },
         )?;
         let t0 = self.t;
+        let x = tr.final_state()?;
         self.events.extend(tr.events.into_iter().map(|mut e| {
             e.t += t0;
             e
         }));
         self.t += dt;
-        self.x = tr.x_final;
+        self.x = x;
         self.last_metrics = tr.metrics;
         Ok(())
     }

@@ -278,7 +278,7 @@ pub fn settle(
                     return Ok(Settled {
                         state: st,
                         stats,
-                        x: tr.x_final,
+                        x: tr.final_state()?,
                     });
                 }
                 Verdict::Running => {}
@@ -294,7 +294,7 @@ pub fn settle(
             }
         }
         prev = Some(st);
-        x = tr.x_final;
+        x = tr.final_state()?;
     }
 }
 

@@ -207,7 +207,7 @@ fn returns(
     let rho = answer_accuracy(kind, scene);
     let speed = model.rhs(x, scene.u, model.mode_at(x, scene.u)).amax();
     let allowed = rho * (1.0 + x.amax()) + rho * period * speed;
-    let gap = (run.x_final - x).amax();
+    let gap = (run.final_state()? - x).amax();
     if gap.is_nan() || gap > allowed {
         return Err(refuted(
             "cycle",

@@ -302,13 +302,13 @@ fn hysteresis_of_a_brute_force_sweep_matches_the_bistable_window() {
             .simulate(
                 &m,
                 &Scene {
-                    x0: t1.x_final.as_slice().to_vec(),
+                    x0: t1.x_final.clone(),
                     ..scene
                 },
             )
             .unwrap();
         let (a1, a2) = (amp(&t1.metrics), amp(&t2.metrics));
-        (a2 > 1.0 || a2 > a1, t2.x_final)
+        (a2 > 1.0 || a2 > a1, t2.final_state().unwrap())
     };
     let us: Vec<f64> = (0..20).map(|k| 4.025 + 0.05 * k as f64).collect();
     // Up: from the 4.025 V cycle (reached from rest), each run from the previous final state.

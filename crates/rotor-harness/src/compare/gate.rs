@@ -443,7 +443,7 @@ mod tests {
             samples,
             events: Vec::new(),
             t_final: 1.0,
-            x_final: State::zeros(),
+            x_final: (State::zeros()).as_slice().to_vec(),
             mode_final: Mode::rig(DiscMode::SlipPos, DiscMode::SlipPos),
             metrics,
             stats: Stats::default(),

@@ -296,7 +296,7 @@ mod tests {
                 .collect(),
             events,
             t_final: 1.0,
-            x_final: State::zeros(),
+            x_final: (State::zeros()).as_slice().to_vec(),
             mode_final: Mode::rig(DiscMode::SlipPos, DiscMode::SlipPos),
             metrics: None,
             stats: Stats::default(),

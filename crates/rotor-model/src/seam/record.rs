@@ -285,7 +285,7 @@ impl Recorder {
             samples: self.samples,
             events: self.events,
             t_final,
-            x_final,
+            x_final: x_final.as_slice().to_vec(),
             mode_final,
             metrics,
             stats: FastForward::counted(

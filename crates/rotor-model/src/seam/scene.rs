@@ -282,15 +282,7 @@ impl Scene {
     /// The initial state as the rig's [`State`]; an error naming `x0` if the list does not
     /// hold the rig's three values.
     pub fn x0_state(&self) -> Result<State, SolveError> {
-        if self.x0.len() != 3 {
-            return Err(FieldError::new(
-                "x0",
-                format!("{} values", self.x0.len()),
-                "the rig's state has 3 (alpha, omega_u, omega_l)",
-            )
-            .into());
-        }
-        Ok(State::from_column_slice(&self.x0))
+        rig_state("x0", &self.x0)
     }
 
     /// Number of grid intervals for `Output::Grid { dt }`: sample times are `k·dt` for
@@ -313,6 +305,20 @@ impl Scene {
         self.metrics_from
             .or((self.output == Output::Metrics).then_some(0.0))
     }
+}
+
+/// A list read as the rig's [`State`]; an error naming `field` if it does not hold three
+/// values.
+fn rig_state(field: &str, x: &[f64]) -> Result<State, SolveError> {
+    if x.len() != 3 {
+        return Err(FieldError::new(
+            field,
+            format!("{} values", x.len()),
+            "the rig's state has 3 (alpha, omega_u, omega_l)",
+        )
+        .into());
+    }
+    Ok(State::from_column_slice(x))
 }
 
 /// The output grid `0, dt, 2dt, …, t_end`, walked without allocation.
@@ -458,8 +464,8 @@ pub struct Trajectory {
     pub events: Vec<Event>,
     /// Final time (= t_end).
     pub t_final: f64,
-    /// Final state.
-    pub x_final: State,
+    /// Final state, a list of the model's size (`[α, ω_u, ω_l]` for the rig).
+    pub x_final: Vec<f64>,
     /// Final mode.
     pub mode_final: Mode,
     /// Steady-state metrics, if the scene asked for them.
@@ -469,16 +475,22 @@ pub struct Trajectory {
 }
 
 impl Trajectory {
+    /// The final state as the rig's [`State`] (an error naming `x_final` for a run of
+    /// another model's size).
+    pub fn final_state(&self) -> Result<State, SolveError> {
+        rig_state("x_final", &self.x_final)
+    }
+
     /// Checks the samples, the events, the final state and the metrics for NaN or ∞: a run
     /// that finished must deliver finite output. The error names the first offender and its
     /// time (`t_final` for the final state and the metrics).
     pub fn check_finite(&self) -> Result<(), SolveError> {
-        let ok = |t: f64, x: &State| t.is_finite() && x.iter().all(|v| v.is_finite());
+        let ok = |t: f64, x: &[f64]| t.is_finite() && x.iter().all(|v| v.is_finite());
         let bad = |t: f64, what| Err(SolveError::NonFiniteOutput { t, what });
-        if let Some(s) = self.samples.iter().find(|s| !ok(s.t, &s.x)) {
+        if let Some(s) = self.samples.iter().find(|s| !ok(s.t, s.x.as_slice())) {
             return bad(s.t, "sample");
         }
-        if let Some(e) = self.events.iter().find(|e| !ok(e.t, &e.x)) {
+        if let Some(e) = self.events.iter().find(|e| !ok(e.t, e.x.as_slice())) {
             return bad(e.t, "event");
         }
         if !ok(self.t_final, &self.x_final) {
@@ -656,7 +668,7 @@ mod tests {
                 kind: EventKind::StickStart(Disc::LOWER),
             }],
             t_final: 1.0,
-            x_final: x,
+            x_final: x.as_slice().to_vec(),
             mode_final: Mode::rig(DiscMode::SlipPos, DiscMode::Stick),
             metrics: Some(SteadyState::Equilibrium {
                 omega_u: 2.0,

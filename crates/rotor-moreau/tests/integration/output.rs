@@ -78,7 +78,7 @@ fn steps_keep_every_step_and_land_on_t_end() {
     assert_eq!(tr.samples[0].t, 0.0);
     let last = tr.samples.last().unwrap();
     assert_eq!(last.t, 1.0);
-    assert_eq!(last.x, tr.x_final);
+    assert_eq!(last.x.as_slice(), tr.x_final);
     for w in tr.samples.windows(2) {
         let dt = w[1].t - w[0].t;
         assert!(dt > 0.0 && dt <= 0.003 * (1.0 + 1e-12));
@@ -107,7 +107,7 @@ fn grid_matches_output_grid() {
     }
     let got: Vec<f64> = tr.samples.iter().map(|s| s.t).collect();
     assert_eq!(got, times);
-    assert_eq!(tr.samples.last().unwrap().x, tr.x_final);
+    assert_eq!(tr.samples.last().unwrap().x.as_slice(), tr.x_final);
     // Linear interpolation between step ends: a grid sample lies between its neighbours'
     // step values; check against a Steps run.
     let steps = MoreauSolver::default()
