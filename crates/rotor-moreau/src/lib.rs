@@ -129,10 +129,12 @@
 
 #![warn(missing_docs)]
 
+pub mod contacts;
 pub mod onestep;
 mod run;
 pub mod stepper;
 
+pub use contacts::{ContactError, ContactSolver, Tridiagonal};
 pub use onestep::{Branch, EnumError, OneStepProblem, OneStepSolution, StickData};
 pub use stepper::{StepOutcome, Stepper};
 
