@@ -95,7 +95,7 @@ fn on_every_fixture_scene_each_solvers_steady_answer_is_what_its_simulation_sett
             SOLVERS.iter().map(|&k| {
                 let scene = Scene {
                     u: s.u,
-                    x0: s.x0.as_slice().to_vec(),
+                    x0: s.x0.clone(),
                     ..Scene::default()
                 };
                 (s.name.clone(), k, s.model, scene)

@@ -296,7 +296,7 @@ pub(crate) fn start(common: &Common) -> Result<Start> {
             Start {
                 u: sc.u,
                 input: sc.input.clone(),
-                x0: sc.x0.as_slice().to_vec(),
+                x0: sc.x0.clone(),
                 model: sc.model,
                 scenario: Some(sc),
             }

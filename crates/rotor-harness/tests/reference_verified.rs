@@ -120,7 +120,7 @@ fn solve(sc: &Scenario, tab: &Tableau, h: f64) -> Result {
             u: sc.u,
             tableau: tab,
         }
-        .run(sc.x0, dt, n, h, from),
+        .run(State::from_column_slice(&sc.x0), dt, n, h, from),
         Some(input) => composed(sc, input, tab, h),
     };
     let steady = sc.compare.steady_from.map(|_| steady_of(&run));
@@ -140,7 +140,7 @@ fn composed(sc: &Scenario, input: &rotor_model::seam::Input, tab: &Tableau, h: f
         .collect();
     cuts.push(sc.t_end);
     let mut out: Option<Run> = None;
-    let (mut t0, mut x) = (0.0, sc.x0);
+    let (mut t0, mut x) = (0.0, State::from_column_slice(&sc.x0));
     for t1 in cuts {
         let piece = input.piece(t0);
         assert_eq!(

@@ -11,7 +11,7 @@ fn main() {
         for p in Scenario::list_dir(&dir).unwrap() {
             let sc = Scenario::from_file(&p).unwrap();
             let st = Stepper::new(&sc.model, sc.u, &MoreauOptions::default());
-            let mut x = sc.x0;
+            let mut x = rotor_model::State::from_column_slice(&sc.x0);
             let n = (sc.t_end / h).round() as u64;
             let mut b = 0;
             for k in 0..n {

@@ -660,7 +660,7 @@ fn scenario<'py>(py: Python<'py>, source: &Bound<'py, PyAny>) -> PyResult<Bound<
     d.set_item("path", sc.path.to_string_lossy().into_owned())?;
     d.set_item("params", to_py(py, &sc.model.params)?)?;
     d.set_item("u", sc.u)?;
-    d.set_item("x0", (sc.x0[0], sc.x0[1], sc.x0[2]))?;
+    d.set_item("x0", pyo3::types::PyTuple::new(py, &sc.x0)?)?;
     d.set_item("t_end", sc.t_end)?;
     d.set_item("dt", sc.compare.dt)?;
     d.set_item("transient", sc.compare.transient)?;

@@ -196,7 +196,7 @@ fn every_fixture_runs_to_t_end() {
             // Stribeck starts from rest with both discs stuck: the upper disc breaks away at
             // once (k_m u > T_su), the lower one after the spring has wound up.
             n if n.starts_with("st-") && n.ends_with("-rest") => {
-                assert_eq!(t.samples[0].x, sc.x0);
+                assert_eq!(t.samples[0].x.as_slice(), sc.x0);
                 assert!(t.x_final[OMEGA_U] > 1.0, "{n}: {:?}", t.x_final);
                 let first_exit = t
                     .events

@@ -525,7 +525,7 @@ pub fn bad_scenario_cases() -> Vec<BadFile> {
         sc(
             "x0 = [0.0, 0.0, 0.0]",
             "x0 = [0.0, 0.0]",
-            &["length 2", "x0 = [0.0, 0.0]"],
+            &["x0 = [0, 0]: length 2: the model's state has 3 values (alpha, omega_u, omega_l)"],
         ),
         sc(
             "x0 = [0.0, 0.0, 0.0]",

@@ -130,7 +130,7 @@ pub(crate) fn load(
     let base = Scene {
         u: scenario.u,
         input: scenario.input.clone(),
-        x0: scenario.x0.as_slice().to_vec(),
+        x0: scenario.x0.clone(),
         t_end: spec.t_end,
         accuracy: Accuracy::Tol(opts.reference_tol),
         output: Output::Grid { dt: spec.dt },

@@ -301,7 +301,7 @@ pub fn run(opts: &BenchOptions, mut progress: impl FnMut(&str)) -> Result<BenchR
             tier: Tier::of(&l.scenario).name().to_owned(),
             description: l.scenario.description.clone(),
             u: l.scenario.u,
-            x0: l.scenario.x0.as_slice().to_vec(),
+            x0: l.scenario.x0.clone(),
             t_end: spec.t_end,
             metrics_from: spec.metrics_from,
             transient: spec.transient,
@@ -420,7 +420,7 @@ pub fn scene_of(spec: &SceneSpec) -> Result<(Model, Scene), BenchError> {
         Scene {
             u: sc.u,
             input: sc.input.clone(),
-            x0: sc.x0.as_slice().to_vec(),
+            x0: sc.x0.clone(),
             t_end: spec.t_end,
             output: Output::Grid { dt: spec.dt },
             metrics_from: Some(spec.metrics_from),

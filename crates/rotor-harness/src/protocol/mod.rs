@@ -207,7 +207,7 @@ impl Job {
                 .input
                 .as_ref()
                 .map(|i| i.rows().iter().map(|&(t, u)| [t, u]).collect()),
-            x0: sc.x0.as_slice().to_vec(),
+            x0: sc.x0.clone(),
             t_end,
             dt,
             tol: (!fixed_step).then_some(setting),

@@ -49,7 +49,7 @@ struct RawScenario {
     #[serde(default)]
     input: Option<RawInput>,
     #[serde(default)]
-    x0: Option<[f64; 3]>,
+    x0: Option<Vec<f64>>,
     #[serde(default)]
     x0_from_equilibrium: Option<[f64; 3]>,
     t_end: f64,
@@ -91,9 +91,9 @@ pub struct Scenario {
     /// A time-varying input u(t) (`input = "NAME.csv"` or `input = [[t, u], ...]` instead of
     /// `u`); `None` for a constant one (a table of one value is read as `u`).
     pub input: Option<Input>,
-    /// Initial state `[α, ω_u, ω_l]` (rad, rad/s, rad/s): `x0`, or the slipping equilibrium
-    /// at `u` plus `x0_from_equilibrium`, or rest.
-    pub x0: State,
+    /// Initial state, a list of the model's size (`[α, ω_u, ω_l]` for the rig: rad, rad/s,
+    /// rad/s): `x0`, or the slipping equilibrium at `u` plus `x0_from_equilibrium`, or rest.
+    pub x0: Vec<f64>,
     /// Horizon \[s\]; runs cover `[0, t_end]`.
     pub t_end: f64,
     /// Tolerance for the adaptive solvers, if the file sets one.
@@ -113,7 +113,7 @@ impl Scenario {
         Scene {
             u: self.u,
             input: self.input.clone(),
-            x0: self.x0.as_slice().to_vec(),
+            x0: self.x0.clone(),
             t_end: self.t_end,
             output,
             metrics_from: self.compare.steady_from,
@@ -396,8 +396,9 @@ fn check_input(
 
 /// The initial state: `x0`, or the one slipping equilibrium at `u` plus the offset
 /// `x0_from_equilibrium` (not both), or rest; every component finite.
-fn initial_state(raw: &RawScenario, model: &Model, bad: Bad) -> Result<State, ScenarioError> {
-    let x0 = match (raw.x0, raw.x0_from_equilibrium) {
+fn initial_state(raw: &RawScenario, model: &Model, bad: Bad) -> Result<Vec<f64>, ScenarioError> {
+    let names = model.state_names();
+    let x0 = match (&raw.x0, raw.x0_from_equilibrium) {
         (Some(_), Some(_)) => {
             return Err(bad.at(
                 "x0_from_equilibrium",
@@ -405,14 +406,32 @@ fn initial_state(raw: &RawScenario, model: &Model, bad: Bad) -> Result<State, Sc
                 "give either x0 or x0_from_equilibrium, not both",
             ));
         }
-        (Some(x), None) => State::new(x[0], x[1], x[2]),
-        (None, Some(d)) => from_equilibrium(d, raw.u.unwrap_or(f64::NAN), model, bad)?,
-        (None, None) => State::zeros(),
-    };
-    for (i, n) in ["x0[0]", "x0[1]", "x0[2]"].iter().enumerate() {
-        if !x0[i].is_finite() {
-            return Err(bad.at(n, Num(x0[i]).to_string(), "must be finite"));
+        (Some(x), None) if x.len() != names.len() => {
+            let shown: Vec<String> = x.iter().map(|&v| Num(v).to_string()).collect();
+            return Err(bad.at(
+                "x0",
+                format!("[{}]", shown.join(", ")),
+                &format!(
+                    "length {}: the model's state has {} values ({})",
+                    x.len(),
+                    names.len(),
+                    names.join(", ")
+                ),
+            ));
         }
+        (Some(x), None) => x.clone(),
+        (None, Some(d)) => {
+            let x = from_equilibrium(d, raw.u.unwrap_or(f64::NAN), model, bad)?;
+            x.as_slice().to_vec()
+        }
+        (None, None) => vec![0.0; names.len()],
+    };
+    if let Some(i) = x0.iter().position(|v| !v.is_finite()) {
+        return Err(bad.at(
+            &format!("x0[{i}]"),
+            Num(x0[i]).to_string(),
+            "must be finite",
+        ));
     }
     Ok(x0)
 }

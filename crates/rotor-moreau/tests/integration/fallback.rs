@@ -73,7 +73,7 @@ fn picard_fallback_converges_to_a_solution_or_is_flagged() {
     for sc in &scenarios() {
         let st = Stepper::new(&sc.model, sc.u, &MoreauOptions::default());
         let n = (sc.t_end / h).round() as u64;
-        let mut x = sc.x0;
+        let mut x = rotor_model::State::from_column_slice(&sc.x0);
         let mut inexact = 0;
         for k in 0..n {
             let o = st.step(k as f64 * h, &x, h).unwrap();
@@ -106,7 +106,7 @@ fn picard_fallback_converges_to_a_solution_or_is_flagged() {
                 &Scene {
                     u: sc.u,
                     input: None,
-                    x0: sc.x0.as_slice().to_vec(),
+                    x0: sc.x0.clone(),
                     t_end: n as f64 * h,
                     accuracy: Accuracy::Step(h),
                     output: Output::Final,
