@@ -1,6 +1,5 @@
 //! The one-step problem of N coupled frictional contacts, solved exactly without
-//! enumerating modes: a primal–dual active-set (semi-smooth Newton) method on a tridiagonal
-//! M-matrix.
+//! enumerating modes: block principal pivoting on a tridiagonal M-matrix.
 //!
 //! A chain's Moreau–Jean step asks for the velocities `v` at the end of the step and the
 //! friction impulses `r` of its N discs (docs/methods.md §3, docs/model.md §4a):
@@ -71,8 +70,8 @@ impl Tridiagonal {
     }
 
     /// Whether the matrix is a Z-matrix with a positive diagonal (off-diagonal ≤ 0), the
-    /// structure the method's convergence rests on (with positive definiteness, which a
-    /// diagonally dominant such matrix has).
+    /// structure of a chain's iteration matrix (springs and couplings pull neighbours
+    /// together); a positive definite one is an M-matrix.
     pub fn is_z_matrix(&self) -> bool {
         self.diag.iter().all(|&d| d > 0.0) && self.off.iter().all(|&e| e <= 0.0)
     }
@@ -83,7 +82,7 @@ impl Tridiagonal {
 pub enum ContactError {
     /// The sizes of `A`, `b`, `lo` and `hi` disagree, or an interval is empty.
     Shape(String),
-    /// The modes did not repeat within the iteration cap (never seen on an M-matrix).
+    /// A mode was still wrong at the iteration cap (never seen in the tests).
     NotConverged {
         /// Iterations taken.
         iterations: usize,
@@ -98,7 +97,7 @@ impl std::fmt::Display for ContactError {
             ContactError::Shape(why) => write!(f, "contact problem: {why}"),
             ContactError::NotConverged { iterations } => write!(
                 f,
-                "contact problem: the active set did not settle in {iterations} iterations"
+                "contact problem: the modes did not settle in {iterations} iterations"
             ),
             ContactError::Singular => write!(f, "contact problem: singular or non-finite"),
         }
@@ -420,12 +419,18 @@ mod tests {
         (a, b, lo, hi)
     }
 
+    /// A warm start drawn as indices: 0 forward, 1 backward, 2 stuck.
+    fn modes_of(drawn: &[usize]) -> Vec<DiscMode> {
+        let modes = [DiscMode::SlipPos, DiscMode::SlipNeg, DiscMode::Stick];
+        drawn.iter().map(|&k| modes[k]).collect()
+    }
+
     proptest! {
         /// Against the enumeration of all 3^N modes (N ≤ 5): exactly one mode is admissible
-        /// (the problem is strictly convex), and the active-set solution is that one, cold
-        /// and warm-started from any mode.
+        /// (the problem is strictly convex), and the pivoting finds that one, cold and
+        /// warm-started from any mode.
         #[test]
-        fn the_active_set_solution_is_the_unique_admissible_mode(
+        fn the_pivoting_finds_the_unique_admissible_mode(
             n in 1usize..=5,
             seed in prop::collection::vec(0.0f64..1.0, 12),
             warm in prop::collection::vec(0usize..3, 5),
@@ -435,12 +440,10 @@ mod tests {
             let all = enumerate(&a, &b, &lo, &hi);
             prop_assert_eq!(all.len(), 1, "admissible modes: {:?}", all);
             let (v, r) = &all[0];
-            let modes = [DiscMode::SlipPos, DiscMode::SlipNeg, DiscMode::Stick];
             for start in [None, Some(&warm)] {
                 let mut s = ContactSolver::new(n);
                 if let Some(w) = start {
-                    let m: Vec<DiscMode> = w[..n].iter().map(|&k| modes[k]).collect();
-                    s.warm_start(&m);
+                    s.warm_start(&modes_of(&w[..n]));
                 }
                 s.solve(&a, &b, &lo, &hi).unwrap();
                 // Two eliminations of the same small system (pivoted dense, Thomas): their
@@ -454,10 +457,8 @@ mod tests {
                 prop_assert!(residual(&a, &b, &lo, &hi, s.v(), s.r()) <= 1e-14);
             }
         }
-    }
 
-    proptest! {
-        /// On the rig's two contacts with frozen bounds, the active-set solver and the
+        /// On the rig's two contacts with frozen bounds, the pivoting solver and the
         /// stepper's enumeration of the nine modes (`onestep`, written separately) solve
         /// the same problem: the same velocities and impulses.
         #[test]
@@ -489,9 +490,7 @@ mod tests {
                 prop_assert!((s.r()[i] - want.r[i]).abs() <= 1e-14, "r: {:?} vs {:?}", s.r(), want.r);
             }
         }
-    }
 
-    proptest! {
         /// Long chains, strongly coupled at long steps, from any warm start: the solver
         /// ends (within its cap) at a residual of rounding.
         #[test]
@@ -501,9 +500,8 @@ mod tests {
             warm in prop::collection::vec(0usize..3, 64),
         ) {
             let (a, b, lo, hi) = problem(n, &seed);
-            let modes = [DiscMode::SlipPos, DiscMode::SlipNeg, DiscMode::Stick];
             let mut s = ContactSolver::new(n);
-            s.warm_start(&warm[..n].iter().map(|&k| modes[k]).collect::<Vec<_>>());
+            s.warm_start(&modes_of(&warm[..n]));
             s.solve(&a, &b, &lo, &hi).unwrap();
             // Rounding of a tridiagonal solve: 1e-14 relative is ~50 ε.
             prop_assert!(residual(&a, &b, &lo, &hi, s.v(), s.r()) <= 1e-14);
