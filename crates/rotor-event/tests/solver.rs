@@ -239,7 +239,7 @@ fn output_levels_keep_only_what_is_asked() {
     assert!(fin.samples.is_empty() && fin.events.is_empty() && fin.metrics.is_none());
     let grid = run(Output::Grid { dt: 0.01 });
     assert_eq!(grid.samples.len(), 20001);
-    assert_eq!(grid.samples[0].t, 0.0);
+    assert_eq!(grid.samples.t(0), 0.0);
     assert_eq!(grid.samples.last().unwrap().t, 200.0);
     // Same final state whatever is kept: output does not perturb the integration.
     assert_eq!(fin.x_final, grid.x_final);

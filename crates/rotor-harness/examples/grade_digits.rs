@@ -44,7 +44,7 @@ fn main() {
                     continue;
                 }
             };
-            let trace = Trace::of_run("run", tr.samples);
+            let trace = Trace::of_run("run", &tr.samples);
             let events = EventsFile::of_run("run", &tr.events);
             match check(&sc, &r, &trace, Some(&events), Level::Strict) {
                 Ok(rep) => {
@@ -74,7 +74,7 @@ fn main() {
         if let Ok(rep) = check(
             &sc,
             &r,
-            &Trace::of_run("ref", r.samples.clone()),
+            &Trace::of_samples("ref", r.samples.clone()),
             Some(&EventsFile::of_run("ref", &r.events)),
             Level::Strict,
         ) {

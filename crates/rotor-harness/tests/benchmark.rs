@@ -150,7 +150,10 @@ fn every_solver_passes_check_at_its_level() {
                     out.push(format!("{} {}:\n{}", sc.name, kind.name(), rep.table()));
                 }
             }
-            let own = parse_trace(&write_trace(&r.samples, sc.compare.dt), Path::new("r.csv"));
+            let own = parse_trace(
+                &write_trace(&r.samples.iter().copied().collect(), sc.compare.dt),
+                Path::new("r.csv"),
+            );
             let ev = parse_events(&write_events(&r.events), Path::new("r.events.csv")).unwrap();
             let rep = check(sc, &r, &own.unwrap(), Some(&ev), Level::Strict).unwrap();
             // Every difference is 0, the orbit's too: it compares the trace's offsets from
@@ -181,7 +184,11 @@ fn good_text() -> String {
         .into_iter()
         .find(|s| s.name == "t1-u0.02-rest")
         .unwrap();
-    String::from_utf8(write_trace(&stored(&sc).samples, sc.compare.dt)).unwrap()
+    String::from_utf8(write_trace(
+        &stored(&sc).samples.iter().copied().collect(),
+        sc.compare.dt,
+    ))
+    .unwrap()
 }
 
 /// Unusable traces are errors that name the file and the line (or the missing time).

@@ -138,7 +138,7 @@ fn grid_samples_between_steps_match_the_event_solver() {
             .zip(&reference.samples)
             .map(|(a, b)| {
                 assert_eq!(a.t, b.t);
-                (a.x - b.x).amax()
+                (a.state() - b.state()).amax()
             })
             .fold(0.0, f64::max);
         // A third or more of the grid times fall between steps (measured: 66 of 68 for the

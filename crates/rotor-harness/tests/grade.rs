@@ -39,7 +39,7 @@ fn all_scenarios() -> Vec<(Scenario, Reference)> {
 /// The reference's own files as a client would hand them in.
 fn own(r: &Reference) -> (Trace, EventsFile) {
     (
-        Trace::of_run("ref.csv", r.samples.clone()),
+        Trace::of_samples("ref.csv", r.samples.clone()),
         EventsFile::of_run("ref.events.csv", &r.events),
     )
 }
@@ -130,7 +130,7 @@ fn wrong_traces_fail() {
         .solver()
         .simulate(&sc.model, &scene_for(SolverKind::EVENT, &wrong_u))
         .unwrap();
-    let t = Trace::of_run("u1.52.csv", tr.samples);
+    let t = Trace::of_run("u1.52.csv", &tr.samples);
     let e = EventsFile::of_run("u1.52.events.csv", &tr.events);
     cases.push(("the run at u = 1.52 V", t, e, true));
 
@@ -597,7 +597,7 @@ fn a_band_of_1e_6_passes_where_its_samples_agree_and_fails_where_not() {
         .filter(|s| s.x[2].abs() > 1e-9 && s.x[2].abs() <= 1e-6)
         .count();
     assert!(stuck_at_eta > 1000, "{stuck_at_eta}");
-    let t = Trace::of_run("switch-eta-1e-6.csv", tr.samples);
+    let t = Trace::of_run("switch-eta-1e-6.csv", &tr.samples);
     let e = EventsFile::of_run("switch-eta-1e-6.events.csv", &tr.events);
     let loose = grade(&sc, &r, &t, Some(&e), Level::Loose);
     assert!(loose.passed, "{}", loose.table());
@@ -621,7 +621,7 @@ fn digits_rise_as_a_method_converges() {
             ..scene_for(kind, &sc)
         };
         let tr = kind.solver().simulate(&sc.model, &scene).unwrap();
-        let t = Trace::of_run("run", tr.samples);
+        let t = Trace::of_run("run", &tr.samples);
         let e = EventsFile::of_run("run.events", &tr.events);
         grade(&sc, &r, &t, Some(&e), Level::Loose).digits
     };

@@ -4,8 +4,8 @@
 //! motion at the step.
 
 use rotor_analysis::solvers::{SOLVERS, SolverKind};
-use rotor_model::seam::{Accuracy, Input, Output, Scene, Trajectory};
-use rotor_model::{Model, State};
+use rotor_model::Model;
+use rotor_model::seam::{Accuracy, Input, Output, Row, Scene, Trajectory};
 
 /// Table 1's rig at 1.5 V from rest (its stick-slip cycle), stepped to 2.5 V at t = 60 s.
 fn step_input() -> Input {
@@ -29,11 +29,13 @@ fn run(kind: SolverKind, scene: &Scene) -> Trajectory {
 }
 
 /// The largest |Δx| between two sample lists of the same length.
-fn max_diff(a: &[rotor_model::seam::Sample], b: &[rotor_model::seam::Sample]) -> f64 {
+fn max_diff<'a>(
+    a: impl ExactSizeIterator<Item = Row<'a>>,
+    b: impl ExactSizeIterator<Item = Row<'a>>,
+) -> f64 {
     assert_eq!(a.len(), b.len());
-    a.iter()
-        .zip(b)
-        .flat_map(|(p, q)| (0..3).map(move |i| (p.x[i] - q.x[i]).abs()))
+    a.zip(b)
+        .flat_map(|(p, q)| p.x.iter().zip(q.x).map(|(v, w)| (v - w).abs()))
         .fold(0.0, f64::max)
 }
 
@@ -81,15 +83,15 @@ fn a_step_is_two_constant_runs_composed() {
         let full = run(kind, &stepped);
         let n = a.samples.len();
         assert_eq!(full.samples.len(), n + b.samples.len() - 1);
-        let first_diff = (0..n).find(|&i| full.samples[i] != a.samples[i]);
+        let first_diff = (0..n).find(|&i| full.samples.row(i) != a.samples.row(i));
         assert_eq!(
             first_diff,
             None,
             "{}: up to the step, the stepped run is the 1.5 V run: {:?}",
             kind.name(),
-            first_diff.map(|i| (full.samples[i], a.samples[i]))
+            first_diff.map(|i| (full.samples.row(i), a.samples.row(i)))
         );
-        let after = max_diff(&full.samples[n - 1..], &b.samples);
+        let after = max_diff(full.samples.iter().skip(n - 1), b.samples.iter());
         eprintln!(
             "{}: composition max |dx| after the step {after:e}",
             kind.name()
@@ -104,7 +106,7 @@ fn a_step_is_two_constant_runs_composed() {
                 ..first.clone()
             },
         );
-        assert!(max_diff(&full.samples, &unstepped.samples) > 0.1);
+        assert!(max_diff(full.samples.iter(), unstepped.samples.iter()) > 0.1);
     }
 }
 
@@ -164,7 +166,12 @@ fn a_ramp_converges_at_each_solvers_order() {
         };
         let errors: Vec<f64> = ladder
             .iter()
-            .map(|&a| max_diff(&run(kind, &ramp_scene(a)).samples, &reference.samples))
+            .map(|&a| {
+                max_diff(
+                    run(kind, &ramp_scene(a)).samples.iter(),
+                    reference.samples.iter(),
+                )
+            })
             .collect();
         let knobs: Vec<f64> = ladder.iter().map(|a| a.value()).collect();
         let p = order(&knobs, &errors);
@@ -241,7 +248,7 @@ fn every_breakpoint_is_a_step_end() {
                 kind.name()
             );
             assert!(
-                !tr.samples.windows(2).any(|w| w[0].t < b && b < w[1].t),
+                !tr.samples.times().windows(2).any(|w| w[0] < b && b < w[1]),
                 "{}: a step straddles the breakpoint {b}",
                 kind.name()
             );
@@ -268,7 +275,7 @@ fn a_step_from_rest_starts_the_motion_at_the_step() {
         let tr = run(kind, &scene);
         for s in &tr.samples {
             if s.t <= 1.0 {
-                assert_eq!(s.x, State::zeros(), "{} at {}", kind.name(), s.t);
+                assert_eq!(s.x, [0.0; 3], "{} at {}", kind.name(), s.t);
             }
         }
         // Already moving one output interval after the step.

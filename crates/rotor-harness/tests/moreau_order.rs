@@ -197,6 +197,8 @@ fn onsets(tr: &rotor_model::seam::Trajectory) -> Vec<f64> {
 /// leaves the lower disc at rest (ω_l = 0 exactly) after a slipping step end, in `[20, t_end]`.
 fn step_onsets(tr: &rotor_model::seam::Trajectory) -> Vec<f64> {
     tr.samples
+        .rig()
+        .unwrap()
         .windows(2)
         .filter(|w| w[0].x[2] != 0.0 && w[1].x[2] == 0.0 && w[1].t >= 20.0)
         .map(|w| w[1].t)
@@ -251,7 +253,7 @@ fn moreau_state_and_stick_onsets_converge_at_second_order() {
         .iter()
         .zip(&loose.samples)
         .filter(|(a, _)| a.t >= WINDOW.0)
-        .map(|(a, b)| (a.x - b.x).amax())
+        .map(|(a, b)| (a.state() - b.state()).amax())
         .fold(0.0, f64::max);
     let ref_err_onset = on_ref
         .iter()
@@ -279,14 +281,14 @@ fn moreau_state_and_stick_onsets_converge_at_second_order() {
         let mut worst: f64 = 0.0;
         for s in tr.samples.iter().filter(|s| s.t >= WINDOW.0) {
             let j = (s.t / REF_DT).round() as usize;
-            let r = &reference.samples[j];
+            let r = reference.samples.row(j);
             assert!(
                 (r.t - s.t).abs() < 1e-9,
                 "h={h}: step end {} vs grid {}",
                 s.t,
                 r.t
             );
-            worst = worst.max((s.x - r.x).amax());
+            worst = worst.max((s.state() - r.state()).amax());
         }
         e_state.push(worst);
         let on = onsets(&tr);

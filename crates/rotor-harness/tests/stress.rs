@@ -350,7 +350,7 @@ fn energy_run(
         metrics_from: None,
     };
     let tr = kind.solver().simulate(m, &scene).expect("energy run");
-    let mut s: Vec<(f64, State)> = tr.samples.iter().map(|s| (s.t, s.x)).collect();
+    let mut s: Vec<(f64, State)> = tr.samples.iter().map(|s| (s.t, s.state())).collect();
     if fixed {
         s.insert(0, (0.0, x0));
     }

@@ -136,9 +136,10 @@ fn a_late_phase_drift_fails_the_event_times_alone() {
         let lag = |t: f64| end_lag * ((t.min(t_last) - t_s) / (t_last - t_s)).max(0.0);
         let band = SolverKind::SWITCH.info().stuck_band;
         for s in tr.samples.iter_mut() {
+            let x = rotor_model::State::from_column_slice(s.x);
             let f = sc
                 .model
-                .rhs(&s.x, sc.u, sample_mode(&sc.model, &s.x, sc.u, band));
+                .rhs(&x, sc.u, sample_mode(&sc.model, &x, sc.u, band));
             let d = lag(s.t);
             for i in 0..3 {
                 s.x[i] -= d * f[i];
@@ -218,10 +219,7 @@ impl<const PPB: u32> Solver for LateOffset<PPB> {
             // differ in the last bits); the part's first sample is the previous one's last.
             for s in part.samples.iter().skip(1) {
                 let k = o.samples.len();
-                o.samples.push(rotor_model::seam::Sample {
-                    t: (k as f64 * dt).min(scene.t_end),
-                    x: s.x,
-                });
+                o.samples.push((k as f64 * dt).min(scene.t_end), s.x);
             }
             o.events.extend(
                 part.events

@@ -190,8 +190,8 @@ pub(crate) fn load(
         u: scenario.steady_u(),
     };
     // The reference's steady state read off its grid as a trace's is.
-    let grid_steady =
-        grid_metrics(&tr.samples, spec.metrics_from, exit).map_err(|_| no_steady())?;
+    let rig: Vec<_> = tr.samples.iter().map(|r| r.sample()).collect();
+    let grid_steady = grid_metrics(&rig, spec.metrics_from, exit).map_err(|_| no_steady())?;
     let grid_refd = RefData {
         steady: SteadyRef::of(Some(&grid_steady)).ok_or_else(no_steady)?,
         ..refd.clone()
@@ -294,7 +294,7 @@ fn graded(
     tr: &rotor_model::seam::Trajectory,
 ) -> (Option<bool>, Option<bool>, Option<f64>) {
     let (sc, r) = &l.view;
-    let trace = crate::grade::trace::Trace::of_run("run", tr.samples.clone());
+    let trace = crate::grade::trace::Trace::of_run("run", &tr.samples);
     let events = crate::grade::trace::EventsFile::of_run("run", &tr.events);
     let loose = check(sc, r, &trace, Some(&events), Level::Loose).ok();
     let strict = check(sc, r, &trace, Some(&events), Level::Strict).ok();

@@ -143,10 +143,10 @@ pub fn scenario_csv(r: &ScenarioResult) -> String {
     let mut row: Vec<f64> = Vec::with_capacity(1 + CSV_QUANTITIES.len() * kinds.len());
     for i in 0..n {
         row.clear();
-        let t = r.traj(kinds[0]).map_or(0.0, |tr| tr.samples[i].t);
+        let t = r.traj(kinds[0]).map_or(0.0, |tr| tr.samples.t(i));
         row.push(crate::grade::trace::round_to(t, digits));
         for k in &kinds {
-            let x = r.traj(*k).map(|tr| tr.samples[i].x).unwrap_or_default();
+            let x = r.traj(*k).map_or([0.0; 3].as_slice(), |tr| tr.samples.x(i));
             // The state's order is the columns' order: α, ω_u, ω_l.
             for v in [x[0], x[1], x[2]] {
                 row.push(round_sig(v, 12, Rounding::Decimal { floor: 0.0 }));
@@ -676,7 +676,7 @@ mod tests {
                 row[0]
             );
             for (j, k) in kinds.iter().enumerate() {
-                let x = r.traj(*k).unwrap().samples[i].x;
+                let x = r.traj(*k).unwrap().samples.x(i);
                 for q in 0..3 {
                     assert_eq!(
                         row[1 + 3 * j + q],

@@ -398,7 +398,7 @@ fn mirror_difference(a: &[(f64, State)], b: &[(f64, State)]) -> f64 {
 }
 
 fn samples(tr: &Trajectory) -> Vec<(f64, State)> {
-    tr.samples.iter().map(|s| (s.t, s.x)).collect()
+    tr.samples.iter().map(|s| (s.t, s.state())).collect()
 }
 
 /// The exact solution of the friction-free system at `times`: `x(t) = [exp(M t) z0]_{0..3}`

@@ -1006,7 +1006,7 @@ pub enum GradeError {
 /// // The scenario's comparison scene: its grid (0.01 s), events and steady window.
 /// let kind = SolverKind::MOREAU;
 /// let run = kind.solver().simulate(&sc.model, &scene_for(kind, &sc))?;
-/// let trace = Trace::of_run("moreau.csv", run.samples);
+/// let trace = Trace::of_run("moreau.csv", &run.samples);
 /// let events = EventsFile::of_run("moreau.events.csv", &run.events);
 ///
 /// let loose = grade(&path, &trace, Some(&events), Level::Loose)?;

@@ -338,7 +338,12 @@ mod tests {
         let tr = rotor_event::EventSolver::default()
             .simulate(&m, &scene)
             .unwrap();
-        let g = grid_metrics(&tr.samples, 100.0, StickExit { model: &m, u }).unwrap();
+        let g = grid_metrics(
+            &tr.samples.rig().unwrap(),
+            100.0,
+            StickExit { model: &m, u },
+        )
+        .unwrap();
         let exact = tr.metrics.unwrap();
         assert_eq!(g.kind(), exact.kind(), "{g:?} vs {exact:?}");
         g.values()

@@ -92,7 +92,7 @@ impl Orbit {
         // The samples with the events merged in, in time order (both lists are).
         let mut all: Vec<Sample> = Vec::with_capacity(tr.samples.len() + tr.events.len());
         let mut events = tr.events.iter().peekable();
-        for s in tr.samples {
+        for s in tr.samples.iter().map(|r| r.sample()) {
             while let Some(e) = events.next_if(|e| e.t < s.t) {
                 all.push(Sample { t: e.t, x: e.x });
             }

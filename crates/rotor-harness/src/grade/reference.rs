@@ -28,7 +28,7 @@ use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
 use rotor_model::scenario::Scenario;
-use rotor_model::seam::{Accuracy, Event, Output, Sample, Scene, SolveError, SteadyState};
+use rotor_model::seam::{Accuracy, Event, Output, Sample, Samples, Scene, SolveError, SteadyState};
 use rotor_model::{Rounding, round_sig};
 use serde::{Deserialize, Serialize};
 
@@ -170,7 +170,7 @@ impl Reference {
         tol: f64,
     ) -> Reference {
         Reference {
-            samples: tr.samples.clone(),
+            samples: tr.samples.iter().map(|r| r.sample()).collect(),
             events: switches(&tr.events),
             json: ReferenceJson {
                 scenario: sc.name.clone(),
@@ -226,11 +226,11 @@ fn switches(events: &[Event]) -> Vec<Event> {
 
 /// Largest |a − b| of each state component over two runs on the same grid (∞ if the grids
 /// differ).
-fn trace_differences(a: &[Sample], b: &[Sample]) -> [f64; 3] {
-    if a.len() != b.len() {
-        return [f64::INFINITY; 3];
+fn trace_differences(a: &Samples, b: &Samples) -> Vec<f64> {
+    if a.len() != b.len() || a.dim() != b.dim() {
+        return vec![f64::INFINITY; a.dim().max(b.dim())];
     }
-    let mut d = [0.0f64; 3];
+    let mut d = vec![0.0f64; a.dim()];
     for (x, y) in a.iter().zip(b) {
         for (i, di) in d.iter_mut().enumerate() {
             *di = di.max((x.x[i] - y.x[i]).abs());
@@ -287,7 +287,7 @@ fn differences(
 /// over the quantities of its own trace and events graded by [`crate::grade::check::check`] (their
 /// scales are the grade's), 0 if they cannot be graded.
 pub fn verified_digits(sc: &Scenario, r: &Reference) -> f64 {
-    let trace = crate::grade::trace::Trace::of_run("reference", r.samples.clone());
+    let trace = crate::grade::trace::Trace::of_samples("reference", r.samples.clone());
     let events = crate::grade::trace::EventsFile::of_run("reference.events", &r.events);
     let Ok(rep) = crate::grade::check::check(
         sc,
@@ -323,6 +323,7 @@ pub fn compute(sc: &Scenario) -> Result<Reference, ReferenceError> {
 fn compute_at(sc: &Scenario, tol: f64, check_tol: f64) -> Result<Reference, ReferenceError> {
     let r = event_run(sc, tol)?;
     let tight = event_run(sc, check_tol)?;
+    let tight_samples: Vec<Sample> = tight.samples.iter().map(|r| r.sample()).collect();
     // The stated error: the difference to the tighter run, with a margin and a floor.
     let scale_of = |name: &str| -> f64 {
         let comp = match name {
@@ -378,7 +379,8 @@ fn compute_at(sc: &Scenario, tol: f64, check_tol: f64) -> Result<Reference, Refe
         .iter()
         .map(|s| Sample {
             t: s.t,
-            x: s.x.map(|v| round_sig(v, trace_digits, Rounding::Scaled)),
+            x: s.state()
+                .map(|v| round_sig(v, trace_digits, Rounding::Scaled)),
         })
         .collect();
     let mut cross_check = BTreeMap::new();
@@ -463,7 +465,7 @@ fn compute_at(sc: &Scenario, tol: f64, check_tol: f64) -> Result<Reference, Refe
         let scale = crate::grade::check::state_scales(&samples);
         let cycle = steady.expect("a cycle");
         if let Some(d) =
-            crate::grade::check::orbit_distance(sc, &partial, cycle, &tight.samples, from, scale)
+            crate::grade::check::orbit_distance(sc, &partial, cycle, &tight_samples, from, scale)
         {
             let (d, _) = d.map_err(|source| ReferenceError::Solve {
                 scenario: format!("{} (orbit)", sc.name),
@@ -494,7 +496,7 @@ pub fn paths(dir: &Path, name: &str) -> [PathBuf; 3] {
 pub fn to_files(r: &Reference) -> [Vec<u8>; 3] {
     let json = serde_json::to_string_pretty(&r.json).expect("plain numbers and strings") + "\n";
     [
-        crate::grade::trace::write_trace(&r.samples, r.json.dt),
+        crate::grade::trace::write_trace(&r.samples.iter().copied().collect(), r.json.dt),
         write_events(&r.events),
         json.into_bytes(),
     ]

@@ -12,7 +12,7 @@
 use std::io::Read;
 use std::path::{Path, PathBuf};
 
-use rotor_model::seam::{Event, EventKind, Sample};
+use rotor_model::seam::{Event, EventKind, Sample, Samples};
 use rotor_model::{Disc, State};
 use thiserror::Error;
 
@@ -37,43 +37,53 @@ pub fn round_to(t: f64, digits: i32) -> f64 {
 }
 
 /// The samples of a run on the grid of step `dt` as a trace file (times rounded to the
-/// grid's decimals, [`time_digits`]).
-pub fn write_trace(samples: &[Sample], dt: f64) -> Vec<u8> {
-    let mut out = Vec::with_capacity(samples.len() * 72 + 32);
+/// grid's decimals, [`time_digits`]), its header the state's names for its size
+/// ([`rotor_model::state_names`]: `t,alpha,omega_u,omega_l` for the rig).
+pub fn write_trace(samples: &Samples, dt: f64) -> Vec<u8> {
+    let mut out = Vec::with_capacity(samples.len() * (24 * samples.dim() + 8) + 32);
     write_trace_to(&mut out, samples, dt).expect("in memory");
     out
 }
 
 /// [`write_trace`] into a writer, row by row: the trace never sits in memory as text (fresh
 /// memory costs a page fault per 4 kB; for 10⁴ rows that is a fair part of the solve).
-pub fn write_trace_to(
+pub fn write_trace_to(w: impl std::io::Write, samples: &Samples, dt: f64) -> std::io::Result<()> {
+    write_named_trace_to(w, &rotor_model::state_names(samples.dim()), samples, dt)
+}
+
+/// [`write_trace_to`] with the state's columns named `names` (a model's own names: a chain
+/// of two written in chain form is headed `alpha_1,omega_1,omega_2`, not the rig's names).
+pub fn write_named_trace_to(
     mut w: impl std::io::Write,
-    samples: &[Sample],
+    names: &[String],
+    samples: &Samples,
     dt: f64,
 ) -> std::io::Result<()> {
-    let header = TRACE_HEADER.join(",") + "\n";
+    debug_assert_eq!(names.len(), samples.dim(), "a name per state value");
+    let mut header = String::from("t");
+    for n in names {
+        header.push(',');
+        header.push_str(n);
+    }
+    header.push('\n');
     w.write_all(header.as_bytes())?;
     write_rows(&mut w, samples, time_digits(dt))?;
     w.flush()
 }
 
 /// The rows of `samples` (no header) into `w`, through the csv writer.
-fn write_rows(w: impl std::io::Write, samples: &[Sample], digits: i32) -> std::io::Result<()> {
+fn write_rows(w: impl std::io::Write, samples: &Samples, digits: i32) -> std::io::Result<()> {
     // Numbers never need quotes: the writer skips scanning for them.
     let mut w = csv::WriterBuilder::new()
         .quote_style(csv::QuoteStyle::Never)
         .buffer_capacity(1 << 16)
         .from_writer(w);
-    let mut bufs = [(); 4].map(|_| zmij::Buffer::new());
+    let mut t_buf = zmij::Buffer::new();
+    let mut bufs: Vec<zmij::Buffer> = (0..samples.dim()).map(|_| zmij::Buffer::new()).collect();
     for s in samples {
-        let [b0, b1, b2, b3] = &mut bufs;
-        let row = [
-            b0.format(round_to(s.t, digits)),
-            b1.format(s.x[0]),
-            b2.format(s.x[1]),
-            b3.format(s.x[2]),
-        ];
-        w.write_record(row)?;
+        let t = t_buf.format(round_to(s.t, digits));
+        let xs = bufs.iter_mut().zip(s.x).map(|(b, &v)| b.format(v));
+        w.write_record(std::iter::once(t).chain(xs))?;
     }
     w.flush()
 }
@@ -247,7 +257,16 @@ pub struct Trace {
 impl Trace {
     /// A run's grid samples as a trace (rows numbered as in a file written from them, at full
     /// precision): how this project's own runs are graded as external traces are.
-    pub fn of_run(path: &str, samples: Vec<Sample>) -> Trace {
+    ///
+    /// # Panics
+    ///
+    /// If the run is not the rig's (the grade reads the rig's state).
+    pub fn of_run(path: &str, samples: &Samples) -> Trace {
+        Trace::of_samples(path, samples.iter().map(|r| r.sample()).collect())
+    }
+
+    /// The rig's samples as a trace, numbered as [`Trace::of_run`] numbers a run's.
+    pub fn of_samples(path: &str, samples: Vec<Sample>) -> Trace {
         Trace {
             path: path.into(),
             lines: (2..samples.len() as u64 + 2).collect(),
@@ -751,7 +770,7 @@ mod tests {
             s(3.0 * 0.1, 0.1 + 0.2, -1.5e-7, 6.336105049),
             s(0.8999999999999999, 1e300, -2.5, 1.0 / 3.0),
         ];
-        let bytes = write_trace(&samples, 0.1);
+        let bytes = write_trace(&samples.iter().copied().collect(), 0.1);
         let text = String::from_utf8(bytes.clone()).unwrap();
         assert!(
             text.starts_with("t,alpha,omega_u,omega_l\n0.0,0.0,0.0,0.0\n"),
@@ -781,7 +800,7 @@ mod tests {
                 )
             })
             .collect();
-        let bytes = write_trace(&samples, 0.01);
+        let bytes = write_trace(&samples.iter().copied().collect(), 0.01);
         let back = parse_trace(&bytes, Path::new("x.csv")).unwrap();
         assert_eq!(back.samples.len(), 10_001);
         assert_eq!(back.samples[5000].x, samples[5000].x);
@@ -971,7 +990,11 @@ mod tests {
     #[test]
     fn traces_from_arrays_match_files_and_name_bad_entries() {
         let samples = vec![s(0.0, 0.0, 0.0, 0.0), s(0.1, 0.5, -1.5e-7, 6.3)];
-        let file = parse_trace(&write_trace(&samples, 0.1), Path::new("x.csv")).unwrap();
+        let file = parse_trace(
+            &write_trace(&samples.iter().copied().collect(), 0.1),
+            Path::new("x.csv"),
+        )
+        .unwrap();
         let col = |k: usize| -> Vec<f64> {
             samples
                 .iter()

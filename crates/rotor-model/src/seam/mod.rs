@@ -14,6 +14,7 @@ pub mod event;
 pub mod fast_forward;
 pub mod input;
 pub mod record;
+pub mod samples;
 pub mod scene;
 pub mod steady;
 
@@ -22,6 +23,7 @@ pub use event::{Event, EventKind};
 pub use fast_forward::{FastForward, Verdict};
 pub use input::{Input, Piece};
 pub use record::{Integration, Recorder};
+pub use samples::{Row, RowMut, Rows, RowsMut, Samples};
 pub use scene::{
     Accuracy, Output, OutputGrid, Sample, Scene, SolveError, Solver, Stats, Trajectory,
     check_finite,

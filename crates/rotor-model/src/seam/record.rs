@@ -14,7 +14,8 @@
 
 use crate::seam::event::Event;
 use crate::seam::fast_forward::{FastForward, Verdict};
-use crate::seam::scene::{Output, OutputGrid, Sample, Scene, SolveError, Stats, Trajectory};
+use crate::seam::samples::Samples;
+use crate::seam::scene::{Output, OutputGrid, Scene, SolveError, Stats, Trajectory};
 use crate::seam::steady::MetricsAccumulator;
 use crate::{Mode, State};
 
@@ -24,7 +25,7 @@ pub struct Recorder {
     grid: Option<OutputGrid>,
     keep_steps: bool,
     keep_events: bool,
-    samples: Vec<Sample>,
+    samples: Samples,
     events: Vec<Event>,
     metrics: Option<MetricsAccumulator>,
     fast_forward: Option<FastForward>,
@@ -65,14 +66,15 @@ impl Recorder {
     pub fn new(scene: &Scene, x0: State, ff_tol: f64, skip_verify: f64) -> Recorder {
         let mut grid = scene.grid();
         let keep_steps = scene.output == Output::Steps;
-        let mut samples = Vec::with_capacity(grid.map_or(usize::from(keep_steps), |g| g.len()));
+        let mut samples =
+            Samples::with_capacity(x0.len(), grid.map_or(usize::from(keep_steps), |g| g.len()));
         if keep_steps {
-            samples.push(Sample { t: 0.0, x: x0 });
+            samples.push(0.0, x0.as_slice());
         }
         if let Some(g) = grid.as_mut()
             && g.peek().is_some_and(|t| t <= 0.0)
         {
-            samples.push(Sample { t: 0.0, x: x0 });
+            samples.push(0.0, x0.as_slice());
             g.advance();
         }
         Recorder {
@@ -116,13 +118,16 @@ impl Recorder {
                 if tg > t1 {
                     break;
                 }
-                let x = if tg == t1 { *x1 } else { interp(tg.max(t0)) };
-                self.samples.push(Sample { t: tg, x });
+                if tg == t1 {
+                    self.samples.push(tg, x1.as_slice());
+                } else {
+                    self.samples.push(tg, interp(tg.max(t0)).as_slice());
+                }
                 g.advance();
             }
         }
         if self.keep_steps {
-            self.samples.push(Sample { t: t1, x: *x1 });
+            self.samples.push(t1, x1.as_slice());
         }
     }
 
@@ -276,7 +281,7 @@ impl Recorder {
     ) -> Trajectory {
         if let Some(g) = self.grid.as_mut() {
             while let Some(tg) = g.peek() {
-                self.samples.push(Sample { t: tg, x: x_final });
+                self.samples.push(tg, x_final.as_slice());
                 g.advance();
             }
         }
@@ -427,7 +432,7 @@ mod tests {
         for (k, s) in tr.samples.iter().enumerate() {
             let t = if k == 1000 { 100.0 } else { k as f64 * 0.1 };
             assert_eq!(s.t, t);
-            assert_eq!(s.x, x(t), "t = {t}");
+            assert_eq!(s.x, x(t).as_slice(), "t = {t}");
         }
         assert_eq!(tr.events.len(), 50, "25 maxima and 25 minima in 100 s");
         assert_eq!(tr.stats.events, 50);
@@ -437,8 +442,8 @@ mod tests {
     fn steps_keep_every_step_end_from_the_initial_state_on() {
         let (tr, steps) = run(Output::Steps, 0.0, 3.0);
         assert_eq!(tr.samples.len() as u64, steps + 1);
-        assert_eq!(tr.samples[0], Sample { t: 0.0, x: x(0.0) });
-        assert!(tr.samples.windows(2).all(|w| w[0].t < w[1].t));
+        assert_eq!((tr.samples.t(0), tr.samples.x(0)), (0.0, x(0.0).as_slice()));
+        assert!(tr.samples.times().windows(2).all(|w| w[0] < w[1]));
         assert_eq!(tr.samples.last().unwrap().t, 100.0);
     }
 

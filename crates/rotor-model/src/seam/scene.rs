@@ -309,7 +309,7 @@ impl Scene {
 
 /// A list read as the rig's [`State`]; an error naming `field` if it does not hold three
 /// values.
-fn rig_state(field: &str, x: &[f64]) -> Result<State, SolveError> {
+pub(crate) fn rig_state(field: &str, x: &[f64]) -> Result<State, SolveError> {
     if x.len() != 3 {
         return Err(FieldError::new(
             field,
@@ -459,7 +459,7 @@ impl std::ops::AddAssign for Stats {
 #[derive(Debug, Clone, PartialEq)]
 pub struct Trajectory {
     /// Samples, as asked by the scene's [`Output`].
-    pub samples: Vec<Sample>,
+    pub samples: crate::seam::samples::Samples,
     /// Events, unless the scene asked for [`Output::Final`] or [`Output::Metrics`].
     pub events: Vec<Event>,
     /// Final time (= t_end).
@@ -487,7 +487,7 @@ impl Trajectory {
     pub fn check_finite(&self) -> Result<(), SolveError> {
         let ok = |t: f64, x: &[f64]| t.is_finite() && x.iter().all(|v| v.is_finite());
         let bad = |t: f64, what| Err(SolveError::NonFiniteOutput { t, what });
-        if let Some(s) = self.samples.iter().find(|s| !ok(s.t, s.x.as_slice())) {
+        if let Some(s) = self.samples.iter().find(|s| !ok(s.t, s.x)) {
             return bad(s.t, "sample");
         }
         if let Some(e) = self.events.iter().find(|e| !ok(e.t, e.x.as_slice())) {
@@ -661,7 +661,7 @@ mod tests {
     fn check_finite_names_the_first_non_finite_output() {
         let x = State::new(0.1, 2.0, 3.0);
         let good = Trajectory {
-            samples: vec![Sample { t: 0.0, x }, Sample { t: 1.0, x }],
+            samples: crate::seam::Samples::from_rig([Sample { t: 0.0, x }, Sample { t: 1.0, x }]),
             events: vec![Event {
                 t: 0.5,
                 x,
@@ -680,8 +680,12 @@ mod tests {
         assert_eq!(good.check_finite(), Ok(()));
         type Spoil = fn(&mut Trajectory);
         let spoilt: [(Spoil, f64, &str); 5] = [
-            (|t| t.samples[1].x[2] = f64::NAN, 1.0, "sample"),
-            (|t| t.samples[1].t = f64::INFINITY, f64::INFINITY, "sample"),
+            (|t| t.samples.x_mut(1)[2] = f64::NAN, 1.0, "sample"),
+            (
+                |t| *t.samples.t_mut(1) = f64::INFINITY,
+                f64::INFINITY,
+                "sample",
+            ),
             (|t| t.events[0].x[0] = f64::NEG_INFINITY, 0.5, "event"),
             (|t| t.x_final[1] = f64::NAN, 1.0, "final state"),
             (
