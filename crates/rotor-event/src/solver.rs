@@ -56,7 +56,9 @@ struct Recording<'r>(&'r mut Recorder);
 
 impl Sink for Recording<'_> {
     fn step(&mut self, dense: &Dense<3>, t0: f64, t1: f64, x1: &State, _mode: Mode) {
-        self.0.step(t0, t1, x1, |t| dense.eval(t));
+        self.0.step(t0, t1, x1.as_slice(), |t, out| {
+            out.copy_from_slice(dense.eval(t).as_slice())
+        });
     }
 
     fn event(&mut self, e: &Event) {
@@ -127,7 +129,7 @@ impl Solver for EventSolver {
         scene.validate_for(model)?;
         let tol = scene.tol();
         let x0 = scene.x0_state()?;
-        let mut rec = Recorder::new(scene, x0, tol, self.options.skip_verify);
+        let mut rec = Recorder::new(scene, x0.as_slice(), tol, self.options.skip_verify);
         let mut integ = Integrator::new(model, scene.u_at(0.0), tol, self.options);
         integ.extrema = rec.wants_extrema();
         let at = RunEnd {
@@ -143,6 +145,6 @@ impl Solver for EventSolver {
         };
         rec.drive(&mut run)?;
         let RunEnd { t, x, mode } = run.at;
-        Ok(rec.finish(t, x, mode, run.integ.stats))
+        Ok(rec.finish(t, x.as_slice(), mode, run.integ.stats))
     }
 }

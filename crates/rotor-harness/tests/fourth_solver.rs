@@ -83,7 +83,13 @@ mod euler {
                 check_finite(t1, &x1)?;
                 let mode = self.mode_at(&x0, &mut x1);
                 self.steps += 1;
-                rec.step(t0, t1, &x1, |t| x0 + (x1 - x0) * ((t - t0) / h));
+                // The step's interpolant, written into the recorder's slice: linear.
+                rec.step(t0, t1, x1.as_slice(), |t, out| {
+                    let s = (t - t0) / h;
+                    for ((o, a), b) in out.iter_mut().zip(&x0).zip(&x1) {
+                        *o = a + (b - a) * s;
+                    }
+                });
                 for (i, d) in Disc::BOTH.into_iter().enumerate() {
                     let (a, b) = (self.mode.of(d), mode.of(d));
                     let kind = match (a, b) {
@@ -154,14 +160,14 @@ mod euler {
             let mut x0 = start;
             run.mode = run.mode_at(&start, &mut x0);
             run.x = x0;
-            let mut rec = Recorder::new(scene, x0, h, 3.0);
+            let mut rec = Recorder::new(scene, x0.as_slice(), h, 3.0);
             rec.drive(&mut run)?;
             let stats = Stats {
                 steps: run.steps,
                 rhs_evals: run.steps,
                 ..Stats::default()
             };
-            Ok(rec.finish(run.t, run.x, run.mode, stats))
+            Ok(rec.finish(run.t, run.x.as_slice(), run.mode, stats))
         }
     }
 }

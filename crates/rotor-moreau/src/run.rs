@@ -248,7 +248,9 @@ impl Run<'_> {
             self.pending.release_before(self.cur.t, rec);
         }
         let cur = self.cur;
-        rec.step(cur.t, next.t, &next.x, |t| lerp(&cur, &next, t));
+        rec.step(cur.t, next.t, next.x.as_slice(), |t, out| {
+            out.copy_from_slice(lerp(&cur, &next, t).as_slice())
+        });
         self.prev = Some(cur);
         self.cur = next;
         Ok(())
@@ -513,7 +515,7 @@ impl Solver for MoreauSolver {
         let full = stepper.step_size(0.0, h)?;
         // The scheme's error on the fixtures' cycles is second order, ≈ 0.6·h² in the period
         // (crate docs), so h² plays the adaptive solvers' tolerance.
-        let mut rec = Recorder::new(scene, x0, h * h, o.skip_verify);
+        let mut rec = Recorder::new(scene, x0.as_slice(), h * h, o.skip_verify);
         rec.reserve(n as usize);
         let m0 = model.mode_at(&x0, u);
         let mut run = Run {
@@ -541,7 +543,7 @@ impl Solver for MoreauSolver {
         };
         rec.drive(&mut run)?;
         let cur = run.cur;
-        Ok(rec.finish(t_end, cur.x, to_mode(&cur.mode), run.stats))
+        Ok(rec.finish(t_end, cur.x.as_slice(), to_mode(&cur.mode), run.stats))
     }
 }
 

@@ -522,7 +522,9 @@ impl Run<'_> {
         }
         let integ = &self.integ;
         let Some((tr, k, g)) = hit else {
-            rec.step(t0, t1, integ.y(), |t| integ.dense(t));
+            rec.step(t0, t1, integ.y().as_slice(), |t, out| {
+                out.copy_from_slice(integ.dense(t).as_slice())
+            });
             return Ok(());
         };
         let mut y = if tr == t1 {
@@ -534,7 +536,9 @@ impl Run<'_> {
         if let Some(w) = w {
             y[f.laws[k].idx] = w;
         }
-        rec.step(t0, tr, &y, |t| integ.dense(t));
+        rec.step(t0, tr, y.as_slice(), |t, out| {
+            out.copy_from_slice(integ.dense(t).as_slice())
+        });
         self.field.regions[k] = r;
         self.field.from_rest[k] = matches!(g, Guard::StickExit(_));
         self.last_extremum[k] = None;
@@ -842,7 +846,7 @@ impl Solver for SwitchSolver {
         let x0 = field.start(0.0, &scene.x0_state()?);
         check_finite(0.0, &x0)?;
         let tol = scene.tol();
-        let mut rec = Recorder::new(scene, x0, tol, o.skip_verify);
+        let mut rec = Recorder::new(scene, x0.as_slice(), tol, o.skip_verify);
         let dopts = Dopri5Options {
             rtol: tol,
             atol: tol,
@@ -879,7 +883,7 @@ impl Solver for SwitchSolver {
             rhs_evals: c.rhs_evals,
             ..Stats::default()
         };
-        Ok(rec.finish(scene.t_end, x_final, mode, stats))
+        Ok(rec.finish(scene.t_end, x_final.as_slice(), mode, stats))
     }
 }
 

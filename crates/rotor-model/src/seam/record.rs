@@ -26,6 +26,8 @@ pub struct Recorder {
     keep_steps: bool,
     keep_events: bool,
     samples: Samples,
+    /// A state the interpolant writes a grid sample into.
+    scratch: Vec<f64>,
     events: Vec<Event>,
     metrics: Option<MetricsAccumulator>,
     fast_forward: Option<FastForward>,
@@ -63,18 +65,18 @@ impl Recorder {
     /// solver's error scale for the fast-forward (its tolerance; h² for Moreau–Jean), and
     /// `skip_verify` the number of those within which the return after a jump must confirm it
     /// ([`FastForward::verify_within`]).
-    pub fn new(scene: &Scene, x0: State, ff_tol: f64, skip_verify: f64) -> Recorder {
+    pub fn new(scene: &Scene, x0: &[f64], ff_tol: f64, skip_verify: f64) -> Recorder {
         let mut grid = scene.grid();
         let keep_steps = scene.output == Output::Steps;
         let mut samples =
             Samples::with_capacity(x0.len(), grid.map_or(usize::from(keep_steps), |g| g.len()));
         if keep_steps {
-            samples.push(0.0, x0.as_slice());
+            samples.push(0.0, x0);
         }
         if let Some(g) = grid.as_mut()
             && g.peek().is_some_and(|t| t <= 0.0)
         {
-            samples.push(0.0, x0.as_slice());
+            samples.push(0.0, x0);
             g.advance();
         }
         Recorder {
@@ -82,6 +84,7 @@ impl Recorder {
             keep_steps,
             keep_events: scene.keeps_events(),
             samples,
+            scratch: vec![0.0; x0.len()],
             events: Vec::new(),
             metrics: scene.metrics_start().map(MetricsAccumulator::new),
             fast_forward: FastForward::for_scene(scene, ff_tol)
@@ -110,24 +113,25 @@ impl Recorder {
     }
 
     /// An accepted step `[t0, t1]` ending at `x1`: the grid times in `(t0, t1]` are sampled
-    /// from `interp`, the step's own interpolant (`x1` at `t1` itself), and [`Output::Steps`]
-    /// keeps `(t1, x1)`.
-    pub fn step(&mut self, t0: f64, t1: f64, x1: &State, interp: impl Fn(f64) -> State) {
+    /// from `interp`, the step's own interpolant, which writes the state at a time into a
+    /// slice (`x1` at `t1` itself), and [`Output::Steps`] keeps `(t1, x1)`.
+    pub fn step(&mut self, t0: f64, t1: f64, x1: &[f64], mut interp: impl FnMut(f64, &mut [f64])) {
         if let Some(g) = self.grid.as_mut() {
             while let Some(tg) = g.peek() {
                 if tg > t1 {
                     break;
                 }
                 if tg == t1 {
-                    self.samples.push(tg, x1.as_slice());
+                    self.samples.push(tg, x1);
                 } else {
-                    self.samples.push(tg, interp(tg.max(t0)).as_slice());
+                    interp(tg.max(t0), &mut self.scratch);
+                    self.samples.push(tg, &self.scratch);
                 }
                 g.advance();
             }
         }
         if self.keep_steps {
-            self.samples.push(t1, x1.as_slice());
+            self.samples.push(t1, x1);
         }
     }
 
@@ -193,7 +197,8 @@ impl Recorder {
     ///     fn advance(&mut self, rec: &mut Recorder) -> Result<(), SolveError> {
     ///         while self.t < self.t_end {
     ///             let (t0, t1) = (self.t, self.t + 1.0);
-    ///             rec.step(t0, t1, &x(t1), x); // the exact solution is the interpolant
+    ///             // The exact solution is the interpolant.
+    ///             rec.step(t0, t1, x(t1).as_slice(), |t, out| out.copy_from_slice(x(t).as_slice()));
     ///             self.t = t1;
     ///             let kind = match t1.rem_euclid(4.0) {
     ///                 1.0 => EventKind::Max(Disc::LOWER),
@@ -224,11 +229,11 @@ impl Recorder {
     ///     output: Output::Metrics,
     ///     ..Scene::default()
     /// };
-    /// let mut rec = Recorder::new(&scene, x(0.0), 1e-10, 3.0);
+    /// let mut rec = Recorder::new(&scene, x(0.0).as_slice(), 1e-10, 3.0);
     /// let mut toy = Toy { t: 0.0, t_end: scene.t_end };
     /// rec.drive(&mut toy)?;
     /// let slip = Mode::rig(DiscMode::SlipPos, DiscMode::SlipPos);
-    /// let tr = rec.finish(toy.t, x(toy.t), slip, Stats::default());
+    /// let tr = rec.finish(toy.t, x(toy.t).as_slice(), slip, Stats::default());
     ///
     /// assert_eq!(tr.t_final, 100.0);
     /// assert!(tr.stats.skipped_periods > 0, "whole periods were skipped, not integrated");
@@ -275,22 +280,29 @@ impl Recorder {
     pub fn finish(
         mut self,
         t_final: f64,
-        x_final: State,
+        x_final: &[f64],
         mode_final: Mode,
         stats: Stats,
     ) -> Trajectory {
         if let Some(g) = self.grid.as_mut() {
             while let Some(tg) = g.peek() {
-                self.samples.push(tg, x_final.as_slice());
+                self.samples.push(tg, x_final);
                 g.advance();
             }
         }
-        let metrics = self.metrics.as_ref().map(|m| m.finish(&x_final));
+        let metrics = self.metrics.as_ref().map(|m| {
+            assert_eq!(
+                x_final.len(),
+                3,
+                "the steady-state metrics read the rig's state"
+            );
+            m.finish(&State::from_column_slice(x_final))
+        });
         Trajectory {
             samples: self.samples,
             events: self.events,
             t_final,
-            x_final: x_final.as_slice().to_vec(),
+            x_final: x_final.to_vec(),
             mode_final,
             metrics,
             stats: FastForward::counted(
@@ -359,7 +371,9 @@ mod tests {
                     } else {
                         EventKind::Min(Disc::LOWER)
                     };
-                    rec.step(self.t, te, &y(te), y);
+                    rec.step(self.t, te, y(te).as_slice(), |t, o| {
+                        o.copy_from_slice(y(t).as_slice())
+                    });
                     self.steps += 1;
                     rec.event(Event {
                         t: te,
@@ -372,7 +386,9 @@ mod tests {
                     }
                     continue;
                 }
-                rec.step(self.t, t1, &y(t1), y);
+                rec.step(self.t, t1, y(t1).as_slice(), |t, o| {
+                    o.copy_from_slice(y(t).as_slice())
+                });
                 self.steps += 1;
                 self.t = t1;
             }
@@ -404,7 +420,7 @@ mod tests {
             metrics_from: (output != Output::Metrics).then_some(50.0),
             ..Scene::default()
         };
-        let mut rec = Recorder::new(&scene, x(0.0), 1e-10, verify);
+        let mut rec = Recorder::new(&scene, x(0.0).as_slice(), 1e-10, verify);
         let mut tri = Triangle {
             t: 0.0,
             t_end: 100.0,
@@ -415,7 +431,7 @@ mod tests {
         rec.drive(&mut tri).unwrap();
         let tr = rec.finish(
             tri.t,
-            x(tri.t - tri.offset),
+            x(tri.t - tri.offset).as_slice(),
             MODE,
             Stats {
                 steps: tri.steps,
@@ -458,14 +474,14 @@ mod tests {
                 output: Output::Final,
                 ..scene
             },
-            x(0.0),
+            x(0.0).as_slice(),
             1e-10,
             3.0,
         );
         rec.count_switch();
         rec.count_switch();
         assert!(!rec.wants_events());
-        let tr = rec.finish(1.0, x(0.0), MODE, Stats::default());
+        let tr = rec.finish(1.0, x(0.0).as_slice(), MODE, Stats::default());
         assert_eq!((tr.stats.events, tr.events.len()), (2, 0));
     }
 
