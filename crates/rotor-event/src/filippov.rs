@@ -29,7 +29,7 @@
 //! polished once more from there. A section crossing is refined as a terminal root.
 
 use nalgebra::Matrix3;
-use rotor_model::seam::{Event, EventKind, Piece, SolveError, Stats, check_finite};
+use rotor_model::seam::{EventKind, EventRef, Piece, SolveError, Stats, check_finite};
 use rotor_model::{Disc, DiscMode, Mode, Model, OMEGA_L, State};
 use std::cell::Cell;
 
@@ -256,9 +256,9 @@ pub(crate) trait Sink {
     /// An accepted step `[t0, t1]` whose dense output is `dense` (valid on `[t0, t1]`).
     fn step(&mut self, _dense: &Dense<3>, _t0: f64, _t1: f64, _x1: &State, _mode: Mode) {}
     /// An event (in time order).
-    fn event(&mut self, _e: &Event) {}
+    fn event(&mut self, _e: EventRef<'_>) {}
     /// Whether to stop after this event.
-    fn stop_after(&mut self, _e: &Event) -> bool {
+    fn stop_after(&mut self, _e: EventRef<'_>) -> bool {
         false
     }
     /// An upward crossing of the Poincaré section; whether to stop there.
@@ -1011,10 +1011,14 @@ impl<'a> Integrator<'a> {
                     Guard::Extremum(d, true) => EventKind::Max(d),
                     _ => EventKind::Max(Disc::LOWER),
                 };
-                let ev = Event { t: te, x: xe, kind };
+                let ev = EventRef {
+                    t: te,
+                    x: xe.as_slice(),
+                    kind,
+                };
                 self.stats.events += 1;
-                sink.event(&ev);
-                sink.stop_after(&ev)
+                sink.event(ev);
+                sink.stop_after(ev)
             };
             if stop {
                 sink.step(dense, t, te, &xe, mode);
@@ -1160,14 +1164,14 @@ impl<'a> Integrator<'a> {
         let (new_mode, kind) = self.transition(g, c.t, &mut c.x, c.mode);
         if let Some(kind) = kind {
             self.stats.events += 1;
-            let ev = Event {
+            let ev = EventRef {
                 t: c.t,
-                x: c.x,
+                x: c.x.as_slice(),
                 kind,
             };
-            sink.event(&ev);
+            sink.event(ev);
             recent.record(c.t, self.opts.zeno_window)?;
-            if sink.stop_after(&ev) {
+            if sink.stop_after(ev) {
                 return Ok(Some(RunEnd {
                     t: c.t,
                     x: c.x,
@@ -1244,10 +1248,14 @@ impl<'a> Integrator<'a> {
             *mode = m;
             fresh[d.position()] = true;
             self.stats.events += 1;
-            let ev = Event { t, x: *x, kind };
-            sink.event(&ev);
+            let ev = EventRef {
+                t,
+                x: x.as_slice(),
+                kind,
+            };
+            sink.event(ev);
             recent.record(t, self.opts.zeno_window)?;
-            if sink.stop_after(&ev) {
+            if sink.stop_after(ev) {
                 return Ok(Some(RunEnd {
                     t,
                     x: *x,

@@ -1,6 +1,6 @@
 //! The flow of the Filippov system as a function, for shooting and continuation.
 
-use rotor_model::seam::{Event, EventKind, SolveError, Stats};
+use rotor_model::seam::{Event, EventKind, EventRef, SolveError, Stats};
 use rotor_model::{Disc, Mode, Model, State};
 
 use crate::filippov::{EventOptions, Integrator, Sink};
@@ -41,10 +41,10 @@ struct FlowSink {
 }
 
 impl Sink for FlowSink {
-    fn event(&mut self, e: &Event) {
-        self.events.push(*e);
+    fn event(&mut self, e: EventRef<'_>) {
+        self.events.push(e.to_event());
     }
-    fn stop_after(&mut self, e: &Event) -> bool {
+    fn stop_after(&mut self, e: EventRef<'_>) -> bool {
         let hit = self.stop == StopAt::LowerStickExit && e.kind == EventKind::StickEnd(Disc::LOWER);
         self.reached |= hit;
         hit

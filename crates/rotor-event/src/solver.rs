@@ -1,7 +1,7 @@
 //! The [`Solver`] seam for the event-driven method.
 
 use rotor_model::seam::{
-    Event, Input, Integration, Recorder, Scene, SolveError, Solver, Trajectory,
+    Event, EventRef, Input, Integration, Recorder, Scene, SolveError, Solver, Trajectory,
 };
 use rotor_model::{Mode, Model, State};
 
@@ -61,11 +61,11 @@ impl Sink for Recording<'_> {
         });
     }
 
-    fn event(&mut self, e: &Event) {
-        self.0.event(*e);
+    fn event(&mut self, e: EventRef<'_>) {
+        self.0.event(e);
     }
 
-    fn stop_after(&mut self, _e: &Event) -> bool {
+    fn stop_after(&mut self, _e: EventRef<'_>) -> bool {
         self.0.halted()
     }
 }

@@ -24,7 +24,7 @@
 //! finds only an unstable cycle, the settled run's own last cycle is the answer
 //! ([`Method::Settled`]).
 
-use rotor_model::seam::{Event, EventKind, MetricsAccumulator, SolveError, SteadyState};
+use rotor_model::seam::{Event, EventKind, EventRef, MetricsAccumulator, SolveError, SteadyState};
 use rotor_model::{Disc, DiscMode, Mode, Model, SlipEquilibrium, State};
 
 use nalgebra::Complex;
@@ -110,7 +110,7 @@ struct StopSink {
 }
 
 impl Sink for StopSink {
-    fn event(&mut self, e: &Event) {
+    fn event(&mut self, e: EventRef<'_>) {
         if e.kind == EventKind::StickEnd(Disc::LOWER) {
             self.lower_exits += 1;
         }
@@ -118,7 +118,7 @@ impl Sink for StopSink {
             a.push(e);
         }
     }
-    fn stop_after(&mut self, e: &Event) -> bool {
+    fn stop_after(&mut self, e: EventRef<'_>) -> bool {
         self.stop == Stop::LowerStickExit && e.kind == EventKind::StickEnd(Disc::LOWER)
     }
     fn section(&mut self, _t: f64, _x: &State) -> bool {
@@ -439,7 +439,7 @@ struct LastExitSink {
 }
 
 impl Sink for LastExitSink {
-    fn event(&mut self, e: &Event) {
+    fn event(&mut self, e: EventRef<'_>) {
         self.acc.push(e);
         if e.kind == EventKind::StickEnd(Disc::LOWER) {
             let upper = if e.x[1] == 0.0 {
@@ -447,7 +447,7 @@ impl Sink for LastExitSink {
             } else {
                 DiscMode::slip_of(e.x[1])
             };
-            self.last_exit = Some((*e, upper));
+            self.last_exit = Some((e.to_event(), upper));
         }
     }
 }
@@ -514,7 +514,7 @@ fn refine_stick_slip(
     exit: &(Event, DiscMode),
     opts: &SteadyOptions,
 ) -> Result<Steady, SolveError> {
-    let (e, upper) = *exit;
+    let (e, upper) = (&exit.0, exit.1);
     let alpha = exit_alpha(flow.model, e.x[0]);
     let mut w = e.x[1];
     let mut upper_mode = upper;
@@ -567,11 +567,11 @@ fn refine_stick_slip(
     // One period from the fixed point, with extrema, into a fresh accumulator.
     let (x, mode) = flow.exit_state(alpha, w, upper_mode);
     let mut acc = MetricsAccumulator::new(0.0);
-    acc.push(&Event {
-        t: 0.0,
-        x,
-        kind: EventKind::StickEnd(Disc::LOWER),
-    });
+    acc.push(&Event::new(
+        0.0,
+        x.as_slice(),
+        EventKind::StickEnd(Disc::LOWER),
+    ));
     let (end, sink) = flow.run(x, mode, 1e4, Stop::LowerStickExit, true, None, Some(acc))?;
     Ok(Steady {
         state: sink.acc.expect("accumulator was given").finish(&end.x),
@@ -697,7 +697,7 @@ struct CountSections {
 }
 
 impl Sink for CountSections {
-    fn event(&mut self, e: &Event) {
+    fn event(&mut self, e: EventRef<'_>) {
         self.acc.push(e);
     }
     fn section(&mut self, _t: f64, _x: &State) -> bool {

@@ -21,7 +21,7 @@ fn switches(events: &[rotor_model::seam::Event]) -> Vec<rotor_model::seam::Event
     events
         .iter()
         .filter(|e| !matches!(e.kind, EventKind::Max(_) | EventKind::Min(_)))
-        .copied()
+        .cloned()
         .collect()
 }
 
@@ -163,9 +163,11 @@ fn a_disc_stuck_on_its_edge_after_a_switch_leaves_at_once() {
             },
         )
         .unwrap();
-    let first = tr.events.first().copied();
+    let first = tr.events.first().cloned();
     assert!(
-        first.is_some_and(|e| e.t == 0.0 && e.kind == EventKind::StickEnd(Disc::LOWER)),
+        first
+            .as_ref()
+            .is_some_and(|e| e.t == 0.0 && e.kind == EventKind::StickEnd(Disc::LOWER)),
         "{first:?}"
     );
     assert_eq!(tr.x_final, b.x.as_slice());

@@ -111,7 +111,7 @@ fn stick_events_at(tol: f64) {
         .filter(|e| e.kind == EventKind::StickStart(Disc::LOWER))
     {
         assert_eq!(e.x[2], 0.0);
-        assert!(m.can_stick(Disc::LOWER, &e.x, 1.5));
+        assert!(m.can_stick(Disc::LOWER, &e.state(), 1.5));
     }
 }
 
@@ -142,9 +142,9 @@ fn extrema_are_roots_of_the_fields_acceleration() {
             rotor_model::DiscMode::slip_of(e.x[1]),
             rotor_model::DiscMode::slip_of(e.x[2]),
         );
-        let f = m.rhs(&e.x, u, mode);
+        let f = m.rhs(&e.state(), u, mode);
         let a = f[d.index()];
-        let rate = (m.jacobian(&e.x, u, mode) * f)[d.index()];
+        let rate = (m.jacobian(&e.state(), u, mode) * f)[d.index()];
         assert!(
             if is_max { a <= 0.0 } else { a >= 0.0 },
             "{:?} at t = {}: acceleration {a:e} on the unfired side",
@@ -517,7 +517,7 @@ fn switches(events: &[rotor_model::seam::Event]) -> Vec<rotor_model::seam::Event
     events
         .iter()
         .filter(|e| !matches!(e.kind, EventKind::Max(_) | EventKind::Min(_)))
-        .copied()
+        .cloned()
         .collect()
 }
 
@@ -602,7 +602,7 @@ fn a_reversal_whose_excursion_returns_within_one_sample_ends_in_stick() {
             EventKind::StickEnd(Disc::LOWER),
         ]
     );
-    let (rev, stick) = (lower[1], lower[2]);
+    let (rev, stick) = (&lower[1], &lower[2]);
     // The reversal needs |k_θ α| > T_s, the stick |k_θ α| ≤ T_s.
     let s_rev = (k * rev.x[0]).abs();
     assert!(s_rev > t_s && (k * stick.x[0]).abs() <= t_s);

@@ -87,7 +87,7 @@ fn a_reversal_without_sticking_matches_the_event_solver() {
         .iter()
         .find(|e| e.kind == EventKind::Reversal(Disc::LOWER))
         .unwrap()
-        .x;
+        .state();
     let rate = m.rhs(&x, scene.u, m.mode_at(&x, scene.u))[OMEGA_L].abs();
     let located = (exact[0].0 - event[0].0).abs();
     assert!(

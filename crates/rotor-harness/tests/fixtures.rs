@@ -11,9 +11,9 @@ use rotor_analysis::solvers::{
 use rotor_harness::compare::gate::gate_scenario;
 use rotor_harness::compare::margins::{MAX_LOOSENESS, floor_violations, margins};
 use rotor_harness::compare::snapshot::snapshot;
+use rotor_model::Disc;
 use rotor_model::scenario::Scenario;
 use rotor_model::seam::{Event, EventKind, SteadyState, Trajectory};
-use rotor_model::{Disc, State};
 
 /// Every fixture through the three solvers, once per test binary (shared by the tests).
 fn all() -> Vec<ScenarioResult> {
@@ -253,7 +253,7 @@ fn every_gate_of_every_fixture_fails_its_negative_control() {
                         // No stick event in the window: one that appears must fail.
                         None => tr.events.push(Event {
                             t: 0.5 * (t0 + t1),
-                            x: State::zeros(),
+                            x: vec![0.0; 3],
                             kind: EventKind::StickStart(Disc::LOWER),
                         }),
                     }
@@ -269,7 +269,7 @@ fn every_gate_of_every_fixture_fails_its_negative_control() {
                             // No switch after the window: one that appears must fail.
                             _ => tr.events.push(Event {
                                 t: 0.5 * (t1 + sc.t_end),
-                                x: State::zeros(),
+                                x: vec![0.0; 3],
                                 kind: EventKind::StickStart(Disc::LOWER),
                             }),
                         }

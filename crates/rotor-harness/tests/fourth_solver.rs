@@ -18,8 +18,8 @@ use rotor_harness::compare::stress::{Gate, Measure, StressRow, cases_for, run_ca
 /// The solver's "crate".
 mod euler {
     use rotor_model::seam::{
-        Event, EventKind, Integration, Recorder, Scene, SolveError, Solver, Stats, Trajectory,
-        check_finite,
+        Event, EventKind, EventRef, Integration, Recorder, Scene, SolveError, Solver, Stats,
+        Trajectory, check_finite,
     };
     use rotor_model::{Disc, DiscMode, Mode, Model, State};
 
@@ -113,7 +113,11 @@ mod euler {
                         .into_iter()
                         .flatten()
                     {
-                        rec.event(Event { t: t0, x: x0, kind });
+                        rec.event(EventRef {
+                            t: t0,
+                            x: x0.as_slice(),
+                            kind,
+                        });
                     }
                 }
                 (self.t, self.x, self.mode) = (t1, x1, mode);

@@ -115,7 +115,7 @@ fn wrong_traces_fail() {
     let mut e = ev.clone();
     let extra = Event {
         t: 150.005,
-        ..e.events[0]
+        ..e.events[0].clone()
     };
     let at = e.events.partition_point(|x| x.t < extra.t);
     e.events.insert(at, extra);

@@ -265,7 +265,7 @@ fn state_near_rest() -> impl Strategy<Value = State> {
 /// smooth): each piece is a list of `(t, x)`.
 fn pieces(samples: &[(f64, State)], events: &[Event]) -> Vec<Vec<(f64, State)>> {
     let mut pts: Vec<(f64, State, bool)> = samples.iter().map(|s| (s.0, s.1, false)).collect();
-    pts.extend(events.iter().map(|e| (e.t, e.x, true)));
+    pts.extend(events.iter().map(|e| (e.t, e.state(), true)));
     pts.sort_by(|a, b| a.0.total_cmp(&b.0));
     let mut out: Vec<Vec<(f64, State)>> = vec![Vec::new()];
     for (t, x, is_event) in pts {
@@ -523,8 +523,8 @@ fn stress_energy_balance_sees_a_perturbed_trajectory() {
         let e2: Vec<Event> = e
             .iter()
             .map(|ev| Event {
-                x: spoil(&ev.x, ev.t),
-                ..*ev
+                x: spoil(&ev.state(), ev.t).as_slice().to_vec(),
+                ..ev.clone()
             })
             .collect();
         let (r2, allowed2, _) = energy_check(kind, &m, 1.5, &s2, &e2);

@@ -221,11 +221,11 @@ impl<const PPB: u32> Solver for LateOffset<PPB> {
                 let k = o.samples.len();
                 o.samples.push((k as f64 * dt).min(scene.t_end), s.x);
             }
-            o.events.extend(
-                part.events
-                    .iter()
-                    .map(|e| rotor_model::seam::Event { t: e.t + t0, ..*e }),
-            );
+            o.events
+                .extend(part.events.iter().map(|e| rotor_model::seam::Event {
+                    t: e.t + t0,
+                    ..e.clone()
+                }));
             o.t_final = t1;
             o.x_final = part.x_final;
             o.mode_final = part.mode_final;

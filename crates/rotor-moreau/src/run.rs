@@ -3,8 +3,8 @@
 //! [`Recorder`], which keeps what the scene asks for and drives the metrics-only skip.
 
 use rotor_model::seam::{
-    Event, EventKind, Input, Integration, Piece, Recorder, Scene, SolveError, Solver, Stats,
-    Trajectory, check_finite,
+    Event, EventKind, EventRef, Input, Integration, Piece, Recorder, Scene, SolveError, Solver,
+    Stats, Trajectory, check_finite,
 };
 use rotor_model::{Disc, DiscMode, FieldError, Mode, Model, State};
 
@@ -14,16 +14,29 @@ use crate::{MoreauOptions, MoreauSolver};
 /// Capacity of the reorder buffer for events (a step detects at most six).
 const PENDING: usize = 16;
 
+/// An event as the stepper finds it, on the rig's state: a value the pending buffer copies
+/// (the seam's [`Event`] is made from it when it is released to the recorder).
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct Found {
+    t: f64,
+    x: State,
+    kind: EventKind,
+}
+
 /// Where released events go: the recorder (or a test's list).
 trait Release {
-    fn take(&mut self, e: &Event);
+    fn take(&mut self, e: &Found);
     /// Whether a jump or an undo waits for the end of the step (nothing more is released).
     fn halted(&self) -> bool;
 }
 
 impl Release for Recorder {
-    fn take(&mut self, e: &Event) {
-        self.event(*e);
+    fn take(&mut self, e: &Found) {
+        self.event(EventRef {
+            t: e.t,
+            x: e.x.as_slice(),
+            kind: e.kind,
+        });
     }
 
     fn halted(&self) -> bool {
@@ -34,7 +47,7 @@ impl Release for Recorder {
 /// Events detected but not yet released in time order.
 #[derive(Clone, Copy)]
 struct Pending {
-    buf: [Option<Event>; PENDING],
+    buf: [Option<Found>; PENDING],
     len: usize,
 }
 
@@ -46,7 +59,7 @@ impl Pending {
         }
     }
 
-    fn push(&mut self, e: Event, sink: &mut impl Release) {
+    fn push(&mut self, e: Found, sink: &mut impl Release) {
         if self.len == PENDING {
             // Never with a step's at most six events; released even while a jump waits, so
             // that the buffer cannot overflow.
@@ -292,7 +305,7 @@ impl Run<'_> {
             let mut x = lerp(&p, next, t);
             x[wi] = 0.0;
             let kind = EventKind::Reversal(d);
-            self.pending.push(Event { t, x, kind }, rec);
+            self.pending.push(Found { t, x, kind }, rec);
         } else if let Some((kind, t)) = kind_t {
             let mut x = if t >= cur.t {
                 lerp(&cur, next, t)
@@ -300,7 +313,7 @@ impl Run<'_> {
                 prev.map_or(cur.x, |p| lerp(&p, &cur, t))
             };
             x[wi] = 0.0;
-            self.pending.push(Event { t, x, kind }, rec);
+            self.pending.push(Found { t, x, kind }, rec);
         }
     }
 
@@ -405,7 +418,7 @@ impl Run<'_> {
             let (a, b) = if t <= cur.t { (&p, &cur) } else { (&cur, next) };
             x[1 + o] = lerp(a, b, t)[1 + o];
         }
-        self.pending.push(Event { t, x, kind }, rec);
+        self.pending.push(Found { t, x, kind }, rec);
     }
 }
 
@@ -553,12 +566,12 @@ mod tests {
 
     /// A list of released events, halted while `halt` is set.
     struct List {
-        events: Vec<Event>,
+        events: Vec<Found>,
         halt: bool,
     }
 
     impl Release for List {
-        fn take(&mut self, e: &Event) {
+        fn take(&mut self, e: &Found) {
             self.events.push(*e);
         }
 
@@ -567,8 +580,8 @@ mod tests {
         }
     }
 
-    fn ev(t: f64) -> Event {
-        Event {
+    fn ev(t: f64) -> Found {
+        Found {
             t,
             x: State::zeros(),
             kind: EventKind::Max(Disc::LOWER),

@@ -1,8 +1,8 @@
 //! The switch-model field, its guards, and the event-located integration loop.
 
 use rotor_model::seam::{
-    Event, EventKind, Input, Integration, Piece, Recorder, Scene, SolveError, Solver, Stats,
-    Trajectory, check_finite,
+    Event, EventKind, EventRef, Input, Integration, Piece, Recorder, Scene, SolveError, Solver,
+    Stats, Trajectory, check_finite,
 };
 use rotor_model::{Disc, DiscMode, FieldError, Mode, Model, OMEGA_L, OMEGA_U, State};
 
@@ -543,7 +543,11 @@ impl Run<'_> {
         self.field.from_rest[k] = matches!(g, Guard::StickExit(_));
         self.last_extremum[k] = None;
         match ev {
-            Some(kind) => rec.event(Event { t: tr, x: y, kind }),
+            Some(kind) => rec.event(EventRef {
+                t: tr,
+                x: y.as_slice(),
+                kind,
+            }),
             None => rec.count_switch(),
         }
         self.zeno.record(tr)?;
@@ -578,7 +582,11 @@ impl Run<'_> {
                 _ => None,
             };
             if let Some(kind) = kind {
-                rec.event(Event { t, x: y, kind });
+                rec.event(EventRef {
+                    t,
+                    x: y.as_slice(),
+                    kind,
+                });
             }
         }
         // As a fresh run: no extremum remembered.
@@ -718,7 +726,11 @@ impl Run<'_> {
                     continue;
                 }
             }
-            rec.event(Event { t, x: y, kind });
+            rec.event(EventRef {
+                t,
+                x: y.as_slice(),
+                kind,
+            });
             if rec.halted() {
                 return;
             }
@@ -746,7 +758,7 @@ impl Integration for Run<'_> {
     fn checkpoint(&self, anchor: &Event) -> Saved {
         Saved {
             t: anchor.t,
-            y: anchor.x,
+            y: anchor.state(),
             regions: self.field.regions,
             last_extremum: self.last_extremum,
         }
@@ -759,7 +771,7 @@ impl Integration for Run<'_> {
     }
 
     fn shift(&mut self, anchor: &Event, dt: f64) {
-        self.restart(anchor.t + dt, anchor.x);
+        self.restart(anchor.t + dt, anchor.state());
     }
 }
 

@@ -341,7 +341,7 @@ fn the_band_moves_a_reversal_without_sticking_by_order_eta() {
         t.events
             .iter()
             .find(|e| e.kind == EventKind::Reversal(Disc::LOWER))
-            .copied()
+            .cloned()
             .expect("a reversal")
     };
     let a = run(0.0, &model, &scene);

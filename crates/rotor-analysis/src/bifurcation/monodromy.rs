@@ -278,8 +278,9 @@ pub fn along(
         };
         let y = segment(model, u, tol, mode, e.t - t, pack(&x, &phi, &p))?;
         let (_, phi_m, p_m) = unpack(&y);
-        let after = mode_after(model, u, &e.x, mode, e.kind);
-        let (s, jump) = saltation(model, u, &e.x, mode, after, &n, h_u)?;
+        let xe = e.state();
+        let after = mode_after(model, u, &xe, mode, e.kind);
+        let (s, jump) = saltation(model, u, &xe, mode, after, &n, h_u)?;
         phi = s * phi_m;
         p = s * p_m + jump;
         switches.push(Switch {
@@ -289,7 +290,7 @@ pub fn along(
             after,
             saltation: s,
         });
-        x = e.x;
+        x = xe;
         mode = after;
         t = e.t;
     }

@@ -119,7 +119,7 @@ impl Section {
                 .rev()
                 .find(|e| e.kind == section.event() && e.t >= 0.5 * t_end)
             {
-                return Ok((section, section.project(&e.x)));
+                return Ok((section, section.project(&e.state())));
             }
         }
         Err(ShootError::NotACycle { t_end })
@@ -322,7 +322,7 @@ impl<'a> Map<'a> {
             .events
             .iter()
             .find(|e| e.kind == self.section.event() && e.t > self.opts.skip)
-            .map(|e| (self.section.project(&e.x), e.t)))
+            .map(|e| (self.section.project(&e.state()), e.t)))
     }
 
     /// The orbit through the fixed point `z` (`P(z)` in `pz`, residual `r` after `iterations`

@@ -188,7 +188,7 @@ impl<'a> Run<'a> {
         self.events
             .iter()
             .filter(|e| e.kind == kind && e.t >= from)
-            .map(|e| (e.t, project(section, &e.x)))
+            .map(|e| (e.t, project(section, &e.state())))
             .collect()
     }
 }

@@ -100,7 +100,7 @@ pub(crate) fn first_crossing(
     run.events
         .iter()
         .find(|e| e.kind == kind && e.t > ShootOptions::default().skip)
-        .map(|e| pick(&e.x))
+        .map(|e| pick(&e.state()))
         .ok_or_else(|| {
             format!(
                 "no {} within {t_end:.3} s at u = {}",

@@ -664,7 +664,7 @@ mod tests {
         let mut a = traj(None);
         let ev = |t: f64, kind| rotor_model::seam::Event {
             t,
-            x: State::zeros(),
+            x: vec![0.0; 3],
             kind,
         };
         a.events = vec![

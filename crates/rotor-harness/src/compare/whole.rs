@@ -104,7 +104,7 @@ pub fn is_anchor(kind: EventKind) -> bool {
 pub fn matched_events(a: &Trajectory, b: &Trajectory) -> Option<Matched> {
     let pair = |keep: fn(EventKind) -> bool| -> Option<Vec<(f64, f64, EventKind)>> {
         let pick = |tr: &Trajectory| -> Vec<Event> {
-            tr.events.iter().filter(|e| keep(e.kind)).copied().collect()
+            tr.events.iter().filter(|e| keep(e.kind)).cloned().collect()
         };
         let (ea, eb) = (pick(a), pick(b));
         if ea.len() != eb.len() || ea.iter().zip(&eb).any(|(x, y)| x.kind != y.kind) {
@@ -146,7 +146,7 @@ pub fn switch_time_difference(a: &Trajectory, b: &Trajectory) -> f64 {
         tr.events
             .iter()
             .filter(|e| is_switch(e.kind))
-            .copied()
+            .cloned()
             .collect()
     };
     let (ea, eb) = (pick(a), pick(b));
@@ -282,7 +282,7 @@ mod tests {
     fn ev(t: f64, kind: EventKind) -> Event {
         Event {
             t,
-            x: State::zeros(),
+            x: vec![0.0; 3],
             kind,
         }
     }

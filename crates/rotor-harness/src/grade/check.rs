@@ -586,7 +586,7 @@ fn grade_events(reference: &[Event], trace: &[Event], t_scale: f64, level: Level
     let switches = |ev: &[Event]| -> Vec<Event> {
         ev.iter()
             .filter(|e| event_row(e.kind).is_some())
-            .copied()
+            .cloned()
             .collect()
     };
     let (reference, trace) = (switches(reference), switches(trace));
@@ -596,7 +596,7 @@ fn grade_events(reference: &[Event], trace: &[Event], t_scale: f64, level: Level
     let (mut worst, mut missing, mut extra) = (0.0f64, Vec::new(), Vec::new());
     for kind in classes {
         let of = |ev: &[Event]| -> Vec<Event> {
-            ev.iter().filter(|e| e.kind == kind).copied().collect()
+            ev.iter().filter(|e| e.kind == kind).cloned().collect()
         };
         let (r, a) = (of(&reference), of(&trace));
         let gap = r
@@ -606,8 +606,8 @@ fn grade_events(reference: &[Event], trace: &[Event], t_scale: f64, level: Level
         let times = |ev: &[Event]| ev.iter().map(|e| e.t).collect::<Vec<_>>();
         let (w, m, x) = match_in_order(&times(&r), &times(&a), 0.5 * gap);
         worst = worst.max(w);
-        missing.extend(m.into_iter().map(|k| r[k]));
-        extra.extend(x.into_iter().map(|k| a[k]));
+        missing.extend(m.into_iter().map(|k| r[k].clone()));
+        extra.extend(x.into_iter().map(|k| a[k].clone()));
     }
     missing.sort_by(|a, b| a.t.total_cmp(&b.t));
     extra.sort_by(|a, b| a.t.total_cmp(&b.t));

@@ -94,11 +94,17 @@ impl Orbit {
         let mut events = tr.events.iter().peekable();
         for s in tr.samples.iter().map(|r| r.sample()) {
             while let Some(e) = events.next_if(|e| e.t < s.t) {
-                all.push(Sample { t: e.t, x: e.x });
+                all.push(Sample {
+                    t: e.t,
+                    x: e.state(),
+                });
             }
             all.push(s);
         }
-        all.extend(events.map(|e| Sample { t: e.t, x: e.x }));
+        all.extend(events.map(|e| Sample {
+            t: e.t,
+            x: e.state(),
+        }));
         Ok(Orbit {
             times: all.iter().map(|s| s.t).collect(),
             points: all.iter().map(|s| scaled(&s.x, &scale)).collect(),

@@ -220,7 +220,7 @@ fn switches(events: &[Event]) -> Vec<Event> {
     events
         .iter()
         .filter(|e| crate::grade::trace::event_row(e.kind).is_some())
-        .copied()
+        .cloned()
         .collect()
 }
 

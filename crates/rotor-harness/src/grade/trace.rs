@@ -347,7 +347,7 @@ impl EventsFile {
         let events: Vec<Event> = events
             .iter()
             .filter(|e| event_row(e.kind).is_some())
-            .copied()
+            .cloned()
             .collect();
         EventsFile {
             path: path.into(),
@@ -378,11 +378,8 @@ impl EventsFile {
             }
             let disc = disc_of(disc).ok_or_else(|| bad("disc", disc, DISC_WORDS))?;
             let kind = kind_of(kind, disc).ok_or_else(|| bad("kind", kind, KIND_WORDS))?;
-            events.push(Event {
-                t,
-                x: State::zeros(),
-                kind,
-            });
+            // An events file carries no state: the rig's zeros stand for it.
+            events.push(Event::new(t, &[0.0; 3], kind));
         }
         Ok(EventsFile {
             path: ARRAYS.into(),
@@ -737,11 +734,7 @@ fn events_from(input: impl Read, path: &Path, limit: usize) -> Result<EventsFile
         };
         let disc = disc_of(&rec[1]).ok_or_else(|| word(2, "disc", DISC_WORDS))?;
         let kind = kind_of(&rec[2], disc).ok_or_else(|| word(3, "kind", KIND_WORDS))?;
-        out.push(Event {
-            t,
-            x: State::zeros(),
-            kind,
-        });
+        out.push(Event::new(t, &[0.0; 3], kind));
         lines.push(line);
         Ok(())
     })?;
@@ -936,7 +929,7 @@ mod tests {
     fn events_files_round_trip_and_name_bad_fields() {
         let ev = |t: f64, kind: EventKind| Event {
             t,
-            x: State::zeros(),
+            x: vec![0.0; 3],
             kind,
         };
         let events = vec![

@@ -33,12 +33,64 @@ impl EventKind {
 }
 
 /// An event with its time and the state there.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, PartialEq)]
 pub struct Event {
     /// Time of the event \[s\], as the reporting solver located it.
     pub t: f64,
-    /// The state `[α, ω_u, ω_l]` at `t` (rad, rad/s, rad/s).
-    pub x: State,
+    /// The state at `t`, of the model's size (`[α, ω_u, ω_l]` for the rig: rad, rad/s,
+    /// rad/s).
+    pub x: Vec<f64>,
     /// What happened, and to which disc.
     pub kind: EventKind,
+}
+
+/// An event whose state is borrowed: what a solver hands to the [`crate::seam::Recorder`],
+/// which copies the state only if it keeps the event.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct EventRef<'a> {
+    /// Time of the event \[s\].
+    pub t: f64,
+    /// The state at `t`, of the model's size.
+    pub x: &'a [f64],
+    /// What happened, and to which disc.
+    pub kind: EventKind,
+}
+
+impl EventRef<'_> {
+    /// The event with its own copy of the state.
+    pub fn to_event(&self) -> Event {
+        Event::new(self.t, self.x, self.kind)
+    }
+}
+
+impl<'a> From<&'a Event> for EventRef<'a> {
+    fn from(e: &'a Event) -> EventRef<'a> {
+        EventRef {
+            t: e.t,
+            x: &e.x,
+            kind: e.kind,
+        }
+    }
+}
+
+impl Event {
+    /// The event `kind` at `(t, x)`.
+    pub fn new(t: f64, x: &[f64], kind: EventKind) -> Event {
+        Event {
+            t,
+            x: x.to_vec(),
+            kind,
+        }
+    }
+
+    /// The rig's state `[α, ω_u, ω_l]` at the event.
+    ///
+    /// # Panics
+    ///
+    /// If the event is not of the rig's size: a reader of the rig's state must be handed a
+    /// rig's run.
+    pub fn state(&self) -> State {
+        assert_eq!(self.x.len(), 3, "a rig's event has 3 values");
+        State::from_column_slice(&self.x)
+    }
 }

@@ -40,9 +40,9 @@
 //! state carries the phase error of the skipped periods, `m·|P_n − P*|`, of the same order as
 //! the phase error a full run accumulates over those periods.
 
-use crate::seam::event::{Event, EventKind};
+use crate::seam::event::{EventKind, EventRef};
 use crate::seam::scene::{Output, Scene, Stats};
-use crate::{Disc, OMEGA_L, State};
+use crate::{Disc, OMEGA_L};
 
 /// A return after the jump must lie within this many tolerances of the return before it: both
 /// lie within one tolerance of the fixed point (the skip criterion), and the integration adds
@@ -100,8 +100,8 @@ pub enum Verdict {
 #[derive(Debug, Clone, Copy)]
 struct Track {
     kind: EventKind,
-    /// Time and state of the last return.
-    last: Option<(f64, State)>,
+    /// Time of the last return.
+    last: Option<f64>,
     /// Signature of the last return (needs the one before it).
     sig: Option<[f64; 4]>,
     /// Increment at the last return, in tolerances.
@@ -159,8 +159,10 @@ impl FastForward {
     /// absolute); `None` for every other output, which integrates the whole horizon, and for a
     /// time-varying input ([`Scene::is_time_varying`]), whose run is not periodic.
     pub(crate) fn for_scene(scene: &Scene, tol: f64) -> Option<FastForward> {
-        // A time-varying input breaks the premise of a skip: one period is not the next.
-        (scene.output == Output::Metrics && !scene.is_time_varying())
+        // A time-varying input breaks the premise of a skip: one period is not the next. The
+        // returns are read on the rig's state (a chain's cycles cross their section many
+        // times, and are not skipped).
+        (scene.output == Output::Metrics && !scene.is_time_varying() && scene.x0.len() == 3)
             .then(|| FastForward::new(tol, scene.metrics_start().unwrap_or(0.0), scene.t_end))
     }
 
@@ -216,7 +218,8 @@ impl FastForward {
     }
 
     /// Feeds an event (in time order, after the metrics have seen it).
-    pub(crate) fn observe(&mut self, e: &Event) -> Verdict {
+    pub(crate) fn observe<'a>(&mut self, e: impl Into<EventRef<'a>>) -> Verdict {
+        let e = e.into();
         match self.phase {
             Phase::Done => Verdict::Continue,
             Phase::Verifying { track, sig, t_jump } => {
@@ -232,11 +235,11 @@ impl FastForward {
                     Verdict::Undo
                 }
             }
-            Phase::Watching => self.watch(e),
+            Phase::Watching => self.watch(&e),
         }
     }
 
-    fn watch(&mut self, e: &Event) -> Verdict {
+    fn watch(&mut self, e: &EventRef) -> Verdict {
         let w = e.x[OMEGA_L];
         for tr in &mut self.tracks {
             (tr.lo, tr.hi) = (tr.lo.min(w), tr.hi.max(w));
@@ -250,14 +253,14 @@ impl FastForward {
         let mut verdict = Verdict::Continue;
         let tr = self.tracks[i];
         let mut next = Track {
-            last: Some((e.t, e.x)),
+            last: Some(e.t),
             lo: w,
             hi: w,
             ..tr
         };
         let amplitude = tr.hi - tr.lo;
         let cycle = amplitude >= MIN_AMPLITUDE * self.tol * (1.0 + tr.lo.abs().max(tr.hi.abs()));
-        if let Some((tp, _)) = tr.last {
+        if let Some(tp) = tr.last {
             let s = [e.x[0], e.x[1], e.x[2], e.t - tp];
             if let Some(sp) = tr.sig {
                 let d = self.distance(&s, &sp);
@@ -337,13 +340,10 @@ impl FastForward {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::seam::Event;
 
     fn exit(t: f64, w: f64) -> Event {
-        Event {
-            t,
-            x: State::new(2.0, w, 0.0),
-            kind: EventKind::StickEnd(Disc::LOWER),
-        }
+        Event::new(t, &[2.0, w, 0.0], EventKind::StickEnd(Disc::LOWER))
     }
 
     /// Returns `t_n = n·P + c·ρⁿ`, `ω_n = w* + ρⁿ`: a return map contracting by ρ.
@@ -361,7 +361,7 @@ mod tests {
     fn first_jump(ff: &mut FastForward, evs: &[Event]) -> Option<(usize, f64)> {
         evs.iter().enumerate().find_map(|(k, e)| {
             if e.kind == EventKind::StickEnd(Disc::LOWER) {
-                let mut max = *e;
+                let mut max = e.clone();
                 (max.t, max.x[2], max.kind) = (e.t - 2.0, 6.0, EventKind::Max(Disc::LOWER));
                 assert_eq!(ff.observe(&max), Verdict::Continue);
             }
@@ -521,11 +521,7 @@ mod tests {
 
     /// Maxima of ω_l = 1 + a_k and minima 1 − a_k between them, every 4 s.
     fn slipping(a: impl Fn(usize) -> f64, n: usize) -> Vec<Event> {
-        let ev = |t: f64, w: f64, kind| Event {
-            t,
-            x: State::new(2.0, 2.5, w),
-            kind,
-        };
+        let ev = |t: f64, w: f64, kind| Event::new(t, &[2.0, 2.5, w], kind);
         (0..n)
             .flat_map(|k| {
                 let t = 4.0 * k as f64;

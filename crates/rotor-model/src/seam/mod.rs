@@ -19,7 +19,7 @@ pub mod scene;
 pub mod steady;
 
 pub use attractor::Attractor;
-pub use event::{Event, EventKind};
+pub use event::{Event, EventKind, EventRef};
 pub use fast_forward::{FastForward, Verdict};
 pub use input::{Input, Piece};
 pub use record::{Integration, Recorder};

@@ -12,12 +12,12 @@
 //! The solvers still share no integration code: what makes their comparison meaningful is
 //! that they integrate independently, not that they record differently.
 
-use crate::seam::event::Event;
+use crate::seam::event::{Event, EventKind, EventRef};
 use crate::seam::fast_forward::{FastForward, Verdict};
 use crate::seam::samples::Samples;
 use crate::seam::scene::{Output, OutputGrid, Scene, SolveError, Stats, Trajectory};
 use crate::seam::steady::MetricsAccumulator;
-use crate::{Mode, State};
+use crate::{Disc, Mode, State};
 
 /// What a scene keeps of a run, collected as the solver goes.
 #[derive(Debug, Clone)]
@@ -33,9 +33,12 @@ pub struct Recorder {
     fast_forward: Option<FastForward>,
     /// Located events, kept or not (`Stats::events`).
     count: u64,
-    /// The fast-forward's verdict on the last event, and that event.
+    /// The fast-forward's verdict on the last event.
     verdict: Verdict,
-    anchor: Option<Event>,
+    /// The event the last jump was decided on: its state's buffer is allocated with the
+    /// recorder, so that a skip allocates nothing (the metrics-only run allocates no more
+    /// than the full one).
+    anchor: Event,
 }
 
 /// A solver's integration, as [`Recorder::drive`] runs it.
@@ -91,7 +94,7 @@ impl Recorder {
                 .map(|f| f.verify_within(skip_verify)),
             count: 0,
             verdict: Verdict::Continue,
-            anchor: None,
+            anchor: Event::new(f64::NAN, x0, EventKind::StickEnd(Disc::LOWER)),
         }
     }
 
@@ -137,17 +140,24 @@ impl Recorder {
 
     /// An event, in time order: counted, kept if the scene keeps events, fed to the metrics
     /// and to the fast-forward, whose verdict may halt the run after it.
-    pub fn event(&mut self, e: Event) {
+    pub fn event<'a>(&mut self, e: impl Into<EventRef<'a>>) {
+        let e = e.into();
         self.count += 1;
-        if self.keep_events {
-            self.events.push(e);
-        }
         if let Some(m) = self.metrics.as_mut() {
-            m.push(&e);
+            m.push(e);
         }
         if let Some(ff) = self.fast_forward.as_mut() {
-            self.verdict = ff.observe(&e);
-            self.anchor = Some(e);
+            self.verdict = ff.observe(e);
+            // The anchor is read only when a jump is decided on it.
+            if matches!(self.verdict, Verdict::Jump { .. }) {
+                self.anchor.t = e.t;
+                self.anchor.kind = e.kind;
+                self.anchor.x.clear();
+                self.anchor.x.extend_from_slice(e.x);
+            }
+        }
+        if self.keep_events {
+            self.events.push(e.to_event());
         }
     }
 
@@ -177,7 +187,8 @@ impl Recorder {
     /// ```
     /// use rotor_model::{Disc, DiscMode, Mode, State};
     /// use rotor_model::seam::{
-    ///     Event, EventKind, Integration, Output, Recorder, Scene, SolveError, Stats, SteadyState,
+    ///     Event, EventKind, EventRef, Integration, Output, Recorder, Scene, SolveError, Stats,
+    ///     SteadyState,
     /// };
     ///
     /// /// ω_l = 2 + tri(t), tri of period 4 between −1 and 1: maxima at t = 1 + 4k.
@@ -205,7 +216,7 @@ impl Recorder {
     ///                 3.0 => EventKind::Min(Disc::LOWER),
     ///                 _ => continue,
     ///             };
-    ///             rec.event(Event { t: t1, x: x(t1), kind });
+    ///             rec.event(EventRef { t: t1, x: x(t1).as_slice(), kind });
     ///             if rec.halted() {
     ///                 return Ok(()); // the recorder decided a jump (or an undo) here
     ///             }
@@ -257,12 +268,12 @@ impl Recorder {
             match verdict {
                 Verdict::Continue => return Ok(()),
                 Verdict::Jump { dt } => {
-                    let anchor = self.anchor.expect("a jump is decided on an event");
-                    saved = Some((integ.checkpoint(&anchor), self.metrics));
+                    let anchor = &self.anchor;
+                    saved = Some((integ.checkpoint(anchor), self.metrics));
                     if let Some(m) = self.metrics.as_mut() {
-                        m.fast_forward(&anchor, dt);
+                        m.fast_forward(anchor, dt);
                     }
-                    integ.shift(&anchor, dt);
+                    integ.shift(anchor, dt);
                 }
                 Verdict::Undo => {
                     let (c, metrics) = saved.take().expect("an undo follows a jump");
@@ -375,11 +386,7 @@ mod tests {
                         o.copy_from_slice(y(t).as_slice())
                     });
                     self.steps += 1;
-                    rec.event(Event {
-                        t: te,
-                        x: y(te),
-                        kind,
-                    });
+                    rec.event(&Event::new(te, y(te).as_slice(), kind));
                     self.t = te;
                     if rec.halted() {
                         return Ok(());

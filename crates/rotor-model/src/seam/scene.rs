@@ -490,7 +490,7 @@ impl Trajectory {
         if let Some(s) = self.samples.iter().find(|s| !ok(s.t, s.x)) {
             return bad(s.t, "sample");
         }
-        if let Some(e) = self.events.iter().find(|e| !ok(e.t, e.x.as_slice())) {
+        if let Some(e) = self.events.iter().find(|e| !ok(e.t, &e.x)) {
             return bad(e.t, "event");
         }
         if !ok(self.t_final, &self.x_final) {
@@ -662,11 +662,11 @@ mod tests {
         let x = State::new(0.1, 2.0, 3.0);
         let good = Trajectory {
             samples: crate::seam::Samples::from_rig([Sample { t: 0.0, x }, Sample { t: 1.0, x }]),
-            events: vec![Event {
-                t: 0.5,
-                x,
-                kind: EventKind::StickStart(Disc::LOWER),
-            }],
+            events: vec![Event::new(
+                0.5,
+                x.as_slice(),
+                EventKind::StickStart(Disc::LOWER),
+            )],
             t_final: 1.0,
             x_final: x.as_slice().to_vec(),
             mode_final: Mode::rig(DiscMode::SlipPos, DiscMode::Stick),

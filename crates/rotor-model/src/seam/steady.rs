@@ -7,7 +7,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use crate::seam::event::{Event, EventKind};
+use crate::seam::event::{Event, EventKind, EventRef};
 use crate::{Disc, OMEGA_L, OMEGA_U, State};
 
 /// The steady state as `rotor steady` prints it (docs/design.md, "The CLI"), and as the
@@ -159,7 +159,7 @@ impl Stream {
         }
     }
 
-    fn anchor(&mut self, t: f64, x: &State) {
+    fn anchor(&mut self, t: f64, x: &[f64]) {
         if let Some(mut c) = self.open.take() {
             c.end = t;
             c.include(x);
@@ -181,7 +181,7 @@ impl Stream {
 }
 
 impl Cycle {
-    fn include(&mut self, x: &State) {
+    fn include(&mut self, x: &[f64]) {
         self.wl_max = self.wl_max.max(x[OMEGA_L]);
         self.wl_min = self.wl_min.min(x[OMEGA_L]);
         self.wu_max = self.wu_max.max(x[OMEGA_U]);
@@ -216,7 +216,8 @@ impl MetricsAccumulator {
     }
 
     /// Feeds one event (in time order).
-    pub fn push(&mut self, e: &Event) {
+    pub fn push<'a>(&mut self, e: impl Into<EventRef<'a>>) {
+        let e = e.into();
         if e.t < self.t_from {
             return;
         }
@@ -247,9 +248,10 @@ impl MetricsAccumulator {
     /// progress move by `dt`. An anchor before the window opens the window at its new time.
     pub fn fast_forward(&mut self, anchor: &Event, dt: f64) {
         if anchor.t < self.t_from {
-            self.push(&Event {
+            self.push(EventRef {
                 t: anchor.t + dt,
-                ..*anchor
+                x: &anchor.x,
+                kind: anchor.kind,
             });
             return;
         }
@@ -320,11 +322,7 @@ mod tests {
     use super::*;
 
     fn ev(t: f64, x: [f64; 3], kind: EventKind) -> Event {
-        Event {
-            t,
-            x: State::new(x[0], x[1], x[2]),
-            kind,
-        }
+        Event::new(t, &x, kind)
     }
 
     #[test]
@@ -444,7 +442,7 @@ mod tests {
             for k in 0..3 {
                 cycle(k as f64).iter().for_each(|e| skip.push(e));
             }
-            let anchor = cycle(3.0)[0];
+            let anchor = cycle(3.0)[0].clone();
             skip.push(&anchor);
             skip.fast_forward(&anchor, 21.0);
             for e in &cycle(10.0)[1..] {
