@@ -13,7 +13,7 @@
 //! `cargo run --release -p rotor-analysis --example step_scales -- [DRAWS] [SEED] [TOL]`
 
 use rotor_event::{EventOptions, EventSolver};
-use rotor_model::seam::{Accuracy, Output, Scene, Solver, SteadyState};
+use rotor_model::seam::{Accuracy, Output, RigSteady, Scene, Solver};
 use rotor_model::{LowerFriction, Model, Params, UpperFriction};
 use rotor_switch::{SwitchOptions, SwitchSolver};
 
@@ -97,7 +97,7 @@ fn seed_set() -> (Params, f64) {
     (p, 1.5 * 1.91649573917313)
 }
 
-fn values(m: &Option<SteadyState>) -> Vec<f64> {
+fn values(m: &Option<RigSteady>) -> Vec<f64> {
     m.as_ref()
         .map(|s| s.values().into_iter().map(|(_, v)| v).collect())
         .unwrap_or_default()
@@ -219,7 +219,7 @@ fn main() {
                     ..scene.clone()
                 },
             )
-            .map(|r| values(&r.metrics));
+            .map(|r| values(&r.rig_metrics()));
         let Ok(reference) = reference else {
             eprintln!("draw {n}: reference failed");
             continue;
@@ -240,7 +240,7 @@ fn main() {
                     eprintln!("draw {n}: {name} k = {k} failed");
                     continue;
                 };
-                let (a, b) = (values(&full.metrics), values(&fast.metrics));
+                let (a, b) = (values(&full.rig_metrics()), values(&fast.rig_metrics()));
                 let t = &mut tally[s][i];
                 let e = diff(&a, &reference);
                 let split = diff(&a, &b);

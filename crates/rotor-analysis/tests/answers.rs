@@ -9,7 +9,7 @@ use rotor_analysis::solvers::SolverKind;
 use rotor_analysis::steady::probes::{Expected, expected};
 use rotor_analysis::steady::{SteadyAnswer, SteadyMethod, SteadyOptions, steady};
 use rotor_model::Model;
-use rotor_model::seam::{Attractor, Scene, SteadyKind, SteadyState};
+use rotor_model::seam::{Attractor, RigSteady, Scene, SteadyKind};
 
 fn answer(kind: SolverKind, m: &Model, u: f64) -> SteadyAnswer {
     let scene = Scene {
@@ -20,9 +20,9 @@ fn answer(kind: SolverKind, m: &Model, u: f64) -> SteadyAnswer {
         .unwrap_or_else(|e| panic!("{} at {u} V: {e}", kind.name()))
 }
 
-fn cycle(st: &SteadyState) -> [f64; 3] {
+fn cycle(st: &RigSteady) -> [f64; 3] {
     match *st {
-        SteadyState::LimitCycle {
+        RigSteady::LimitCycle {
             period,
             omega_l_max,
             omega_l_min,
@@ -93,7 +93,7 @@ fn next_to_the_first_hopf_point_the_event_solver_answers() {
     assert_eq!(ev.state.kind(), SteadyKind::Equilibrium, "{:?}", ev.state);
     let eq = m.slip_equilibria(below)[0];
     assert!(m.equilibrium_is_stable(&eq));
-    let SteadyState::Equilibrium { omega_l, alpha, .. } = ev.state else {
+    let RigSteady::Equilibrium { omega_l, alpha, .. } = ev.state else {
         unreachable!()
     };
     assert_eq!((omega_l, alpha), (eq.omega, eq.alpha));

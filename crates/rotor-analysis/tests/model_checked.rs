@@ -17,13 +17,13 @@ use rotor_analysis::steady::verify::answer_accuracy;
 use rotor_analysis::steady::{SteadyAnswer, SteadyOptions, simulated};
 use rotor_model::Model;
 use rotor_model::scenario::Scenario;
-use rotor_model::seam::{Scene, SteadyState};
+use rotor_model::seam::{RigSteady, Scene};
 
 /// `(kind, values)` of an answer: an equilibrium's (α, ω_u, ω_l), a cycle's six metrics.
 fn values(a: &SteadyAnswer) -> (&'static str, Vec<(&'static str, f64)>) {
     let kind = match a.state {
-        SteadyState::Equilibrium { .. } => "equilibrium",
-        SteadyState::LimitCycle { .. } => "cycle",
+        RigSteady::Equilibrium { .. } => "equilibrium",
+        RigSteady::LimitCycle { .. } => "cycle",
     };
     (kind, a.state.values().to_vec())
 }

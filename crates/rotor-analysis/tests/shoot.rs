@@ -4,7 +4,7 @@
 //! flow with saltation matrices, an independent method).
 
 use rotor_analysis::shoot::{Section, ShootOptions, shoot};
-use rotor_model::seam::{Scene, Solver, SteadyState};
+use rotor_model::seam::{RigSteady, Scene, Solver};
 use rotor_model::{Model, State};
 
 fn solvers() -> Vec<(&'static str, Box<dyn Solver>)> {
@@ -53,7 +53,7 @@ fn every_solver_shoots_the_stable_stick_slip_cycle() {
         &Default::default(),
     )
     .unwrap();
-    let SteadyState::LimitCycle { period: t_ref, .. } = reference.state else {
+    let RigSteady::LimitCycle { period: t_ref, .. } = reference.state else {
         panic!("{reference:?}")
     };
     // P'(w*) of the reference's own stick-exit map.

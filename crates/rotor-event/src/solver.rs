@@ -20,7 +20,7 @@ use crate::filippov::{EventOptions, Integrator, RunEnd, Sink};
 /// ```
 /// use rotor_event::EventSolver;
 /// use rotor_model::{Model, State};
-/// use rotor_model::seam::{Accuracy, Output, Scene, Solver, SteadyState};
+/// use rotor_model::seam::{Accuracy, Output, Scene, Solver, RigSteady};
 ///
 /// let model = Model::table1();
 /// let scene = Scene {
@@ -35,9 +35,9 @@ use crate::filippov::{EventOptions, Integrator, RunEnd, Sink};
 /// let run = EventSolver::default().simulate(&model, &scene)?;
 ///
 /// assert_eq!(run.t_final, 60.0);
-/// let Some(SteadyState::LimitCycle { period, omega_l_min, stick_time, .. }) = run.metrics
+/// let Some(RigSteady::LimitCycle { period, omega_l_min, stick_time, .. }) = run.rig_metrics()
 /// else {
-///     panic!("a stick-slip cycle: {:?}", run.metrics)
+///     panic!("a stick-slip cycle: {:?}", run.rig_metrics())
 /// };
 /// assert!((period - 4.57776).abs() < 1e-4, "period {period} s");
 /// assert_eq!(omega_l_min, 0.0, "the lower disc sticks exactly");

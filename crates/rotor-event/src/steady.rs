@@ -24,7 +24,7 @@
 //! finds only an unstable cycle, the settled run's own last cycle is the answer
 //! ([`Method::Settled`]).
 
-use rotor_model::seam::{Event, EventKind, EventRef, MetricsAccumulator, SolveError, SteadyState};
+use rotor_model::seam::{Event, EventKind, EventRef, MetricsAccumulator, RigSteady, SolveError};
 use rotor_model::{Disc, DiscMode, Mode, Model, SlipEquilibrium, State};
 
 use nalgebra::Complex;
@@ -48,7 +48,7 @@ pub enum Method {
 pub struct Steady {
     /// The steady state's metrics (an equilibrium's state, or a cycle's period, extrema and
     /// stick time).
-    pub state: SteadyState,
+    pub state: RigSteady,
     /// How it was obtained.
     pub method: Method,
     /// A state on the cycle (at the fixed point of the return map, or the settled run's
@@ -243,7 +243,7 @@ pub fn steady_state(
         elapsed: 0.0,
     };
     let (rough, last_exit, _) = run.until(1e-6)?;
-    if let SteadyState::Equilibrium { .. } = rough {
+    if let RigSteady::Equilibrium { .. } = rough {
         return Ok(equilibrium(model, u, &run.x));
     }
     // 2. Refine; accept only a stable cycle.
@@ -276,7 +276,7 @@ pub fn steady_state(
     // unstable cycle nearby. The run goes on until period and amplitude are steady to 1e-10
     // from one cycle to the next, and the refinement is tried again from there.
     let (rough, last_exit, settled) = run.until(1e-10)?;
-    if let SteadyState::Equilibrium { .. } = rough {
+    if let RigSteady::Equilibrium { .. } = rough {
         return Ok(equilibrium(model, u, &run.x));
     }
     match refine_cycle(&flow, &run, &rough, last_exit, opts) {
@@ -309,7 +309,7 @@ pub fn steady_state(
 /// next to a Hopf point the decay rate Re λ is proportional to the distance in u), else none.
 fn collapsed(model: &Model, e: &SlipEquilibrium) -> Option<Steady> {
     model.equilibrium_is_stable(e).then(|| Steady {
-        state: SteadyState::Equilibrium {
+        state: RigSteady::Equilibrium {
             omega_u: e.omega,
             omega_l: e.omega,
             alpha: e.alpha,
@@ -350,11 +350,11 @@ enum Refined {
 fn refine_cycle(
     flow: &Flow,
     run: &Settling,
-    rough: &SteadyState,
+    rough: &RigSteady,
     last_exit: Option<(Event, DiscMode)>,
     opts: &SteadyOptions,
 ) -> Result<Refined, SolveError> {
-    let SteadyState::LimitCycle {
+    let RigSteady::LimitCycle {
         stick_time,
         omega_l_max,
         omega_l_min,
@@ -397,7 +397,7 @@ struct Settling<'a> {
 
 /// A chunk's rough steady state, its last stick exit of the lower disc, and whether the
 /// run has settled.
-type Rough = (SteadyState, Option<(Event, DiscMode)>, bool);
+type Rough = (RigSteady, Option<(Event, DiscMode)>, bool);
 
 impl Settling<'_> {
     /// Runs chunks until the last cycle's period and amplitude drift by less than `drift`
@@ -423,8 +423,8 @@ impl Settling<'_> {
                 .unwrap_or(0.0)
                 .max(sink.acc.amplitude_drift().unwrap_or(0.0));
             let settled = match st {
-                SteadyState::Equilibrium { .. } => true,
-                SteadyState::LimitCycle { .. } => d < drift,
+                RigSteady::Equilibrium { .. } => true,
+                RigSteady::LimitCycle { .. } => d < drift,
             };
             if settled || self.elapsed >= self.opts.max_settle {
                 return Ok((st, sink.last_exit, settled));
@@ -452,21 +452,21 @@ impl Sink for LastExitSink {
     }
 }
 
-fn refine_equilibrium(model: &Model, u: f64, x: &State) -> SteadyState {
+fn refine_equilibrium(model: &Model, u: f64, x: &State) -> RigSteady {
     // Lower disc stuck: a unique stuck equilibrium (smooth upper disc) is exact; within a
     // stuck *set* the orbit's own resting point is the answer.
     if x[2] == 0.0
         && let Some(set) = model.stuck_equilibria(u)
         && set.alpha_min == set.alpha_max
     {
-        return SteadyState::Equilibrium {
+        return RigSteady::Equilibrium {
             omega_u: 0.0,
             omega_l: 0.0,
             alpha: set.alpha_min,
         };
     }
     if x[1] == 0.0 && x[2] == 0.0 {
-        return SteadyState::Equilibrium {
+        return RigSteady::Equilibrium {
             omega_u: 0.0,
             omega_l: 0.0,
             alpha: x[0],
@@ -484,7 +484,7 @@ fn refine_equilibrium(model: &Model, u: f64, x: &State) -> SteadyState {
         let alpha_rate = x[1] - x[2];
         let limit = x[0].clamp(set.alpha_min, set.alpha_max);
         if (limit - x[0]) * alpha_rate > 0.0 {
-            return SteadyState::Equilibrium {
+            return RigSteady::Equilibrium {
                 omega_u: 0.0,
                 omega_l: 0.0,
                 alpha: limit,
@@ -496,12 +496,12 @@ fn refine_equilibrium(model: &Model, u: f64, x: &State) -> SteadyState {
         .into_iter()
         .min_by(|a, b| (a.state() - x).norm().total_cmp(&(b.state() - x).norm()));
     match best {
-        Some(e) => SteadyState::Equilibrium {
+        Some(e) => RigSteady::Equilibrium {
             omega_u: e.omega,
             omega_l: e.omega,
             alpha: e.alpha,
         },
-        None => SteadyState::Equilibrium {
+        None => RigSteady::Equilibrium {
             omega_u: x[1],
             omega_l: x[2],
             alpha: x[0],
@@ -752,7 +752,7 @@ mod tests {
             &EventOptions::default(),
         )
         .unwrap();
-        let SteadyState::LimitCycle { period, .. } = st.state else {
+        let RigSteady::LimitCycle { period, .. } = st.state else {
             panic!("{:?}", st.state)
         };
         let run = crate::flow::flow(

@@ -6,7 +6,7 @@ use std::path::Path;
 use nalgebra::{Matrix3, Vector3};
 use rotor_event::{EventOptions, EventSolver, SteadyOptions, steady_state};
 use rotor_model::scenario::Scenario;
-use rotor_model::seam::{EventKind, Output, Scene, SolveError, Solver, SteadyState};
+use rotor_model::seam::{EventKind, Output, RigSteady, Scene, SolveError, Solver};
 use rotor_model::{Disc, LowerFriction, Model, Params, State};
 
 fn fixtures() -> std::path::PathBuf {
@@ -207,12 +207,12 @@ fn cycle_extremes_are_as_accurate_as_the_steps() {
         EventSolver::default()
             .simulate(&m, &scene)
             .unwrap()
-            .metrics
+            .rig_metrics()
             .unwrap()
     };
     let tol = 1e-10;
     let (a, b) = (run(tol), run(1e-13));
-    assert!(matches!(a, SteadyState::LimitCycle { .. }), "{a:?}");
+    assert!(matches!(a, RigSteady::LimitCycle { .. }), "{a:?}");
     for ((name, va), (_, vb)) in a.values().into_iter().zip(b.values()) {
         if name.starts_with("omega") {
             assert!(
@@ -236,7 +236,7 @@ fn output_levels_keep_only_what_is_asked() {
         EventSolver::default().simulate(&m, &s).unwrap()
     };
     let fin = run(Output::Final);
-    assert!(fin.samples.is_empty() && fin.events.is_empty() && fin.metrics.is_none());
+    assert!(fin.samples.is_empty() && fin.events.is_empty() && fin.rig_metrics().is_none());
     let grid = run(Output::Grid { dt: 0.01 });
     assert_eq!(grid.samples.len(), 20001);
     assert_eq!(grid.samples.t(0), 0.0);
@@ -248,9 +248,9 @@ fn output_levels_keep_only_what_is_asked() {
     assert!(ev.samples.is_empty() && !ev.events.is_empty());
 }
 
-fn cycle(st: SteadyState) -> [f64; 3] {
+fn cycle(st: RigSteady) -> [f64; 3] {
     match st {
-        SteadyState::LimitCycle {
+        RigSteady::LimitCycle {
             period,
             omega_l_max,
             stick_time,
@@ -301,7 +301,7 @@ fn steady_state_converges_in_tolerance_and_matches_long_run() {
         EventSolver::default()
             .simulate(&m, &s)
             .unwrap()
-            .metrics
+            .rig_metrics()
             .unwrap(),
     );
     for i in 0..3 {
@@ -366,14 +366,14 @@ fn steady_state_mirrors_under_u_to_minus_u() {
     for (u, rel) in [(0.5, 1e-10), (1.5, 1e-12), (2.5, 1e-12)] {
         let (p, n) = (steady(u), steady(-u));
         let (
-            SteadyState::LimitCycle {
+            RigSteady::LimitCycle {
                 period: tp,
                 omega_l_max: a_max,
                 omega_l_min: a_min,
                 stick_time: sp,
                 ..
             },
-            SteadyState::LimitCycle {
+            RigSteady::LimitCycle {
                 period: tn,
                 omega_l_max: b_max,
                 omega_l_min: b_min,
@@ -446,7 +446,7 @@ fn creeping_onto_the_stick_boundary_settles_on_it() {
         .unwrap()
         .state;
         let alpha = (p.k_m * u - (p.upper.t_s + p.upper.dt_s)) / p.k_theta;
-        let SteadyState::Equilibrium {
+        let RigSteady::Equilibrium {
             omega_u,
             omega_l,
             alpha: a,
@@ -668,11 +668,11 @@ fn steady_state_accepts_only_a_stable_cycle_near_a_fold() {
         )
         .unwrap();
     let (
-        SteadyState::LimitCycle { omega_l_max: a, .. },
-        Some(SteadyState::LimitCycle { omega_l_max: b, .. }),
-    ) = (st.state, run.metrics)
+        RigSteady::LimitCycle { omega_l_max: a, .. },
+        Some(RigSteady::LimitCycle { omega_l_max: b, .. }),
+    ) = (st.state, run.rig_metrics())
     else {
-        panic!("{:?} / {:?}", st.state, run.metrics)
+        panic!("{:?} / {:?}", st.state, run.rig_metrics())
     };
     assert!(((a - b) / b).abs() < 1e-5, "refined {a} vs run {b}");
 }
@@ -699,7 +699,7 @@ fn steady_state_next_to_a_hopf_point_answers_the_focus() {
     assert_eq!(st.method, rotor_event::Method::Equilibrium);
     assert_eq!(
         st.state,
-        SteadyState::Equilibrium {
+        RigSteady::Equilibrium {
             omega_u: eq.omega,
             omega_l: eq.omega,
             alpha: eq.alpha
@@ -781,8 +781,8 @@ fn stick_time(solver: &EventSolver, m: &Model, tol: f64) -> f64 {
         output: Output::Final,
         metrics_from: Some(50.0),
     };
-    match solver.simulate(m, &scene).unwrap().metrics {
-        Some(SteadyState::LimitCycle { stick_time, .. }) => stick_time,
+    match solver.simulate(m, &scene).unwrap().rig_metrics() {
+        Some(RigSteady::LimitCycle { stick_time, .. }) => stick_time,
         other => panic!("a stick-slip cycle: {other:?}"),
     }
 }
@@ -874,7 +874,7 @@ fn a_misjudged_step_found_at_an_event_is_redone() {
     let (on, off) = (run(rotor_event::DEFECT_LIMIT), run(f64::INFINITY));
     assert!(on.stats.defect_rejections > 0, "the check never fired");
     assert_eq!(off.stats.defect_rejections, 0);
-    let a = on.metrics.unwrap();
+    let a = on.rig_metrics().unwrap();
     let reference = EventSolver {
         options: EventOptions {
             h_scale: 2.0,
@@ -889,7 +889,7 @@ fn a_misjudged_step_found_at_an_event_is_redone() {
         },
     )
     .unwrap()
-    .metrics
+    .rig_metrics()
     .unwrap();
     for ((name, x), (_, r)) in a.values().into_iter().zip(reference.values()) {
         // The redone run against tol 1e-13: 10 tolerances of tol 1e-10; measured ≤ 6.3e-11

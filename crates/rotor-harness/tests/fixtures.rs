@@ -13,7 +13,7 @@ use rotor_harness::compare::margins::{MAX_LOOSENESS, floor_violations, margins};
 use rotor_harness::compare::snapshot::snapshot;
 use rotor_model::Disc;
 use rotor_model::scenario::Scenario;
-use rotor_model::seam::{Event, EventKind, SteadyState, Trajectory};
+use rotor_model::seam::{Event, EventKind, RigSteady, Trajectory};
 
 /// Every fixture through the three solvers, once per test binary (shared by the tests).
 fn all() -> Vec<ScenarioResult> {
@@ -188,17 +188,17 @@ fn gate_margins_every_gate_is_within_its_rule() {
 }
 
 /// Moves one metric of a steady state by `by` (absolute).
-fn shift_metric(m: &mut SteadyState, name: &str, by: f64) {
+fn shift_metric(m: &mut RigSteady, name: &str, by: f64) {
     let v = match (m, name) {
-        (SteadyState::Equilibrium { omega_u, .. }, "omega_u") => omega_u,
-        (SteadyState::Equilibrium { omega_l, .. }, "omega_l") => omega_l,
-        (SteadyState::Equilibrium { alpha, .. }, "alpha") => alpha,
-        (SteadyState::LimitCycle { period, .. }, "period") => period,
-        (SteadyState::LimitCycle { omega_l_max, .. }, "omega_l_max") => omega_l_max,
-        (SteadyState::LimitCycle { omega_l_min, .. }, "omega_l_min") => omega_l_min,
-        (SteadyState::LimitCycle { omega_u_max, .. }, "omega_u_max") => omega_u_max,
-        (SteadyState::LimitCycle { omega_u_min, .. }, "omega_u_min") => omega_u_min,
-        (SteadyState::LimitCycle { stick_time, .. }, "stick_time") => stick_time,
+        (RigSteady::Equilibrium { omega_u, .. }, "omega_u") => omega_u,
+        (RigSteady::Equilibrium { omega_l, .. }, "omega_l") => omega_l,
+        (RigSteady::Equilibrium { alpha, .. }, "alpha") => alpha,
+        (RigSteady::LimitCycle { period, .. }, "period") => period,
+        (RigSteady::LimitCycle { omega_l_max, .. }, "omega_l_max") => omega_l_max,
+        (RigSteady::LimitCycle { omega_l_min, .. }, "omega_l_min") => omega_l_min,
+        (RigSteady::LimitCycle { omega_u_max, .. }, "omega_u_max") => omega_u_max,
+        (RigSteady::LimitCycle { omega_u_min, .. }, "omega_u_min") => omega_u_min,
+        (RigSteady::LimitCycle { stick_time, .. }, "stick_time") => stick_time,
         (m, n) => panic!("{n} is not a metric of {m:?}"),
     };
     *v += by;
@@ -281,7 +281,7 @@ fn every_gate_of_every_fixture_fails_its_negative_control() {
                         tr.samples.last_mut().unwrap().x[i] += excess;
                     }
                 } else if let Some(name) = q.strip_prefix("steady ") {
-                    let metrics = tr.metrics.as_mut().unwrap();
+                    let mut metrics = tr.rig_metrics().unwrap();
                     let v = metrics
                         .values()
                         .into_iter()
@@ -306,7 +306,8 @@ fn every_gate_of_every_fixture_fails_its_negative_control() {
                     } else {
                         excess
                     };
-                    shift_metric(metrics, name, by);
+                    shift_metric(&mut metrics, name, by);
+                    tr.metrics = Some(metrics.into());
                 } else {
                     panic!("{}: unknown quantity {q}", sc.name);
                 }
@@ -344,7 +345,7 @@ fn a_shift_of_every_solver_alike_changes_the_snapshot() {
         let mut p = r.clone();
         let mut any = false;
         for run in &mut p.runs {
-            if let Some(SteadyState::LimitCycle { period, .. }) =
+            if let Some(rotor_model::seam::SteadyState::LimitCycle { period, .. }) =
                 run.result.as_mut().unwrap().metrics.as_mut()
             {
                 *period *= 1.0 + 1e-6;
@@ -465,7 +466,7 @@ fn stale_cross_check(
         ];
         // The steady metrics, absolute; an equilibrium's alpha, omega_u, omega_l share the
         // trace's names and the file keeps the larger.
-        if let (Some(ma), Some(mb)) = (event.metrics, other.metrics) {
+        if let (Some(ma), Some(mb)) = (event.rig_metrics(), other.rig_metrics()) {
             for ((name, va), (_, vb)) in ma.values().into_iter().zip(mb.values()) {
                 let d = (va - vb).abs();
                 match now.iter_mut().find(|x| x.0 == name) {

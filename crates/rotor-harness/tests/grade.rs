@@ -12,7 +12,7 @@ use rotor_harness::grade::check::{
 use rotor_harness::grade::reference::{self, REQUIRED_DIGITS, Reference};
 use rotor_harness::grade::trace::{EventsFile, Trace, parse_trace, read_events, read_trace};
 use rotor_model::scenario::Scenario;
-use rotor_model::seam::{Event, Scene, Solver, SteadyState};
+use rotor_model::seam::{Event, RigSteady, Scene, Solver};
 
 fn fixtures() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../../fixtures")
@@ -449,7 +449,7 @@ fn strict_is_a_full_digit_inside_every_reference() {
         }
         assert!(
             rep.quantities.iter().any(|q| q.name == "orbit")
-                == matches!(r.steady(), Some(SteadyState::LimitCycle { .. })),
+                == matches!(r.steady(), Some(RigSteady::LimitCycle { .. })),
             "{}: orbit graded for a cycle only",
             sc.name
         );

@@ -11,7 +11,7 @@ use rotor_analysis::solvers::run::scene_for;
 use rotor_analysis::solvers::{Knob, SOLVERS, SolverKind, pair_name};
 use rotor_event::{EventOptions, EventSolver};
 use rotor_model::scenario::Scenario;
-use rotor_model::seam::{Output, Scene, Solver, SteadyState, Trajectory};
+use rotor_model::seam::{Output, RigSteady, Scene, Solver, Trajectory};
 use rotor_moreau::{MoreauOptions, MoreauSolver};
 use rotor_switch::{SwitchOptions, SwitchSolver};
 
@@ -95,7 +95,7 @@ fn run(solver: &dyn Solver, sc: &Scenario, kind: SolverKind, output: Output) -> 
 
 /// Failures of a metrics-only answer `fast` against the same solver's full run.
 fn gate(sc: &Scenario, kind: SolverKind, full: &Trajectory, fast: &Trajectory) -> Vec<String> {
-    let (Some(a), Some(b)) = (full.metrics, fast.metrics) else {
+    let (Some(a), Some(b)) = (full.rig_metrics(), fast.rig_metrics()) else {
         return vec![format!("{} {}: no metrics", sc.name, kind.name())];
     };
     if a.kind() != b.kind() {
@@ -142,7 +142,7 @@ fn metrics_only_scenes_give_the_full_answer_and_skip_only_converged_cycles() {
                     // run.
                     if fast.stats.skipped_periods == 0
                         && fast.stats.undone_skips == 0
-                        && (fast.metrics != full.metrics
+                        && (fast.rig_metrics() != full.rig_metrics()
                             || fast.x_final != full.x_final
                             || fast.stats != full.stats)
                     {
@@ -237,8 +237,8 @@ fn a_skip_that_the_next_return_does_not_confirm_is_undone() {
             "{name}"
         );
         assert!(matches!(
-            undone.metrics,
-            Some(SteadyState::LimitCycle { .. })
+            undone.rig_metrics(),
+            Some(RigSteady::LimitCycle { .. })
         ));
         let bad = gate(sc, kind, &full, &undone);
         assert!(bad.is_empty(), "{bad:#?}");
@@ -252,7 +252,7 @@ fn a_skip_that_the_next_return_does_not_confirm_is_undone() {
         );
         // Moreau–Jean goes back to the saved step end and takes the very steps of the full run.
         if kind == SolverKind::MOREAU {
-            assert_eq!(undone.metrics, full.metrics);
+            assert_eq!(undone.rig_metrics(), full.rig_metrics());
             assert_eq!(undone.x_final, full.x_final);
         }
     }

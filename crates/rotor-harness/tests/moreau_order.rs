@@ -17,7 +17,7 @@
 //! tolerances at h = 1e-3 are derived from them (see the scenario files).
 
 use rotor_event::EventSolver;
-use rotor_model::seam::{Accuracy, EventKind, Output, Scene, Solver, SteadyState};
+use rotor_model::seam::{Accuracy, EventKind, Output, RigSteady, Scene, Solver};
 use rotor_model::{Disc, Model};
 use rotor_moreau::{FrictionLevel, MoreauOptions, MoreauSolver};
 
@@ -37,8 +37,8 @@ fn scene(accuracy: Accuracy) -> Scene {
 }
 
 fn cycle(tr: &rotor_model::seam::Trajectory, who: &str) -> (f64, f64) {
-    match tr.metrics {
-        Some(SteadyState::LimitCycle {
+    match tr.rig_metrics() {
+        Some(RigSteady::LimitCycle {
             period,
             omega_l_max,
             ..

@@ -96,7 +96,7 @@ fn the_reference_is_tight_enough() {
     )
     .unwrap()
     .state;
-    let rotor_model::seam::SteadyState::LimitCycle {
+    let rotor_model::seam::RigSteady::LimitCycle {
         period,
         omega_l_max,
         ..

@@ -26,7 +26,7 @@ use independent::{Ev, Problem, Run, Tableau};
 use rayon::prelude::*;
 use rotor_harness::grade::reference;
 use rotor_model::scenario::Scenario;
-use rotor_model::seam::{EventKind, Sample, SteadyState};
+use rotor_model::seam::{EventKind, RigSteady, Sample};
 use rotor_model::{Disc, OMEGA_L, OMEGA_U, State};
 
 fn fixtures() -> PathBuf {
@@ -45,7 +45,7 @@ const EQUILIBRIUM_AMPLITUDE: f64 = 1e-6;
 /// of ω_l; extremes over the events of the cycle (switches and velocity extrema); the stick
 /// time the time stuck within the cycle. An amplitude below 1e-6 rad/s, or no complete cycle,
 /// is an equilibrium: the final state.
-fn steady_of(run: &Run) -> SteadyState {
+fn steady_of(run: &Run) -> RigSteady {
     let w = &run.window;
     let exits: Vec<usize> = (0..w.len())
         .filter(|&i| w[i].kind == EventKind::StickEnd(Disc::LOWER))
@@ -57,7 +57,7 @@ fn steady_of(run: &Run) -> SteadyState {
             .filter(|&i| w[i].kind == EventKind::Max(Disc::LOWER))
             .collect()
     };
-    let equilibrium = || SteadyState::Equilibrium {
+    let equilibrium = || RigSteady::Equilibrium {
         omega_u: run.final_state[OMEGA_U],
         omega_l: run.final_state[OMEGA_L],
         alpha: run.final_state[0],
@@ -93,7 +93,7 @@ fn steady_of(run: &Run) -> SteadyState {
         }
     }
     // A stick phase that began before the cycle and ends at its first anchor counts 0.
-    SteadyState::LimitCycle {
+    RigSteady::LimitCycle {
         period: cycle[cycle.len() - 1].t - cycle[0].t,
         omega_l_max: wl_max,
         omega_l_min: wl_min,
@@ -107,7 +107,7 @@ fn steady_of(run: &Run) -> SteadyState {
 /// its samples and events kept for the one-to-one comparisons.
 struct Result {
     run: Run,
-    steady: Option<SteadyState>,
+    steady: Option<RigSteady>,
 }
 
 fn solve(sc: &Scenario, tab: &Tableau, h: f64) -> Result {
@@ -390,7 +390,7 @@ fn verify(case: &Case, r: &reference::Reference) -> (Vec<Check>, Vec<String>) {
     // which is what an exact trace scores there. Its own error: the largest scaled difference
     // of its two runs over the steady samples (the offset moves by at most as much), plus
     // a few units of rounding of the scaled values.
-    if let (Some(from), Some(cycle @ SteadyState::LimitCycle { .. })) =
+    if let (Some(from), Some(cycle @ RigSteady::LimitCycle { .. })) =
         (sc.compare.steady_from, r.json.steady)
     {
         let scale = rotor_harness::grade::check::state_scales(&r.samples);
@@ -546,7 +546,7 @@ fn a_reference_moved_by_more_than_its_stated_error_fails() {
     assert_eq!(failing(&r), ["event_time"]);
 
     let mut r = c.r.clone();
-    let period = |s: Option<SteadyState>| s.unwrap().values()[0].1;
+    let period = |s: Option<RigSteady>| s.unwrap().values()[0].1;
     assert_eq!(c.r.json.steady.unwrap().values()[0].0, "period");
     let here = (period(r.json.steady) - period(c.fine.steady)).signum();
     let by = here * moved("period");

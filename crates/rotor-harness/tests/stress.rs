@@ -478,7 +478,7 @@ proptest! {
             };
             prop_assert!(tr.samples.iter().all(|s| s.x.iter().all(|v| v.is_finite())),
                 "{}: NaN in samples", kind.name());
-            prop_assert!(tr.metrics.is_some_and(|s| s.values().iter().all(|v| v.1.is_finite())));
+            prop_assert!(tr.rig_metrics().is_some_and(|s| s.values().iter().all(|v| v.1.is_finite())));
             // Mirror symmetry: both friction laws are odd here (the generator keeps Table 1's
             // symmetric upper disc), and every solver's arithmetic is sign-symmetric, so the
             // mirrored run is the negated run bit for bit.
@@ -705,7 +705,7 @@ fn stress_random_parameters_metrics_only_matches_the_full_run() {
                 let run = |output| kind.solver().simulate(&m, &Scene { output, ..scene.clone() })
                     .map_err(|e| TestCaseError::fail(format!("{} ({output:?}): {e}", kind.name())));
                 let (full, fast) = (run(Output::Final)?, run(Output::Metrics)?);
-                let (a, b) = (full.metrics.unwrap(), fast.metrics.unwrap());
+                let (a, b) = (full.rig_metrics().unwrap(), fast.rig_metrics().unwrap());
                 prop_assert_eq!(a.kind(), b.kind(), "{}", kind.name());
                 skipped[i] = fast.stats.skipped_periods > 0;
                 if fast.stats.skipped_periods == 0 && fast.stats.undone_skips == 0 {
@@ -713,7 +713,7 @@ fn stress_random_parameters_metrics_only_matches_the_full_run() {
                 }
                 // Moreau–Jean's stick time may also take in a slip below its resolution.
                 let merged = match (kind.name(), a) {
-                    ("moreau", rotor_model::seam::SteadyState::LimitCycle { period, .. }) => {
+                    ("moreau", rotor_model::seam::RigSteady::LimitCycle { period, .. }) => {
                         let evs = &events.events;
                         moreau_unresolved_slip(&m, scene.step(), evs, 50.0, scene.t_end, period)
                     }
@@ -810,8 +810,8 @@ fn stress_moreau_reports_a_one_step_hold_between_opposite_slips_as_a_reversal() 
     // something only if there are reversals to count).
     assert!(reversals(&event) >= 6, "{}", reversals(&event));
     assert_eq!(reversals(&moreau), reversals(&event));
-    let period = |tr: &rotor_model::seam::Trajectory| match tr.metrics {
-        Some(rotor_model::seam::SteadyState::LimitCycle { period, .. }) => period,
+    let period = |tr: &rotor_model::seam::Trajectory| match tr.rig_metrics() {
+        Some(rotor_model::seam::RigSteady::LimitCycle { period, .. }) => period,
         m => panic!("{m:?}"),
     };
     // Moreau–Jean is first order across a reversal (crate docs): its period within h of the
@@ -904,13 +904,13 @@ fn stress_an_extremum_of_one_disc_keeps_the_other_discs_stick() {
                 "{}: the cycle does not reverse",
                 kind.name()
             );
-            let Some(rotor_model::seam::SteadyState::LimitCycle {
+            let Some(rotor_model::seam::RigSteady::LimitCycle {
                 omega_l_min,
                 stick_time,
                 ..
-            }) = tr.metrics
+            }) = tr.rig_metrics()
             else {
-                panic!("{}: {:?}", kind.name(), tr.metrics);
+                panic!("{}: {:?}", kind.name(), tr.rig_metrics());
             };
             assert!(
                 stick_time > 1.0,

@@ -45,7 +45,7 @@ fn main() {
             (t, t0.elapsed().as_secs_f64())
         };
         let (exact, _) = run(0.0);
-        let m0 = exact.metrics.unwrap();
+        let m0 = exact.rig_metrics().unwrap();
         println!(
             "{name} u={u}: exact {:?}  rhs {}",
             m0.values(),
@@ -54,7 +54,7 @@ fn main() {
         {
             for eta in [1e-5, 1e-6, 1e-7, 1e-8, 1e-9, 5e-10, 1e-10] {
                 let (t, secs) = run(eta);
-                let m = t.metrics.unwrap();
+                let m = t.rig_metrics().unwrap();
                 let diffs: Vec<String> = m0
                     .values()
                     .iter()

@@ -4,7 +4,7 @@ use std::path::{Path, PathBuf};
 
 use rotor_model::scenario::Scenario;
 use rotor_model::seam::{
-    Accuracy, EventKind, Output, OutputGrid, Scene, SolveError, Solver, SteadyState, Trajectory,
+    Accuracy, EventKind, Output, OutputGrid, RigSteady, Scene, SolveError, Solver, Trajectory,
 };
 use rotor_model::{Disc, Model, OMEGA_L, OMEGA_U};
 use rotor_switch::{SwitchOptions, SwitchSolver};
@@ -26,8 +26,8 @@ fn run(eta: f64, model: &Model, scene: &Scene) -> Trajectory {
 
 /// (period, ω_l max, stick time) of a stick-slip steady state.
 fn cycle(t: &Trajectory) -> [f64; 3] {
-    match t.metrics {
-        Some(SteadyState::LimitCycle {
+    match t.rig_metrics() {
+        Some(RigSteady::LimitCycle {
             period,
             omega_l_max,
             stick_time,
@@ -116,8 +116,8 @@ fn default_eta_meets_the_metric_target() {
     let eta = SwitchOptions::default().eta;
     for u in [1.5, 4.5] {
         let scene = steady_scene(u);
-        let a = run(0.0, &model, &scene).metrics.unwrap();
-        let b = run(eta, &model, &scene).metrics.unwrap();
+        let a = run(0.0, &model, &scene).rig_metrics().unwrap();
+        let b = run(eta, &model, &scene).rig_metrics().unwrap();
         assert_eq!(a.kind(), b.kind());
         for ((name, x), (_, y)) in a.values().into_iter().zip(b.values()) {
             // 1e-8 relative: 8× the measured 1.2e-9. ω_l min is 0 exactly (η = 0) and the
@@ -165,7 +165,7 @@ fn every_fixture_runs_to_t_end() {
         assert!(t.samples.iter().all(|p| p.x.iter().all(|v| v.is_finite())));
         assert!(t.x_final.iter().all(|v| v.is_finite()), "{}", sc.name);
         assert_eq!(t.samples.last().unwrap().x, t.x_final, "{}", sc.name);
-        assert!(t.metrics.is_some());
+        assert!(t.rig_metrics().is_some());
         let eta = s.options.eta;
         match sc.name.as_str() {
             // k_m u below the upper static level: both discs stay stuck, exactly at 0.
@@ -274,7 +274,7 @@ fn output_levels_are_honoured() {
         )
         .unwrap();
     assert!(fin.samples.is_empty() && fin.events.is_empty());
-    assert!(fin.metrics.is_none());
+    assert!(fin.rig_metrics().is_none());
     assert!(fin.stats.events > 0, "switches are still counted");
     let ev = s
         .simulate(

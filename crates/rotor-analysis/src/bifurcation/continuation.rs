@@ -31,7 +31,7 @@
 
 use nalgebra::{Complex, Matrix3, Vector3};
 use rotor_model::State;
-use rotor_model::seam::{Output, Scene, Solver, SteadyState};
+use rotor_model::seam::{Output, RigSteady, Scene, Solver};
 
 use crate::bifurcation::BifError;
 use crate::bifurcation::monodromy::order_multipliers;
@@ -356,8 +356,8 @@ impl Continuer<'_> {
         let traj = rotor_event::EventSolver::default()
             .simulate(self.sh.model, &scene)
             .map_err(BifError::Solve)?;
-        let (wl_max, wl_min, wu_min, stick_time) = match traj.metrics {
-            Some(SteadyState::LimitCycle {
+        let (wl_max, wl_min, wu_min, stick_time) = match traj.rig_metrics() {
+            Some(RigSteady::LimitCycle {
                 omega_l_max,
                 omega_l_min,
                 omega_u_min,

@@ -44,7 +44,7 @@ pub fn classify(model: &Model, u: f64, x0: State) -> Option<Attractor> {
     };
     let metrics = rotor_event::EventSolver::default()
         .simulate(model, &scene)
-        .map(|t| t.metrics);
+        .map(|t| t.rig_metrics());
     metrics.ok().flatten().as_ref().map(Attractor::of)
 }
 

@@ -43,7 +43,7 @@
 use crate::shoot::{Orbit, Section, ShootOptions, shoot};
 use crate::solvers::SolverKind;
 use nalgebra::Complex;
-use rotor_model::seam::{Event, SteadyState};
+use rotor_model::seam::{Event, RigSteady};
 use rotor_model::seam::{EventKind, Output, Scene, Solver};
 use rotor_model::{Disc, Model, OMEGA_L, OMEGA_U, State};
 
@@ -129,7 +129,7 @@ struct Run<'a> {
     events: Vec<Event>,
     t: f64,
     x: State,
-    last_metrics: Option<SteadyState>,
+    last_metrics: Option<RigSteady>,
     /// The slipping equilibria at the scene's input, found once: the checks ask for them
     /// after every chunk, and each search scans the branch `u(ω)` on 4000 points.
     equilibria: std::cell::OnceCell<Vec<rotor_model::SlipEquilibrium>>,
@@ -169,13 +169,13 @@ impl<'a> Run<'a> {
         )?;
         let t0 = self.t;
         let x = tr.final_state()?;
+        self.last_metrics = tr.rig_metrics();
         self.events.extend(tr.events.into_iter().map(|mut e| {
             e.t += t0;
             e
         }));
         self.t += dt;
         self.x = x;
-        self.last_metrics = tr.metrics;
         Ok(())
     }
 
@@ -317,7 +317,7 @@ fn stable_equilibrium(run: &Run, omega: f64) -> Option<rotor_model::SlipEquilibr
 
 fn equilibrium_answer(e: &rotor_model::SlipEquilibrium) -> SteadyAnswer {
     SteadyAnswer {
-        state: SteadyState::Equilibrium {
+        state: RigSteady::Equilibrium {
             omega_u: e.omega,
             omega_l: e.omega,
             alpha: e.alpha,
@@ -437,7 +437,7 @@ fn shot_and_checked(
             t: run.t,
             answer: SteadyAnswer {
                 state: s.state,
-                on_cycle: matches!(s.state, SteadyState::LimitCycle { .. }).then_some(s.x),
+                on_cycle: matches!(s.state, RigSteady::LimitCycle { .. }).then_some(s.x),
                 method: SteadyMethod::Simulated,
                 multipliers: None,
                 stable: None,
@@ -605,7 +605,7 @@ fn spectral_radius(o: &Orbit) -> f64 {
 /// rad/s): the stuck set, or a slipping equilibrium whose eigenvalues say it is stable.
 fn at_rest(run: &Run) -> Option<SteadyAnswer> {
     let (model, u) = (run.model, run.scene.u);
-    let Some(SteadyState::Equilibrium { omega_l, alpha, .. }) = run.last_metrics else {
+    let Some(RigSteady::Equilibrium { omega_l, alpha, .. }) = run.last_metrics else {
         return None;
     };
     if omega_l == 0.0 {
@@ -749,7 +749,7 @@ mod tests {
                 "{}: {c:?}",
                 kind.name()
             );
-            let SteadyState::Equilibrium { omega_l, .. } = c.answer.state else {
+            let RigSteady::Equilibrium { omega_l, .. } = c.answer.state else {
                 panic!("{}: not an equilibrium: {c:?}", kind.name());
             };
             assert!(
@@ -807,7 +807,7 @@ mod tests {
             assert!(!o.is_stable(), "{}: {:?}", kind.name(), o.multipliers);
             let a = checked_or_simulated(kind, &m, &scene, &Default::default()).unwrap();
             assert_ne!(a.stable, Some(false), "{}: {a:?}", kind.name());
-            if let SteadyState::LimitCycle { period, .. } = a.state {
+            if let RigSteady::LimitCycle { period, .. } = a.state {
                 // Not the unstable cycle: its period differs by far more than any solver's
                 // error (1e-4 s, Moreau–Jean's O(h²) period error is ~6e-7 s).
                 assert!((period - row.period).abs() > 1e-4, "{}: {a:?}", kind.name());
@@ -817,10 +817,10 @@ mod tests {
                     crate::steady::compute::steady(kind, &m, &scene, &Default::default()).unwrap();
                 match (a.state, sim.state) {
                     (
-                        SteadyState::LimitCycle { period: p, .. },
-                        SteadyState::LimitCycle { period: q, .. },
+                        RigSteady::LimitCycle { period: p, .. },
+                        RigSteady::LimitCycle { period: q, .. },
                     ) => assert!((p - q).abs() <= 1e-5 * q, "{a:?} vs {sim:?}"),
-                    (SteadyState::Equilibrium { .. }, SteadyState::Equilibrium { .. }) => {}
+                    (RigSteady::Equilibrium { .. }, RigSteady::Equilibrium { .. }) => {}
                     _ => panic!("default {a:?} vs simulation {sim:?}"),
                 }
             }

@@ -15,7 +15,7 @@
 use crate::bifurcation::continuation::{ContOptions, Continuer};
 use crate::bifurcation::periodic::{Shooter, T_RETURN};
 use nalgebra::Complex;
-use rotor_model::seam::{Scene, SolveError, Stats, SteadyState};
+use rotor_model::seam::{RigSteady, Scene, SolveError, Stats};
 use rotor_model::{Model, State};
 use serde::Serialize;
 
@@ -55,7 +55,7 @@ pub struct SteadyOptions {
 pub struct SteadyAnswer {
     /// The metrics: an equilibrium's state, or a cycle's period, extremes and stick time.
     #[serde(flatten)]
-    pub state: SteadyState,
+    pub state: RigSteady,
     /// How they were obtained.
     pub method: SteadyMethod,
     /// Floquet multipliers `[re, im]` of a refined cycle, the trivial one (≈ 1) first, then by
@@ -185,7 +185,7 @@ pub enum SteadyError {
     /// A value of the answer is not finite.
     #[error("the steady state has a non-finite {name}: {value}")]
     NonFinite {
-        /// The metric ([`SteadyState::values`]'s name).
+        /// The metric ([`RigSteady::values`]'s name).
         name: &'static str,
         /// Its value.
         value: f64,
@@ -205,14 +205,14 @@ pub enum SteadyError {
 ///
 /// ```
 /// use rotor_model::{Model, State};
-/// use rotor_model::seam::{Scene, SteadyState};
+/// use rotor_model::seam::{Scene, RigSteady};
 /// use rotor_analysis::solvers::SolverKind;
 /// use rotor_analysis::steady::{SteadyMethod, steady};
 ///
 /// let model = Model::table1();
 /// let scene = Scene { u: 1.5, x0: vec![0.0; 3], ..Scene::default() };
 /// let a = steady(SolverKind::EVENT, &model, &scene, &Default::default())?;
-/// let SteadyState::LimitCycle { period, stick_time, .. } = a.state else { panic!("{a:?}") };
+/// let RigSteady::LimitCycle { period, stick_time, .. } = a.state else { panic!("{a:?}") };
 /// assert!((period - 4.5777579).abs() < 1e-6); // the 1.5 V stick-slip cycle
 /// assert!(stick_time > 0.0);
 /// assert_eq!(a.method, SteadyMethod::Refined);
@@ -223,7 +223,7 @@ pub enum SteadyError {
 ///
 /// let m = steady(SolverKind::MOREAU, &model, &scene, &Default::default())?;
 /// assert_eq!(m.method, SteadyMethod::Simulated);
-/// let SteadyState::LimitCycle { period: pm, .. } = m.state else { panic!("{m:?}") };
+/// let RigSteady::LimitCycle { period: pm, .. } = m.state else { panic!("{m:?}") };
 /// assert!((pm - period).abs() < 1e-5, "Moreau-Jean's period {pm} s");
 /// # Ok::<(), rotor_analysis::steady::SteadyError>(())
 /// ```
@@ -307,7 +307,7 @@ pub fn simulated(
     scene.validate()?;
     let s = settle(kind, model, scene, &opts.settle)?;
     let answer = SteadyAnswer {
-        on_cycle: matches!(s.state, SteadyState::LimitCycle { .. }).then_some(s.x),
+        on_cycle: matches!(s.state, RigSteady::LimitCycle { .. }).then_some(s.x),
         state: s.state,
         method: SteadyMethod::Simulated,
         multipliers: None,
@@ -325,13 +325,13 @@ pub(crate) fn shot_answer(
     run: rotor_model::seam::Trajectory,
     t_end: f64,
 ) -> Result<SteadyAnswer, SteadyError> {
-    let state = run
-        .metrics
-        .ok_or(SteadyError::Shoot(crate::shoot::ShootError::NoReturn {
-            what: orbit.section.as_str(),
-            horizon: t_end,
-            z: orbit.z.clone(),
-        }))?;
+    let state =
+        run.rig_metrics()
+            .ok_or(SteadyError::Shoot(crate::shoot::ShootError::NoReturn {
+                what: orbit.section.as_str(),
+                horizon: t_end,
+                z: orbit.z.clone(),
+            }))?;
     let mut multipliers = vec![Complex::new(1.0, 0.0)];
     multipliers.extend(orbit.multipliers.iter().map(|m| Complex::new(m[0], m[1])));
     if multipliers.len() == 2 {

@@ -6,7 +6,7 @@
 use crate::bifurcation::PeriodicRow;
 use crate::shoot::{Orbit, Section, ShootOptions};
 use crate::solvers::{Knob, SolverKind};
-use rotor_model::seam::{Accuracy, EventKind, Output, Scene, SteadyState};
+use rotor_model::seam::{Accuracy, EventKind, Output, RigSteady, Scene};
 use rotor_model::{Disc, Model, OMEGA_L, OMEGA_U};
 use serde::Serialize;
 
@@ -141,16 +141,19 @@ pub(crate) fn row_of(
             },
         )
         .map_err(|e| e.to_string())?;
-    let Some(SteadyState::LimitCycle {
+    let Some(RigSteady::LimitCycle {
         period,
         omega_l_max,
         omega_l_min,
         omega_u_min,
         stick_time,
         ..
-    }) = run.metrics
+    }) = run.rig_metrics()
     else {
-        return Err(format!("no cycle read off the orbit: {:?}", run.metrics));
+        return Err(format!(
+            "no cycle read off the orbit: {:?}",
+            run.rig_metrics()
+        ));
     };
     let mut multipliers = vec![[1.0, 0.0]];
     multipliers.extend(orbit.multipliers.iter().copied());

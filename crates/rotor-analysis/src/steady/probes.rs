@@ -18,7 +18,7 @@
 use crate::bifurcation::continuation::{ContOptions, Continuer};
 use crate::bifurcation::periodic::Shooter;
 use crate::bifurcation::{Diagram, PointKind};
-use rotor_model::seam::{Attractor, Scene, SteadyState};
+use rotor_model::seam::{Attractor, RigSteady, Scene};
 use rotor_model::{Model, State};
 
 use crate::solvers::registry::SolverKind;
@@ -361,11 +361,11 @@ fn refusal(e: &SteadyError) -> Option<&'static str> {
 
 /// The largest relative difference between an answer and an attractor (∞ if the kinds
 /// differ); `floor` bounds the scale from below (rad/s, s).
-fn distance(st: &SteadyState, a: &Expected, floor: f64) -> f64 {
+fn distance(st: &RigSteady, a: &Expected, floor: f64) -> f64 {
     let rel = |x: f64, y: f64| (x - y).abs() / x.abs().max(y.abs()).max(floor);
     match (*st, a) {
         (
-            SteadyState::Equilibrium {
+            RigSteady::Equilibrium {
                 omega_u,
                 omega_l,
                 alpha,
@@ -375,7 +375,7 @@ fn distance(st: &SteadyState, a: &Expected, floor: f64) -> f64 {
             .max(rel(omega_l, *omega))
             .max(rel(alpha, *a0)),
         (
-            SteadyState::Equilibrium {
+            RigSteady::Equilibrium {
                 omega_u,
                 omega_l,
                 alpha,
@@ -391,7 +391,7 @@ fn distance(st: &SteadyState, a: &Expected, floor: f64) -> f64 {
                 .max(outside / alpha.abs().max(floor))
         }
         (
-            SteadyState::LimitCycle {
+            RigSteady::LimitCycle {
                 period,
                 omega_l_max,
                 omega_l_min,

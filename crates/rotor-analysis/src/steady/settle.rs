@@ -9,7 +9,7 @@
 //! point — is followed until it has decayed, or reported as not settled at `max_time`,
 //! instead of as a limit cycle.
 
-use rotor_model::seam::{Output, Scene, SolveError, Stats, SteadyState};
+use rotor_model::seam::{Output, RigSteady, Scene, SolveError, Stats};
 use rotor_model::{Model, State};
 
 use crate::solvers::registry::SolverKind;
@@ -161,8 +161,8 @@ impl std::fmt::Display for Unsettled {
 }
 
 /// The cause of a run that has not settled, from its last chunk's metrics.
-fn unsettled(fixed_step: bool, h: f64, last: &SteadyState) -> Unsettled {
-    if let SteadyState::LimitCycle {
+fn unsettled(fixed_step: bool, h: f64, last: &RigSteady) -> Unsettled {
+    if let RigSteady::LimitCycle {
         omega_l_max,
         omega_l_min,
         stick_time,
@@ -183,7 +183,7 @@ fn unsettled(fixed_step: bool, h: f64, last: &SteadyState) -> Unsettled {
 
 /// The largest relative change between two steady states' metrics, and its name (an
 /// infinite change when the kinds differ).
-fn change(a: &SteadyState, b: &SteadyState, abs: f64) -> (String, f64) {
+fn change(a: &RigSteady, b: &RigSteady, abs: f64) -> (String, f64) {
     if a.kind() != b.kind() {
         return (
             format!("the kind ({} then {})", a.kind(), b.kind()),
@@ -205,12 +205,12 @@ fn change(a: &SteadyState, b: &SteadyState, abs: f64) -> (String, f64) {
     // A cycle's amplitude relative to itself: a focus decaying near a Hopf point keeps its
     // mean velocity and period while its amplitude shrinks by a fixed factor per chunk.
     if let (
-        SteadyState::LimitCycle {
+        RigSteady::LimitCycle {
             omega_l_max: a1,
             omega_l_min: a0,
             ..
         },
-        SteadyState::LimitCycle {
+        RigSteady::LimitCycle {
             omega_l_max: b1,
             omega_l_min: b0,
             ..
@@ -230,7 +230,7 @@ fn change(a: &SteadyState, b: &SteadyState, abs: f64) -> (String, f64) {
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Settled {
     /// The metrics of the last chunk's last complete cycle (or its final state, at rest).
-    pub state: SteadyState,
+    pub state: RigSteady,
     /// The work counters of all chunks, summed.
     pub stats: Stats,
     /// The last chunk's final state (on the cycle, for a cycle).
@@ -254,7 +254,7 @@ pub fn settle(
     let mut x = base.x0_state()?;
     let mut t = 0.0;
     let mut stats = Stats::default();
-    let mut prev: Option<SteadyState> = None;
+    let mut prev: Option<RigSteady> = None;
     let mut history = History::new(rel, opts);
     loop {
         let scene = Scene {
@@ -267,7 +267,7 @@ pub fn settle(
         let tr = solver.simulate_finite(model, &scene)?;
         t += opts.chunk;
         stats += tr.stats;
-        let st = tr.metrics.ok_or(SolveError::Unsupported {
+        let st = tr.rig_metrics().ok_or(SolveError::Unsupported {
             detail: format!("{} returned no metrics", kind.name()),
         })?;
         if let Some(p) = prev {
@@ -328,14 +328,14 @@ struct History {
 }
 
 /// The ω_l range `max ω_l − min ω_l` of a cycle (NaN at an equilibrium).
-fn omega_l_range(st: &SteadyState) -> f64 {
+fn omega_l_range(st: &RigSteady) -> f64 {
     match *st {
-        SteadyState::LimitCycle {
+        RigSteady::LimitCycle {
             omega_l_max,
             omega_l_min,
             ..
         } => omega_l_max - omega_l_min,
-        SteadyState::Equilibrium { .. } => f64::NAN,
+        RigSteady::Equilibrium { .. } => f64::NAN,
     }
 }
 
@@ -365,7 +365,7 @@ impl History {
     /// Records the change `c` of the chunk ending at `t` with metrics `st`, and judges the run:
     /// settled, running, or not settling ([`Self::slow_growth`], [`Self::slow_decay`], or
     /// `cause` once the run jitters or reaches `max_time`).
-    fn judge(&mut self, c: f64, st: &SteadyState, t: f64, cause: Unsettled) -> Verdict {
+    fn judge(&mut self, c: f64, st: &RigSteady, t: f64, cause: Unsettled) -> Verdict {
         // Changes falling geometrically by q per chunk leave c·q/(1 − q) still to come:
         // settled when all of it is within `rel`. Changes that do not fall are the
         // solver's cycle-to-cycle jitter: settled when within `rel`.
@@ -406,11 +406,11 @@ impl History {
     /// is leaving a weakly unstable equilibrium, and cannot settle before its amplitude `a`
     /// has grown to that 1 %, after `n = ln(0.01·ω̄/a) / ln r` chunks. Said now if that is
     /// past `max_time` (at the run's time `t`).
-    fn slow_growth(&self, st: &SteadyState, t: f64) -> Option<Unsettled> {
+    fn slow_growth(&self, st: &RigSteady, t: f64) -> Option<Unsettled> {
         let (r, rs, range, opts) = (self.rs[2], &self.rs, self.prev_range, &self.opts);
         let growing = r >= 1.01
             && rs.iter().all(|y| (y - r).abs() <= 0.1 * (r - 1.0))
-            && if let SteadyState::LimitCycle {
+            && if let RigSteady::LimitCycle {
                 omega_l_max,
                 omega_l_min,
                 ..
@@ -424,12 +424,12 @@ impl History {
             return None;
         }
         let mean = match *st {
-            SteadyState::LimitCycle {
+            RigSteady::LimitCycle {
                 omega_l_max,
                 omega_l_min,
                 ..
             } => (0.5 * (omega_l_max + omega_l_min)).abs().max(1.0),
-            SteadyState::Equilibrium { .. } => 1.0,
+            RigSteady::Equilibrium { .. } => 1.0,
         };
         let n = (0.01 * mean / range).ln() / r.ln();
         (t + n * opts.chunk > opts.max_time).then_some(Unsettled::SlowGrowth {
@@ -481,7 +481,7 @@ mod tests {
     }
 
     /// The event-driven solver's refined steady state from rest.
-    fn event_steady(m: &Model, u: f64) -> SteadyState {
+    fn event_steady(m: &Model, u: f64) -> RigSteady {
         rotor_event::steady_state(
             m,
             u,
@@ -519,12 +519,12 @@ mod tests {
             )
             .unwrap();
         assert_eq!(
-            one_run.metrics.unwrap().kind(),
+            one_run.rig_metrics().unwrap().kind(),
             rotor_model::seam::SteadyKind::LimitCycle
         );
         for kind in [SolverKind::SWITCH, SolverKind::MOREAU] {
             let s = settle(kind, &m, &base(u), &SettleOptions::default()).unwrap();
-            let SteadyState::Equilibrium { omega_l, alpha, .. } = s.state else {
+            let RigSteady::Equilibrium { omega_l, alpha, .. } = s.state else {
                 panic!("{kind:?}: {:?}", s.state);
             };
             // The settled state is within the settling agreement (1e-5 relative) of the
@@ -590,7 +590,7 @@ mod tests {
         );
         let m = Model::new(rotor_model::Params::from_file(std::path::Path::new(path)).unwrap());
         let ev = event_steady(&m, 0.12);
-        assert!(matches!(ev, SteadyState::Equilibrium { .. }), "{ev:?}");
+        assert!(matches!(ev, RigSteady::Equilibrium { .. }), "{ev:?}");
         let opts = SettleOptions::default();
         for kind in [SolverKind::SWITCH, SolverKind::MOREAU] {
             let s = settle(kind, &m, &base(0.12), &opts).unwrap();

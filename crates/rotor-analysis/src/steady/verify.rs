@@ -24,7 +24,7 @@
 
 use crate::solvers::SolverKind;
 use rotor_model::seam::steady::EQUILIBRIUM_AMPLITUDE;
-use rotor_model::seam::{Output, Scene, SteadyState};
+use rotor_model::seam::{Output, RigSteady, Scene};
 use rotor_model::{Disc, DiscMode, Mode, Model, State};
 
 use crate::steady::compute::{SteadyAnswer, SteadyError};
@@ -54,7 +54,7 @@ pub fn verify(
         }
     }
     match answer.state {
-        SteadyState::Equilibrium {
+        RigSteady::Equilibrium {
             omega_u,
             omega_l,
             alpha,
@@ -64,7 +64,7 @@ pub fn verify(
             &State::new(alpha, omega_u, omega_l),
             kind.info().stuck_band,
         ),
-        SteadyState::LimitCycle { period, .. } => {
+        RigSteady::LimitCycle { period, .. } => {
             metrics_of_a_cycle(&answer.state)?;
             let Some(x) = answer.on_cycle else {
                 return Err(refuted(
@@ -155,8 +155,8 @@ pub fn equilibrium(model: &Model, u: f64, x: &State, band: f64) -> Result<(), St
 
 /// A cycle's metrics are a cycle's: a positive finite period, an ω_l range above the
 /// equilibrium amplitude, extrema in order, a stick time in `[0, period]`.
-fn metrics_of_a_cycle(st: &SteadyState) -> Result<(), SteadyError> {
-    let SteadyState::LimitCycle {
+fn metrics_of_a_cycle(st: &RigSteady) -> Result<(), SteadyError> {
+    let RigSteady::LimitCycle {
         period,
         omega_l_max,
         omega_l_min,
@@ -232,7 +232,7 @@ mod tests {
         Model::new(rotor_model::Params::from_file(&path).unwrap())
     }
 
-    fn answer(state: SteadyState, on_cycle: Option<State>) -> SteadyAnswer {
+    fn answer(state: RigSteady, on_cycle: Option<State>) -> SteadyAnswer {
         SteadyAnswer {
             state,
             method: SteadyMethod::Simulated,
@@ -302,7 +302,7 @@ mod tests {
 
     #[test]
     fn metrics_that_are_no_cycle_are_refused() {
-        let cycle = SteadyState::LimitCycle {
+        let cycle = RigSteady::LimitCycle {
             period: 4.5,
             omega_l_max: 3.0,
             omega_l_min: 0.0,

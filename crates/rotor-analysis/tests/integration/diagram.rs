@@ -5,7 +5,7 @@ use rotor_analysis::bifurcation::equilibria::{complex_pair, hopf_points, omega_r
 use rotor_analysis::bifurcation::periodic::{Shooter, eig2};
 use rotor_analysis::bifurcation::{Diagram, DiagramOptions, diagram, start_point};
 use rotor_event::{EventOptions, SteadyOptions, steady_state};
-use rotor_model::seam::SteadyState;
+use rotor_model::seam::RigSteady;
 use rotor_model::{Model, State};
 
 use crate::common::{cont_options, model, points, st_diagram, t1_diagram};
@@ -103,7 +103,7 @@ fn branch_period_matches_steady_state_refinement() {
     )
     .unwrap()
     .state;
-    let SteadyState::LimitCycle {
+    let RigSteady::LimitCycle {
         period,
         omega_l_max,
         ..
@@ -280,8 +280,8 @@ fn hysteresis_of_a_brute_force_sweep_matches_the_bistable_window() {
     // stable cycles here have amplitudes ≥ 8 rad/s) or if the oscillation grows (a2 > a1:
     // an unstable equilibrium, Re λ > 0); it is on (or settling to) the equilibrium
     // otherwise. The growth test needs no threshold on the slow transients near the Hopf point.
-    let amp = |s: &Option<SteadyState>| match s {
-        Some(SteadyState::LimitCycle {
+    let amp = |s: &Option<RigSteady>| match s {
+        Some(RigSteady::LimitCycle {
             omega_l_max,
             omega_l_min,
             ..
@@ -307,7 +307,7 @@ fn hysteresis_of_a_brute_force_sweep_matches_the_bistable_window() {
                 },
             )
             .unwrap();
-        let (a1, a2) = (amp(&t1.metrics), amp(&t2.metrics));
+        let (a1, a2) = (amp(&t1.rig_metrics()), amp(&t2.rig_metrics()));
         (a2 > 1.0 || a2 > a1, t2.final_state().unwrap())
     };
     let us: Vec<f64> = (0..20).map(|k| 4.025 + 0.05 * k as f64).collect();

@@ -6,7 +6,7 @@ use std::path::{Path, PathBuf};
 use anyhow::{Context, Result, bail};
 
 use rotor_model::Params;
-use rotor_model::seam::SteadyState;
+use rotor_model::seam::RigSteady;
 
 use crate::common::{fixture_path, fixtures_dir, progress_bar, thread_pool, threads_arg};
 use crate::out;
@@ -85,13 +85,14 @@ pub(crate) fn compare(
     ))?;
     for r in results {
         for run in &r.runs {
-            let (kind, period, wmax) = match run.result.as_ref().ok().and_then(|t| t.metrics) {
-                Some(SteadyState::LimitCycle {
+            let (kind, period, wmax) = match run.result.as_ref().ok().and_then(|t| t.rig_metrics())
+            {
+                Some(RigSteady::LimitCycle {
                     period,
                     omega_l_max,
                     ..
                 }) => ("cycle", format!("{period:.6}"), format!("{omega_l_max:.6}")),
-                Some(SteadyState::Equilibrium { omega_l, .. }) => {
+                Some(RigSteady::Equilibrium { omega_l, .. }) => {
                     ("equilibrium", "-".into(), format!("{omega_l:.6}"))
                 }
                 None => ("error", "-".into(), "-".into()),

@@ -168,7 +168,7 @@ pub(crate) fn load(
             // The reference measured against the tighter run.
             Some(cd) => (
                 Some(cd.errors(
-                    SteadyRef::of(tr.metrics.as_ref()),
+                    SteadyRef::of(tr.rig_metrics().as_ref()),
                     &window(&tr, spec.transient, spec.dt),
                 )),
                 None,

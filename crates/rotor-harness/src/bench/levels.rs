@@ -130,7 +130,7 @@ pub(crate) fn output_levels(
             skipped_periods: a.stats.skipped_periods,
             undone_skips: a.stats.undone_skips,
             metrics_diff: metrics_difference(&a, &b),
-            same_answer: f.metrics == b.metrics && f.x_final == b.x_final,
+            same_answer: f.rig_metrics() == b.rig_metrics() && f.x_final == b.x_final,
         });
     }
     Ok(v)
@@ -142,7 +142,7 @@ fn metrics_difference(
     a: &rotor_model::seam::Trajectory,
     b: &rotor_model::seam::Trajectory,
 ) -> Option<f64> {
-    match (a.metrics, b.metrics) {
+    match (a.rig_metrics(), b.rig_metrics()) {
         (Some(ma), Some(mb)) if ma.kind() == mb.kind() => Some(
             ma.values()
                 .into_iter()

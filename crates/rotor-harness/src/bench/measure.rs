@@ -3,7 +3,7 @@
 use std::time::Instant;
 
 use rotor_model::OMEGA_L;
-use rotor_model::seam::{Output, Scene, SolveError, Solver, SteadyState, Trajectory};
+use rotor_model::seam::{Output, RigSteady, Scene, SolveError, Solver, Trajectory};
 use serde::{Deserialize, Serialize};
 
 use crate::bench::options::SolverKind;
@@ -99,9 +99,9 @@ pub enum SteadyRef {
 
 impl SteadyRef {
     /// The steady state of a run's metrics (`None`: the run reports none).
-    pub fn of(m: Option<&SteadyState>) -> Option<SteadyRef> {
+    pub fn of(m: Option<&RigSteady>) -> Option<SteadyRef> {
         match m? {
-            SteadyState::LimitCycle {
+            RigSteady::LimitCycle {
                 period,
                 omega_l_max,
                 ..
@@ -109,7 +109,7 @@ impl SteadyRef {
                 period: *period,
                 omega_l_max: *omega_l_max,
             }),
-            SteadyState::Equilibrium {
+            RigSteady::Equilibrium {
                 omega_u,
                 omega_l,
                 alpha,
@@ -164,7 +164,7 @@ impl RefData {
     /// Reads the reference from a full-trace run with metrics; `None` if it reports no steady
     /// state or the window holds no sample.
     pub fn new(tr: &Trajectory, transient: [f64; 2], dt: f64) -> Option<RefData> {
-        let steady = SteadyRef::of(tr.metrics.as_ref())?;
+        let steady = SteadyRef::of(tr.rig_metrics().as_ref())?;
         let w = window(tr, transient, dt);
         let k0 = grid_index(w.first()?.0, dt)?;
         Some(RefData {
@@ -278,7 +278,7 @@ pub(crate) fn run_point(
     let s = solver(kind);
     let (tr, timing) = timed(repeats, budget, || s.simulate(model, scene))?;
     let errors = refd.errors(
-        SteadyRef::of(tr.metrics.as_ref()),
+        SteadyRef::of(tr.rig_metrics().as_ref()),
         &window(&tr, transient, refd.dt),
     );
     Ok((tr, timing, errors))

@@ -15,7 +15,7 @@
 
 use rotor_model::Disc;
 use rotor_model::scenario::PairTolerance;
-use rotor_model::seam::{EventKind, SteadyState, Trajectory};
+use rotor_model::seam::{EventKind, RigSteady, Trajectory};
 
 use rotor_analysis::solvers::registry::{SolverKind, all_pairs, pair_name, pairs};
 use rotor_analysis::solvers::run::ScenarioResult;
@@ -200,9 +200,15 @@ pub fn check_pair(
     }
     if tol.gates_steady() {
         let floor = tol.steady_abs.unwrap_or(0.0);
-        let (Some(sa), Some(sb)) = (a.metrics, b.metrics) else {
+        let (Some(sa), Some(sb)) = (a.rig_metrics(), b.rig_metrics()) else {
             // A gated steady state that a solver did not deliver fails the gate.
-            let which = |tr: &Trajectory| if tr.metrics.is_some() { "yes" } else { "none" };
+            let which = |tr: &Trajectory| {
+                if tr.rig_metrics().is_some() {
+                    "yes"
+                } else {
+                    "none"
+                }
+            };
             m.push(Measured {
                 quantity: format!("steady metrics ({} vs {})", which(a), which(b)),
                 key: None,
@@ -300,8 +306,8 @@ pub fn check_whole(
 ///
 /// [`SolverInfo::stuck_band`]: rotor_analysis::solvers::SolverInfo::stuck_band
 pub fn steady_differences(
-    sa: &SteadyState,
-    sb: &SteadyState,
+    sa: &RigSteady,
+    sb: &RigSteady,
     tol: &PairTolerance,
     floor: f64,
     stuck_band: f64,
@@ -312,7 +318,7 @@ pub fn steady_differences(
         .map(|((name, va), (_, vb))| {
             let (q, t) = tol
                 .for_metric(name)
-                .expect("every metric of SteadyState::values has a quantity");
+                .expect("every metric of RigSteady::values has a quantity");
             let t = t.unwrap_or(0.0);
             let d = beyond_stuck_band(name, va, vb, stuck_band);
             let diff = if !q.relative {
@@ -367,8 +373,8 @@ pub fn beyond_stuck_band(name: &str, va: f64, vb: f64, stuck_band: f64) -> f64 {
 }
 
 /// The steady metrics of a trajectory, if computed.
-pub fn metrics(tr: &Trajectory) -> Option<SteadyState> {
-    tr.metrics
+pub fn metrics(tr: &Trajectory) -> Option<RigSteady> {
+    tr.rig_metrics()
 }
 
 /// Gates every pair of one scenario. A solver error, or a pair without a tolerance in the
@@ -429,7 +435,7 @@ mod tests {
     use rotor_model::{DiscMode, Mode, State};
 
     /// A trajectory with samples every 0.01 s on [0, 1] and the given metrics.
-    fn traj(metrics: Option<SteadyState>) -> Trajectory {
+    fn traj(metrics: Option<RigSteady>) -> Trajectory {
         let samples = (0..=100)
             .map(|k| {
                 let t = k as f64 * 0.01;
@@ -445,12 +451,12 @@ mod tests {
             t_final: 1.0,
             x_final: (State::zeros()).as_slice().to_vec(),
             mode_final: Mode::rig(DiscMode::SlipPos, DiscMode::SlipPos),
-            metrics,
+            metrics: metrics.map(Into::into),
             stats: Stats::default(),
         }
     }
 
-    const EQ: SteadyState = SteadyState::Equilibrium {
+    const EQ: RigSteady = RigSteady::Equilibrium {
         omega_u: 1.0,
         omega_l: 1.0,
         alpha: 0.1,
@@ -493,7 +499,7 @@ mod tests {
         );
     }
 
-    const CYCLE: SteadyState = SteadyState::LimitCycle {
+    const CYCLE: RigSteady = RigSteady::LimitCycle {
         period: 4.5,
         omega_l_max: 6.3,
         omega_l_min: 0.0,
@@ -523,12 +529,12 @@ mod tests {
                 .failures("s")
                 .is_empty()
         );
-        type Shift = fn(&mut SteadyState, f64);
+        type Shift = fn(&mut RigSteady, f64);
         let shifts: [(&str, Shift, f64); 6] = [
             (
                 "period",
                 |m, f| {
-                    if let SteadyState::LimitCycle { period, .. } = m {
+                    if let RigSteady::LimitCycle { period, .. } = m {
                         *period *= 1.0 + f
                     }
                 },
@@ -537,7 +543,7 @@ mod tests {
             (
                 "omega_l_max",
                 |m, f| {
-                    if let SteadyState::LimitCycle { omega_l_max, .. } = m {
+                    if let RigSteady::LimitCycle { omega_l_max, .. } = m {
                         *omega_l_max *= 1.0 + f
                     }
                 },
@@ -546,7 +552,7 @@ mod tests {
             (
                 "omega_l_min",
                 |m, f| {
-                    if let SteadyState::LimitCycle { omega_l_min, .. } = m {
+                    if let RigSteady::LimitCycle { omega_l_min, .. } = m {
                         *omega_l_min += f
                     }
                 },
@@ -555,7 +561,7 @@ mod tests {
             (
                 "omega_u_max",
                 |m, f| {
-                    if let SteadyState::LimitCycle { omega_u_max, .. } = m {
+                    if let RigSteady::LimitCycle { omega_u_max, .. } = m {
                         *omega_u_max *= 1.0 + f
                     }
                 },
@@ -565,7 +571,7 @@ mod tests {
             (
                 "omega_u_min",
                 |m, f| {
-                    if let SteadyState::LimitCycle { omega_u_min, .. } = m {
+                    if let RigSteady::LimitCycle { omega_u_min, .. } = m {
                         *omega_u_min *= 1.0 + f
                     }
                 },
@@ -574,7 +580,7 @@ mod tests {
             (
                 "stick_time",
                 |m, f| {
-                    if let SteadyState::LimitCycle { stick_time, .. } = m {
+                    if let RigSteady::LimitCycle { stick_time, .. } = m {
                         *stick_time += f
                     }
                 },
@@ -584,7 +590,9 @@ mod tests {
         for (name, shift, gate) in shifts {
             for (factor, fails) in [(2.0, true), (0.5, false)] {
                 let mut b = a.clone();
-                shift(b.metrics.as_mut().unwrap(), factor * gate);
+                let mut m = b.rig_metrics().unwrap();
+                shift(&mut m, factor * gate);
+                b.metrics = Some(m.into());
                 let f = check_pair("p", &a, &b, None, &tol, 0.0).failures("s");
                 // ω_l's minimum is gated absolutely (rad/s) by its own 3e-9, not through
                 // the relative gates' floor: 6e-9 fails and 1.5e-9 passes.
@@ -620,7 +628,7 @@ mod tests {
             ..PairTolerance::default()
         };
         let eq = |w_u: f64, w_l: f64| {
-            traj(Some(SteadyState::Equilibrium {
+            traj(Some(RigSteady::Equilibrium {
                 omega_u: w_u,
                 omega_l: w_l,
                 alpha: -0.08,

@@ -149,7 +149,7 @@ pub fn margins(r: &ScenarioResult) -> Vec<Margin> {
             continue;
         };
         let band = stuck_band(a, b);
-        let metrics = |k| r.traj(k).and_then(|t| t.metrics).map(|m| m.values());
+        let metrics = |k| r.traj(k).and_then(|t| t.rig_metrics()).map(|m| m.values());
         let (ma, mb) = (metrics(a), metrics(b));
         for m in &g.measured {
             let quantity = STEADY_QUANTITIES.iter().find(|q| Some(q.key) == m.key);

@@ -5,7 +5,7 @@ use std::io::Write as _;
 use std::path::Path;
 
 use rotor_model::scenario::Scenario;
-use rotor_model::seam::SteadyState;
+use rotor_model::seam::RigSteady;
 use rotor_model::{Disc, Friction, Model, Params, Rounding, round_sig};
 
 use crate::compare::gate::{Failure, GateResult, gate_scenario};
@@ -300,15 +300,15 @@ fn friction_panels<'a>(sets: &[(&'a str, Params)]) -> Vec<Panel<'a>> {
     panels
 }
 
-fn fmt_metrics(st: &Option<SteadyState>) -> String {
+fn fmt_metrics(st: &Option<RigSteady>) -> String {
     match st {
         None => "—".into(),
-        Some(SteadyState::Equilibrium {
+        Some(RigSteady::Equilibrium {
             omega_u, omega_l, ..
         }) => {
             format!("equilibrium ω_u = {omega_u:.6}, ω_l = {omega_l:.6}")
         }
-        Some(SteadyState::LimitCycle {
+        Some(RigSteady::LimitCycle {
             period,
             omega_l_max,
             omega_l_min,
@@ -447,7 +447,7 @@ pub fn write_report(
     for r in results {
         for run in &r.runs {
             let (st, stats) = match &run.result {
-                Ok(t) => (fmt_metrics(&t.metrics), t.stats),
+                Ok(t) => (fmt_metrics(&t.rig_metrics()), t.stats),
                 Err(e) => (format!("**error: {e}**"), Default::default()),
             };
             let _ = writeln!(

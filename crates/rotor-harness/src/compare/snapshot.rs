@@ -24,7 +24,7 @@
 
 use std::collections::BTreeMap;
 
-use rotor_model::seam::{Stats, SteadyState};
+use rotor_model::seam::{RigSteady, Stats};
 use rotor_model::{Rounding, round_sig};
 use serde::Serialize;
 
@@ -162,7 +162,7 @@ pub fn snapshot(r: &ScenarioResult) -> ScenarioSnapshot {
                 Ok(t) => {
                     let mut metrics = BTreeMap::new();
                     let mut digits = BTreeMap::new();
-                    for (name, v) in t.metrics.map(|m| m.values()).unwrap_or_default() {
+                    for (name, v) in t.rig_metrics().map(|m| m.values()).unwrap_or_default() {
                         let tightest = tols
                             .iter()
                             .filter_map(|p| p.for_metric(name).and_then(|(_, t)| t))
@@ -182,12 +182,15 @@ pub fn snapshot(r: &ScenarioResult) -> ScenarioSnapshot {
                     }
                     SolverSnapshot {
                         solver: run.kind.name(),
-                        steady: t.metrics.map_or("none", |m| m.kind().as_str()).to_owned(),
+                        steady: t
+                            .rig_metrics()
+                            .map_or("none", |m| m.kind().as_str())
+                            .to_owned(),
                         metrics,
                         digits,
                         counters: Counters::new(
                             t.stats,
-                            matches!(t.metrics, Some(SteadyState::Equilibrium { .. })),
+                            matches!(t.rig_metrics(), Some(RigSteady::Equilibrium { .. })),
                         ),
                         error: None,
                     }

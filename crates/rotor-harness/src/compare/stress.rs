@@ -28,7 +28,7 @@ use std::time::Instant;
 
 use nalgebra::{Matrix4, Vector4};
 use rotor_model::seam::{
-    Accuracy, Event, EventKind, Output, Scene, SolveError, Stats, SteadyState, Trajectory,
+    Accuracy, Event, EventKind, Output, RigSteady, Scene, SolveError, Stats, Trajectory,
 };
 use rotor_model::{Disc, LowerFriction, Model, OMEGA_L, Params, State, UpperFriction};
 
@@ -445,8 +445,8 @@ fn periods(events: &[Event], from: f64) -> Vec<(f64, usize)> {
 }
 
 fn period_of(tr: &Trajectory) -> Option<f64> {
-    match tr.metrics {
-        Some(SteadyState::LimitCycle { period, .. }) => Some(period),
+    match tr.rig_metrics() {
+        Some(RigSteady::LimitCycle { period, .. }) => Some(period),
         _ => None,
     }
 }

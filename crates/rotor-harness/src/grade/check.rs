@@ -52,7 +52,7 @@ use std::path::PathBuf;
 
 use rotor_model::Disc;
 use rotor_model::scenario::Scenario;
-use rotor_model::seam::{Event, EventKind, Sample, SteadyState};
+use rotor_model::seam::{Event, EventKind, RigSteady, Sample};
 use serde::{Serialize, Serializer};
 
 use crate::grade::gridmetrics::{StickExit, grid_metrics_at};
@@ -466,7 +466,7 @@ pub fn state_scales(reference: &[Sample]) -> [f64; 3] {
 /// transient to an equilibrium has no period to measure event times against).
 pub fn time_scale(reference: &Reference) -> f64 {
     match reference.steady() {
-        Some(SteadyState::LimitCycle { period, .. }) => period,
+        Some(RigSteady::LimitCycle { period, .. }) => period,
         _ => 1.0,
     }
 }
@@ -824,8 +824,8 @@ fn grade_steady(
     }
     q.push(graded("steady_kind", 0.0, 1.0, level));
     let period = match r {
-        SteadyState::LimitCycle { period, .. } => period,
-        SteadyState::Equilibrium { .. } => 1.0,
+        RigSteady::LimitCycle { period, .. } => period,
+        RigSteady::Equilibrium { .. } => 1.0,
     };
     for ((name, va), (_, vr)) in a.values().into_iter().zip(r.values()) {
         let s = match name {
@@ -869,12 +869,12 @@ fn grade_steady(
 pub fn orbit_distance(
     sc: &Scenario,
     reference: &Reference,
-    cycle: SteadyState,
+    cycle: RigSteady,
     trace: &[Sample],
     from: f64,
     scale: [f64; 3],
 ) -> Option<Result<(f64, f64), rotor_model::seam::SolveError>> {
-    let SteadyState::LimitCycle { period, .. } = reference.steady().unwrap_or(cycle) else {
+    let RigSteady::LimitCycle { period, .. } = reference.steady().unwrap_or(cycle) else {
         return None;
     };
     let window = &trace[trace.partition_point(|s| s.t < from - TIME_TOL)..];

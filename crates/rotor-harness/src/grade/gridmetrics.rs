@@ -37,7 +37,7 @@
 //! steps fall, so another choice of anchor reads another period.
 
 use rotor_model::seam::steady::EQUILIBRIUM_AMPLITUDE;
-use rotor_model::seam::{Sample, SteadyState};
+use rotor_model::seam::{RigSteady, Sample};
 use rotor_model::{Disc, DiscMode, Model, OMEGA_L, OMEGA_U, State};
 
 /// |ω_l| at or below which [`grid_metrics`] counts a sample as stuck [rad/s]: an event-driven
@@ -73,7 +73,7 @@ pub fn grid_metrics(
     samples: &[Sample],
     from: f64,
     exit: StickExit,
-) -> Result<SteadyState, GridMetricsError> {
+) -> Result<RigSteady, GridMetricsError> {
     grid_metrics_at(samples, from, exit, STUCK)
 }
 
@@ -83,11 +83,11 @@ pub fn grid_metrics_at(
     from: f64,
     exit: StickExit,
     stuck: f64,
-) -> Result<SteadyState, GridMetricsError> {
+) -> Result<RigSteady, GridMetricsError> {
     let start = samples.partition_point(|s| s.t < from - 1e-9);
     let w = &samples[start..];
     let last = w.last().ok_or(GridMetricsError::Empty { from })?;
-    let equilibrium = SteadyState::Equilibrium {
+    let equilibrium = RigSteady::Equilibrium {
         omega_u: last.x[OMEGA_U],
         omega_l: last.x[OMEGA_L],
         alpha: last.x[0],
@@ -132,7 +132,7 @@ pub fn grid_metrics_at(
         .map(|(on, e)| e - on.max(ta))
         .sum::<f64>()
         + 0.0;
-    Ok(SteadyState::LimitCycle {
+    Ok(RigSteady::LimitCycle {
         period: tb - ta,
         omega_l_max: wl_max,
         omega_l_min: wl_min,
@@ -344,7 +344,7 @@ mod tests {
             StickExit { model: &m, u },
         )
         .unwrap();
-        let exact = tr.metrics.unwrap();
+        let exact = tr.rig_metrics().unwrap();
         assert_eq!(g.kind(), exact.kind(), "{g:?} vs {exact:?}");
         g.values()
             .into_iter()
@@ -375,13 +375,13 @@ mod tests {
         let m = Model::table1();
         assert!(matches!(
             grid_metrics(&flat, 0.0, exit(&m)),
-            Ok(SteadyState::Equilibrium { .. })
+            Ok(RigSteady::Equilibrium { .. })
         ));
         // A monotone approach has no complete cycle: an equilibrium (its last state).
         let rise: Vec<Sample> = (0..100).map(|k| sample(k as f64, k as f64)).collect();
         assert!(matches!(
             grid_metrics(&rise, 0.0, exit(&m)),
-            Ok(SteadyState::Equilibrium { omega_l: 99.0, .. })
+            Ok(RigSteady::Equilibrium { omega_l: 99.0, .. })
         ));
         assert!(matches!(
             grid_metrics(&rise, 1000.0, exit(&m)),

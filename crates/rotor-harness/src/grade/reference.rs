@@ -28,7 +28,7 @@ use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
 use rotor_model::scenario::Scenario;
-use rotor_model::seam::{Accuracy, Event, Output, Sample, Samples, Scene, SolveError, SteadyState};
+use rotor_model::seam::{Accuracy, Event, Output, RigSteady, Sample, Samples, Scene, SolveError};
 use rotor_model::{Rounding, round_sig};
 use serde::{Deserialize, Serialize};
 
@@ -86,7 +86,7 @@ pub struct ReferenceJson {
     /// The steady state as `rotor steady` prints it (`kind` and its metrics), over the
     /// scenario's `[steady_from, t_end]`; absent when the scenario compares no steady state.
     #[serde(flatten)]
-    pub steady: Option<SteadyState>,
+    pub steady: Option<RigSteady>,
     /// How the reference was computed.
     pub solver: String,
     /// The solver's tolerance ([`REFERENCE_TOL`] for the stored reference).
@@ -174,7 +174,7 @@ impl Reference {
             events: switches(&tr.events),
             json: ReferenceJson {
                 scenario: sc.name.clone(),
-                steady: sc.compare.steady_from.and(tr.metrics),
+                steady: sc.compare.steady_from.and(tr.rig_metrics()),
                 solver: "event".into(),
                 tol,
                 dt: sc.compare.dt,
@@ -195,7 +195,7 @@ impl Reference {
     }
 
     /// The steady state, if the scenario compares one.
-    pub fn steady(&self) -> Option<SteadyState> {
+    pub fn steady(&self) -> Option<RigSteady> {
         self.json.steady
     }
 }
@@ -265,7 +265,7 @@ fn differences(
         "event_time".into(),
         event_difference(&switches(&r.events), &switches(&reference.events)),
     );
-    if let (Some(a), Some(b)) = (r.metrics, reference.metrics) {
+    if let (Some(a), Some(b)) = (r.rig_metrics(), reference.rig_metrics()) {
         if a.kind() == b.kind() {
             for ((name, va), (_, vb)) in a.values().into_iter().zip(b.values()) {
                 // An equilibrium's `alpha`, `omega_u`, `omega_l` share their names with the
@@ -339,7 +339,7 @@ fn compute_at(sc: &Scenario, tol: f64, check_tol: f64) -> Result<Reference, Refe
             // quantity's own size (a period of 4 s from exits near 200 s carries ulp(200 s)).
             None if matches!(name, "event_time" | "period" | "stick_time") => sc.t_end,
             None => r
-                .metrics
+                .rig_metrics()
                 .map(|m| {
                     m.values()
                         .into_iter()
@@ -406,7 +406,7 @@ fn compute_at(sc: &Scenario, tol: f64, check_tol: f64) -> Result<Reference, Refe
     }
     // Metrics to the digits their error justifies (as the trace), errors and differences to
     // two: the file changes only when a result does, not with the last bits of a machine.
-    let steady = sc.compare.steady_from.and(r.metrics).map(|m| {
+    let steady = sc.compare.steady_from.and(r.rig_metrics()).map(|m| {
         let rounded = |name: &str, v: f64| {
             let e = error.get(name).copied().unwrap_or(0.0);
             let d = if v == 0.0 || e == 0.0 {
@@ -456,7 +456,7 @@ fn compute_at(sc: &Scenario, tol: f64, check_tol: f64) -> Result<Reference, Refe
     // The orbit: what `rotor check` charges the tighter run (nearly exact) in `orbit` is
     // what it charges an exact trace, up to the tighter run's own error: the error of this
     // reference's orbit quantity, stated as the others are.
-    if let (Some(from), Some(SteadyState::LimitCycle { .. })) = (sc.compare.steady_from, steady) {
+    if let (Some(from), Some(RigSteady::LimitCycle { .. })) = (sc.compare.steady_from, steady) {
         let partial = Reference {
             samples: samples.clone(),
             events: switches(&r.events),

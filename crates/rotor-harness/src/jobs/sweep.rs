@@ -17,7 +17,7 @@ use std::io::{BufRead, Read, Write};
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
 
-use rotor_model::seam::{Attractor, Output, Scene, SteadyState};
+use rotor_model::seam::{Attractor, Output, RigSteady, Scene};
 use rotor_model::{FieldError, Model, Params, State};
 
 use rotor_analysis::solvers::registry::SolverKind;
@@ -278,12 +278,12 @@ impl Sweep {
         };
         let f = |v: f64| zmij::Buffer::new().format(v).to_owned();
         let metrics = self.solver.solver().simulate_finite(&model, &scene);
-        match metrics.ok().and_then(|tr| tr.metrics) {
+        match metrics.ok().and_then(|tr| tr.rig_metrics()) {
             Some(m) => {
                 s.push(',');
                 s.push_str(kind_word(Attractor::of(&m)));
                 match m {
-                    SteadyState::LimitCycle {
+                    RigSteady::LimitCycle {
                         period,
                         omega_l_max,
                         omega_l_min,
@@ -296,7 +296,7 @@ impl Sweep {
                         f(omega_l_min),
                         f(stick_time)
                     )),
-                    SteadyState::Equilibrium { .. } => s.push_str(",,,,"),
+                    RigSteady::Equilibrium { .. } => s.push_str(",,,,"),
                 }
             }
             None => s.push_str(",failed,,,,"),

@@ -603,8 +603,8 @@ mod tests {
     /// Every metric of both kinds of steady state has exactly one key, and no key gates two.
     #[test]
     fn one_key_per_steady_metric() {
-        use crate::seam::SteadyState;
-        let cycle = SteadyState::LimitCycle {
+        use crate::seam::RigSteady;
+        let cycle = RigSteady::LimitCycle {
             period: 1.0,
             omega_l_max: 1.0,
             omega_l_min: 0.0,
@@ -612,7 +612,7 @@ mod tests {
             omega_u_min: 1.0,
             stick_time: 0.0,
         };
-        let eq = SteadyState::Equilibrium {
+        let eq = RigSteady::Equilibrium {
             omega_u: 1.0,
             omega_l: 1.0,
             alpha: 0.1,

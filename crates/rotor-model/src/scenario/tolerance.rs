@@ -181,7 +181,7 @@ pub const EQUILIBRIUM_KEYS: [&str; 3] = [
 ];
 
 /// The steady-state quantities a [`PairTolerance`] gates, one key per metric of
-/// [`crate::seam::SteadyState::values`]: its key in the file, the metric, and whether the
+/// [`crate::seam::RigSteady::values`]: its key in the file, the metric, and whether the
 /// tolerance is relative.
 pub const STEADY_QUANTITIES: [SteadyQuantity; 9] = [
     SteadyQuantity::relative("period_rel", "period"),
@@ -208,7 +208,7 @@ pub const STEADY_QUANTITIES: [SteadyQuantity; 9] = [
 pub struct SteadyQuantity {
     /// The key in a `[tolerance.<pair>]` table (`period_rel`, `stick_time`, ...).
     pub key: &'static str,
-    /// The [`crate::seam::SteadyState`] metric it gates (`period`, `stick_time`, ...).
+    /// The [`crate::seam::RigSteady`] metric it gates (`period`, `stick_time`, ...).
     pub metric: &'static str,
     /// Whether the tolerance is relative to the metric (with `steady_abs` as its floor);
     /// otherwise it is absolute, in the metric's unit.
@@ -283,7 +283,7 @@ impl PairTolerance {
             .collect()
     }
 
-    /// The steady-state quantity gating a metric of [`crate::seam::SteadyState::values`], and its
+    /// The steady-state quantity gating a metric of [`crate::seam::RigSteady::values`], and its
     /// tolerance if stated.
     pub fn for_metric(&self, metric: &str) -> Option<(SteadyQuantity, Option<f64>)> {
         STEADY_QUANTITIES

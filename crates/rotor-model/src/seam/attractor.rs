@@ -1,7 +1,7 @@
 //! What a run settles on, named once for every user: the plane's regions, the sweep's rows
 //! and the steady-state probes.
 
-use crate::seam::steady::{SteadyKind, SteadyState};
+use crate::seam::steady::{RigSteady, SteadyKind};
 
 /// The attractor a run reaches, told apart by its steady-state metrics: both discs at rest,
 /// a slipping equilibrium, or a cycle with or without a stick phase of the lower disc.
@@ -11,7 +11,7 @@ use crate::seam::steady::{SteadyKind, SteadyState};
 /// `failed` in a sweep's rows).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub enum Attractor {
-    /// Both discs at rest: an equilibrium with ω_l = 0 exactly ([`SteadyState::is_stuck`]).
+    /// Both discs at rest: an equilibrium with ω_l = 0 exactly ([`RigSteady::is_stuck`]).
     Stuck,
     /// A slipping equilibrium.
     Equilibrium,
@@ -23,14 +23,14 @@ pub enum Attractor {
 
 impl Attractor {
     /// The attractor whose steady-state metrics are `st`.
-    pub fn of(st: &SteadyState) -> Attractor {
+    pub fn of(st: &RigSteady) -> Attractor {
         match *st {
             _ if st.is_stuck() => Attractor::Stuck,
-            SteadyState::Equilibrium { .. } => Attractor::Equilibrium,
-            SteadyState::LimitCycle { stick_time, .. } if stick_time > 0.0 => {
+            RigSteady::Equilibrium { .. } => Attractor::Equilibrium,
+            RigSteady::LimitCycle { stick_time, .. } if stick_time > 0.0 => {
                 Attractor::StickSlipCycle
             }
-            SteadyState::LimitCycle { .. } => Attractor::SlippingCycle,
+            RigSteady::LimitCycle { .. } => Attractor::SlippingCycle,
         }
     }
 
@@ -69,12 +69,12 @@ mod tests {
     /// viscous upper disc does); a cycle is stick-slip when it sticks at all.
     #[test]
     fn metrics_name_their_attractor() {
-        let eq = |omega_u: f64, omega_l: f64| SteadyState::Equilibrium {
+        let eq = |omega_u: f64, omega_l: f64| RigSteady::Equilibrium {
             omega_u,
             omega_l,
             alpha: 0.1,
         };
-        let cycle = |stick_time: f64| SteadyState::LimitCycle {
+        let cycle = |stick_time: f64| RigSteady::LimitCycle {
             period: 4.5,
             omega_l_max: 2.0,
             omega_l_min: 0.0,

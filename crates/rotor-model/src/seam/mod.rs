@@ -1,5 +1,5 @@
 //! The solver seam: what every solver of the two-disc rotor is asked ([`Scene`]), what it
-//! returns ([`Trajectory`]: samples, [`Event`]s, counters, [`SteadyState`] metrics), and the
+//! returns ([`Trajectory`]: samples, [`Event`]s, counters, [`RigSteady`] metrics), and the
 //! output contract written once for all of them ([`Recorder`], driven through a solver's
 //! [`Integration`]).
 //!
@@ -28,4 +28,4 @@ pub use scene::{
     Accuracy, Output, OutputGrid, Sample, Scene, SolveError, Solver, Stats, Trajectory,
     check_finite,
 };
-pub use steady::{MetricsAccumulator, SteadyKind, SteadyState};
+pub use steady::{MetricsAccumulator, RigSteady, SteadyKind, SteadyState};

@@ -188,7 +188,7 @@ impl Recorder {
     /// use rotor_model::{Disc, DiscMode, Mode, State};
     /// use rotor_model::seam::{
     ///     Event, EventKind, EventRef, Integration, Output, Recorder, Scene, SolveError, Stats,
-    ///     SteadyState,
+    ///     RigSteady,
     /// };
     ///
     /// /// ω_l = 2 + tri(t), tri of period 4 between −1 and 1: maxima at t = 1 + 4k.
@@ -248,9 +248,9 @@ impl Recorder {
     ///
     /// assert_eq!(tr.t_final, 100.0);
     /// assert!(tr.stats.skipped_periods > 0, "whole periods were skipped, not integrated");
-    /// let Some(SteadyState::LimitCycle { period, omega_l_max, omega_l_min, .. }) = tr.metrics
+    /// let Some(RigSteady::LimitCycle { period, omega_l_max, omega_l_min, .. }) = tr.rig_metrics()
     /// else {
-    ///     panic!("a cycle: {:?}", tr.metrics)
+    ///     panic!("a cycle: {:?}", tr.rig_metrics())
     /// };
     /// assert_eq!((period, omega_l_max, omega_l_min), (4.0, 3.0, 1.0));
     /// # Ok::<(), SolveError>(())
@@ -307,7 +307,7 @@ impl Recorder {
                 3,
                 "the steady-state metrics read the rig's state"
             );
-            m.finish(&State::from_column_slice(x_final))
+            m.finish(&State::from_column_slice(x_final)).into()
         });
         Trajectory {
             samples: self.samples,
@@ -331,7 +331,7 @@ impl Recorder {
 mod tests {
     use super::*;
     use crate::seam::event::EventKind;
-    use crate::seam::steady::SteadyState;
+    use crate::seam::steady::RigSteady;
     use crate::{Disc, DiscMode};
 
     /// A triangle wave of period 4 and amplitude 1 (exact in binary arithmetic).
@@ -496,8 +496,8 @@ mod tests {
     fn metrics_are_those_of_the_last_cycle() {
         let (tr, _) = run(Output::Events, 0.0, 3.0);
         assert_eq!(
-            tr.metrics,
-            Some(SteadyState::LimitCycle {
+            tr.rig_metrics(),
+            Some(RigSteady::LimitCycle {
                 period: 4.0,
                 omega_l_max: 3.0,
                 omega_l_min: 1.0,
@@ -515,7 +515,7 @@ mod tests {
     fn metrics_only_skips_converged_periods() {
         let (full, full_steps) = run(Output::Final, 0.0, 3.0);
         let (fast, steps) = run(Output::Metrics, 0.0, 3.0);
-        assert_eq!(fast.metrics, full.metrics);
+        assert_eq!(fast.rig_metrics(), full.rig_metrics());
         assert_eq!(
             (fast.stats.skipped_periods, fast.stats.undone_skips),
             (20, 0)
@@ -535,7 +535,7 @@ mod tests {
     fn an_unconfirmed_jump_is_undone() {
         let (full, full_steps) = run(Output::Final, 0.0, 3.0);
         let (undone, steps) = run(Output::Metrics, 1e-3, 3.0);
-        assert_eq!(undone.metrics, full.metrics);
+        assert_eq!(undone.rig_metrics(), full.rig_metrics());
         assert_eq!(undone.stats.skipped_periods, 0);
         assert_eq!(
             undone.stats.undone_skips,

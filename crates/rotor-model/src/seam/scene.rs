@@ -6,7 +6,7 @@ use thiserror::Error;
 use crate::FieldError;
 use crate::seam::event::Event;
 use crate::seam::input::{Input, Piece};
-use crate::seam::steady::SteadyState;
+use crate::seam::steady::{RigSteady, SteadyState};
 use crate::{Mode, Model, State};
 
 /// What a solver keeps while it runs. Every level keeps the final state and the counters.
@@ -468,7 +468,8 @@ pub struct Trajectory {
     pub x_final: Vec<f64>,
     /// Final mode.
     pub mode_final: Mode,
-    /// Steady-state metrics, if the scene asked for them.
+    /// Steady-state metrics, if the scene asked for them: per-disc lists
+    /// ([`Trajectory::rig_metrics`] is the rig's view).
     pub metrics: Option<SteadyState>,
     /// Work counters.
     pub stats: Stats,
@@ -479,6 +480,12 @@ impl Trajectory {
     /// another model's size).
     pub fn final_state(&self) -> Result<State, SolveError> {
         rig_state("x_final", &self.x_final)
+    }
+
+    /// The steady-state metrics by the rig's names ([`SteadyState::rig`]): `None` where none
+    /// were asked, or for a run of another size.
+    pub fn rig_metrics(&self) -> Option<RigSteady> {
+        self.metrics.as_ref().and_then(SteadyState::rig)
     }
 
     /// Checks the samples, the events, the final state and the metrics for NaN or ∞: a run
@@ -496,8 +503,8 @@ impl Trajectory {
         if !ok(self.t_final, &self.x_final) {
             return bad(self.t_final, "final state");
         }
-        if let Some(m) = self.metrics
-            && m.values().iter().any(|(_, v)| !v.is_finite())
+        if let Some(m) = &self.metrics
+            && !m.is_finite()
         {
             return bad(self.t_final, "steady-state metrics");
         }
@@ -654,7 +661,7 @@ pub fn check_finite(t: f64, x: &State) -> Result<(), SolveError> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::seam::{EventKind, SteadyState};
+    use crate::seam::{EventKind, RigSteady};
     use crate::{Disc, DiscMode};
 
     #[test]
@@ -670,11 +677,14 @@ mod tests {
             t_final: 1.0,
             x_final: x.as_slice().to_vec(),
             mode_final: Mode::rig(DiscMode::SlipPos, DiscMode::Stick),
-            metrics: Some(SteadyState::Equilibrium {
-                omega_u: 2.0,
-                omega_l: 3.0,
-                alpha: 0.1,
-            }),
+            metrics: Some(
+                RigSteady::Equilibrium {
+                    omega_u: 2.0,
+                    omega_l: 3.0,
+                    alpha: 0.1,
+                }
+                .into(),
+            ),
             stats: Stats::default(),
         };
         assert_eq!(good.check_finite(), Ok(()));
@@ -690,11 +700,14 @@ mod tests {
             (|t| t.x_final[1] = f64::NAN, 1.0, "final state"),
             (
                 |t| {
-                    t.metrics = Some(SteadyState::Equilibrium {
-                        omega_u: 2.0,
-                        omega_l: f64::NAN,
-                        alpha: 0.1,
-                    })
+                    t.metrics = Some(
+                        RigSteady::Equilibrium {
+                            omega_u: 2.0,
+                            omega_l: f64::NAN,
+                            alpha: 0.1,
+                        }
+                        .into(),
+                    )
                 },
                 1.0,
                 "steady-state metrics",

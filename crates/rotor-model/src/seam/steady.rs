@@ -10,11 +10,149 @@ use serde::{Deserialize, Serialize};
 use crate::seam::event::{Event, EventKind, EventRef};
 use crate::{Disc, OMEGA_L, OMEGA_U, State};
 
-/// The steady state as `rotor steady` prints it (docs/design.md, "The CLI"), and as the
-/// reference data stores and reads it back.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+/// A steady state of a chain of discs, as per-disc lists (disc order: 0 is the driven
+/// disc at the top).
+///
+/// What a run measures of its steady state ([`crate::seam::Trajectory::metrics`]). Its JSON is
+/// the chain's (`"omega_max": [..]`); the rig's two discs read it through [`RigSteady`], their
+/// named fields, which is what `rotor steady` prints and the reference data stores for the
+/// rig. A stick time is per disc and optional: the rig's data measure the lower disc's only,
+/// and a list keeps what was measured, never a number that was not.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(tag = "kind", rename_all = "snake_case")]
 pub enum SteadyState {
+    /// A rest point: every twist `α_i` (N − 1, rad) and velocity `ω_i` (N, rad/s).
+    Equilibrium {
+        /// The springs' twists α_i = θ_i − θ_{i+1} \[rad\].
+        alpha: Vec<f64>,
+        /// The discs' velocities [rad/s] (a stuck disc's exactly 0).
+        omega: Vec<f64>,
+    },
+    /// A periodic orbit: its period and, per disc, the extremes of ω and the time stuck per
+    /// period.
+    LimitCycle {
+        /// Period \[s\].
+        period: f64,
+        /// Largest ω_i over the cycle [rad/s].
+        omega_max: Vec<f64>,
+        /// Smallest ω_i over the cycle [rad/s].
+        omega_min: Vec<f64>,
+        /// Time disc i spends stuck per period \[s\], where it was measured.
+        stick_time: Vec<Option<f64>>,
+    },
+}
+
+impl SteadyState {
+    /// An equilibrium or a limit cycle.
+    pub fn kind(&self) -> SteadyKind {
+        match self {
+            SteadyState::Equilibrium { .. } => SteadyKind::Equilibrium,
+            SteadyState::LimitCycle { .. } => SteadyKind::LimitCycle,
+        }
+    }
+
+    /// Whether every number is finite (a stick time not measured counts as finite).
+    pub fn is_finite(&self) -> bool {
+        match self {
+            SteadyState::Equilibrium { alpha, omega } => {
+                alpha.iter().chain(omega).all(|v| v.is_finite())
+            }
+            SteadyState::LimitCycle {
+                period,
+                omega_max,
+                omega_min,
+                stick_time,
+            } => {
+                period.is_finite()
+                    && omega_max.iter().chain(omega_min).all(|v| v.is_finite())
+                    && stick_time.iter().flatten().all(|v| v.is_finite())
+            }
+        }
+    }
+
+    /// The number of discs.
+    pub fn discs(&self) -> usize {
+        match self {
+            SteadyState::Equilibrium { omega, .. } => omega.len(),
+            SteadyState::LimitCycle { omega_max, .. } => omega_max.len(),
+        }
+    }
+
+    /// The rig's view: its two discs' named fields, for a steady state of two discs (with
+    /// the lower disc's stick time measured, for a cycle); `None` for any other.
+    pub fn rig(&self) -> Option<RigSteady> {
+        match self {
+            SteadyState::Equilibrium { alpha, omega } => match (alpha.as_slice(), omega.as_slice())
+            {
+                (&[alpha], &[omega_u, omega_l]) => Some(RigSteady::Equilibrium {
+                    omega_u,
+                    omega_l,
+                    alpha,
+                }),
+                _ => None,
+            },
+            SteadyState::LimitCycle {
+                period,
+                omega_max,
+                omega_min,
+                stick_time,
+            } => match (
+                omega_max.as_slice(),
+                omega_min.as_slice(),
+                stick_time.as_slice(),
+            ) {
+                (&[omega_u_max, omega_l_max], &[omega_u_min, omega_l_min], &[_, Some(stick)]) => {
+                    Some(RigSteady::LimitCycle {
+                        period: *period,
+                        omega_l_max,
+                        omega_l_min,
+                        omega_u_max,
+                        omega_u_min,
+                        stick_time: stick,
+                    })
+                }
+                _ => None,
+            },
+        }
+    }
+}
+
+impl From<RigSteady> for SteadyState {
+    /// The rig's steady state as lists: the upper disc first, and a stick time for the
+    /// lower disc only (the rig's metrics measure no other).
+    fn from(r: RigSteady) -> SteadyState {
+        match r {
+            RigSteady::Equilibrium {
+                omega_u,
+                omega_l,
+                alpha,
+            } => SteadyState::Equilibrium {
+                alpha: vec![alpha],
+                omega: vec![omega_u, omega_l],
+            },
+            RigSteady::LimitCycle {
+                period,
+                omega_l_max,
+                omega_l_min,
+                omega_u_max,
+                omega_u_min,
+                stick_time,
+            } => SteadyState::LimitCycle {
+                period,
+                omega_max: vec![omega_u_max, omega_l_max],
+                omega_min: vec![omega_u_min, omega_l_min],
+                stick_time: vec![None, Some(stick_time)],
+            },
+        }
+    }
+}
+
+/// The steady state of the rig's two discs by name: a view of [`SteadyState`]'s lists
+/// ([`SteadyState::rig`]), as `rotor steady` prints it for the rig (docs/design.md, "The
+/// CLI"), and as the reference data stores and reads it back.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "kind", rename_all = "snake_case")]
+pub enum RigSteady {
     /// An equilibrium (rad, rad/s): a run's final state when read off a run
     /// ([`MetricsAccumulator::finish`]), or the solved equilibrium.
     Equilibrium {
@@ -43,9 +181,9 @@ pub enum SteadyState {
     },
 }
 
-impl SteadyState {
+impl RigSteady {
     /// The metrics as named values, in a fixed order (for comparisons and reports): the
-    /// order of [`SteadyState::map`]'s calls.
+    /// order of [`RigSteady::map`]'s calls.
     pub fn values(&self) -> Vec<(&'static str, f64)> {
         let mut out = Vec::with_capacity(6);
         self.map(|name, v| {
@@ -57,25 +195,25 @@ impl SteadyState {
 
     /// The same steady state with every metric `v` named `name` replaced by `f(name, v)`,
     /// called once per metric in the order of the fields.
-    pub fn map(self, mut f: impl FnMut(&'static str, f64) -> f64) -> SteadyState {
+    pub fn map(self, mut f: impl FnMut(&'static str, f64) -> f64) -> RigSteady {
         match self {
-            SteadyState::Equilibrium {
+            RigSteady::Equilibrium {
                 omega_u,
                 omega_l,
                 alpha,
-            } => SteadyState::Equilibrium {
+            } => RigSteady::Equilibrium {
                 omega_u: f("omega_u", omega_u),
                 omega_l: f("omega_l", omega_l),
                 alpha: f("alpha", alpha),
             },
-            SteadyState::LimitCycle {
+            RigSteady::LimitCycle {
                 period,
                 omega_l_max,
                 omega_l_min,
                 omega_u_max,
                 omega_u_min,
                 stick_time,
-            } => SteadyState::LimitCycle {
+            } => RigSteady::LimitCycle {
                 period: f("period", period),
                 omega_l_max: f("omega_l_max", omega_l_max),
                 omega_l_min: f("omega_l_min", omega_l_min),
@@ -92,14 +230,14 @@ impl SteadyState {
     /// disc with only viscous friction (Table 1) never sticks, and its velocity decays to the
     /// rounding of α (1e-16 rad/s after 1500 s, 1e-10 in a Moreau–Jean run), never to 0.
     pub fn is_stuck(&self) -> bool {
-        matches!(self, SteadyState::Equilibrium { omega_l, .. } if *omega_l == 0.0)
+        matches!(self, RigSteady::Equilibrium { omega_l, .. } if *omega_l == 0.0)
     }
 
     /// An equilibrium or a limit cycle.
     pub fn kind(&self) -> SteadyKind {
         match self {
-            SteadyState::Equilibrium { .. } => SteadyKind::Equilibrium,
-            SteadyState::LimitCycle { .. } => SteadyKind::LimitCycle,
+            RigSteady::Equilibrium { .. } => SteadyKind::Equilibrium,
+            RigSteady::LimitCycle { .. } => SteadyKind::LimitCycle,
         }
     }
 }
@@ -108,9 +246,9 @@ impl SteadyState {
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize)]
 #[serde(rename_all = "snake_case")]
 pub enum SteadyKind {
-    /// A rest point: [`SteadyState::Equilibrium`].
+    /// A rest point: [`RigSteady::Equilibrium`].
     Equilibrium,
-    /// A periodic orbit: [`SteadyState::LimitCycle`].
+    /// A periodic orbit: [`RigSteady::LimitCycle`].
     LimitCycle,
 }
 
@@ -278,9 +416,9 @@ impl MetricsAccumulator {
 
     /// The steady state after a run ending at `(t, x)`: the last complete cycle if the orbit
     /// still oscillates with amplitude above [`EQUILIBRIUM_AMPLITUDE`], else the final state.
-    pub fn finish(&self, x_final: &State) -> SteadyState {
+    pub fn finish(&self, x_final: &State) -> RigSteady {
         match self.stream().last[0] {
-            Some(c) if c.wl_max - c.wl_min > EQUILIBRIUM_AMPLITUDE => SteadyState::LimitCycle {
+            Some(c) if c.wl_max - c.wl_min > EQUILIBRIUM_AMPLITUDE => RigSteady::LimitCycle {
                 period: c.end - c.start,
                 omega_l_max: c.wl_max,
                 omega_l_min: c.wl_min,
@@ -288,7 +426,7 @@ impl MetricsAccumulator {
                 omega_u_min: c.wu_min,
                 stick_time: c.stick,
             },
-            _ => SteadyState::Equilibrium {
+            _ => RigSteady::Equilibrium {
                 omega_u: x_final[OMEGA_U],
                 omega_l: x_final[OMEGA_L],
                 alpha: x_final[0],
@@ -321,13 +459,71 @@ impl MetricsAccumulator {
 mod tests {
     use super::*;
 
+    #[test]
+    fn the_rig_view_of_the_lists_round_trips() {
+        let cycle = RigSteady::LimitCycle {
+            period: 5.0,
+            omega_l_max: 7.0,
+            omega_l_min: 0.0,
+            omega_u_max: 2.5,
+            omega_u_min: 2.0,
+            stick_time: 1.5,
+        };
+        let lists = SteadyState::from(cycle);
+        assert_eq!(
+            lists,
+            SteadyState::LimitCycle {
+                period: 5.0,
+                omega_max: vec![2.5, 7.0],
+                omega_min: vec![2.0, 0.0],
+                stick_time: vec![None, Some(1.5)],
+            }
+        );
+        assert_eq!(lists.rig(), Some(cycle));
+        let rest = RigSteady::Equilibrium {
+            omega_u: 1.0,
+            omega_l: 1.0,
+            alpha: 0.3,
+        };
+        assert_eq!(SteadyState::from(rest).rig(), Some(rest));
+        assert_eq!(SteadyState::from(rest).discs(), 2);
+        // Three discs, or a cycle whose lower stick time was not measured, have no rig view.
+        let chain = SteadyState::Equilibrium {
+            alpha: vec![0.1, 0.2],
+            omega: vec![1.0; 3],
+        };
+        assert_eq!((chain.rig(), chain.discs()), (None, 3));
+        let unmeasured = SteadyState::LimitCycle {
+            period: 5.0,
+            omega_max: vec![2.5, 7.0],
+            omega_min: vec![2.0, 0.0],
+            stick_time: vec![None, None],
+        };
+        assert_eq!(unmeasured.rig(), None);
+    }
+
+    #[test]
+    fn the_lists_print_as_the_chain_contract_names_them() {
+        let json = serde_json::to_string(&SteadyState::LimitCycle {
+            period: 5.0,
+            omega_max: vec![2.5, 7.0],
+            omega_min: vec![2.0, 0.0],
+            stick_time: vec![None, Some(1.5)],
+        })
+        .unwrap();
+        assert_eq!(
+            json,
+            r#"{"kind":"limit_cycle","period":5.0,"omega_max":[2.5,7.0],"omega_min":[2.0,0.0],"stick_time":[null,1.5]}"#
+        );
+    }
+
     fn ev(t: f64, x: [f64; 3], kind: EventKind) -> Event {
         Event::new(t, &x, kind)
     }
 
     #[test]
     fn values_name_every_field_once_in_field_order() {
-        let eq = SteadyState::Equilibrium {
+        let eq = RigSteady::Equilibrium {
             omega_u: 1.0,
             omega_l: 2.0,
             alpha: 3.0,
@@ -336,7 +532,7 @@ mod tests {
             eq.values(),
             [("omega_u", 1.0), ("omega_l", 2.0), ("alpha", 3.0)]
         );
-        let lc = SteadyState::LimitCycle {
+        let lc = RigSteady::LimitCycle {
             period: 1.0,
             omega_l_max: 2.0,
             omega_l_min: 3.0,
@@ -379,7 +575,7 @@ mod tests {
         for e in &evs {
             m.push(e);
         }
-        let SteadyState::LimitCycle {
+        let RigSteady::LimitCycle {
             period,
             omega_l_max,
             omega_l_min,
@@ -453,7 +649,7 @@ mod tests {
             let x = State::zeros();
             assert_eq!(skip.finish(&x), full.finish(&x), "t_from = {t_from}");
             assert!(
-                matches!(full.finish(&x), SteadyState::LimitCycle { period, stick_time, .. }
+                matches!(full.finish(&x), RigSteady::LimitCycle { period, stick_time, .. }
                 if period == 3.0 && stick_time == 0.5)
             );
         }
@@ -465,7 +661,7 @@ mod tests {
         let x = State::new(1.0, 2.0, 2.0);
         assert_eq!(
             m.finish(&x),
-            SteadyState::Equilibrium {
+            RigSteady::Equilibrium {
                 omega_u: 2.0,
                 omega_l: 2.0,
                 alpha: 1.0

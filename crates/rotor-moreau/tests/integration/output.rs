@@ -59,7 +59,7 @@ fn final_keeps_no_samples_and_no_events() {
         .unwrap();
     assert!(tr.samples.is_empty());
     assert!(tr.events.is_empty());
-    assert!(tr.metrics.is_some());
+    assert!(tr.rig_metrics().is_some());
     assert!(tr.stats.events > 0, "events are located for the metrics");
     assert_eq!(tr.t_final, 30.0);
 }

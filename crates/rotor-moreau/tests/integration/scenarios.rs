@@ -22,7 +22,7 @@ fn every_fixture_runs_at_h_1e3() {
             .unwrap_or_else(|e| panic!("{}: {e}", sc.name));
         assert_eq!(tr.t_final, sc.t_end);
         assert!(tr.x_final.iter().all(|v| v.is_finite()), "{}", sc.name);
-        let m = tr.metrics.expect("metrics asked");
+        let m = tr.rig_metrics().expect("metrics asked");
         assert!(m.values().iter().all(|(_, v)| v.is_finite()), "{}", sc.name);
         assert_eq!(tr.stats.steps, (sc.t_end / 1e-3).round() as u64);
         assert!(tr.samples.is_empty() && tr.events.is_empty());
