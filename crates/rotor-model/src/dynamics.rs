@@ -63,7 +63,16 @@ impl Disc {
 
     /// The disc at `position` (0 = the top). Positions beyond [`Mode::MAX_DISCS`] have no
     /// mode and are refused where a chain is read.
+    ///
+    /// # Panics
+    ///
+    /// If `position ≥` [`Mode::MAX_DISCS`]: a mode's bit for it would wrap onto another
+    /// disc's, so such a disc is a bug, never a value.
     pub const fn at(position: usize) -> Disc {
+        assert!(
+            position < Mode::MAX_DISCS,
+            "a disc's position is below Mode::MAX_DISCS"
+        );
         Disc(position as u16)
     }
 
@@ -438,6 +447,19 @@ impl Model {
 mod tests {
     use super::*;
     use approx::assert_relative_eq;
+
+    #[test]
+    fn the_last_disc_a_mode_holds_is_its_own() {
+        let last = Disc::at(Mode::MAX_DISCS - 1);
+        let m = Mode::uniform(Mode::MAX_DISCS, DiscMode::SlipPos).with(last, DiscMode::Stick);
+        assert!(m.is_stuck(last) && !m.is_stuck(Disc::UPPER));
+    }
+
+    #[test]
+    #[should_panic(expected = "below Mode::MAX_DISCS")]
+    fn a_disc_beyond_the_modes_is_a_bug() {
+        let _ = Disc::at(Mode::MAX_DISCS);
+    }
 
     fn models() -> Vec<Model> {
         let st = Params::from_toml_str(
