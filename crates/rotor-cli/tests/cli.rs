@@ -389,6 +389,17 @@ fn a_report_written_twice_is_the_same_bytes() {
         !readme.contains("[ms]"),
         "no run times in the committed report"
     );
+    // A report of scenes given speaks of those scenes only: it names them, and carries
+    // neither the suite's opening (what Table 1 does against the source's prose, the
+    // scenarios in fixtures/) nor the suite's version.
+    let opening = readme.split("\n## ").next().unwrap();
+    assert!(
+        opening.contains("`t1-u1.5-rest`, `st-u0.05-rest`"),
+        "{opening}"
+    );
+    for suite_text in ["Table 1", "fixtures/scenarios", "Suite: `"] {
+        assert!(!readme.contains(suite_text), "{suite_text}: {opening}");
+    }
     std::fs::remove_dir_all(&base).ok();
 }
 

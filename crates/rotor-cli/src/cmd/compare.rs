@@ -41,6 +41,12 @@ pub(crate) fn compare(
     main_job: bool,
     threads: Option<usize>,
 ) -> Result<()> {
+    // A report of the suite opens with what Table 1 does; one of scenes given, with those.
+    let scenes = if files.is_empty() {
+        rotor_harness::compare::report::Scenes::Suite
+    } else {
+        rotor_harness::compare::report::Scenes::Given
+    };
     let files = if files.is_empty() {
         let dir = fixtures_dir()?.join("scenarios");
         rotor_model::scenario::Scenario::list_dir(&dir)
@@ -77,7 +83,7 @@ pub(crate) fn compare(
     let compared = rotor_harness::report::run(&scenarios, &sets, main_job, &|| bar.inc(1))?;
     bar.finish_and_clear();
     let wall = t0.elapsed().as_secs_f64();
-    let fails = rotor_harness::report::write(report, &compared, stribeck)?;
+    let fails = rotor_harness::report::write(report, &compared, stribeck, scenes)?;
     let (results, sections) = (&compared.results, &compared.sections);
     out::line(format_args!(
         "{:<18} {:<7} {:<12} {:>10} {:>12} {:>9}",

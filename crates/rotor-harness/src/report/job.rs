@@ -105,22 +105,30 @@ pub fn run(
     })
 }
 
-/// Writes the report of `compared` to `dir` ([`crate::compare::report::write_report`], with
-/// the friction curves of Table 1 and of `stribeck`); returns the failed agreement gates.
+/// Writes the report of `compared`, a run of `scenes`, to `dir`
+/// ([`crate::compare::report::write_report`], with the friction curves of Table 1 and of
+/// `stribeck`); returns the failed agreement gates.
 pub fn write(
     dir: &Path,
     compared: &Compared,
     stribeck: Params,
+    scenes: crate::compare::report::Scenes,
 ) -> Result<Vec<crate::compare::Failure>, ReportError> {
     let params = [
         ("Table 1 (exponential)", Params::table1()),
         ("Stribeck set (unverified)", stribeck),
     ];
-    crate::compare::report::write_report(dir, &compared.results, &params, &compared.sections)
-        .map_err(|source| ReportError::Write {
-            dir: dir.to_owned(),
-            source,
-        })
+    crate::compare::report::write_report(
+        dir,
+        &compared.results,
+        &params,
+        &compared.sections,
+        scenes,
+    )
+    .map_err(|source| ReportError::Write {
+        dir: dir.to_owned(),
+        source,
+    })
 }
 
 #[cfg(test)]
