@@ -610,6 +610,21 @@ impl ChainModel {
         self.j[i]
     }
 
+    /// Motor constant `k_m` (the motor drives disc 0).
+    pub fn k_m(&self) -> f64 {
+        self.k_m
+    }
+
+    /// Stiffness `k_i` of the spring between disc `i` and `i + 1`.
+    pub fn spring(&self, i: usize) -> f64 {
+        self.k[i]
+    }
+
+    /// Viscous coupling `c_i` between disc `i` and `i + 1` (0 where there is none).
+    pub fn coupling(&self, i: usize) -> f64 {
+        self.c[i]
+    }
+
     /// Torque on disc `i` from everything but its own friction, with the discs' velocities
     /// read by `w`:
     /// `[i = 1] k_m u + k_{i−1} α_{i−1} + c_{i−1}(ω_{i−1} − ω_i) − k_i α_i − c_i(ω_i − ω_{i+1})`.

@@ -129,11 +129,13 @@
 
 #![warn(missing_docs)]
 
+pub mod chain;
 pub mod contacts;
 pub mod onestep;
 mod run;
 pub mod stepper;
 
+pub use chain::{ChainCounts, ChainStepError, ChainStepper};
 pub use contacts::{ContactError, ContactSolver, Tridiagonal};
 pub use onestep::{Branch, EnumError, OneStepProblem, OneStepSolution, StickData};
 pub use stepper::{StepOutcome, Stepper};

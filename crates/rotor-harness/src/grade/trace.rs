@@ -758,7 +758,7 @@ mod tests {
 
     #[test]
     fn written_traces_read_back_exactly_with_grid_times_as_decimals() {
-        let samples = vec![
+        let samples = [
             s(0.0, 0.0, 0.0, 0.0),
             s(3.0 * 0.1, 0.1 + 0.2, -1.5e-7, 6.336105049),
             s(0.8999999999999999, 1e300, -2.5, 1.0 / 3.0),
@@ -982,7 +982,7 @@ mod tests {
     /// and the index.
     #[test]
     fn traces_from_arrays_match_files_and_name_bad_entries() {
-        let samples = vec![s(0.0, 0.0, 0.0, 0.0), s(0.1, 0.5, -1.5e-7, 6.3)];
+        let samples = [s(0.0, 0.0, 0.0, 0.0), s(0.1, 0.5, -1.5e-7, 6.3)];
         let file = parse_trace(
             &write_trace(&samples.iter().copied().collect(), 0.1),
             Path::new("x.csv"),

@@ -361,7 +361,7 @@ impl MetricsAccumulator {
         }
         for s in [&mut self.stick_exits, &mut self.maxima] {
             if let Some(c) = s.open.as_mut() {
-                c.include(&e.x);
+                c.include(e.x);
             }
         }
         match e.kind {
@@ -374,9 +374,9 @@ impl MetricsAccumulator {
                         }
                     }
                 }
-                self.stick_exits.anchor(e.t, &e.x);
+                self.stick_exits.anchor(e.t, e.x);
             }
-            EventKind::Max(Disc::LOWER) => self.maxima.anchor(e.t, &e.x),
+            EventKind::Max(Disc::LOWER) => self.maxima.anchor(e.t, e.x),
             _ => {}
         }
     }
