@@ -37,7 +37,7 @@ pub(crate) struct Common {
     /// source's Table 1).
     #[arg(long, conflicts_with = "scenario")]
     pub(crate) params: Option<PathBuf>,
-    /// Initial state alpha,omega_u,omega_l (default: rest).
+    /// Initial state alpha,omega_u,omega_l (a chain's alpha_1,…,omega_N; default: rest).
     #[arg(long, allow_hyphen_values = true, conflicts_with = "scenario")]
     pub(crate) x0: Option<String>,
     /// Integration tolerance (switch, event).

@@ -27,8 +27,9 @@
 //! equations by semi-smooth Newton over its nine modes; on a chain of two the two agree to
 //! their stopping tolerance (a test).
 
-use rotor_model::DiscMode;
 use rotor_model::chain::ChainModel;
+use rotor_model::seam::{Output, Recorder, Scene, SolveError, Stats, Trajectory};
+use rotor_model::{DiscMode, FieldError, Mode};
 
 use crate::contacts::{ContactError, ContactSolver, Tridiagonal};
 
@@ -246,6 +247,92 @@ impl ChainStepper {
     }
 }
 
+/// Moreau–Jean on a chain of N discs: `scene` run at its step (the default one for a scene
+/// that sets a tolerance), every step but the last of size h and the last landing on
+/// `t_end`, the samples of the chain's size (between step ends, linear interpolation, as
+/// the rig's run).
+///
+/// What the chain's run does not do yet is refused by name: a time-varying input,
+/// steady-state metrics (`metrics_from`, [`Output::Metrics`]) and the event list
+/// ([`Output::Events`]); a grid run reports no events.
+pub fn simulate_chain(model: &ChainModel, scene: &Scene) -> Result<Trajectory, SolveError> {
+    scene.validate()?;
+    let n = model.discs();
+    if scene.x0.len() != model.dim() {
+        return Err(FieldError::new(
+            "x0",
+            format!("{} values", scene.x0.len()),
+            format!(
+                "a chain of {n} discs has {} (alpha_1 … alpha_{}, omega_1 … omega_{n})",
+                model.dim(),
+                n - 1
+            ),
+        )
+        .into());
+    }
+    let unsupported = |what: &str| {
+        Err(SolveError::Unsupported {
+            detail: format!("{what} on a chain of {n} discs (not yet: the rig only)"),
+        })
+    };
+    if scene.is_time_varying() {
+        return unsupported("an input that changes in time");
+    }
+    if scene.metrics_from.is_some() || scene.output == Output::Metrics {
+        return unsupported("steady-state metrics");
+    }
+    if scene.output == Output::Events {
+        return unsupported("the event list");
+    }
+    let h = scene.checked_step()?;
+    let (u, t_end) = (scene.u_at(0.0), scene.t_end);
+    let steps = ((t_end / h) - 1e-9).ceil().max(1.0);
+    let max_steps = crate::MoreauOptions::default().max_steps;
+    if steps > max_steps as f64 {
+        return Err(SolveError::TooManySteps { t: 0.0, max_steps });
+    }
+    let full = steps as u64 - 1;
+    let last = t_end - full as f64 * h;
+    let mut x = scene.x0.clone();
+    let mut prev = x.clone();
+    let mut rec = Recorder::new(scene, &x, h * h, 3.0);
+    rec.reserve(full as usize + 1);
+    let mut counts = ChainCounts::default();
+    let mut modes = vec![DiscMode::Stick; n];
+    let failed = |t: f64, e: ChainStepError| SolveError::Complementarity {
+        t,
+        detail: e.to_string(),
+    };
+    for (size, count) in [(h, full), (last, 1)] {
+        let mut st = ChainStepper::new(model, size, 0.5);
+        st.contacts.warm_start(&modes);
+        st.modes.copy_from_slice(&modes);
+        for _ in 0..count {
+            let t0 = counts.steps as f64 * h;
+            let t1 = if counts.steps == full { t_end } else { t0 + h };
+            prev.copy_from_slice(&x);
+            st.step(&mut x, u).map_err(|e| failed(t0, e))?;
+            counts.steps += 1;
+            rec.step(t0, t1, &x, |t, out| {
+                let s = (t - t0) / (t1 - t0);
+                for ((o, a), b) in out.iter_mut().zip(&prev).zip(&x) {
+                    *o = a + (b - a) * s;
+                }
+            });
+        }
+        let c = st.counts();
+        counts.solves += c.solves;
+        counts.linear_solves += c.linear_solves;
+        modes.copy_from_slice(st.modes());
+    }
+    let stats = Stats {
+        steps: counts.steps,
+        lcp_solves: counts.solves,
+        ..Stats::default()
+    };
+    Ok(rec.finish(t_end, &x, Mode::from_discs(&modes), stats))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -290,6 +377,79 @@ mod tests {
                 "{name}: the run sticks ({stuck_steps} steps)"
             );
         }
+    }
+
+    /// A chain's run samples what the stepper computes: the grid rows at step ends are the
+    /// stepper's states, the last row lands on t_end, and what the chain's run does not do
+    /// is refused by name.
+    #[test]
+    fn a_chain_run_records_the_steppers_states() {
+        use rotor_model::seam::Accuracy;
+        let chain = ChainModel::new(&ChainParams::rig_copies(&Params::table1(), 3));
+        let scene = Scene {
+            u: 1.5,
+            x0: vec![0.0; 5],
+            t_end: 1.0,
+            accuracy: Accuracy::Step(1e-3),
+            output: Output::Grid { dt: 0.1 },
+            metrics_from: None,
+            ..Scene::default()
+        };
+        let tr = simulate_chain(&chain, &scene).unwrap();
+        assert_eq!((tr.samples.len(), tr.samples.dim()), (11, 5));
+        assert_eq!(tr.stats.steps, 1000);
+        let mut st = ChainStepper::new(&chain, 1e-3, 0.5);
+        let mut x = vec![0.0; 5];
+        for k in 1..=1000 {
+            st.step(&mut x, 1.5).unwrap();
+            if k % 100 == 0 {
+                // 0.1 is k·h up to rounding: the row is the step end's state, or the
+                // interpolant a rounding away from it.
+                let row = tr.samples.x(k / 100);
+                let d = row
+                    .iter()
+                    .zip(&x)
+                    .map(|(a, b)| (a - b).abs())
+                    .fold(0.0, f64::max);
+                assert!(d <= 1e-12, "row {}: {d:e}", k / 100);
+            }
+        }
+        assert_eq!(tr.x_final, x);
+        assert_eq!(tr.samples.last().unwrap().t, 1.0);
+        let refused = |sc: Scene, what: &str| {
+            let e = simulate_chain(&chain, &sc).unwrap_err().to_string();
+            assert!(e.contains(what), "{e}");
+        };
+        refused(
+            Scene {
+                x0: vec![0.0; 3],
+                ..scene.clone()
+            },
+            "x0 = 3 values: a chain of 3 discs has 5",
+        );
+        refused(
+            Scene {
+                metrics_from: Some(0.5),
+                ..scene.clone()
+            },
+            "steady-state metrics on a chain of 3 discs",
+        );
+        refused(
+            Scene {
+                output: Output::Events,
+                ..scene.clone()
+            },
+            "the event list on a chain of 3 discs",
+        );
+        // A horizon of more steps than the rig's run allows is refused before it starts.
+        refused(
+            Scene {
+                t_end: 1e12,
+                output: Output::Final,
+                ..scene
+            },
+            "step limit",
+        );
     }
 
     /// Every step's one-step problem is solved exactly: its complementarity residual is at

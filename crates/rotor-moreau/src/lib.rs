@@ -135,7 +135,7 @@ pub mod onestep;
 mod run;
 pub mod stepper;
 
-pub use chain::{ChainCounts, ChainStepError, ChainStepper};
+pub use chain::{ChainCounts, ChainStepError, ChainStepper, simulate_chain};
 pub use contacts::{ContactError, ContactSolver, Tridiagonal};
 pub use onestep::{Branch, EnumError, OneStepProblem, OneStepSolution, StickData};
 pub use stepper::{StepOutcome, Stepper};

@@ -205,8 +205,9 @@ fn raw(name: &str, contents: impl Into<Vec<u8>>, needles: &[&'static str]) -> Ba
 
 /// Bad parameter files: mutations of [`TABLE1`] and [`STRIBECK`] (unknown, missing and
 /// mistyped keys, non-finite and out-of-range values, an unknown family) and empty, binary
-/// and control-character files; chains in chain form the solvers refuse ([`CHAIN3`]). Each is a
-/// whole parameter file, to be loaded on its own.
+/// and control-character files; chains in chain form that the rig's readers refuse
+/// ([`CHAIN3`], which `rotor simulate --solver moreau` runs as a chain). Each is a whole
+/// parameter file, to be loaded on its own.
 pub fn bad_params_cases() -> Vec<BadFile> {
     let t1 = |from: &str, to: &str, needles: &[&'static str]| {
         edited("table1", TABLE1, from, to, needles)

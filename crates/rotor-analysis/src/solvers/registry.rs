@@ -174,6 +174,29 @@ impl SolverKind {
         SOLVERS.iter().copied().find(|k| k.name() == name)
     }
 
+    /// `scene` on a chain of N discs, by this solver: Moreau–Jean's chain run
+    /// ([`rotor_moreau::simulate_chain`]); the event-driven and switch solvers run the rig's
+    /// two discs only so far, and say so.
+    pub fn simulate_chain(
+        self,
+        model: &rotor_model::ChainModel,
+        scene: &rotor_model::seam::Scene,
+    ) -> Result<rotor_model::seam::Trajectory, rotor_model::seam::SolveError> {
+        if self != SolverKind::MOREAU {
+            return Err(rotor_model::seam::SolveError::Unsupported {
+                detail: format!(
+                    "a chain with {} discs on {}: only moreau runs chains so far (event and \
+                     switch run the rig's two discs)",
+                    model.discs(),
+                    self.name()
+                ),
+            });
+        }
+        let tr = rotor_moreau::simulate_chain(model, scene)?;
+        tr.check_finite()?;
+        Ok(tr)
+    }
+
     /// `"tol"` or `"h"`.
     pub fn setting_name(self) -> &'static str {
         self.0.knob.name()

@@ -56,12 +56,95 @@ pub(crate) fn check_grid(t_end: f64, dt: f64, given: bool) -> Result<()> {
     Ok(())
 }
 
+/// The chain a `--params` file in chain form gives, with its path (`None` for a file in the
+/// rig's form, or no `--params`). A chain of two is the rig, and runs as the rig; its trace
+/// is headed with the chain's names, as any chain file's.
+fn chain_file(common: &Common) -> Result<Option<(PathBuf, rotor_model::ChainParams)>> {
+    let Some(p) = common.params.as_deref() else {
+        return Ok(None);
+    };
+    let path = crate::common::fixture_path("--params", p, "params")?;
+    let chain = rotor_model::ChainParams::from_file(&path)?;
+    // The file loaded, so it is a small text file: read again to tell its form.
+    let text = std::fs::read_to_string(&path)
+        .with_context(|| format!("{}: cannot read", path.display()))?;
+    Ok(rotor_model::ChainParams::is_chain_form(&text).then_some((path, chain)))
+}
+
+/// `rotor simulate` of a chain of N discs: a constant `--u`, `--x0` of the chain's 2N − 1
+/// values, Moreau–Jean's step `--h`; the trace headed with the chain's state names
+/// (`t,alpha_1,…,omega_N`). What a chain does not take yet is refused by name.
+fn simulate_chain(
+    common: &Common,
+    (path, chain): (&Path, &rotor_model::ChainModel),
+    t_end: Option<f64>,
+    dt: Option<f64>,
+    csv_path: &Path,
+) -> Result<()> {
+    let n = chain.discs();
+    if common.input.is_some() {
+        return Err(unusable(format_args!(
+            "--input: the chain of {} (a chain with {n} discs) takes a constant --u so far",
+            path.display()
+        )));
+    }
+    let kind = rotor_analysis::solvers::solver_kind(&common.solver)?;
+    if kind != rotor_analysis::solvers::SolverKind::MOREAU {
+        return Err(unusable(format_args!(
+            "--solver {}: {} is a chain with {n} discs, which runs on --solver moreau only \
+             so far (event and switch run the rig's two discs)",
+            kind.name(),
+            path.display()
+        )));
+    }
+    if common.tol.is_some() {
+        return Err(unusable("--tol: moreau takes a step, --h"));
+    }
+    let names = chain.state_names();
+    let refs: Vec<&str> = names.iter().map(String::as_str).collect();
+    let x0 = crate::common::parse_x0(common.x0.as_deref(), &refs)?;
+    let t_end = t_end.unwrap_or(DEFAULT_T_END);
+    let given = dt.is_some();
+    let dt = dt.unwrap_or(DEFAULT_DT);
+    check_grid(t_end, dt, given)?;
+    let scene = rotor_model::seam::Scene {
+        // clap requires --u without a scenario or --input.
+        u: common.u.unwrap_or(f64::NAN),
+        input: None,
+        x0,
+        t_end,
+        accuracy: rotor_model::seam::Accuracy::Step(
+            common.h.unwrap_or(rotor_model::seam::scene::DEFAULT_STEP),
+        ),
+        output: rotor_model::seam::Output::Grid { dt },
+        metrics_from: None,
+    };
+    let traj = kind
+        .simulate_chain(chain, &scene)
+        .with_context(|| format!("solver {}", kind.name()))?;
+    rotor_harness::compare::report::write_output_with(csv_path, |w| {
+        rotor_harness::grade::trace::write_named_trace_to(w, &names, &traj.samples, dt)
+    })
+    .with_context(|| format!("{}: cannot write", csv_path.display()))?;
+    Ok(())
+}
+
 pub(crate) fn simulate(
     common: &Common,
     t_end: Option<f64>,
     dt: Option<f64>,
     csv_path: &Path,
 ) -> Result<()> {
+    let chain = match common.scenario {
+        None => chain_file(common)?,
+        Some(_) => None,
+    };
+    if let Some((path, params)) = &chain
+        && params.len() > 2
+    {
+        let model = rotor_model::ChainModel::new(params);
+        return simulate_chain(common, (path, &model), t_end, dt, csv_path);
+    }
     let start = start(common)?;
     let sc = start.scenario.as_ref();
     let t_end = t_end.unwrap_or(sc.map_or(DEFAULT_T_END, |s| s.t_end));
@@ -76,8 +159,14 @@ pub(crate) fn simulate(
         .simulate_finite(&start.model, &scene)
         .with_context(|| format!("solver {}", solver.name()))?;
     warn_inexact(&traj.stats);
+    // A chain file's columns are the chain's (a chain of two in chain form included); the
+    // rig's file keeps the rig's names.
+    let names = match &chain {
+        Some((_, params)) => rotor_model::ChainModel::new(params).state_names(),
+        None => rotor_model::state_names(traj.samples.dim()),
+    };
     rotor_harness::compare::report::write_output_with(csv_path, |w| {
-        rotor_harness::grade::trace::write_trace_to(w, &traj.samples, dt)
+        rotor_harness::grade::trace::write_named_trace_to(w, &names, &traj.samples, dt)
     })
     .with_context(|| format!("{}: cannot write", csv_path.display()))?;
     Ok(())
