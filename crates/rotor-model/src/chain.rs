@@ -547,7 +547,7 @@ impl ChainParams {
 }
 
 /// `alpha_1 … alpha_{n−1}, omega_1 … omega_n`: the state's components of a chain of `n`.
-pub(crate) fn chain_state_names(n: usize) -> Vec<String> {
+pub fn chain_state_names(n: usize) -> Vec<String> {
     let alphas = (1..n).map(|i| format!("alpha_{i}"));
     alphas
         .chain((1..=n).map(|i| format!("omega_{i}")))

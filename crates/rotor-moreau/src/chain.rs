@@ -118,7 +118,6 @@ impl ChainStepper {
     /// smooth part, the rig's default).
     pub fn new(model: &ChainModel, h: f64, theta: f64) -> ChainStepper {
         let n = model.discs();
-        let springs = |i: usize| (model.spring(i), model.coupling(i));
         // The Laplacians' diagonal and off-diagonal: disc i feels the springs above and below.
         let lap = |f: &dyn Fn(usize) -> f64| -> (Vec<f64>, Vec<f64>) {
             let diag = (0..n)
@@ -131,8 +130,8 @@ impl ChainStepper {
             let off = (0..n - 1).map(|i| -f(i)).collect();
             (diag, off)
         };
-        let (lk_d, lk_o) = lap(&|i| springs(i).0);
-        let (lc_d, lc_o) = lap(&|i| springs(i).1);
+        let (lk_d, lk_o) = lap(&|i| model.spring(i));
+        let (lc_d, lc_o) = lap(&|i| model.coupling(i));
         let mat = |s_c: f64, s_k: f64| Tridiagonal {
             diag: (0..n)
                 .map(|i| {
@@ -286,8 +285,9 @@ pub fn simulate_chain(model: &ChainModel, scene: &Scene) -> Result<Trajectory, S
     }
     let h = scene.checked_step()?;
     let (u, t_end) = (scene.u_at(0.0), scene.t_end);
+    let options = crate::MoreauOptions::default();
     let steps = ((t_end / h) - 1e-9).ceil().max(1.0);
-    let max_steps = crate::MoreauOptions::default().max_steps;
+    let max_steps = options.max_steps;
     if steps > max_steps as f64 {
         return Err(SolveError::TooManySteps { t: 0.0, max_steps });
     }
@@ -295,7 +295,8 @@ pub fn simulate_chain(model: &ChainModel, scene: &Scene) -> Result<Trajectory, S
     let last = t_end - full as f64 * h;
     let mut x = scene.x0.clone();
     let mut prev = x.clone();
-    let mut rec = Recorder::new(scene, &x, h * h, 3.0);
+    // (h² the fast-forward's error scale, as the rig's run; the skip is off for a chain.)
+    let mut rec = Recorder::new(scene, &x, h * h, options.skip_verify);
     rec.reserve(full as usize + 1);
     let mut counts = ChainCounts::default();
     let mut modes = vec![DiscMode::Stick; n];

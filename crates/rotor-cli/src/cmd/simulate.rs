@@ -162,7 +162,7 @@ pub(crate) fn simulate(
     // A chain file's columns are the chain's (a chain of two in chain form included); the
     // rig's file keeps the rig's names.
     let names = match &chain {
-        Some((_, params)) => rotor_model::ChainModel::new(params).state_names(),
+        Some((_, params)) => rotor_model::chain::chain_state_names(params.len()),
         None => rotor_model::state_names(traj.samples.dim()),
     };
     rotor_harness::compare::report::write_output_with(csv_path, |w| {

@@ -323,7 +323,6 @@ pub fn compute(sc: &Scenario) -> Result<Reference, ReferenceError> {
 fn compute_at(sc: &Scenario, tol: f64, check_tol: f64) -> Result<Reference, ReferenceError> {
     let r = event_run(sc, tol)?;
     let tight = event_run(sc, check_tol)?;
-    let tight_samples: Vec<Sample> = tight.samples.iter().map(|r| r.sample()).collect();
     // The stated error: the difference to the tighter run, with a margin and a floor.
     let scale_of = |name: &str| -> f64 {
         let comp = match name {
@@ -464,6 +463,7 @@ fn compute_at(sc: &Scenario, tol: f64, check_tol: f64) -> Result<Reference, Refe
         };
         let scale = crate::grade::check::state_scales(&samples);
         let cycle = steady.expect("a cycle");
+        let tight_samples: Vec<Sample> = tight.samples.iter().map(|r| r.sample()).collect();
         if let Some(d) =
             crate::grade::check::orbit_distance(sc, &partial, cycle, &tight_samples, from, scale)
         {
