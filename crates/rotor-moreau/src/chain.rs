@@ -29,7 +29,7 @@
 
 use rotor_model::chain::ChainModel;
 use rotor_model::seam::{Output, Recorder, Scene, SolveError, Stats, Trajectory};
-use rotor_model::{DiscMode, FieldError, Mode};
+use rotor_model::{DiscMode, Mode};
 
 use crate::contacts::{ContactError, ContactSolver, Tridiagonal};
 
@@ -255,20 +255,8 @@ impl ChainStepper {
 /// steady-state metrics (`metrics_from`, [`Output::Metrics`]) and the event list
 /// ([`Output::Events`]); a grid run reports no events.
 pub fn simulate_chain(model: &ChainModel, scene: &Scene) -> Result<Trajectory, SolveError> {
-    scene.validate()?;
+    scene.validate_chain(model)?;
     let n = model.discs();
-    if scene.x0.len() != model.dim() {
-        return Err(FieldError::new(
-            "x0",
-            format!("{} values", scene.x0.len()),
-            format!(
-                "a chain of {n} discs has {} (alpha_1 … alpha_{}, omega_1 … omega_{n})",
-                model.dim(),
-                n - 1
-            ),
-        )
-        .into());
-    }
     let unsupported = |what: &str| {
         Err(SolveError::Unsupported {
             detail: format!("{what} on a chain of {n} discs (not yet: the rig only)"),

@@ -1,12 +1,13 @@
 //! The switch-model field, its guards, and the event-located integration loop.
 
+use nalgebra::{Const, DefaultAllocator, Dim, Dyn, allocator::Allocator};
 use rotor_model::seam::{
     Event, EventKind, EventRef, Input, Integration, Piece, Recorder, Scene, SolveError, Solver,
-    Stats, Trajectory, check_finite,
+    Stats, Trajectory,
 };
-use rotor_model::{Disc, DiscMode, FieldError, Mode, Model, OMEGA_L, OMEGA_U, State};
+use rotor_model::{ChainModel, ChainParams, Disc, DiscMode, FieldError, Mode, Model};
 
-use crate::dopri5::{Dopri5, Dopri5Error, Dopri5Options};
+use crate::dopri5::{Dopri5, Dopri5Error, Dopri5Options, Vector};
 
 /// An extremum is reported only if ω moved by more than this many tolerances (relative to
 /// 1 + |ω|) since the extremum found before it, without a region change between: the
@@ -25,6 +26,26 @@ const EXTREMUM_RESOLUTION: f64 = 10.0;
 pub fn step_bound(model: &Model, tol: f64, k: f64) -> f64 {
     let s = model.time_scales();
     k * (tol / 1e-10).powf(1.0 / 5.0) * s.friction[0].min(s.friction[1])
+}
+
+/// [`step_bound`] for a chain: `k·(tol/1e-10)^{1/5}·min_i τ_fric,i` over its discs, with
+/// `τ_fric,i = v_i/(T_i/J_i)` (the law's velocity scale over the disc's acceleration scale,
+/// as [`rotor_model::TimeScales`] defines it for the rig; ∞ for a law without a velocity
+/// scale). On a chain of two it is the rig's bound to the last bit.
+pub fn chain_step_bound(model: &ChainModel, tol: f64, k: f64) -> f64 {
+    let tau = (0..model.discs())
+        .map(|i| {
+            let f = model.friction(i);
+            let v = f.velocity_scale().unwrap_or(f64::INFINITY);
+            let a = f.torque_scale() / model.inertia(i);
+            if v.is_finite() && a > 0.0 {
+                v / a
+            } else {
+                f64::INFINITY
+            }
+        })
+        .fold(f64::INFINITY, f64::min);
+    k * (tol / 1e-10).powf(1.0 / 5.0) * tau
 }
 
 /// Settings of the switch-model solver.
@@ -112,6 +133,8 @@ impl Region {
 #[derive(Debug, Clone, Copy)]
 struct Law {
     disc: Disc,
+    /// The disc's position (its index in the model), and its velocity's index in the state.
+    pos: usize,
     idx: usize,
     j: f64,
     lo: f64,
@@ -152,48 +175,52 @@ enum Guard {
     EdgeOut(f64),
 }
 
-/// The switch-model vector field with the current regions.
-#[derive(Debug, Clone, Copy)]
+/// The switch-model vector field with the current regions, one per disc of a chain (the rig
+/// is its chain of two, whose field [`ChainModel`] evaluates bit for bit as the rig's).
+#[derive(Debug, Clone)]
 struct Field<'a> {
-    model: &'a Model,
+    model: &'a ChainModel,
     /// The input's piece, `u(t) = u0 + slope·(t − t0)` up to the next breakpoint.
     piece: Piece,
     eta: f64,
-    laws: [Law; 2],
-    regions: [Region; 2],
+    laws: Vec<Law>,
+    regions: Vec<Region>,
     /// Per disc: its `Trans` region began at rest (a stick exit, or the start of the run in
     /// the band), so a sign change of ω inside the band is the stuck velocity's, not a
     /// reversal (a stuck disc keeps the velocity it entered the band with, which may lie on
     /// either side of 0).
-    from_rest: [bool; 2],
+    from_rest: Vec<bool>,
 }
 
 impl Field<'_> {
     /// The applied torque on disc k at time t, state x (the input at t on the piece).
     #[inline]
-    fn tex(&self, k: usize, t: f64, x: &State) -> f64 {
+    fn tex(&self, k: usize, t: f64, x: &[f64]) -> f64 {
         self.model
-            .applied_torque(self.laws[k].disc, x, self.piece.at(t))
+            .applied_torque(self.laws[k].pos, x, self.piece.at(t))
     }
 
     /// `ω̇_i = (T_ex,i − T_f,i)/J_i` with the region's friction (table in the crate docs).
-    fn accel(&self, k: usize, t: f64, x: &State) -> f64 {
+    fn accel(&self, k: usize, t: f64, x: &[f64]) -> f64 {
         let l = &self.laws[k];
         let tex = self.tex(k, t, x);
         match self.regions[k] {
-            Region::Slip(s) => (tex - self.model.friction(l.disc).torque(x[l.idx], s)) / l.j,
+            Region::Slip(s) => (tex - self.model.friction(l.pos).torque(x[l.idx], s)) / l.j,
             Region::Stick | Region::Edge(_) => 0.0,
             Region::Trans(s) => (tex - l.bound(s)) / l.j,
         }
     }
 
-    /// `ẋ = [ω_u − ω_l, ω̇_u, ω̇_l]`.
-    fn rhs(&self, t: f64, x: &State) -> State {
-        State::new(
-            x[OMEGA_U] - x[OMEGA_L],
-            self.accel(0, t, x),
-            self.accel(1, t, x),
-        )
+    /// `ẋ = [ω_1 − ω_2, …, ω_{N−1} − ω_N, ω̇_1, …, ω̇_N]` (the rig: `[ω_u − ω_l, ω̇_u, ω̇_l]`),
+    /// written into `dx`.
+    fn rhs(&self, t: f64, x: &[f64], dx: &mut [f64]) {
+        let n = self.laws.len();
+        for i in 0..n - 1 {
+            dx[i] = x[n - 1 + i] - x[n + i];
+        }
+        for (k, l) in self.laws.iter().enumerate() {
+            dx[l.idx] = self.accel(k, t, x);
+        }
     }
 
     /// The guards of disc k in its region (at most two).
@@ -208,7 +235,7 @@ impl Field<'_> {
         }
     }
 
-    fn guard_value(&self, k: usize, g: Guard, t: f64, x: &State) -> f64 {
+    fn guard_value(&self, k: usize, g: Guard, t: f64, x: &[f64]) -> f64 {
         let l = &self.laws[k];
         let w = x[l.idx];
         match g {
@@ -260,7 +287,7 @@ impl Field<'_> {
 
     /// Initial region of disc k at state x at the start time t (0, or a breakpoint of the
     /// input); the velocity to set (η = 0 stick: 0).
-    fn initial_region(&self, k: usize, t: f64, x: &State) -> (Region, Option<f64>) {
+    fn initial_region(&self, k: usize, t: f64, x: &[f64]) -> (Region, Option<f64>) {
         let l = &self.laws[k];
         let w = x[l.idx];
         let tex = self.tex(k, t, x);
@@ -289,7 +316,7 @@ impl Field<'_> {
         k: usize,
         g: Guard,
         t: f64,
-        x: &State,
+        x: &[f64],
     ) -> (Region, Option<f64>, Option<EventKind>) {
         let d = self.laws[k].disc;
         let tex = self.tex(k, t, x);
@@ -445,29 +472,69 @@ impl Zeno {
 
 /// What the run goes back to if a jump is undone: the anchor's time and state, and the
 /// regions and extremum memory there.
-struct Saved {
+struct Saved<D: Dim>
+where
+    DefaultAllocator: Allocator<D>,
+{
     t: f64,
-    y: State,
-    regions: [Region; 2],
-    last_extremum: [Option<f64>; 2],
+    y: Vector<D>,
+    regions: PerDisc<Region>,
+    last_extremum: PerDisc<Option<f64>>,
 }
 
-fn map_err(e: Dopri5Error, x: &State) -> SolveError {
+/// Per-disc values kept at a checkpoint: inline for the rig's two discs, so that a skip of
+/// whole periods allocates nothing (the skip runs on the rig only), on the heap for a chain.
+#[derive(Debug, Clone)]
+enum PerDisc<T: Copy> {
+    Two([T; 2]),
+    Any(Vec<T>),
+}
+
+impl<T: Copy> PerDisc<T> {
+    fn of(v: &[T]) -> PerDisc<T> {
+        match v {
+            [a, b] => PerDisc::Two([*a, *b]),
+            _ => PerDisc::Any(v.to_vec()),
+        }
+    }
+
+    fn copy_to(&self, out: &mut [T]) {
+        match self {
+            PerDisc::Two(a) => out.copy_from_slice(a),
+            PerDisc::Any(v) => out.copy_from_slice(v),
+        }
+    }
+}
+
+fn map_err(e: Dopri5Error, x: &[f64]) -> SolveError {
     match e {
         Dopri5Error::StepSizeUnderflow { t, h } => SolveError::StepSizeUnderflow {
             t,
             h,
-            x: x.as_slice().to_vec(),
+            x: x.to_vec(),
         },
         Dopri5Error::TooManySteps { t, max_steps } => SolveError::TooManySteps { t, max_steps },
     }
 }
 
+/// An error naming the state if it holds a value that is not finite.
+fn check_finite(t: f64, x: &[f64]) -> Result<(), SolveError> {
+    if x.iter().all(|v| v.is_finite()) {
+        Ok(())
+    } else {
+        Err(SolveError::NonFinite { t, x: x.to_vec() })
+    }
+}
+
 /// The switch-model integration: DOPRI5 on the field of the current regions, cut at every
 /// region change (the earliest guard root on the step's dense output) and restarted there.
-struct Run<'a> {
+/// `D` is the state's size: `Const<3>` for the rig (on the stack), `Dyn` for a chain.
+struct Run<'a, D: Dim>
+where
+    DefaultAllocator: Allocator<D>,
+{
     field: Field<'a>,
-    integ: Dopri5<3>,
+    integ: Dopri5<D>,
     t_end: f64,
     /// Where the current piece of the input ends: its next breakpoint, or `t_end`.
     seg_end: f64,
@@ -477,40 +544,55 @@ struct Run<'a> {
     /// Guard samples per step.
     samples: usize,
     zeno: Zeno,
-    /// ω at the last extremum found per disc (upper, lower) since the disc's last region
-    /// change: an extremum within EXTREMUM_RESOLUTION tolerances of it is not resolved by the
+    /// ω at the last extremum found per disc since the disc's last region change: an
+    /// extremum within EXTREMUM_RESOLUTION tolerances of it is not resolved by the
     /// integration (rounding-level turns while settling onto an equilibrium).
-    last_extremum: [Option<f64>; 2],
-    /// Markers found in one step (reused).
-    found: Vec<(f64, EventKind)>,
+    last_extremum: Vec<Option<f64>>,
+    /// Markers found in one step (reused): time, disc, kind.
+    found: Vec<(f64, usize, EventKind)>,
+    /// The dense output at a step's guard samples, and one more state (reused).
+    xs: Vec<Vector<D>>,
+    y: Vector<D>,
 }
 
-impl Run<'_> {
+impl<D: Dim> Run<'_, D>
+where
+    DefaultAllocator: Allocator<D>,
+{
     /// Restarts the integration at `(t, y)` with the current regions' field.
-    fn restart(&mut self, t: f64, y: State) {
-        let f = self.field;
-        self.integ.restart(t, y, &mut |t, y: &State| f.rhs(t, y));
+    fn restart(&mut self, t: f64, y: &Vector<D>) {
+        let f = &self.field;
+        self.integ
+            .restart(t, y, &mut |t, y: &Vector<D>, dy: &mut Vector<D>| {
+                f.rhs(t, y.as_slice(), dy.as_mut_slice())
+            });
     }
 
     /// One accepted step, up to its first region change: the markers before it, the samples,
     /// the switch itself, and the restart after it.
     fn step(&mut self, rec: &mut Recorder) -> Result<(), SolveError> {
-        let f = self.field;
-        let before = *self.integ.y();
+        self.y.copy_from(self.integ.y());
+        let f = &self.field;
+        let before = &self.y;
         self.integ
-            .step(&mut |t, y: &State| f.rhs(t, y), self.seg_end)
+            .step(
+                &mut |t, y: &Vector<D>, dy: &mut Vector<D>| {
+                    f.rhs(t, y.as_slice(), dy.as_mut_slice())
+                },
+                self.seg_end,
+            )
             .map_err(|e| {
-                let y = *self.integ.y();
-                if f.rhs(self.integ.t(), &y).iter().any(|v| !v.is_finite()) {
-                    SolveError::NonFinite {
-                        t: self.integ.t(),
-                        x: y.as_slice().to_vec(),
-                    }
+                let t = self.integ.t();
+                let y = self.integ.y().as_slice();
+                let mut dy = y.to_vec();
+                f.rhs(t, y, &mut dy);
+                if dy.iter().any(|v| !v.is_finite()) {
+                    SolveError::NonFinite { t, x: y.to_vec() }
                 } else {
-                    map_err(e, &before)
+                    map_err(e, before.as_slice())
                 }
             })?;
-        check_finite(self.integ.t(), self.integ.y())?;
+        check_finite(self.integ.t(), self.integ.y().as_slice())?;
         let (t0, t1) = self.integ.last_step();
         let hit = self.first_switch(t0, t1);
         let te = hit.map_or(t1, |h| h.0);
@@ -521,31 +603,29 @@ impl Run<'_> {
             }
         }
         let integ = &self.integ;
+        let dense = |t: f64, out: &mut [f64]| integ.dense_into(t, out);
         let Some((tr, k, g)) = hit else {
-            rec.step(t0, t1, integ.y().as_slice(), |t, out| {
-                out.copy_from_slice(integ.dense(t).as_slice())
-            });
+            rec.step(t0, t1, integ.y().as_slice(), dense);
             return Ok(());
         };
-        let mut y = if tr == t1 {
-            *integ.y()
+        if tr == t1 {
+            self.y.copy_from(integ.y());
         } else {
-            integ.dense(tr)
-        };
-        let (r, w, ev) = f.fire(k, g, tr, &y);
-        if let Some(w) = w {
-            y[f.laws[k].idx] = w;
+            integ.dense_into(tr, self.y.as_mut_slice());
         }
-        rec.step(t0, tr, y.as_slice(), |t, out| {
-            out.copy_from_slice(integ.dense(t).as_slice())
-        });
+        let f = &self.field;
+        let (r, w, ev) = f.fire(k, g, tr, self.y.as_slice());
+        if let Some(w) = w {
+            self.y[f.laws[k].idx] = w;
+        }
+        rec.step(t0, tr, self.y.as_slice(), dense);
         self.field.regions[k] = r;
         self.field.from_rest[k] = matches!(g, Guard::StickExit(_));
         self.last_extremum[k] = None;
         match ev {
             Some(kind) => rec.event(EventRef {
                 t: tr,
-                x: y.as_slice(),
+                x: self.y.as_slice(),
                 kind,
             }),
             None => rec.count_switch(),
@@ -554,8 +634,12 @@ impl Run<'_> {
         if rec.halted() {
             return Ok(());
         }
-        self.restart(tr, y);
-        check_finite(tr, &y)
+        let f = &self.field;
+        self.integ
+            .restart(tr, &self.y, &mut |t, y: &Vector<D>, dy: &mut Vector<D>| {
+                f.rhs(t, y.as_slice(), dy.as_mut_slice())
+            });
+        check_finite(tr, self.y.as_slice())
     }
 
     /// At a breakpoint of the input (the run's step ended on it): the next piece, and a
@@ -568,10 +652,11 @@ impl Run<'_> {
             return Ok(());
         };
         let t = self.integ.t();
-        let before = self.field.regions;
+        let before = self.field.regions.clone();
         self.field.piece = input.piece(t);
         self.seg_end = self.field.piece.end.min(self.t_end);
-        let y = self.field.start(t, self.integ.y());
+        self.y.copy_from(self.integ.y());
+        self.field.start(t, self.y.as_mut_slice());
         for (k, was) in before.into_iter().enumerate() {
             let d = self.field.laws[k].disc;
             let is = self.field.regions[k];
@@ -584,34 +669,42 @@ impl Run<'_> {
             if let Some(kind) = kind {
                 rec.event(EventRef {
                     t,
-                    x: y.as_slice(),
+                    x: self.y.as_slice(),
                     kind,
                 });
             }
         }
         // As a fresh run: no extremum remembered.
-        self.last_extremum = [None; 2];
-        let f = self.field;
-        self.integ
-            .reinit(t, y, self.seg_end, &mut |t, y: &State| f.rhs(t, y));
-        check_finite(t, &y)
+        self.last_extremum.fill(None);
+        let f = &self.field;
+        self.integ.reinit(
+            t,
+            &self.y,
+            self.seg_end,
+            &mut |t, y: &Vector<D>, dy: &mut Vector<D>| f.rhs(t, y.as_slice(), dy.as_mut_slice()),
+        );
+        check_finite(t, self.y.as_slice())
     }
 
     /// The earliest guard root on the dense output of `[t0, t1]`: its time, disc and guard.
-    fn first_switch(&self, t0: f64, t1: f64) -> Option<(f64, usize, Guard)> {
-        let (f, integ, m) = (&self.field, &self.integ, self.samples);
-        let mut xs = [State::zeros(); 17];
+    fn first_switch(&mut self, t0: f64, t1: f64) -> Option<(f64, usize, Guard)> {
+        let m = self.samples;
         for (j, t) in sample_times(t0, t1, m).enumerate() {
-            xs[j] = if j == m { *integ.y() } else { integ.dense(t) };
+            if j == m {
+                self.xs[j].copy_from(self.integ.y());
+            } else {
+                self.integ.dense_into(t, self.xs[j].as_mut_slice());
+            }
         }
+        let (f, integ, xs) = (&self.field, &self.integ, &self.xs);
         let mut hit: Option<(f64, usize, Guard)> = None;
-        for k in 0..2 {
+        for k in 0..f.laws.len() {
             for g in f.guards(k).into_iter().flatten() {
                 let mut vals = [(0.0, 0.0); 17];
                 for (j, t) in sample_times(t0, t1, m).enumerate() {
-                    vals[j] = (t, f.guard_value(k, g, t, &xs[j]));
+                    vals[j] = (t, f.guard_value(k, g, t, xs[j].as_slice()));
                 }
-                let guard = |tt: f64| f.guard_value(k, g, tt, &integ.dense(tt));
+                let guard = |tt: f64| f.guard_value(k, g, tt, integ.dense(tt).as_slice());
                 let root =
                     first_crossing(&vals[..=m], guard).or_else(|| self.dip(k, g, &vals[..=m]));
                 if let Some(tr) = root
@@ -646,16 +739,16 @@ impl Run<'_> {
         };
         let (f, integ) = (&self.field, &self.integ);
         let idx = f.laws[k].idx;
-        let slope = |t: f64| s * integ.dense_slope(t)[idx];
+        let slope = |t: f64| s * integ.dense_slope(t, idx);
         let mut prev = slope(vals[0].0);
         for j in 1..vals.len() {
             let cur = slope(vals[j].0);
             if prev < 0.0 && cur > 0.0 && vals[j - 1].1 > 0.0 {
                 let (ta, tb) = (vals[j - 1].0, vals[j].0);
                 let (tm, _) = illinois(slope, ta, prev, tb, cur);
-                let gm = f.guard_value(k, g, tm, &integ.dense(tm));
+                let gm = f.guard_value(k, g, tm, integ.dense(tm).as_slice());
                 if gm < 0.0 {
-                    let guard = |tt: f64| f.guard_value(k, g, tt, &integ.dense(tt));
+                    let guard = |tt: f64| f.guard_value(k, g, tt, integ.dense(tt).as_slice());
                     return Some(illinois(guard, ta, vals[j - 1].1, tm, gm).0);
                 }
             }
@@ -667,11 +760,12 @@ impl Run<'_> {
     /// Markers in `(t0, te]` (reversals inside the band, extrema of ω when metrics are asked),
     /// in time order, to the recorder; stops after an event on which it halts.
     fn markers(&mut self, rec: &mut Recorder, t0: f64, t1: f64, te: f64) {
-        let (f, m) = (self.field, self.samples);
+        let m = self.samples;
         let extrema = rec.wants_extrema();
         self.found.clear();
         let mut extra_rhs = 0u64;
-        for k in 0..2 {
+        let f = &self.field;
+        for k in 0..f.laws.len() {
             let l = f.laws[k];
             let (kind_pos, kind_neg, sign): (EventKind, EventKind, f64) = match f.regions[k] {
                 Region::Trans(s) if !f.from_rest[k] => {
@@ -683,12 +777,16 @@ impl Run<'_> {
             let integ = &self.integ;
             // Reversal: g = s·ω upward through 0; extrema: g = ω̇, either way.
             let mut gfun = |t: f64| {
-                let y = if t == t1 { *integ.y() } else { integ.dense(t) };
+                let y = if t == t1 {
+                    integ.y().clone()
+                } else {
+                    integ.dense(t)
+                };
                 if sign != 0.0 {
                     sign * y[l.idx]
                 } else {
                     extra_rhs += 1;
-                    f.accel(k, t, &y)
+                    f.accel(k, t, y.as_slice())
                 }
             };
             let mut prev = (t0, gfun(t0));
@@ -706,7 +804,7 @@ impl Run<'_> {
                     } else {
                         kind_neg
                     };
-                    self.found.push((tr, kind));
+                    self.found.push((tr, k, kind));
                 }
                 prev = (t, gv);
             }
@@ -714,11 +812,11 @@ impl Run<'_> {
         self.integ.count_rhs(extra_rhs);
         self.found.sort_by(|a, b| a.0.total_cmp(&b.0));
         for i in 0..self.found.len() {
-            let (t, kind) = self.found[i];
-            let y = self.integ.dense(t);
-            if let EventKind::Max(d) | EventKind::Min(d) = kind {
-                let w = y[d.index()];
-                let slot = &mut self.last_extremum[usize::from(d == Disc::LOWER)];
+            let (t, k, kind) = self.found[i];
+            self.integ.dense_into(t, self.y.as_mut_slice());
+            if let EventKind::Max(_) | EventKind::Min(_) = kind {
+                let w = self.y[self.field.laws[k].idx];
+                let slot = &mut self.last_extremum[k];
                 let resolvable = slot.replace(w).is_none_or(|w_prev| {
                     (w - w_prev).abs() > EXTREMUM_RESOLUTION * self.tol * (1.0 + w.abs())
                 });
@@ -728,7 +826,7 @@ impl Run<'_> {
             }
             rec.event(EventRef {
                 t,
-                x: y.as_slice(),
+                x: self.y.as_slice(),
                 kind,
             });
             if rec.halted() {
@@ -738,8 +836,11 @@ impl Run<'_> {
     }
 }
 
-impl Integration for Run<'_> {
-    type Checkpoint = Saved;
+impl<D: Dim> Integration for Run<'_, D>
+where
+    DefaultAllocator: Allocator<D>,
+{
+    type Checkpoint = Saved<D>;
 
     fn advance(&mut self, rec: &mut Recorder) -> Result<(), SolveError> {
         while self.integ.t() < self.t_end {
@@ -755,23 +856,36 @@ impl Integration for Run<'_> {
     }
 
     /// The anchor's time and state (the run stops at the event it halts on).
-    fn checkpoint(&self, anchor: &Event) -> Saved {
+    fn checkpoint(&self, anchor: &Event) -> Saved<D> {
         Saved {
             t: anchor.t,
-            y: anchor.state(),
-            regions: self.field.regions,
-            last_extremum: self.last_extremum,
+            y: self.state_of(&anchor.x),
+            regions: PerDisc::of(&self.field.regions),
+            last_extremum: PerDisc::of(&self.last_extremum),
         }
     }
 
-    fn restore(&mut self, sv: Saved) {
-        self.field.regions = sv.regions;
-        self.last_extremum = sv.last_extremum;
-        self.restart(sv.t, sv.y);
+    fn restore(&mut self, sv: Saved<D>) {
+        sv.regions.copy_to(&mut self.field.regions);
+        sv.last_extremum.copy_to(&mut self.last_extremum);
+        self.restart(sv.t, &sv.y);
     }
 
     fn shift(&mut self, anchor: &Event, dt: f64) {
-        self.restart(anchor.t + dt, anchor.state());
+        let y = self.state_of(&anchor.x);
+        self.restart(anchor.t + dt, &y);
+    }
+}
+
+impl<D: Dim> Run<'_, D>
+where
+    DefaultAllocator: Allocator<D>,
+{
+    /// A state of the run's size holding `x` (on the stack for the rig).
+    fn state_of(&self, x: &[f64]) -> Vector<D> {
+        let mut y = self.y.clone();
+        y.as_mut_slice().copy_from_slice(x);
+        y
     }
 }
 
@@ -798,16 +912,18 @@ impl SwitchOptions {
 }
 
 impl<'a> Field<'a> {
-    /// The field of `model` at input `u` with band `eta`, both discs in `Stick` until
+    /// The field of `model` at input `u` with band `eta`, every disc in `Stick` until
     /// [`Field::start`] sets their regions.
-    fn new(model: &'a Model, piece: Piece, eta: f64) -> Field<'a> {
-        let law = |disc: Disc| {
-            let f = model.friction(disc);
+    fn new(model: &'a ChainModel, piece: Piece, eta: f64) -> Field<'a> {
+        let n = model.discs();
+        let law = |pos: usize| {
+            let f = model.friction(pos);
             let (lo, hi) = f.static_interval();
             Law {
-                disc,
-                idx: disc.index(),
-                j: model.inertia(disc),
+                disc: Disc::at(pos),
+                pos,
+                idx: model.omega(pos),
+                j: model.inertia(pos),
                 lo,
                 hi,
                 set_valued: f.is_set_valued(),
@@ -819,25 +935,112 @@ impl<'a> Field<'a> {
             model,
             piece,
             eta,
-            laws: [law(Disc::UPPER), law(Disc::LOWER)],
-            regions: [Region::Stick; 2],
-            from_rest: [true; 2],
+            laws: (0..n).map(law).collect(),
+            regions: vec![Region::Stick; n],
+            from_rest: vec![true; n],
         }
     }
 
-    /// Sets the initial regions at `x` at time `t` and returns the state the run starts from
-    /// (a velocity in the band is kept; with η = 0 a stuck disc's is 0).
-    fn start(&mut self, t: f64, x: &State) -> State {
-        let mut x = *x;
-        for k in 0..2 {
-            let (r, w) = self.initial_region(k, t, &x);
+    /// Sets the initial regions at `x` at time `t` and puts into `x` the state the run starts
+    /// from (a velocity in the band is kept; with η = 0 a stuck disc's is 0).
+    fn start(&mut self, t: f64, x: &mut [f64]) {
+        for k in 0..self.laws.len() {
+            let (r, w) = self.initial_region(k, t, x);
             self.regions[k] = r;
             self.from_rest[k] = true;
             if let Some(w) = w {
                 x[self.laws[k].idx] = w;
             }
         }
-        x
+    }
+
+    /// The mode of every disc, from its region.
+    fn mode(&self) -> Mode {
+        let modes: Vec<DiscMode> = self.regions.iter().map(|r| r.disc_mode()).collect();
+        Mode::from_discs(&modes)
+    }
+}
+
+impl SwitchSolver {
+    /// Integrates the switch model of a chain of N discs over `[0, t_end]` (state
+    /// `[α_1 … α_{N−1}, ω_1 … ω_N]`), as [`Solver::simulate`] does the rig: one region per
+    /// disc, each disc's guards located on the dense output. The rig's own run is this one on
+    /// its chain of two, with the state on the stack.
+    pub fn simulate_chain(
+        &self,
+        model: &ChainModel,
+        scene: &Scene,
+    ) -> Result<Trajectory, SolveError> {
+        scene.validate_chain(model)?;
+        let bound = chain_step_bound(model, scene.tol(), self.options.h_scale);
+        let x0 = nalgebra::DVector::from_column_slice(&scene.x0);
+        self.run::<Dyn>(model, scene, x0, bound)
+    }
+
+    /// The run on `model` from `x0` (the scene's initial state, of the model's size), with the
+    /// step bounded by `bound` as well as by `h_max`.
+    fn run<D: Dim>(
+        &self,
+        model: &ChainModel,
+        scene: &Scene,
+        mut x0: Vector<D>,
+        bound: f64,
+    ) -> Result<Trajectory, SolveError>
+    where
+        DefaultAllocator: Allocator<D>,
+    {
+        let o = self.options;
+        o.validate()?;
+        let varying = scene.input.as_ref().filter(|_| scene.is_time_varying());
+        let piece = scene.piece(0.0);
+        let mut field = Field::new(model, piece, o.eta);
+        field.start(0.0, x0.as_mut_slice());
+        check_finite(0.0, x0.as_slice())?;
+        let tol = scene.tol();
+        let mut rec = Recorder::new(scene, x0.as_slice(), tol, o.skip_verify);
+        let dopts = Dopri5Options {
+            rtol: tol,
+            atol: tol,
+            h0: None,
+            h_max: o.h_max.min(bound),
+            max_steps: o.max_steps,
+            ..Dopri5Options::default()
+        };
+        let seg_end = piece.end.min(scene.t_end);
+        let integ = Dopri5::new(dopts, 0.0, x0.clone(), seg_end, &mut |t,
+                                                                       y: &Vector<D>,
+                                                                       dy: &mut Vector<
+            D,
+        >| {
+            field.rhs(t, y.as_slice(), dy.as_mut_slice())
+        });
+        let samples = o.guard_samples.clamp(1, 16);
+        let n = model.discs();
+        let mut run = Run {
+            field,
+            integ,
+            t_end: scene.t_end,
+            seg_end,
+            input: varying,
+            tol,
+            samples,
+            zeno: Zeno::new(o.zeno_count, o.zeno_window),
+            last_extremum: vec![None; n],
+            found: Vec::new(),
+            xs: vec![x0.clone(); samples + 1],
+            y: x0,
+        };
+        rec.drive(&mut run)?;
+        let x_final = run.integ.y().as_slice();
+        check_finite(run.integ.t(), x_final)?;
+        let c = run.integ.counters();
+        let stats = Stats {
+            steps: c.accepted,
+            rejected: c.rejected,
+            rhs_evals: c.rhs_evals,
+            ..Stats::default()
+        };
+        Ok(rec.finish(scene.t_end, x_final, run.field.mode(), stats))
     }
 }
 
@@ -850,52 +1053,9 @@ impl Solver for SwitchSolver {
     /// locating every region change (guards of the crate docs) and restarting there.
     fn simulate(&self, model: &Model, scene: &Scene) -> Result<Trajectory, SolveError> {
         scene.validate_for(model)?;
-        let o = self.options;
-        o.validate()?;
-        let varying = scene.input.as_ref().filter(|_| scene.is_time_varying());
-        let piece = scene.piece(0.0);
-        let mut field = Field::new(model, piece, o.eta);
-        let x0 = field.start(0.0, &scene.x0_state()?);
-        check_finite(0.0, &x0)?;
-        let tol = scene.tol();
-        let mut rec = Recorder::new(scene, x0.as_slice(), tol, o.skip_verify);
-        let dopts = Dopri5Options {
-            rtol: tol,
-            atol: tol,
-            h0: None,
-            h_max: o.h_max.min(step_bound(model, tol, o.h_scale)),
-            max_steps: o.max_steps,
-            ..Dopri5Options::default()
-        };
-        let seg_end = piece.end.min(scene.t_end);
-        let integ = Dopri5::new(dopts, 0.0, x0, seg_end, &mut |t, y: &State| field.rhs(t, y));
-        let mut run = Run {
-            field,
-            integ,
-            t_end: scene.t_end,
-            seg_end,
-            input: varying,
-            tol,
-            samples: o.guard_samples.clamp(1, 16),
-            zeno: Zeno::new(o.zeno_count, o.zeno_window),
-            last_extremum: [None; 2],
-            found: Vec::new(),
-        };
-        rec.drive(&mut run)?;
-        let x_final = *run.integ.y();
-        check_finite(run.integ.t(), &x_final)?;
-        let c = run.integ.counters();
-        let mode = Mode::rig(
-            run.field.regions[0].disc_mode(),
-            run.field.regions[1].disc_mode(),
-        );
-        let stats = Stats {
-            steps: c.accepted,
-            rejected: c.rejected,
-            rhs_evals: c.rhs_evals,
-            ..Stats::default()
-        };
-        Ok(rec.finish(scene.t_end, x_final.as_slice(), mode, stats))
+        let chain = ChainModel::new(&ChainParams::from_params(&model.params));
+        let bound = step_bound(model, scene.tol(), self.options.h_scale);
+        self.run::<Const<3>>(&chain, scene, scene.x0_state()?, bound)
     }
 }
 

@@ -279,6 +279,50 @@ impl Scene {
         Ok(())
     }
 
+    /// [`Scene::validate`], and the scene against a chain of N discs: `x0` holds the chain's
+    /// `2N − 1` values, the motor torque k_m·u (at every value of the input) and the initial
+    /// spring torques k_i·α_i are finite.
+    pub fn validate_chain(&self, model: &crate::ChainModel) -> Result<(), SolveError> {
+        self.validate()?;
+        let n = model.discs();
+        if self.x0.len() != model.dim() {
+            return Err(FieldError::new(
+                "x0",
+                format!("{} values", self.x0.len()),
+                format!(
+                    "a chain of {n} discs has {} (alpha_1 … alpha_{}, omega_1 … omega_{n})",
+                    model.dim(),
+                    n - 1
+                ),
+            )
+            .into());
+        }
+        if !(model.k_m() * self.u).is_finite() {
+            return Err(FieldError::num("u", self.u, "the motor torque k_m u overflows").into());
+        }
+        if let Some(i) = &self.input
+            && !(model.k_m() * i.max_abs()).is_finite()
+        {
+            return Err(FieldError::num(
+                "input",
+                i.max_abs(),
+                "the motor torque k_m u overflows at this |u|",
+            )
+            .into());
+        }
+        for i in 0..n - 1 {
+            if !(model.spring(i) * self.x0[i]).is_finite() {
+                return Err(FieldError::num(
+                    format!("x0[{i}]"),
+                    self.x0[i],
+                    "the spring torque k alpha overflows",
+                )
+                .into());
+            }
+        }
+        Ok(())
+    }
+
     /// The initial state as the rig's [`State`]; an error naming `x0` if the list does not
     /// hold the rig's three values.
     pub fn x0_state(&self) -> Result<State, SolveError> {
