@@ -64,8 +64,8 @@ fn bad_parameter_files_are_named_with_field_and_value() {
         let o = rotor(&["steady", "--solver", "event", "--u", "1", "--params", fs]);
         assert_clean_error(&o, what, &needles);
         let csv = dir.join(format!("p{i}.csv"));
-        // The event solver: Moreau–Jean runs a good chain of three, which the event solver
-        // refuses by name.
+        // The event solver: the switch model and Moreau–Jean run a good chain of three,
+        // which the event solver refuses by name.
         let o = rotor(&[
             "simulate",
             "--solver",

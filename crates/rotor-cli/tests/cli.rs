@@ -55,10 +55,10 @@ fn simulate_writes_the_contract_csv() {
     assert!(!std::path::Path::new("-").exists(), "no file named '-'");
 }
 
-/// A flag the solver does not use is a warning on stderr, and the run goes on.
 /// A two-disc parameter file written in chain form is the rig: the same numbers, bit for bit,
-/// from every solver, under the chain's column names; a chain of three runs on Moreau–Jean
-/// and is refused by name by the others (exit 2), with no trace written.
+/// from every solver, under the chain's column names. A chain of three runs on the switch
+/// model and Moreau–Jean, each at its own setting only, and the event solver refuses it by
+/// name (exit 2), with no trace written.
 #[test]
 fn a_chain_of_two_in_the_rigs_shape_runs_as_the_rig() {
     let dir = rotor_testkit::tmp_dir("rotor-cli-chain");
@@ -101,40 +101,64 @@ fn a_chain_of_two_in_the_rigs_shape_runs_as_the_rig() {
         assert_eq!(chain_head, "t,alpha_1,omega_1,omega_2", "{solver}");
         assert_eq!(rig_rows, chain_rows, "{solver}");
     }
-    // A chain of three runs on Moreau–Jean, headed with its five states; the other solvers
-    // refuse it by name (exit 2), with no trace written.
+    // A chain of three runs on the switch model and on Moreau–Jean, headed with its five
+    // states; the event solver refuses it by name (exit 2), with no trace written.
     let chain3 = dir.join("chain3.toml");
     std::fs::write(&chain3, rotor_testkit::CHAIN3).unwrap();
     let csv = dir.join("three.csv");
-    for solver in ["event", "switch"] {
+    let o = run(chain3.to_str().unwrap(), &csv, "event");
+    assert_eq!(o.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        err.contains("a chain with 3 discs") && err.contains("--solver switch or moreau"),
+        "{err}"
+    );
+    assert!(!csv.exists());
+    for solver in ["switch", "moreau"] {
         let o = run(chain3.to_str().unwrap(), &csv, solver);
-        assert_eq!(o.status.code(), Some(2), "{solver}");
-        let err = String::from_utf8_lossy(&o.stderr);
-        assert!(
-            err.contains("a chain with 3 discs") && err.contains("--solver moreau"),
-            "{err}"
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        let text = std::fs::read_to_string(&csv).unwrap();
+        let mut lines = text.lines();
+        assert_eq!(
+            lines.next(),
+            Some("t,alpha_1,alpha_2,omega_1,omega_2,omega_3"),
+            "{solver}"
         );
+        let rows: Vec<Vec<f64>> = lines
+            .map(|l| l.split(',').map(|v| v.parse().unwrap()).collect())
+            .collect();
+        // 5 s at the default 0.01: 501 rows of six finite numbers; the top disc is moving
+        // by the end (the motor drives it at 1.5 V).
+        assert_eq!(rows.len(), 501, "{solver}");
+        assert!(
+            rows.iter()
+                .all(|r| r.len() == 6 && r.iter().all(|v| v.is_finite())),
+            "{solver}"
+        );
+        assert!(rows[500][3] > 1.0, "{solver}: {:?}", rows[500]);
+        std::fs::remove_file(&csv).unwrap();
+    }
+    // Each solver's own accuracy setting only: the other one is refused by name.
+    for (solver, flag) in [("switch", "--h"), ("moreau", "--tol")] {
+        let o = rotor(&[
+            "simulate",
+            "--solver",
+            solver,
+            "--u",
+            "1.5",
+            "--t-end",
+            "1",
+            flag,
+            "1e-3",
+            "--params",
+            chain3.to_str().unwrap(),
+            "--csv",
+            csv.to_str().unwrap(),
+        ]);
+        assert_eq!(o.status.code(), Some(2), "{solver} {flag}");
+        assert!(String::from_utf8_lossy(&o.stderr).contains(flag));
         assert!(!csv.exists());
     }
-    let o = run(chain3.to_str().unwrap(), &csv, "moreau");
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    let text = std::fs::read_to_string(&csv).unwrap();
-    let mut lines = text.lines();
-    assert_eq!(
-        lines.next(),
-        Some("t,alpha_1,alpha_2,omega_1,omega_2,omega_3")
-    );
-    let rows: Vec<Vec<f64>> = lines
-        .map(|l| l.split(',').map(|v| v.parse().unwrap()).collect())
-        .collect();
-    // 5 s at the default 0.01: 501 rows of six finite numbers; the top disc is moving
-    // by the end (the motor drives it at 1.5 V).
-    assert_eq!(rows.len(), 501);
-    assert!(
-        rows.iter()
-            .all(|r| r.len() == 6 && r.iter().all(|v| v.is_finite()))
-    );
-    assert!(rows[500][3] > 1.0, "{:?}", rows[500]);
     std::fs::remove_dir_all(&dir).ok();
 }
 

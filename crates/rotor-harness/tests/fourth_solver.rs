@@ -196,6 +196,8 @@ static EULER: SolverInfo = SolverInfo {
     // Table 1's stable cycle from the unstable one next to its fold.
     steady_agreement: 1e-3,
     make: || Box::new(euler::EulerSolver),
+    // The rig's two discs only.
+    chain: None,
 };
 
 /// The scenario's tolerances for the new pairs, by the fixtures' rule: each about 5x the

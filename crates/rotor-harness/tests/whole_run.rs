@@ -249,6 +249,7 @@ fn entry(make: fn() -> Box<dyn Solver>) -> SolverKind {
         stuck_band: s.stuck_band,
         steady_agreement: s.steady_agreement,
         make,
+        chain: None,
     })))
 }
 

@@ -81,7 +81,16 @@ pub struct SolverInfo {
     pub steady_agreement: f64,
     /// A solver with its default options.
     pub make: fn() -> Box<dyn Solver>,
+    /// Its run of a chain of N discs, with its default options; `None` for a solver that
+    /// runs the rig's two discs only.
+    pub chain: Option<ChainRun>,
 }
+
+/// A solver's run of a scene on a chain of N discs.
+pub type ChainRun = fn(
+    &rotor_model::ChainModel,
+    &rotor_model::seam::Scene,
+) -> Result<rotor_model::seam::Trajectory, rotor_model::seam::SolveError>;
 
 const DECADES_3_12: [f64; 10] = [
     1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-9, 1e-10, 1e-11, 1e-12,
@@ -103,6 +112,7 @@ pub static EVENT: SolverInfo = SolverInfo {
     stuck_band: 0.0,
     steady_agreement: 1e-6,
     make: || Box::new(rotor_event::EventSolver::default()),
+    chain: None,
 };
 
 /// Leine's switch model as published (DOPRI5, band η = 1e-10).
@@ -122,6 +132,7 @@ pub static SWITCH: SolverInfo = SolverInfo {
     stuck_band: 1e-10,
     steady_agreement: 1e-5,
     make: || Box::new(rotor_switch::SwitchSolver::default()),
+    chain: Some(|model, scene| rotor_switch::SwitchSolver::default().simulate_chain(model, scene)),
 };
 
 /// Moreau–Jean time-stepping on the Lagrangian form. Every step of its ladder divides the
@@ -142,6 +153,7 @@ pub static MOREAU: SolverInfo = SolverInfo {
     stuck_band: 0.0,
     steady_agreement: 1e-4,
     make: || Box::new(rotor_moreau::MoreauSolver::default()),
+    chain: Some(rotor_moreau::simulate_chain),
 };
 
 /// A solver, by its entry.
@@ -174,25 +186,31 @@ impl SolverKind {
         SOLVERS.iter().copied().find(|k| k.name() == name)
     }
 
-    /// `scene` on a chain of N discs, by this solver: Moreau–Jean's chain run
-    /// ([`rotor_moreau::simulate_chain`]); the event-driven and switch solvers run the rig's
-    /// two discs only so far, and say so.
+    /// `scene` on a chain of N discs, by this solver's [`SolverInfo::chain`] (Moreau–Jean's
+    /// [`rotor_moreau::simulate_chain`], the switch model's
+    /// [`rotor_switch::SwitchSolver::simulate_chain`]); a solver without one (the
+    /// event-driven solver, so far) says so. Steady-state metrics are the rig's (they
+    /// read its two discs), so a chain refuses them by name.
     pub fn simulate_chain(
         self,
         model: &rotor_model::ChainModel,
         scene: &rotor_model::seam::Scene,
     ) -> Result<rotor_model::seam::Trajectory, rotor_model::seam::SolveError> {
-        if self != SolverKind::MOREAU {
-            return Err(rotor_model::seam::SolveError::Unsupported {
-                detail: format!(
-                    "a chain with {} discs on {}: only moreau runs chains so far (event and \
-                     switch run the rig's two discs)",
-                    model.discs(),
-                    self.name()
-                ),
-            });
+        use rotor_model::seam::{Output, SolveError};
+        let unsupported = |what: &str| SolveError::Unsupported {
+            detail: format!(
+                "{what} on a chain with {} discs by {} (not yet: the rig only)",
+                model.discs(),
+                self.name()
+            ),
+        };
+        if scene.metrics_from.is_some() || scene.output == Output::Metrics {
+            return Err(unsupported("steady-state metrics"));
         }
-        let tr = rotor_moreau::simulate_chain(model, scene)?;
+        let Some(chain) = self.0.chain else {
+            return Err(unsupported("a run"));
+        };
+        let tr = chain(model, scene)?;
         tr.check_finite()?;
         Ok(tr)
     }

@@ -71,9 +71,10 @@ fn chain_file(common: &Common) -> Result<Option<(PathBuf, rotor_model::ChainPara
     Ok(rotor_model::ChainParams::is_chain_form(&text).then_some((path, chain)))
 }
 
-/// `rotor simulate` of a chain of N discs: a constant `--u`, `--x0` of the chain's 2N − 1
-/// values, Moreau–Jean's step `--h`; the trace headed with the chain's state names
-/// (`t,alpha_1,…,omega_N`). What a chain does not take yet is refused by name.
+/// `rotor simulate` of a chain of N discs: `--x0` of the chain's 2N − 1 values, the switch
+/// model at `--tol` (a constant `--u` or an `--input` in time) or Moreau–Jean at `--h` (a
+/// constant `--u`); the trace headed with the chain's state names (`t,alpha_1,…,omega_N`).
+/// What a chain does not take yet is refused by name.
 fn simulate_chain(
     common: &Common,
     (path, chain): (&Path, &rotor_model::ChainModel),
@@ -82,24 +83,47 @@ fn simulate_chain(
     csv_path: &Path,
 ) -> Result<()> {
     let n = chain.discs();
-    if common.input.is_some() {
-        return Err(unusable(format_args!(
-            "--input: the chain of {} (a chain with {n} discs) takes a constant --u so far",
-            path.display()
-        )));
-    }
     let kind = rotor_analysis::solvers::solver_kind(&common.solver)?;
-    if kind != rotor_analysis::solvers::SolverKind::MOREAU {
+    if kind.info().chain.is_none() {
         return Err(unusable(format_args!(
-            "--solver {}: {} is a chain with {n} discs, which runs on --solver moreau only \
-             so far (event and switch run the rig's two discs)",
+            "--solver {}: {} is a chain with {n} discs, which runs on --solver switch or \
+             moreau so far (event runs the rig's two discs)",
             kind.name(),
             path.display()
         )));
     }
-    if common.tol.is_some() {
-        return Err(unusable("--tol: moreau takes a step, --h"));
+    if kind == rotor_analysis::solvers::SolverKind::MOREAU && common.input.is_some() {
+        return Err(unusable(format_args!(
+            "--input: the chain of {} (a chain with {n} discs) takes a constant --u on \
+             --solver moreau so far (--solver switch takes an input in time)",
+            path.display()
+        )));
     }
+    // Each solver's own setting only: the other one would be silently unused.
+    match (
+        kind.is_fixed_step(),
+        common.tol.is_some(),
+        common.h.is_some(),
+    ) {
+        (true, true, _) => {
+            return Err(unusable(format_args!(
+                "--tol: {} takes a step, --h",
+                kind.name()
+            )));
+        }
+        (false, _, true) => {
+            return Err(unusable(format_args!(
+                "--h: {} takes a tolerance, --tol",
+                kind.name()
+            )));
+        }
+        _ => {}
+    }
+    let input = common
+        .input
+        .as_deref()
+        .map(crate::common::read_input)
+        .transpose()?;
     let names = chain.state_names();
     let refs: Vec<&str> = names.iter().map(String::as_str).collect();
     let x0 = crate::common::parse_x0(common.x0.as_deref(), &refs)?;
@@ -107,18 +131,18 @@ fn simulate_chain(
     let given = dt.is_some();
     let dt = dt.unwrap_or(DEFAULT_DT);
     check_grid(t_end, dt, given)?;
-    let scene = rotor_model::seam::Scene {
+    let request = rotor_harness::jobs::request::Request {
+        solver: &common.solver,
         // clap requires --u without a scenario or --input.
         u: common.u.unwrap_or(f64::NAN),
-        input: None,
+        input,
         x0,
-        t_end,
-        accuracy: rotor_model::seam::Accuracy::Step(
-            common.h.unwrap_or(rotor_model::seam::scene::DEFAULT_STEP),
-        ),
-        output: rotor_model::seam::Output::Grid { dt },
-        metrics_from: None,
+        tol: common.tol,
+        h: common.h,
     };
+    let scene = request
+        .scene(kind, t_end, rotor_model::seam::Output::Grid { dt })
+        .map_err(crate::common::flagged)?;
     let traj = kind
         .simulate_chain(chain, &scene)
         .with_context(|| format!("solver {}", kind.name()))?;
