@@ -25,7 +25,7 @@
 use std::path::Path;
 
 use nalgebra::DMatrix;
-use serde::Deserialize;
+use serde::{Deserialize, Serialize};
 
 use crate::params::{
     ParamsError, check_finite, check_lower, check_upper, lower_fields, one_line, upper_fields,
@@ -44,6 +44,24 @@ pub enum DiscLaw {
     Upper(UpperFriction),
     /// `exponential` or `stribeck`: the rig's lower-disc laws.
     Lower(LowerFriction),
+}
+
+fn is_zero(v: &f64) -> bool {
+    *v == 0.0
+}
+
+/// A law as the file writes it: `family`, then its fields.
+impl Serialize for DiscLaw {
+    fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        use serde::ser::SerializeMap;
+        let fields = self.fields();
+        let mut m = s.serialize_map(Some(fields.len() + 1))?;
+        m.serialize_entry("family", self.family())?;
+        for (key, value) in &fields {
+            m.serialize_entry(key.trim_start_matches("friction."), value)?;
+        }
+        m.end()
+    }
 }
 
 impl DiscLaw {
@@ -96,24 +114,31 @@ impl DiscLaw {
 }
 
 /// One disc of a chain: its inertia, its coupling to the disc above and its friction law.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct ChainDisc {
     /// J [kg m²]: inertia.
     pub j: f64,
-    /// k [N m/rad]: stiffness of the spring to the disc above (0 for disc 1, which has none).
+    /// k [N m/rad]: stiffness of the spring to the disc above (0 for disc 1, which has none;
+    /// not written then, as a file must not give it).
+    #[serde(skip_serializing_if = "is_zero")]
     pub k: f64,
-    /// c [N m s/rad]: viscous coupling to the disc above (0 for disc 1).
+    /// c [N m s/rad]: viscous coupling to the disc above (0 for disc 1; not written when 0,
+    /// the file's default).
+    #[serde(skip_serializing_if = "is_zero")]
     pub c: f64,
     /// The disc's friction law.
+    #[serde(rename = "friction")]
     pub law: DiscLaw,
 }
 
-/// A validated chain of N ≥ 2 discs.
-#[derive(Debug, Clone, PartialEq)]
+/// A validated chain of N ≥ 2 discs. It serializes in the file's chain form (`k_m`, then a
+/// `disc` list of `j`, `k`, `c` and `friction` with its `family`), which a job file carries.
+#[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct ChainParams {
     /// k_m [N m/V]: motor constant (the motor drives disc 1).
     pub k_m: f64,
     /// The discs, top (driven) first.
+    #[serde(rename = "disc")]
     pub discs: Vec<ChainDisc>,
 }
 
@@ -806,6 +831,32 @@ friction = { family = "stribeck", t_s = 0.2, t_c = 0.1, omega_s = 1.5, delta = 2
 
     fn chain(text: &str) -> Result<ChainParams, String> {
         ChainParams::from_toml_str(text, Path::new("c.toml")).map_err(|e| e.to_string())
+    }
+
+    /// A chain serializes in the file's form: written back as TOML and read again it is the
+    /// same chain, for every family; as JSON (a job file's `params`) its discs are a `disc`
+    /// list with each law's `family`.
+    #[test]
+    fn a_chain_serializes_in_the_files_form() {
+        let mut p = chain(DESIGN_EXAMPLE).unwrap();
+        p.discs[1].c = 0.002;
+        p.discs.push(ChainDisc {
+            j: 0.01,
+            k: 0.05,
+            c: 0.0,
+            law: DiscLaw::Viscous { b: 0.3 },
+        });
+        let table = toml::Table::try_from(&p).unwrap();
+        assert_eq!(
+            ChainParams::from_table(table, Path::new("again.toml")).unwrap(),
+            p
+        );
+        let json = serde_json::to_value(&p).unwrap();
+        assert_eq!(json["disc"].as_array().unwrap().len(), 4);
+        assert_eq!(json["disc"][2]["friction"]["family"], "stribeck");
+        assert_eq!(json["disc"][2]["friction"]["omega_s"], 1.5);
+        assert_eq!(json["disc"][3]["friction"]["family"], "viscous");
+        assert_eq!(json["k_m"], 3.995);
     }
 
     fn modes3() -> [DiscMode; 3] {
