@@ -146,6 +146,10 @@ pub struct Panel<'a> {
     pub x_log: bool,
     /// Logarithmic y axis (see `x_log`).
     pub y_log: bool,
+    /// The x axis's ticks at these data values, labelled as numbers, instead of the automatic
+    /// ones (round steps, or decades on a log axis): a log axis over less than two decades,
+    /// say, whose decades alone leave it with one tick.
+    pub x_ticks: Vec<f64>,
 }
 
 impl<'a> Panel<'a> {
@@ -167,6 +171,7 @@ impl<'a> Panel<'a> {
             clear_x: Vec::new(),
             x_log: false,
             y_log: false,
+            x_ticks: Vec::new(),
         }
     }
 }
@@ -366,6 +371,8 @@ struct Frame {
     x_log: bool,
     /// Whether the y axis is logarithmic.
     y_log: bool,
+    /// The x ticks asked for, in data coordinates (empty: automatic).
+    x_ticks: Vec<f64>,
 }
 
 impl Frame {
@@ -457,6 +464,7 @@ impl Frame {
             y1,
             x_log: p.x_log,
             y_log: p.y_log,
+            x_ticks: p.x_ticks.clone(),
         })
     }
 
@@ -520,7 +528,16 @@ fn write_axes(s: &mut String, p: &Panel, f: &Frame) {
 /// about 8 round steps in x and 6 in y on a linear axis, decades on a log axis.
 fn write_ticks(s: &mut String, f: &Frame) {
     let (l, r, t, b) = (f.l, f.r, f.t, f.b);
-    for (tx, label) in tick_labels(f.x0, f.x1, f.x_log, 8) {
+    let x_ticks = if f.x_ticks.is_empty() {
+        tick_labels(f.x0, f.x1, f.x_log, 8)
+    } else {
+        f.x_ticks
+            .iter()
+            .map(|&v| (axis(v, f.x_log), fmt_tick(v)))
+            .filter(|(a, _)| a.is_finite())
+            .collect()
+    };
+    for (tx, label) in x_ticks {
         let x = f.ax(tx);
         let _ = writeln!(
             s,
