@@ -516,3 +516,42 @@ fn octave_peer_refuses_a_bad_job_by_name() {
     }
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// Siconos' MoreauJeanOSI on a chain (bench/peers/siconos_chain.py, one Lemke problem a step
+/// coupling the contacts), through the scaling study: at Moreau–Jean's h, on its shorter
+/// horizon, it is within the study's target error of the reference on every sample of every
+/// state of chains of 2 and 3 discs (so its cost is at the study's error), and takes the steps
+/// of its horizon.
+#[test]
+fn siconos_chain_peer_reaches_the_scaling_studys_error() {
+    let o = options();
+    if !peer_present(&o.peers.siconos_python, "siconos.kernel") {
+        return;
+    }
+    use rotor_harness::bench::scaling::{ScalingOptions, SiconosOptions, run as scaling};
+    let work = rotor_testkit::tmp_dir("siconos-chain");
+    let opts = ScalingOptions {
+        discs: vec![2, 3],
+        t_end: 4.0,
+        repeats: 1,
+        siconos: Some(SiconosOptions {
+            python: o.peers.siconos_python.clone(),
+            dir: o.peers.dir.clone(),
+            horizon: 0.4,
+            timeout: 60.0,
+            work: work.clone(),
+        }),
+        ..ScalingOptions::default()
+    };
+    let r = scaling(&opts, &mut |m| eprintln!("{m}")).unwrap();
+    assert!(r.skipped.is_empty(), "{:?}", r.skipped);
+    let peer: Vec<_> = r.points.iter().filter(|p| p.runner == "siconos").collect();
+    assert_eq!(peer.len(), 2);
+    for p in peer {
+        assert!(p.error <= opts.target, "{p:?}");
+        assert_eq!(p.horizon, 0.4, "{p:?}");
+        assert_eq!(p.steps, (0.4 / p.setting).round() as u64, "{p:?}");
+        assert!(p.per_step_ratio.is_some_and(|x| x.is_finite() && x > 0.0));
+    }
+    std::fs::remove_dir_all(&work).ok();
+}

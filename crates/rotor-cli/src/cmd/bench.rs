@@ -2,7 +2,7 @@
 
 use std::path::{Path, PathBuf};
 
-use anyhow::{Result, bail};
+use anyhow::{Context, Result, bail};
 
 use super::bench_out::{write_bench, write_results};
 use crate::common::{check, fixture_path, fixtures_dir};
@@ -60,13 +60,23 @@ pub struct Args {
     /// solvers are timed first, alone. 1 gives the quietest times.
     #[arg(long, value_name = "N")]
     pub jobs: Option<usize>,
+    /// Run the chain scaling study instead of the suite: chains of N = 2 … 64 discs (the
+    /// rig's top disc and N − 1 copies of its lower disc), each solver that runs chains at
+    /// the loosest setting within one error, and Siconos' MoreauJeanOSI at Moreau–Jean's h
+    /// when installed (--no-peers: not); the table on stdout, --json, --svg and --csv
+    /// written. With --quick: N = 2, 4, 8 over 5 s.
+    #[arg(
+        long,
+        conflicts_with_all = ["shard", "external", "fixed_step", "scenario", "keep", "tier", "jobs", "results"]
+    )]
+    pub scaling: bool,
     /// Run nothing: join the reports of `--shard` runs (any order) into the report one
     /// run writes, timings aside (BENCHMARK.md), written with --json, --svg, --csv.
     #[arg(
         long,
         value_name = "SHARD.json",
         num_args = 1..,
-        conflicts_with_all = ["shard", "quick", "no_peers", "external", "fixed_step", "scenario", "keep", "tier", "jobs"]
+        conflicts_with_all = ["shard", "quick", "no_peers", "external", "fixed_step", "scenario", "keep", "tier", "jobs", "scaling"]
     )]
     pub merge: Vec<PathBuf>,
 }
@@ -75,6 +85,9 @@ pub fn run(a: &Args) -> Result<()> {
     let outputs = [a.json.as_deref(), a.svg.as_deref(), a.csv.as_deref()];
     if !a.merge.is_empty() {
         return super::bench_merge::bench_merge(&a.merge, outputs, a.results.as_deref());
+    }
+    if a.scaling {
+        return scaling(outputs, a.quick, a.no_peers, a.timeout);
     }
     bench(
         outputs,
@@ -245,4 +258,66 @@ fn plan(opts: &rotor_harness::bench::BenchOptions) -> String {
         opts.clients.len(),
         scenes * per_scene
     )
+}
+
+/// `rotor bench --scaling`: the chain scaling study
+/// ([`rotor_harness::bench::scaling`]), its table on stdout and its files written.
+fn scaling(
+    [json, svg, csv]: [Option<&Path>; 3],
+    quick: bool,
+    no_peers: bool,
+    timeout: f64,
+) -> Result<()> {
+    use rotor_harness::bench::scaling::{ScalingOptions, SiconosOptions};
+    check(
+        "timeout",
+        timeout,
+        timeout > 0.0,
+        "must be positive and finite",
+    )?;
+    let mut opts = ScalingOptions::default();
+    if quick {
+        opts.discs = vec![2, 4, 8];
+        opts.t_end = 5.0;
+    }
+    let peer = rotor_harness::bench::BenchOptions::default().peers;
+    let work = tempfile_dir()?;
+    if !no_peers {
+        match rotor_harness::protocol::peers::available(&peer.siconos_python, "siconos.kernel") {
+            Ok(()) => {
+                opts.siconos = Some(SiconosOptions {
+                    python: peer.siconos_python.clone(),
+                    dir: peer.dir.clone(),
+                    // 0.4 s: 400 steps at h = 1e-3, about 55 s at N = 64 (0.14 s a step).
+                    horizon: if quick { 0.2 } else { 0.4 },
+                    timeout,
+                    work: work.clone(),
+                })
+            }
+            Err(why) => eprintln!("siconos peer skipped: {why}"),
+        }
+    }
+    let report = rotor_harness::bench::scaling::run(&opts, &mut |m| eprintln!("{m}"));
+    std::fs::remove_dir_all(&work).ok();
+    let report = report?;
+    crate::common::say(&report.to_markdown(), [json, svg, csv])?;
+    let json_text = serde_json::to_string_pretty(&report)?;
+    for (path, text) in [
+        (json, json_text),
+        (svg, report.to_svg()),
+        (csv, report.to_csv()),
+    ] {
+        if let Some(path) = path {
+            rotor_harness::compare::report::write_output(path, text.as_bytes())
+                .with_context(|| format!("{}: cannot write", path.display()))?;
+        }
+    }
+    Ok(())
+}
+
+/// A fresh working directory for the peer's job and trace files.
+fn tempfile_dir() -> Result<PathBuf> {
+    let dir = std::env::temp_dir().join(format!("rotor-scaling-{}", std::process::id()));
+    std::fs::create_dir_all(&dir)?;
+    Ok(dir)
 }

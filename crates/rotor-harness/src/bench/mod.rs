@@ -44,6 +44,7 @@ mod peers;
 pub mod profile;
 mod report;
 mod results;
+pub mod scaling;
 mod word;
 
 use rotor_model::Model;
