@@ -16,7 +16,7 @@ use std::ffi::CString;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-use numpy::{AllowTypeChange, PyArray1, PyArrayLike1};
+use numpy::{AllowTypeChange, PyArray1, PyArray2, PyArrayLike1};
 use pyo3::exceptions::{PyOSError, PyRuntimeError, PyTypeError, PyUserWarning, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::{PyBool, PyDict, PyList, PyString};
@@ -27,7 +27,7 @@ use rotor_harness::grade::check::{GradeError, Level};
 use rotor_harness::grade::trace::{EventsFile, Trace, disc_name, event_row, round_to, time_digits};
 use rotor_harness::jobs::request::Request;
 use rotor_model::seam::Stats;
-use rotor_model::{FieldError, Model, Params};
+use rotor_model::{ChainModel, ChainParams, FieldError, Model, Params};
 
 pyo3::create_exception!(
     rotorbench,
@@ -203,6 +203,20 @@ fn table_of(d: &Bound<'_, PyDict>, at: &str) -> PyResult<toml::Table> {
             return Err(PyTypeError::new_err(format!(
                 "{here} = {v}: expected a number, got bool"
             )));
+        } else if let (true, Ok(list)) = (key == "disc", v.cast::<PyList>()) {
+            // A chain's `disc` list (the one list of a parameter file): one dict per disc.
+            let mut items = Vec::with_capacity(list.len());
+            for (i, item) in list.iter().enumerate() {
+                let at = format!("{here}[{i}]");
+                let Ok(sub) = item.cast::<PyDict>() else {
+                    return Err(PyTypeError::new_err(format!(
+                        "{at}: expected a dict of the disc's keys, got {}",
+                        type_name(&item)
+                    )));
+                };
+                items.push(toml::Value::Table(table_of(sub, &at)?));
+            }
+            toml::Value::Array(items)
         } else if let Ok(x) = v.extract::<f64>() {
             toml::Value::Float(x)
         } else {
@@ -228,6 +242,31 @@ fn params_of(params: Option<&Bound<'_, PyAny>>) -> PyResult<Params> {
     }
     let path = resolve("params", p, "params")?;
     Params::from_file(&path).map_err(value_error)
+}
+
+/// `params` as a chain, if it is written in the chain form (a file whose text is, or a dict
+/// with a `disc` list); `None` for the rig's form.
+fn chain_of(params: Option<&Bound<'_, PyAny>>) -> PyResult<Option<ChainParams>> {
+    let Some(p) = params.filter(|p| !p.is_none()) else {
+        return Ok(None);
+    };
+    if let Ok(d) = p.cast::<PyDict>() {
+        if !d.contains("disc")? {
+            return Ok(None);
+        }
+        return ChainParams::from_table(table_of(d, "params")?, Path::new("params"))
+            .map(Some)
+            .map_err(value_error);
+    }
+    let path = resolve("params", p, "params")?;
+    // The reader takes both forms and bounds what it reads (a file that it refuses is the rig
+    // reader's to report); one that loaded is a small text file, read again to tell its form.
+    let Ok(chain) = ChainParams::from_file(&path) else {
+        return Ok(None);
+    };
+    let text = std::fs::read_to_string(&path)
+        .map_err(|e| PyValueError::new_err(format!("params = {}: {e}", path.display())))?;
+    Ok(ChainParams::is_chain_form(&text).then_some(chain))
 }
 
 /// A JSON value as plain Python objects (dict, list, float, int, str, bool, None).
@@ -332,6 +371,12 @@ fn input_of(rows: Option<Vec<[f64; 2]>>) -> PyResult<Option<rotor_model::seam::I
 /// released during the run. ``input`` (an (n, 2) array or a list of ``[t, u]`` pairs) is an
 /// input that changes in time, in place of ``u``: linear between rows, constant before the
 /// first and after the last, two rows at one t a step.
+///
+/// A chain of N discs (``params`` in the chain form: a file of ``[[disc]]`` tables, or a dict
+/// with a ``disc`` list) returns ``alpha`` ((N − 1) × len(t)) and ``omega`` (N × len(t)) as
+/// 2-D arrays instead, events naming the disc by its number (1 … N); ``x0`` then holds its
+/// 2N − 1 values ``alpha_1 … omega_N`` (the default, three zeros, is rest for any N). A chain longer than two runs on ``"switch"`` or
+/// ``"moreau"`` (whose chain run locates no events yet: its list is empty).
 #[pyfunction]
 #[pyo3(
     signature = (solver="event", u=1.5, params=None, x0=vec![0.0; 3], t_end=100.0, dt=0.01, tol=None, h=None, input=None),
@@ -350,6 +395,24 @@ fn simulate<'py>(
     h: Option<f64>,
     input: Option<Vec<[f64; 2]>>,
 ) -> PyResult<Bound<'py, PyDict>> {
+    if let Some(chain) = chain_of(params)? {
+        // The default, rest, is rest for a chain of any size.
+        let rest = x0.len() == 3 && x0.iter().all(|&v| v == 0.0);
+        let x0 = if rest {
+            vec![0.0; 2 * chain.len() - 1]
+        } else {
+            x0
+        };
+        let req = Request {
+            solver,
+            u,
+            input: input_of(input)?,
+            x0,
+            tol,
+            h,
+        };
+        return simulate_chain(py, &req, &chain, t_end, dt);
+    }
     let req = Request {
         solver,
         u,
@@ -383,6 +446,71 @@ fn simulate<'py>(
     }
     out.set_item("events", events)?;
     out.set_item("stats", to_py(py, &columns.stats)?)?;
+    Ok(out)
+}
+
+/// ``simulate`` of a chain given in the chain form: ``alpha`` ((N − 1) rows) and ``omega`` (N
+/// rows) as 2-D arrays, events naming the disc by its number (1 … N). A chain of two in the
+/// rig's shape runs as the rig (the same numbers, bit for bit, as ``rotor simulate`` writes
+/// under the chain's names); a longer one by the solver's chain run.
+fn simulate_chain<'py>(
+    py: Python<'py>,
+    req: &Request,
+    chain: &ChainParams,
+    t_end: f64,
+    dt: f64,
+) -> PyResult<Bound<'py, PyDict>> {
+    let (kind, scene) = req.simulation(t_end, dt).map_err(bad)?;
+    warn_ignored(py, req)?;
+    let n = chain.len();
+    let rig = chain.to_params();
+    if rig.is_none() {
+        if kind.info().chain.is_none() {
+            return Err(PyValueError::new_err(format!(
+                "solver = {:?}: a chain with {n} discs runs on \"switch\" or \"moreau\" so far \
+                 (\"{}\" runs the rig's two discs)",
+                kind.name(),
+                kind.name()
+            )));
+        }
+        if kind == rotor_analysis::solvers::SolverKind::MOREAU && scene.is_time_varying() {
+            return Err(PyValueError::new_err(format!(
+                "input: a chain with {n} discs takes a constant u on \"moreau\" so far \
+                 (\"switch\" takes an input in time)"
+            )));
+        }
+    }
+    let model = ChainModel::new(chain);
+    let tr = detached(py, move || match rig {
+        Some(p) => kind.solver().simulate_finite(&Model::new(p), &scene),
+        None => kind.simulate_chain(&model, &scene),
+    })?
+    .map_err(|e| from_solve(py, e))?;
+    warn_inexact(py, &tr.stats)?;
+    let digits = time_digits(dt);
+    let t: Vec<f64> = tr.samples.iter().map(|s| round_to(s.t, digits)).collect();
+    let rows = |range: std::ops::Range<usize>| -> Vec<Vec<f64>> {
+        range
+            .map(|k| tr.samples.iter().map(|s| s.x[k]).collect())
+            .collect()
+    };
+    let out = PyDict::new(py);
+    out.set_item("t", PyArray1::from_vec(py, t))?;
+    let array = |v: Vec<Vec<f64>>| PyArray2::from_vec2(py, &v).map_err(value_error);
+    out.set_item("alpha", array(rows(0..n - 1))?)?;
+    out.set_item("omega", array(rows(n - 1..2 * n - 1))?)?;
+    let events = PyList::empty(py);
+    for e in &tr.events {
+        if let Some((d, k)) = event_row(e.kind) {
+            let ev = PyDict::new(py);
+            ev.set_item("t", e.t)?;
+            ev.set_item("disc", d.number())?;
+            ev.set_item("kind", k)?;
+            events.append(ev)?;
+        }
+    }
+    out.set_item("events", events)?;
+    out.set_item("stats", to_py(py, &tr.stats)?)?;
     Ok(out)
 }
 

@@ -46,6 +46,21 @@ class Simulation(TypedDict):
     events: List[Event]
     stats: Dict[str, int]
 
+class ChainEvent(TypedDict):
+    t: float
+    #: The disc's number, 1 (the driven one) to N.
+    disc: int
+    kind: Literal["stick_start", "stick_end", "reversal"]
+
+class ChainSimulation(TypedDict):
+    t: npt.NDArray[np.float64]
+    #: (N - 1) x len(t): alpha_i = theta_i - theta_{i+1}.
+    alpha: npt.NDArray[np.float64]
+    #: N x len(t).
+    omega: npt.NDArray[np.float64]
+    events: List[ChainEvent]
+    stats: Dict[str, int]
+
 def simulate(
     solver: Solver = "event",
     u: float = 1.5,
@@ -56,8 +71,13 @@ def simulate(
     tol: Optional[float] = None,
     h: Optional[float] = None,
     input: Optional[Sequence[Sequence[float]]] = None,
-) -> Simulation:
+) -> Union[Simulation, ChainSimulation]:
     """Simulates one scene; the trajectory on the grid 0, dt, ..., t_end.
+
+    For a chain of N discs (``params`` in the chain form) the result is a ChainSimulation:
+    ``alpha`` and ``omega`` as 2-D arrays, events with the disc's number; ``x0`` then holds
+    2N - 1 values (the default, three zeros, is rest for any N). A chain longer than two runs
+    on "switch" or "moreau".
 
     ``input``: an (n, 2) array or a list of [t, u] pairs, an input that changes in time in
     place of ``u`` (linear between rows, constant outside them, two rows at one t a step).

@@ -1,0 +1,104 @@
+"""Chains of N discs through the package: 2-D arrays, disc numbers, the CLI's numbers."""
+
+import numpy as np
+import pytest
+
+import rotorbench
+
+CHAIN3 = """name = "chain3"
+k_m = 3.9950
+[[disc]]
+j = 0.4765
+friction = { family = "upper", t_s = 0.0, dt_s = 0.0, b = 2.2247, db = 0.0 }
+[[disc]]
+j = 0.0326
+k = 0.0727
+friction = { family = "exponential", t_s = 0.1642, t_1 = 0.0603, t_2 = -0.2267, w_1 = 5.7468, w_2 = 0.2941, b = 0.0109 }
+[[disc]]
+j = 0.0326
+k = 0.0727
+c = 0.001
+friction = { family = "stribeck", t_s = 0.2, t_c = 0.1, omega_s = 1.5, delta = 2.0, b = 0.01 }
+"""
+
+
+def read_trace(text):
+    lines = text.splitlines()
+    header = lines[0].split(",")
+    rows = np.array([[float(v) for v in line.split(",")] for line in lines[1:]])
+    return header, rows
+
+
+@pytest.fixture
+def chain3(tmp_path):
+    path = tmp_path / "chain3.toml"
+    path.write_text(CHAIN3)
+    return path
+
+
+@pytest.mark.parametrize("solver, knob", [("switch", {"tol": 1e-9}), ("moreau", {"h": 2e-3})])
+def test_a_chain_gives_two_dimensional_arrays_with_the_clis_bits(cli, chain3, tmp_path, solver, knob):
+    """alpha is (N - 1) x len(t) and omega N x len(t), the numbers those of `rotor simulate`
+    bit for bit, from a file and from a dict of its keys alike."""
+    (name, value), = knob.items()
+    x0 = (0.1, 0.0, 0.5, 0.2, 0.0)
+    r = rotorbench.simulate(solver, 1.5, params=str(chain3), x0=x0, t_end=20.0, dt=0.05, **knob)
+    assert r["alpha"].shape == (2, 401) and r["omega"].shape == (3, 401)
+    assert "omega_u" not in r
+    out = tmp_path / "trace.csv"
+    cli(
+        "simulate", "--solver", solver, "--u", "1.5", "--params", chain3,
+        "--x0", ",".join(map(repr, x0)), "--t-end", "20", "--dt", "0.05",
+        f"--{name}", repr(value), "--csv", out,
+    )
+    header, rows = read_trace(out.read_text())
+    assert header == ["t", "alpha_1", "alpha_2", "omega_1", "omega_2", "omega_3"]
+    assert np.array_equal(r["t"], rows[:, 0])
+    assert np.array_equal(r["alpha"], rows[:, 1:3].T)
+    assert np.array_equal(r["omega"], rows[:, 3:].T)
+    if solver == "switch":
+        # The discs stick and slip, and events name them by number (Moreau-Jean's chain run
+        # locates no events yet).
+        discs = {e["disc"] for e in r["events"]}
+        assert discs and discs <= {1, 2, 3}, r["events"][:5]
+    params = {
+        "k_m": 3.995,
+        "disc": [
+            {"j": 0.4765, "friction": {"family": "upper", "t_s": 0.0, "dt_s": 0.0, "b": 2.2247, "db": 0.0}},
+            {"j": 0.0326, "k": 0.0727, "friction": {"family": "exponential", "t_s": 0.1642, "t_1": 0.0603,
+                                                     "t_2": -0.2267, "w_1": 5.7468, "w_2": 0.2941, "b": 0.0109}},
+            {"j": 0.0326, "k": 0.0727, "c": 0.001, "friction": {"family": "stribeck", "t_s": 0.2, "t_c": 0.1,
+                                                                 "omega_s": 1.5, "delta": 2.0, "b": 0.01}},
+        ],
+    }
+    d = rotorbench.simulate(solver, 1.5, params=params, x0=x0, t_end=20.0, dt=0.05, **knob)
+    assert np.array_equal(d["omega"], r["omega"])
+
+
+def test_a_chain_of_two_in_chain_form_is_the_rig():
+    """The rig written as a chain of two gives the rig's numbers, as 2-D arrays."""
+    params = {
+        "k_m": 3.995,
+        "disc": [
+            {"j": 0.4765, "friction": {"family": "upper", "t_s": 0.0, "dt_s": 0.0, "b": 2.2247, "db": 0.0}},
+            {"j": 0.0326, "k": 0.0727, "friction": {"family": "exponential", "t_s": 0.1642, "t_1": 0.0603,
+                                                     "t_2": -0.2267, "w_1": 5.7468, "w_2": 0.2941, "b": 0.0109}},
+        ],
+    }
+    rig = rotorbench.simulate("event", 1.5, t_end=10.0)
+    chain = rotorbench.simulate("event", 1.5, params=params, t_end=10.0)
+    assert np.array_equal(chain["alpha"][0], rig["alpha"])
+    assert np.array_equal(chain["omega"][0], rig["omega_u"])
+    assert np.array_equal(chain["omega"][1], rig["omega_l"])
+    assert {e["disc"] for e in chain["events"]} <= {1, 2}
+
+
+def test_a_chain_refuses_what_it_cannot_take_by_name(chain3):
+    with pytest.raises(ValueError, match=r"solver = \"event\": a chain with 3 discs"):
+        rotorbench.simulate("event", 1.5, params=str(chain3), t_end=1.0)
+    with pytest.raises(ValueError, match="^input: a chain with 3 discs"):
+        rotorbench.simulate("moreau", params=str(chain3), t_end=1.0, input=[[0, 1.5], [1, 2.5]])
+    with pytest.raises(ValueError, match="x0"):
+        rotorbench.simulate("switch", 1.5, params=str(chain3), x0=(0.0, 0.1, 0.0), t_end=1.0)
+    with pytest.raises(TypeError, match=r"params\['disc'\]\[0\]"):
+        rotorbench.simulate("switch", 1.5, params={"k_m": 1.0, "disc": [1.0, 2.0]}, t_end=1.0)
