@@ -228,3 +228,96 @@ fn switch_and_moreau_agree_on_which_discs_are_stuck() {
         );
     }
 }
+
+/// A run's stick onsets, stick exits and reversals, per disc in time order: (kind, time).
+fn events_by_disc(t: &Trajectory, n: usize) -> Vec<Vec<(EventKind, f64)>> {
+    let mut v = vec![Vec::new(); n];
+    for e in &t.events {
+        if let EventKind::StickStart(d) | EventKind::StickEnd(d) | EventKind::Reversal(d) = e.kind {
+            v[d.position()].push((e.kind, e.t));
+        }
+    }
+    v
+}
+
+/// Every stick onset, stick exit and reversal: the switch model and Moreau–Jean find the same
+/// events of every disc in the same order, and Moreau–Jean's times converge at order 2 onto
+/// the switch model's. The gate is the state gate's rule on times: `|t_sw − t_h| ≤
+/// 2·(4/3)·|t_h − t_{h/2}| + 1e-9 s` (Richardson's estimate of Moreau–Jean's own error,
+/// twice; the floor is far above the switch model's timing error, η/|ω̇| ≈ 1e-10 s). The
+/// chain one spring 0.1 % off fails it.
+#[test]
+fn switch_and_moreau_find_the_same_events_at_converging_times() {
+    for (name, p) in chains() {
+        let model = ChainModel::new(&p);
+        let n = model.discs();
+        let events = |kind: SolverKind, a: Accuracy| {
+            let scene = Scene {
+                u: 1.5,
+                x0: vec![0.0; model.dim()],
+                t_end: 20.0,
+                accuracy: a,
+                output: Output::Events,
+                ..Scene::default()
+            };
+            let tr = kind.simulate_chain(&model, &scene).unwrap();
+            events_by_disc(&tr, n)
+        };
+        let sw = events(SolverKind::SWITCH, Accuracy::Tol(SWITCH_TOL));
+        let m = events(SolverKind::MOREAU, Accuracy::Step(H));
+        let m2 = events(SolverKind::MOREAU, Accuracy::Step(H / 2.0));
+        let mut worst: f64 = 0.0;
+        let mut count = 0;
+        for disc in 0..n {
+            let kinds = |v: &[(EventKind, f64)]| v.iter().map(|e| e.0).collect::<Vec<_>>();
+            assert_eq!(
+                kinds(&sw[disc]),
+                kinds(&m[disc]),
+                "{name}, disc {}",
+                disc + 1
+            );
+            assert_eq!(
+                kinds(&m[disc]),
+                kinds(&m2[disc]),
+                "{name}, disc {}",
+                disc + 1
+            );
+            for ((a, b), c) in sw[disc].iter().zip(&m[disc]).zip(&m2[disc]) {
+                let gate = 2.0 * 4.0 / 3.0 * (b.1 - c.1).abs() + 1e-9;
+                worst = worst.max((a.1 - b.1).abs() / gate);
+                count += 1;
+            }
+        }
+        eprintln!("{name}: {count} events, worst |t_sw − t_h| / gate = {worst:.3}");
+        assert!(count >= 3, "{name}: {count} events");
+        assert!(worst <= 1.0, "{name}: {worst}");
+        // The negative control: the chain one spring 0.1 % off moves some event out of its
+        // gate.
+        let mut off = p.clone();
+        off.discs[1].k *= 1.001;
+        let wrong = {
+            let model = ChainModel::new(&off);
+            let scene = Scene {
+                u: 1.5,
+                x0: vec![0.0; model.dim()],
+                t_end: 20.0,
+                accuracy: Accuracy::Tol(SWITCH_TOL),
+                output: Output::Events,
+                ..Scene::default()
+            };
+            events_by_disc(
+                &SolverKind::SWITCH.simulate_chain(&model, &scene).unwrap(),
+                n,
+            )
+        };
+        let mut worst_wrong: f64 = 0.0;
+        for disc in 0..n {
+            for ((a, b), c) in wrong[disc].iter().zip(&m[disc]).zip(&m2[disc]) {
+                let gate = 2.0 * 4.0 / 3.0 * (b.1 - c.1).abs() + 1e-9;
+                worst_wrong = worst_wrong.max((a.1 - b.1).abs() / gate);
+            }
+        }
+        eprintln!("{name} with k_2 × 1.001: worst / gate = {worst_wrong:.1}");
+        assert!(worst_wrong > 1.0, "{name}: {worst_wrong}");
+    }
+}

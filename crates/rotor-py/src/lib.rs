@@ -375,8 +375,8 @@ fn input_of(rows: Option<Vec<[f64; 2]>>) -> PyResult<Option<rotor_model::seam::I
 /// A chain of N discs (``params`` in the chain form: a file of ``[[disc]]`` tables, or a dict
 /// with a ``disc`` list) returns ``alpha`` ((N − 1) × len(t)) and ``omega`` (N × len(t)) as
 /// 2-D arrays instead, events naming the disc by its number (1 … N); ``x0`` then holds its
-/// 2N − 1 values ``alpha_1 … omega_N`` (the default, three zeros, is rest for any N). A chain longer than two runs on ``"switch"`` or
-/// ``"moreau"`` (whose chain run locates no events yet: its list is empty).
+/// 2N − 1 values ``alpha_1 … omega_N`` (the default, three zeros, is rest for any N). A
+/// chain longer than two runs on ``"switch"`` or ``"moreau"``.
 #[pyfunction]
 #[pyo3(
     signature = (solver="event", u=1.5, params=None, x0=vec![0.0; 3], t_end=100.0, dt=0.01, tol=None, h=None, input=None),

@@ -56,11 +56,9 @@ def test_a_chain_gives_two_dimensional_arrays_with_the_clis_bits(cli, chain3, tm
     assert np.array_equal(r["t"], rows[:, 0])
     assert np.array_equal(r["alpha"], rows[:, 1:3].T)
     assert np.array_equal(r["omega"], rows[:, 3:].T)
-    if solver == "switch":
-        # The discs stick and slip, and events name them by number (Moreau-Jean's chain run
-        # locates no events yet).
-        discs = {e["disc"] for e in r["events"]}
-        assert discs and discs <= {1, 2, 3}, r["events"][:5]
+    # The discs stick and slip, and events name them by number.
+    discs = {e["disc"] for e in r["events"]}
+    assert discs and discs <= {1, 2, 3}, r["events"][:5]
     params = {
         "k_m": 3.995,
         "disc": [
