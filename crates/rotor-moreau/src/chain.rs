@@ -458,8 +458,8 @@ impl<'a> ChainEvents<'a> {
 /// `t_end`, the samples of the chain's size (between step ends, linear interpolation, as
 /// the rig's run).
 ///
-/// Its stick onsets and exits and reversals are read off the steps disc by disc
-/// ([`ChainEvents`]). What the chain's run does not do yet is refused by name: a
+/// Its stick onsets and exits and reversals are read off the steps disc by disc, with the
+/// rig's run's rules (crate docs, "Events"). What the chain's run does not do yet is refused by name: a
 /// time-varying input and steady-state metrics (`metrics_from`, [`Output::Metrics`]).
 pub fn simulate_chain(model: &ChainModel, scene: &Scene) -> Result<Trajectory, SolveError> {
     scene.validate_chain(model)?;

@@ -41,13 +41,13 @@ use crate::protocol::{ClientSays, Ended, Job, run_client};
 pub struct ScalingOptions {
     /// The chains' numbers of discs.
     pub discs: Vec<usize>,
-    /// The motor's input [V].
+    /// The motor's input \[V\].
     pub u: f64,
-    /// Every disc's velocity at t = 0 [rad/s] (the springs relaxed).
+    /// Every disc's velocity at t = 0 \[rad/s\] (the springs relaxed).
     pub omega0: f64,
-    /// The horizon [s].
+    /// The horizon \[s\].
     pub t_end: f64,
-    /// The sample grid [s].
+    /// The sample grid \[s\].
     pub dt: f64,
     /// The error every solver's setting must reach.
     pub target: f64,
@@ -66,10 +66,10 @@ pub struct SiconosOptions {
     pub python: String,
     /// The directory of the peer scripts (`bench/peers`).
     pub dir: PathBuf,
-    /// Its horizon [s], shorter than the study's (its cost per step grows fast with N: about
+    /// Its horizon \[s\], shorter than the study's (its cost per step grows fast with N: about
     /// 0.1 s a step at N = 64).
     pub horizon: f64,
-    /// A run's timeout [s].
+    /// A run's timeout \[s\].
     pub timeout: f64,
     /// Where the job and trace files go (a temporary directory: not reported).
     #[serde(skip)]
@@ -105,15 +105,15 @@ pub struct ScalingPoint {
     pub setting_name: &'static str,
     /// Its value.
     pub setting: f64,
-    /// The simulated horizon [s].
+    /// The simulated horizon \[s\].
     pub horizon: f64,
     /// Steps taken.
     pub steps: u64,
-    /// The run's time (median) [s].
+    /// The run's time (median) \[s\].
     pub seconds: f64,
-    /// Cost per simulated second [s/s].
+    /// Cost per simulated second \[s/s\].
     pub per_second: f64,
-    /// Cost per step [s].
+    /// Cost per step \[s\].
     pub per_step: f64,
     /// Largest |Δ| over every sample of every state against the reference (over the peer's
     /// shorter horizon for the peer).
