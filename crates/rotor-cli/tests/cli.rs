@@ -58,7 +58,8 @@ fn simulate_writes_the_contract_csv() {
 /// A two-disc parameter file written in chain form is the rig: the same numbers, bit for bit,
 /// from every solver, under the chain's column names. A chain of three runs on the switch
 /// model and Moreau–Jean, each at its own setting only, and the event solver refuses it by
-/// name (exit 2), with no trace written.
+/// name (exit 2), with no trace written; the switch model takes an input in time on it, and
+/// Moreau–Jean refuses one by name.
 #[test]
 fn a_chain_of_two_in_the_rigs_shape_runs_as_the_rig() {
     let dir = rotor_testkit::tmp_dir("rotor-cli-chain");
@@ -159,6 +160,59 @@ fn a_chain_of_two_in_the_rigs_shape_runs_as_the_rig() {
         assert!(String::from_utf8_lossy(&o.stderr).contains(flag));
         assert!(!csv.exists());
     }
+    // An input in time: the switch model takes it on a chain (the step of u changes the
+    // run), Moreau–Jean's chain run refuses it by name.
+    let input = dir.join("step.csv");
+    std::fs::write(&input, "t,u\n0,1.5\n2,1.5\n2,3.0\n").unwrap();
+    let with_input = |solver: &str, out: &std::path::Path| {
+        rotor(&[
+            "simulate",
+            "--solver",
+            solver,
+            "--input",
+            input.to_str().unwrap(),
+            "--t-end",
+            "5",
+            "--params",
+            chain3.to_str().unwrap(),
+            "--csv",
+            out.to_str().unwrap(),
+        ])
+    };
+    let stepped = dir.join("stepped.csv");
+    let o = with_input("switch", &stepped);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let stepped = std::fs::read_to_string(&stepped).unwrap();
+    // Up to the step at t = 2 s it is the 1.5 V run to 2 s, bit for bit (each ends its last
+    // step on t = 2, the breakpoint or the horizon: rows 0 … 200 of the 0.01 s grid) …
+    let o = rotor(&[
+        "simulate",
+        "--solver",
+        "switch",
+        "--u",
+        "1.5",
+        "--t-end",
+        "2",
+        "--params",
+        chain3.to_str().unwrap(),
+        "--csv",
+        csv.to_str().unwrap(),
+    ]);
+    assert!(o.status.success());
+    let before = std::fs::read_to_string(&csv).unwrap();
+    let head: Vec<&str> = stepped.lines().take(202).collect();
+    assert_eq!(head, before.lines().collect::<Vec<_>>());
+    // … and after it the run is another than the 1.5 V one.
+    let o = run(chain3.to_str().unwrap(), &csv, "switch");
+    assert!(o.status.success());
+    let constant = std::fs::read_to_string(&csv).unwrap();
+    assert_eq!(stepped.lines().count(), constant.lines().count());
+    assert_ne!(stepped.lines().last(), constant.lines().last());
+    std::fs::remove_file(&csv).unwrap();
+    let o = with_input("moreau", &csv);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("--input"));
+    assert!(!csv.exists());
     std::fs::remove_dir_all(&dir).ok();
 }
 
