@@ -7,13 +7,16 @@ the trace (header t,alpha,omega_u,omega_l, one row per grid time 0, dt, ..., t_e
 locates them, the events (header t,disc,kind), and prints one JSON line with its in-process
 time, `{"solve_seconds": S, ...}`.
 
-Used by scipy_rotor.py and siconos_rotor.py (each inserts its own directory at the front of
+Used by scipy_rotor.py, siconos_rotor.py and siconos_chain.py (each inserts its own directory at the front of
 sys.path before importing this module, so they run from any working directory). Standard
 library and numpy only: it imports without scipy or Siconos installed.
 """
 
 import json
 import math
+import os
+import shutil
+import subprocess
 import sys
 import time
 
@@ -98,3 +101,40 @@ def report(solve_seconds, version, method, steps=None, rhs_evals=None):
     if rhs_evals is not None:
         out["rhs_evals"] = rhs_evals
     print(json.dumps(out))
+
+
+def build_plugin(source, workdir):
+    """Compiles the C plugin `source` (a file beside the peer scripts) with cc into `workdir`;
+    returns the shared library's path (built before any timing)."""
+    src = os.path.join(os.path.dirname(os.path.abspath(__file__)), source)
+    out = os.path.join(workdir, os.path.splitext(source)[0] + ".so")
+    cc = shutil.which("cc") or shutil.which("gcc")
+    if cc is None:
+        raise RuntimeError("no C compiler (cc/gcc) to build the Siconos plugin")
+    subprocess.run([cc, "-O2", "-shared", "-fPIC", "-o", out, src, "-lm"], check=True)
+    return out
+
+
+def on_grid(step_ends, a0, grid, h):
+    """A fixed-step run sampled on `grid`: `step_ends` yields each step's end as (t, state),
+    `a0` is the state at t = 0; a grid time gets the linear interpolation between the step
+    ends around it (the last state after the last end). Returns (the dim x len(grid) array,
+    the number of steps)."""
+    y = np.empty((len(a0), len(grid)))
+    i = 0
+    while i < len(grid) and grid[i] <= 0.0:
+        y[:, i] = a0
+        i += 1
+    t_a, a_a = 0.0, a0
+    steps = 0
+    for t_b, a_b in step_ends:
+        steps += 1
+        while i < len(grid) and grid[i] <= t_b + 1e-12 * h:
+            s = (grid[i] - t_a) / (t_b - t_a)
+            y[:, i] = a_a + s * (a_b - a_a)
+            i += 1
+        t_a, a_a = t_b, a_b
+    while i < len(grid):
+        y[:, i] = a_a
+        i += 1
+    return y, steps

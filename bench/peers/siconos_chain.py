@@ -25,8 +25,6 @@ omega_1,...,omega_N; linear between step ends) and prints {"solve_seconds": S, "
 
 import math
 import os
-import shutil
-import subprocess
 import sys
 import tempfile
 from importlib import metadata
@@ -43,16 +41,6 @@ STICK_V = 1e-14
 FAMILIES = {"viscous": 0.0, "upper": 1.0, "exponential": 2.0, "stribeck": 3.0}
 FIELDS = ["k", "c", "b", "t_s", "dt_s", "db", "t_1", "t_2", "w_1", "w_2", "t_c", "omega_s",
           "delta"]
-
-
-def build_plugin(workdir):
-    src = os.path.join(os.path.dirname(os.path.abspath(__file__)), "siconos_chain_plugin.c")
-    out = os.path.join(workdir, "siconos_chain_plugin.so")
-    cc = shutil.which("cc") or shutil.which("gcc")
-    if cc is None:
-        raise RuntimeError("no C compiler (cc/gcc) to build the Siconos plugin")
-    subprocess.run([cc, "-O2", "-shared", "-fPIC", "-o", out, src, "-lm"], check=True)
-    return out
 
 
 class Chain:
@@ -118,33 +106,18 @@ def simulate(c, plugin, x0, t_end, h, grid):
 
     q = ds.q()
     v = ds.velocity()
-    dim = 2 * n - 1
-    y = np.empty((dim, len(grid)))
-    a0 = np.concatenate([alpha0, omega0])
-    i = 0
-    while i < len(grid) and grid[i] <= 0.0:
-        y[:, i] = a0
-        i += 1
-    t_a, a_a = 0.0, a0
-    steps = 0
-    while sim.hasNextEvent():
-        sim.computeOneStep()
-        steps += 1
-        t_b = sim.nextTime()
-        a_b = np.empty(dim)
-        a_b[: n - 1] = [q[k] - q[k + 1] for k in range(n - 1)]
-        a_b[n - 1 :] = [v[k] for k in range(n)]
-        a_b[n - 1 :][np.abs(a_b[n - 1 :]) <= STICK_V] = 0.0
-        while i < len(grid) and grid[i] <= t_b + 1e-12 * h:
-            s = (grid[i] - t_a) / (t_b - t_a)
-            y[:, i] = a_a + s * (a_b - a_a)
-            i += 1
-        t_a, a_a = t_b, a_b
-        sim.nextStep()
-    while i < len(grid):
-        y[:, i] = a_a
-        i += 1
-    return y, steps
+
+    def step_ends():
+        while sim.hasNextEvent():
+            sim.computeOneStep()
+            a_b = np.empty(2 * n - 1)
+            a_b[: n - 1] = [q[k] - q[k + 1] for k in range(n - 1)]
+            a_b[n - 1 :] = [v[k] for k in range(n)]
+            a_b[n - 1 :][np.abs(a_b[n - 1 :]) <= STICK_V] = 0.0
+            yield sim.nextTime(), a_b
+            sim.nextStep()
+
+    return common.on_grid(step_ends(), np.concatenate([alpha0, omega0]), grid, h)
 
 
 def write_trace(path, grid, y, n):
@@ -169,7 +142,7 @@ def main():
     sn.numerics_set_verbose(0)
     grid = common.grid_times(job["dt"], job["t_end"])
     with tempfile.TemporaryDirectory() as workdir:
-        plugin = build_plugin(workdir)
+        plugin = common.build_plugin("siconos_chain_plugin.c", workdir)
         try:
             (y, steps), seconds = common.timed(
                 lambda: simulate(c, plugin, job["x0"], job["t_end"], h, grid)

@@ -39,8 +39,6 @@ job and writing the trace excluded).
 
 import math
 import os
-import shutil
-import subprocess
 import sys
 import tempfile
 from importlib import metadata
@@ -57,16 +55,6 @@ import peer_common as common  # noqa: E402  (shared set-up, next to this script)
 # after a (tangential) stick exit has theta_l' ~ (k_theta omega_u / 2 J_l) h^2 >= 7e-11 rad/s
 # at h = 1e-5. 1e-14 separates the two by three decades on both sides.
 STICK_V = 1e-14
-
-
-def build_plugin(workdir):
-    src = os.path.join(os.path.dirname(os.path.abspath(__file__)), "siconos_rotor_plugin.c")
-    out = os.path.join(workdir, "siconos_rotor_plugin.so")
-    cc = shutil.which("cc") or shutil.which("gcc")
-    if cc is None:
-        raise RuntimeError("no C compiler (cc/gcc) to build the Siconos plugin")
-    subprocess.run([cc, "-O2", "-shared", "-fPIC", "-o", out, src, "-lm"], check=True)
-    return out
 
 
 class Params:
@@ -136,31 +124,17 @@ def simulate(p, plugin, x0, t_end, h, grid):
 
     q = ds.q()
     v = ds.velocity()
-    y = np.empty((3, len(grid)))
-    i = 0
-    while i < len(grid) and grid[i] <= 0.0:
-        y[:, i] = (alpha0, wu0, wl0)
-        i += 1
-    # The previous step end: (t, alpha, omega_u, omega_l).
-    t_a, a_a = 0.0, np.array([alpha0, wu0, wl0])
-    steps = 0
-    while sim.hasNextEvent():
-        sim.computeOneStep()
-        steps += 1
-        t_b = sim.nextTime()
-        a_b = np.array([q[0] - q[1], v[0], v[1]])
-        if abs(a_b[2]) <= STICK_V:
-            a_b[2] = 0.0
-        while i < len(grid) and grid[i] <= t_b + 1e-12 * h:
-            s = (grid[i] - t_a) / (t_b - t_a)
-            y[:, i] = a_a + s * (a_b - a_a)
-            i += 1
-        t_a, a_a = t_b, a_b
-        sim.nextStep()
-    while i < len(grid):
-        y[:, i] = a_a
-        i += 1
-    return y, steps
+
+    def step_ends():
+        while sim.hasNextEvent():
+            sim.computeOneStep()
+            a_b = np.array([q[0] - q[1], v[0], v[1]])
+            if abs(a_b[2]) <= STICK_V:
+                a_b[2] = 0.0
+            yield sim.nextTime(), a_b
+            sim.nextStep()
+
+    return common.on_grid(step_ends(), np.array([alpha0, wu0, wl0]), grid, h)
 
 
 def main():
@@ -173,7 +147,7 @@ def main():
     sn.numerics_set_verbose(0)
     grid = common.grid_times(job["dt"], job["t_end"])
     with tempfile.TemporaryDirectory() as workdir:
-        plugin = build_plugin(workdir)
+        plugin = common.build_plugin("siconos_rotor_plugin.c", workdir)
         try:
             (y, steps), seconds = common.timed(
                 lambda: simulate(p, plugin, job["x0"], job["t_end"], h, grid)

@@ -34,6 +34,7 @@ use rotor_model::seam::{
 use rotor_model::{Disc, DiscMode, Mode};
 
 use crate::contacts::{ContactError, ContactSolver, Tridiagonal};
+use crate::run::{exit_time, onset_time};
 
 /// Fixed-point iterations per step before the step is refused.
 const MAX_ITERATIONS: usize = 60;
@@ -378,11 +379,7 @@ impl<'a> ChainEvents<'a> {
                     };
                     let (za, zb) = (z(&cur.x), z(&next.x));
                     let t0 = self.back.as_ref().map_or(cur.t, |b| b.t);
-                    let t = if zb > za {
-                        (cur.t - za * (next.t - cur.t) / (zb - za)).clamp(t0, next.t)
-                    } else {
-                        cur.t + self.theta * (next.t - cur.t)
-                    };
+                    let t = exit_time(za, zb, (t0, cur.t, next.t), self.theta);
                     let x = match &self.back {
                         Some(b) if t < cur.t => Self::lerp(b, cur, t),
                         _ => Self::lerp(cur, next, t),
@@ -426,18 +423,7 @@ impl<'a> ChainEvents<'a> {
         let acc = f[k];
         let jac = model.jacobian(&cur.x, mode);
         let jerk: f64 = (0..model.dim()).map(|c| jac[(k, c)] * f[c]).sum();
-        if acc * w < 0.0 {
-            let d1 = -w / acc;
-            let den = acc + jerk * d1;
-            let d2 = if den * acc > 0.0 {
-                d1 - 0.5 * jerk * d1 * d1 / den
-            } else {
-                d1
-            };
-            (cur.t + d2).clamp(cur.t, next.t)
-        } else {
-            next.t
-        }
+        onset_time(w, acc, jerk, cur.t, next.t)
     }
 
     /// Releases the events before `t` (every event found later lies at or after it).

@@ -201,6 +201,37 @@ fn steps_to(t_end: f64, base: f64, h: f64) -> f64 {
     ((t_end - base) / h - 1e-9).ceil().max(1.0)
 }
 
+/// A stick exit within the step `t_a → t_b`: the zero of the applied torque's excess over the
+/// stick interval, `z_a` at `t_a` and `z_b` at `t_b`, linear between the step's ends and
+/// clamped to `[t_0, t_b]` (`t_0` the start of the step before: the disc may have been held
+/// one step too long); where the excess does not grow over the step, the θ-point of the step.
+pub(crate) fn exit_time(za: f64, zb: f64, (t0, ta, tb): (f64, f64, f64), theta: f64) -> f64 {
+    if zb > za {
+        (ta - za * (tb - ta) / (zb - za)).clamp(t0, tb)
+    } else {
+        ta + theta * (tb - ta)
+    }
+}
+
+/// A stick onset within the step `t_a → t_b` of a disc at velocity `w` with acceleration
+/// `acc` and jerk `jerk` at `t_a`: the zero of `ω(t_a + Δ) ≈ w + accΔ + ½jerkΔ²`, one Newton
+/// correction from the linear zero `−w/acc` (the linear zero where the correction would
+/// turn back), clamped to the step; `t_b` where the disc is not decelerating toward 0.
+pub(crate) fn onset_time(w: f64, acc: f64, jerk: f64, ta: f64, tb: f64) -> f64 {
+    if acc * w < 0.0 {
+        let d1 = -w / acc;
+        let den = acc + jerk * d1;
+        let d2 = if den * acc > 0.0 {
+            d1 - 0.5 * jerk * d1 * d1 / den
+        } else {
+            d1
+        };
+        (ta + d2).clamp(ta, tb)
+    } else {
+        tb
+    }
+}
+
 impl Run<'_> {
     /// One step, its events (when the recorder wants them) and its samples.
     fn step(&mut self, rec: &mut Recorder) -> Result<(), SolveError> {
@@ -333,11 +364,7 @@ impl Run<'_> {
         };
         let (za, zb) = (z(&cur.x, cur.t), z(&next.x, next.t));
         let t0 = self.prev.map_or(cur.t, |p| p.t);
-        if zb > za {
-            (cur.t - za * (next.t - cur.t) / (zb - za)).clamp(t0, next.t)
-        } else {
-            cur.t + self.theta * (next.t - cur.t)
-        }
+        exit_time(za, zb, (t0, cur.t, next.t), self.theta)
     }
 
     /// Stick onset of disc `d` from `slip` within the step to `next`: the zero of
@@ -359,18 +386,7 @@ impl Run<'_> {
             0.0
         };
         let jerk = (model.jacobian(&cur.x, 0.0, mode) * f)[wi] + drift;
-        if acc * w < 0.0 {
-            let d1 = -w / acc;
-            let den = acc + jerk * d1;
-            let d2 = if den * acc > 0.0 {
-                d1 - 0.5 * jerk * d1 * d1 / den
-            } else {
-                d1
-            };
-            (cur.t + d2).clamp(cur.t, next.t)
-        } else {
-            next.t
-        }
+        onset_time(w, acc, jerk, cur.t, next.t)
     }
 
     /// An extremum of disc `d`'s velocity while it slips over the last three step ends: the

@@ -21,6 +21,15 @@ c = 0.001
 friction = { family = "stribeck", t_s = 0.2, t_c = 0.1, omega_s = 1.5, delta = 2.0, b = 0.01 }
 """
 
+#: CHAIN3's discs as a dict's `disc` list (its first two are Table 1's rig).
+DISCS = [
+    {"j": 0.4765, "friction": {"family": "upper", "t_s": 0.0, "dt_s": 0.0, "b": 2.2247, "db": 0.0}},
+    {"j": 0.0326, "k": 0.0727, "friction": {"family": "exponential", "t_s": 0.1642, "t_1": 0.0603,
+                                             "t_2": -0.2267, "w_1": 5.7468, "w_2": 0.2941, "b": 0.0109}},
+    {"j": 0.0326, "k": 0.0727, "c": 0.001, "friction": {"family": "stribeck", "t_s": 0.2, "t_c": 0.1,
+                                                         "omega_s": 1.5, "delta": 2.0, "b": 0.01}},
+]
+
 
 def read_trace(text):
     lines = text.splitlines()
@@ -59,30 +68,14 @@ def test_a_chain_gives_two_dimensional_arrays_with_the_clis_bits(cli, chain3, tm
     # The discs stick and slip, and events name them by number.
     discs = {e["disc"] for e in r["events"]}
     assert discs and discs <= {1, 2, 3}, r["events"][:5]
-    params = {
-        "k_m": 3.995,
-        "disc": [
-            {"j": 0.4765, "friction": {"family": "upper", "t_s": 0.0, "dt_s": 0.0, "b": 2.2247, "db": 0.0}},
-            {"j": 0.0326, "k": 0.0727, "friction": {"family": "exponential", "t_s": 0.1642, "t_1": 0.0603,
-                                                     "t_2": -0.2267, "w_1": 5.7468, "w_2": 0.2941, "b": 0.0109}},
-            {"j": 0.0326, "k": 0.0727, "c": 0.001, "friction": {"family": "stribeck", "t_s": 0.2, "t_c": 0.1,
-                                                                 "omega_s": 1.5, "delta": 2.0, "b": 0.01}},
-        ],
-    }
+    params = {"k_m": 3.995, "disc": DISCS}
     d = rotorbench.simulate(solver, 1.5, params=params, x0=x0, t_end=20.0, dt=0.05, **knob)
     assert np.array_equal(d["omega"], r["omega"])
 
 
 def test_a_chain_of_two_in_chain_form_is_the_rig():
     """The rig written as a chain of two gives the rig's numbers, as 2-D arrays."""
-    params = {
-        "k_m": 3.995,
-        "disc": [
-            {"j": 0.4765, "friction": {"family": "upper", "t_s": 0.0, "dt_s": 0.0, "b": 2.2247, "db": 0.0}},
-            {"j": 0.0326, "k": 0.0727, "friction": {"family": "exponential", "t_s": 0.1642, "t_1": 0.0603,
-                                                     "t_2": -0.2267, "w_1": 5.7468, "w_2": 0.2941, "b": 0.0109}},
-        ],
-    }
+    params = {"k_m": 3.995, "disc": DISCS[:2]}
     rig = rotorbench.simulate("event", 1.5, t_end=10.0)
     chain = rotorbench.simulate("event", 1.5, params=params, t_end=10.0)
     assert np.array_equal(chain["alpha"][0], rig["alpha"])

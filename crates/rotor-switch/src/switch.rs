@@ -571,9 +571,7 @@ where
     /// One accepted step, up to its first region change: the markers before it, the samples,
     /// the switch itself, and the restart after it.
     fn step(&mut self, rec: &mut Recorder) -> Result<(), SolveError> {
-        self.y.copy_from(self.integ.y());
         let f = &self.field;
-        let before = &self.y;
         self.integ
             .step(
                 &mut |t, y: &Vector<D>, dy: &mut Vector<D>| {
@@ -582,6 +580,7 @@ where
                 self.seg_end,
             )
             .map_err(|e| {
+                // A failed step leaves the stepper where it was: its state is the one before.
                 let t = self.integ.t();
                 let y = self.integ.y().as_slice();
                 let mut dy = y.to_vec();
@@ -589,7 +588,7 @@ where
                 if dy.iter().any(|v| !v.is_finite()) {
                     SolveError::NonFinite { t, x: y.to_vec() }
                 } else {
-                    map_err(e, before.as_slice())
+                    map_err(e, y)
                 }
             })?;
         check_finite(self.integ.t(), self.integ.y().as_slice())?;

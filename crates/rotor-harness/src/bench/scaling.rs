@@ -490,26 +490,25 @@ impl ScalingReport {
         v
     }
 
-    /// A runner's slope of cost per simulated second against N (log–log), over its points.
-    pub fn slope(&self, runner: &str) -> Option<f64> {
+    /// A runner's log–log slope against N of one cost of its points.
+    fn slope_of(&self, runner: &str, cost: fn(&ScalingPoint) -> f64) -> Option<f64> {
         let pts: Vec<(f64, f64)> = self
             .points
             .iter()
             .filter(|p| p.runner == runner)
-            .map(|p| (p.discs as f64, p.per_second))
+            .map(|p| (p.discs as f64, cost(p)))
             .collect();
         log_slope(&pts)
     }
 
+    /// A runner's slope of cost per simulated second against N (log–log), over its points.
+    pub fn slope(&self, runner: &str) -> Option<f64> {
+        self.slope_of(runner, |p| p.per_second)
+    }
+
     /// A runner's slope of cost per step against N (log–log).
     pub fn step_slope(&self, runner: &str) -> Option<f64> {
-        let pts: Vec<(f64, f64)> = self
-            .points
-            .iter()
-            .filter(|p| p.runner == runner)
-            .map(|p| (p.discs as f64, p.per_step))
-            .collect();
-        log_slope(&pts)
+        self.slope_of(runner, |p| p.per_step)
     }
 
     /// The points as CSV, one row each.
