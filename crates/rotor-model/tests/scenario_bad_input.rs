@@ -97,3 +97,19 @@ fn a_missing_scenario_file() {
     let e = Scenario::from_file(&missing).unwrap_err().to_string();
     check_message("missing file", &e, &missing, &["cannot read scenario file"]);
 }
+
+/// An input file whose name holds a line break (a fuzzed file found it): the message escapes
+/// the name and stays one line.
+#[test]
+fn an_input_file_named_with_a_line_break_is_one_line() {
+    let text = edit(
+        &local_scenario(),
+        "u = 1.5 ",
+        "input = \"\"\"two\nlines\"\"\" ",
+    );
+    scenario_err(
+        "input file with a line break",
+        text.as_bytes(),
+        &["input", "two\\nlines"],
+    );
+}

@@ -377,10 +377,10 @@ fn check_input(
                 bad.at(
                     "input",
                     format!("{:?}", file.display().to_string()),
-                    &format!("cannot read {}: {e}", p.display()),
+                    &format!("cannot read {}: {e}", crate::params::shown(&p)),
                 )
             })?;
-            Input::from_csv(&text, &file.display().to_string()).map_err(|e| {
+            Input::from_csv(&text, &crate::params::shown(file)).map_err(|e| {
                 ScenarioError::Invalid {
                     path: path.to_owned(),
                     error: e,
