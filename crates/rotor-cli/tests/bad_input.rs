@@ -64,8 +64,15 @@ fn bad_parameter_files_are_named_with_field_and_value() {
         let o = rotor(&["steady", "--solver", "event", "--u", "1", "--params", fs]);
         assert_clean_error(&o, what, &needles);
         let csv = dir.join(format!("p{i}.csv"));
-        // The event solver: the switch model and Moreau–Jean run a good chain of three,
-        // which the event solver refuses by name.
+        // A good chain of three is bad only where the rig is read (`steady` above): every
+        // solver simulates it.
+        let good_chain = std::str::from_utf8(&c.contents)
+            .ok()
+            .and_then(|t| rotor_model::ChainParams::from_toml_str(t, Path::new("c")).ok())
+            .is_some_and(|p| p.len() > 2);
+        if good_chain {
+            continue;
+        }
         let o = rotor(&[
             "simulate",
             "--solver",

@@ -56,10 +56,9 @@ fn simulate_writes_the_contract_csv() {
 }
 
 /// A two-disc parameter file written in chain form is the rig: the same numbers, bit for bit,
-/// from every solver, under the chain's column names. A chain of three runs on the switch
-/// model and Moreau–Jean, each at its own setting only, and the event solver refuses it by
-/// name (exit 2), with no trace written; the switch model takes an input in time on it, and
-/// Moreau–Jean refuses one by name.
+/// from every solver, under the chain's column names. A chain of three runs on every solver,
+/// each at its own setting only; the event solver and the switch model take an input in
+/// time on it, and Moreau–Jean refuses one by name.
 #[test]
 fn a_chain_of_two_in_the_rigs_shape_runs_as_the_rig() {
     let dir = rotor_testkit::tmp_dir("rotor-cli-chain");
@@ -102,20 +101,11 @@ fn a_chain_of_two_in_the_rigs_shape_runs_as_the_rig() {
         assert_eq!(chain_head, "t,alpha_1,omega_1,omega_2", "{solver}");
         assert_eq!(rig_rows, chain_rows, "{solver}");
     }
-    // A chain of three runs on the switch model and on Moreau–Jean, headed with its five
-    // states; the event solver refuses it by name (exit 2), with no trace written.
+    // A chain of three runs on every solver, headed with its five states.
     let chain3 = dir.join("chain3.toml");
     std::fs::write(&chain3, rotor_testkit::CHAIN3).unwrap();
     let csv = dir.join("three.csv");
-    let o = run(chain3.to_str().unwrap(), &csv, "event");
-    assert_eq!(o.status.code(), Some(2));
-    let err = String::from_utf8_lossy(&o.stderr);
-    assert!(
-        err.contains("a chain with 3 discs") && err.contains("--solver switch or moreau"),
-        "{err}"
-    );
-    assert!(!csv.exists());
-    for solver in ["switch", "moreau"] {
+    for solver in ["event", "switch", "moreau"] {
         let o = run(chain3.to_str().unwrap(), &csv, solver);
         assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
         let text = std::fs::read_to_string(&csv).unwrap();
@@ -140,7 +130,7 @@ fn a_chain_of_two_in_the_rigs_shape_runs_as_the_rig() {
         std::fs::remove_file(&csv).unwrap();
     }
     // Each solver's own accuracy setting only: the other one is refused by name.
-    for (solver, flag) in [("switch", "--h"), ("moreau", "--tol")] {
+    for (solver, flag) in [("event", "--h"), ("switch", "--h"), ("moreau", "--tol")] {
         let o = rotor(&[
             "simulate",
             "--solver",
@@ -160,8 +150,8 @@ fn a_chain_of_two_in_the_rigs_shape_runs_as_the_rig() {
         assert!(String::from_utf8_lossy(&o.stderr).contains(flag));
         assert!(!csv.exists());
     }
-    // An input in time: the switch model takes it on a chain (the step of u changes the
-    // run), Moreau–Jean's chain run refuses it by name.
+    // An input in time: the event solver and the switch model take it on a chain (the step
+    // of u changes the run), Moreau–Jean's chain run refuses it by name.
     let input = dir.join("step.csv");
     std::fs::write(&input, "t,u\n0,1.5\n2,1.5\n2,3.0\n").unwrap();
     let with_input = |solver: &str, out: &std::path::Path| {
@@ -179,35 +169,38 @@ fn a_chain_of_two_in_the_rigs_shape_runs_as_the_rig() {
             out.to_str().unwrap(),
         ])
     };
-    let stepped = dir.join("stepped.csv");
-    let o = with_input("switch", &stepped);
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    let stepped = std::fs::read_to_string(&stepped).unwrap();
-    // Up to the step at t = 2 s it is the 1.5 V run to 2 s, bit for bit (each ends its last
-    // step on t = 2, the breakpoint or the horizon: rows 0 … 200 of the 0.01 s grid) …
-    let o = rotor(&[
-        "simulate",
-        "--solver",
-        "switch",
-        "--u",
-        "1.5",
-        "--t-end",
-        "2",
-        "--params",
-        chain3.to_str().unwrap(),
-        "--csv",
-        csv.to_str().unwrap(),
-    ]);
-    assert!(o.status.success());
-    let before = std::fs::read_to_string(&csv).unwrap();
-    let head: Vec<&str> = stepped.lines().take(202).collect();
-    assert_eq!(head, before.lines().collect::<Vec<_>>());
-    // … and after it the run is another than the 1.5 V one.
-    let o = run(chain3.to_str().unwrap(), &csv, "switch");
-    assert!(o.status.success());
-    let constant = std::fs::read_to_string(&csv).unwrap();
-    assert_eq!(stepped.lines().count(), constant.lines().count());
-    assert_ne!(stepped.lines().last(), constant.lines().last());
+    for solver in ["event", "switch"] {
+        let stepped = dir.join("stepped.csv");
+        let o = with_input(solver, &stepped);
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        let stepped = std::fs::read_to_string(&stepped).unwrap();
+        // Up to the step at t = 2 s it is the 1.5 V run to 2 s, bit for bit (each ends its
+        // last step on t = 2, the breakpoint or the horizon: rows 0 … 200 of the 0.01 s
+        // grid) …
+        let o = rotor(&[
+            "simulate",
+            "--solver",
+            solver,
+            "--u",
+            "1.5",
+            "--t-end",
+            "2",
+            "--params",
+            chain3.to_str().unwrap(),
+            "--csv",
+            csv.to_str().unwrap(),
+        ]);
+        assert!(o.status.success());
+        let before = std::fs::read_to_string(&csv).unwrap();
+        let head: Vec<&str> = stepped.lines().take(202).collect();
+        assert_eq!(head, before.lines().collect::<Vec<_>>(), "{solver}");
+        // … and after it the run is another than the 1.5 V one.
+        let o = run(chain3.to_str().unwrap(), &csv, solver);
+        assert!(o.status.success());
+        let constant = std::fs::read_to_string(&csv).unwrap();
+        assert_eq!(stepped.lines().count(), constant.lines().count());
+        assert_ne!(stepped.lines().last(), constant.lines().last(), "{solver}");
+    }
     std::fs::remove_file(&csv).unwrap();
     let o = with_input("moreau", &csv);
     assert_eq!(o.status.code(), Some(2));

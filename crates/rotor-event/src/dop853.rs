@@ -5,11 +5,51 @@
 //! The stepper is split so that the caller owns the loop (and so can stop at events):
 //! [`Dop853::trial`] computes one step and its error, [`Dop853::accept`]/[`Dop853::reject`]
 //! run the controller, [`Dop853::dense`] builds the continuous extension of an accepted step.
-//! Everything is on fixed-size nalgebra vectors: no heap allocation.
+//!
+//! The state is an `OVector<f64, D>`: fixed-size on the stack for the rig (no heap
+//! allocation), a `DVector` for a chain of any size (one vector per stage). Every stage's
+//! argument `y + h·Σ_j a_ij k_j` is summed component by component, left to right, the
+//! order in which the fixed-size expressions summed it, so the rig's steps are the same to
+//! the last bit whatever the storage.
 
-use nalgebra::SVector;
+use nalgebra::{DefaultAllocator, Dim, OVector, allocator::Allocator};
 
 use crate::tableau::*;
+
+/// A state of dimension `D`.
+pub type Vector<D> = OVector<f64, D>;
+
+/// `y + (Σ_j c_j·k_j)·h`, the sum taken component by component from the left.
+#[inline(always)]
+fn stage<D: Dim>(y: &Vector<D>, terms: &[(&Vector<D>, f64)], h: f64) -> Vector<D>
+where
+    DefaultAllocator: Allocator<D>,
+{
+    let mut out = y.clone();
+    for (i, o) in out.iter_mut().enumerate() {
+        let mut s = terms[0].0[i] * terms[0].1;
+        for (k, c) in &terms[1..] {
+            s += k[i] * *c;
+        }
+        *o += s * h;
+    }
+    out
+}
+
+/// `Σ_j c_j·k_j`, component by component from the left.
+#[inline(always)]
+fn combine<D: Dim>(terms: &[(&Vector<D>, f64)]) -> Vector<D>
+where
+    DefaultAllocator: Allocator<D>,
+{
+    let mut out = terms[0].0 * terms[0].1;
+    for (i, o) in out.iter_mut().enumerate() {
+        for (k, c) in &terms[1..] {
+            *o += k[i] * *c;
+        }
+    }
+    out
+}
 
 /// Step-size controller and tolerances.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -33,41 +73,60 @@ pub struct Dop853 {
 }
 
 /// A trial step: the new state, its scaled error, and the stages needed for dense output.
-#[derive(Debug, Clone, Copy)]
-pub struct Trial<const N: usize> {
+#[derive(Debug, Clone)]
+pub struct Trial<D: Dim>
+where
+    DefaultAllocator: Allocator<D>,
+{
     /// Start time of the step.
     pub t: f64,
     /// Step size; the step ends at `t + h`.
     pub h: f64,
     /// State at `t`.
-    pub y0: SVector<f64, N>,
+    pub y0: Vector<D>,
     /// The 8th-order solution at `t + h`.
-    pub y1: SVector<f64, N>,
+    pub y1: Vector<D>,
     /// Scaled error norm (≤ 1: acceptable).
     pub err: f64,
     /// Stages k1..k12 (index 0..11).
-    k: [SVector<f64, N>; 12],
+    k: [Vector<D>; 12],
 }
 
 /// The 7th-order continuous extension of one accepted step.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Dense<const N: usize> {
+#[derive(Debug, Clone, PartialEq)]
+pub struct Dense<D: Dim>
+where
+    DefaultAllocator: Allocator<D>,
+{
     /// Start time of the step it interpolates.
     pub t0: f64,
     /// Length of that step; the interpolant covers `[t0, t0 + h]`.
     pub h: f64,
-    c: [SVector<f64, N>; 8],
+    c: [Vector<D>; 8],
 }
 
-impl<const N: usize> Dense<N> {
+impl<D: Dim> Dense<D>
+where
+    DefaultAllocator: Allocator<D>,
+{
     /// The interpolant at time t (meant for `t ∈ [t0, t0 + h]`).
     #[inline]
-    pub fn eval(&self, t: f64) -> SVector<f64, N> {
+    pub fn eval(&self, t: f64) -> Vector<D> {
+        let mut out = self.c[0].clone();
+        self.eval_into(t, out.as_mut_slice());
+        out
+    }
+
+    /// [`Dense::eval`] written into `out` (of the state's size).
+    #[inline]
+    pub fn eval_into(&self, t: f64, out: &mut [f64]) {
         let s = (t - self.t0) / self.h;
         let s1 = 1.0 - s;
         let c = &self.c;
-        let par = c[4] + (c[5] + (c[6] + c[7] * s) * s1) * s;
-        c[0] + (c[1] + (c[2] + (c[3] + par * s1) * s) * s1) * s
+        for (i, o) in out.iter_mut().enumerate() {
+            let par = c[4][i] + (c[5][i] + (c[6][i] + c[7][i] * s) * s1) * s;
+            *o = c[0][i] + (c[1][i] + (c[2][i] + (c[3][i] + par * s1) * s) * s1) * s;
+        }
     }
 
     /// The interpolant and its time derivative at time t (meant for `t ∈ [t0, t0 + h]`):
@@ -75,28 +134,55 @@ impl<const N: usize> Dense<N> {
     /// (with ds₁/ds = −1), divided by h. At the ends the derivative is the field there, up
     /// to rounding: the interpolant is Hermite at both ends.
     #[inline]
-    pub(crate) fn eval_with_rate(&self, t: f64) -> (SVector<f64, N>, SVector<f64, N>) {
+    pub(crate) fn eval_with_rate(&self, t: f64) -> (Vector<D>, Vector<D>) {
         let s = (t - self.t0) / self.h;
         let s1 = 1.0 - s;
         let c = &self.c;
-        let p7 = c[6] + c[7] * s;
-        let p6 = c[5] + p7 * s1;
-        let d6 = c[7] * s1 - p7;
-        let p5 = c[4] + p6 * s;
+        let mut x = c[0].clone();
+        let mut r = c[0].clone();
+        for i in 0..x.len() {
+            let p7 = c[6][i] + c[7][i] * s;
+            let p6 = c[5][i] + p7 * s1;
+            let d6 = c[7][i] * s1 - p7;
+            let p5 = c[4][i] + p6 * s;
+            let d5 = d6 * s + p6;
+            let p4 = c[3][i] + p5 * s1;
+            let d4 = d5 * s1 - p5;
+            let p3 = c[2][i] + p4 * s;
+            let d3 = d4 * s + p4;
+            let p2 = c[1][i] + p3 * s1;
+            let d2 = d3 * s1 - p3;
+            x[i] = c[0][i] + p2 * s;
+            r[i] = (d2 * s + p2) / self.h;
+        }
+        (x, r)
+    }
+
+    /// One component of the interpolant's time derivative at time t.
+    #[inline]
+    pub(crate) fn rate_of(&self, t: f64, i: usize) -> f64 {
+        let s = (t - self.t0) / self.h;
+        let s1 = 1.0 - s;
+        let c = &self.c;
+        let p7 = c[6][i] + c[7][i] * s;
+        let p6 = c[5][i] + p7 * s1;
+        let d6 = c[7][i] * s1 - p7;
+        let p5 = c[4][i] + p6 * s;
         let d5 = d6 * s + p6;
-        let p4 = c[3] + p5 * s1;
+        let p4 = c[3][i] + p5 * s1;
         let d4 = d5 * s1 - p5;
-        let p3 = c[2] + p4 * s;
+        let p3 = c[2][i] + p4 * s;
         let d3 = d4 * s + p4;
-        let p2 = c[1] + p3 * s1;
+        let p2 = c[1][i] + p3 * s1;
         let d2 = d3 * s1 - p3;
-        (c[0] + p2 * s, (d2 * s + p2) / self.h)
+        (d2 * s + p2) / self.h
     }
 
     /// The interpolant of a constant state on `[t0, t0 + h]`.
-    pub fn constant(t0: f64, h: f64, y: &SVector<f64, N>) -> Dense<N> {
-        let mut c = [SVector::<f64, N>::zeros(); 8];
-        c[0] = *y;
+    pub fn constant(t0: f64, h: f64, y: &Vector<D>) -> Dense<D> {
+        let zero = y * 0.0;
+        let mut c = std::array::from_fn(|_| zero.clone());
+        c[0] = y.clone();
         Dense { t0, h, c }
     }
 
@@ -135,16 +221,20 @@ impl Dop853 {
     }
 
     /// Hairer's initial step guess (`hinit` with order 8); one extra evaluation of f.
-    pub fn initial_step<const N: usize>(
+    pub fn initial_step<D: Dim>(
         &self,
-        f: &mut impl FnMut(f64, &SVector<f64, N>) -> SVector<f64, N>,
+        f: &mut impl FnMut(f64, &Vector<D>) -> Vector<D>,
         t: f64,
-        y: &SVector<f64, N>,
-        f0: &SVector<f64, N>,
-    ) -> f64 {
+        y: &Vector<D>,
+        f0: &Vector<D>,
+    ) -> f64
+    where
+        DefaultAllocator: Allocator<D>,
+    {
+        let n = y.len();
         let mut dnf = 0.0;
         let mut dny = 0.0;
-        for i in 0..N {
+        for i in 0..n {
             let sk = self.atol + self.rtol * y[i].abs();
             dnf += (f0[i] / sk).powi(2);
             dny += (y[i] / sk).powi(2);
@@ -155,10 +245,10 @@ impl Dop853 {
             (dny / dnf).sqrt() * 0.01
         };
         h = h.min(self.h_max);
-        let y1 = y + f0 * h;
+        let y1 = stage(y, &[(f0, 1.0)], h);
         let f1 = f(t + h, &y1);
         let mut der2: f64 = 0.0;
-        for i in 0..N {
+        for i in 0..n {
             let sk = self.atol + self.rtol * y[i].abs();
             der2 += ((f1[i] - f0[i]) / sk).powi(2);
         }
@@ -173,96 +263,146 @@ impl Dop853 {
     }
 
     /// One trial step of size h from `(t, y)` with `f0 = f(t, y)`: 11 evaluations of f.
-    pub fn trial<const N: usize>(
+    pub fn trial<D: Dim>(
         &self,
-        f: &mut impl FnMut(f64, &SVector<f64, N>) -> SVector<f64, N>,
+        f: &mut impl FnMut(f64, &Vector<D>) -> Vector<D>,
         t: f64,
-        y: &SVector<f64, N>,
-        f0: &SVector<f64, N>,
+        y: &Vector<D>,
+        f0: &Vector<D>,
         h: f64,
-    ) -> Trial<N> {
-        let k1 = *f0;
-        let k2 = f(t + C2 * h, &(y + k1 * (h * A21)));
-        let k3 = f(t + C3 * h, &(y + (k1 * A31 + k2 * A32) * h));
-        let k4 = f(t + C4 * h, &(y + (k1 * A41 + k3 * A43) * h));
-        let k5 = f(t + C5 * h, &(y + (k1 * A51 + k3 * A53 + k4 * A54) * h));
-        let k6 = f(t + C6 * h, &(y + (k1 * A61 + k4 * A64 + k5 * A65) * h));
+    ) -> Trial<D>
+    where
+        DefaultAllocator: Allocator<D>,
+    {
+        let k1 = f0.clone();
+        let k2 = f(t + C2 * h, &stage(y, &[(&k1, h * A21)], 1.0));
+        let k3 = f(t + C3 * h, &stage(y, &[(&k1, A31), (&k2, A32)], h));
+        let k4 = f(t + C4 * h, &stage(y, &[(&k1, A41), (&k3, A43)], h));
+        let k5 = f(
+            t + C5 * h,
+            &stage(y, &[(&k1, A51), (&k3, A53), (&k4, A54)], h),
+        );
+        let k6 = f(
+            t + C6 * h,
+            &stage(y, &[(&k1, A61), (&k4, A64), (&k5, A65)], h),
+        );
         let k7 = f(
             t + C7 * h,
-            &(y + (k1 * A71 + k4 * A74 + k5 * A75 + k6 * A76) * h),
+            &stage(y, &[(&k1, A71), (&k4, A74), (&k5, A75), (&k6, A76)], h),
         );
         let k8 = f(
             t + C8 * h,
-            &(y + (k1 * A81 + k4 * A84 + k5 * A85 + k6 * A86 + k7 * A87) * h),
+            &stage(
+                y,
+                &[(&k1, A81), (&k4, A84), (&k5, A85), (&k6, A86), (&k7, A87)],
+                h,
+            ),
         );
         let k9 = f(
             t + C9 * h,
-            &(y + (k1 * A91 + k4 * A94 + k5 * A95 + k6 * A96 + k7 * A97 + k8 * A98) * h),
+            &stage(
+                y,
+                &[
+                    (&k1, A91),
+                    (&k4, A94),
+                    (&k5, A95),
+                    (&k6, A96),
+                    (&k7, A97),
+                    (&k8, A98),
+                ],
+                h,
+            ),
         );
         let k10 = f(
             t + C10 * h,
-            &(y + (k1 * A101
-                + k4 * A104
-                + k5 * A105
-                + k6 * A106
-                + k7 * A107
-                + k8 * A108
-                + k9 * A109)
-                * h),
+            &stage(
+                y,
+                &[
+                    (&k1, A101),
+                    (&k4, A104),
+                    (&k5, A105),
+                    (&k6, A106),
+                    (&k7, A107),
+                    (&k8, A108),
+                    (&k9, A109),
+                ],
+                h,
+            ),
         );
         let k11 = f(
             t + C11 * h,
-            &(y + (k1 * A111
-                + k4 * A114
-                + k5 * A115
-                + k6 * A116
-                + k7 * A117
-                + k8 * A118
-                + k9 * A119
-                + k10 * A1110)
-                * h),
+            &stage(
+                y,
+                &[
+                    (&k1, A111),
+                    (&k4, A114),
+                    (&k5, A115),
+                    (&k6, A116),
+                    (&k7, A117),
+                    (&k8, A118),
+                    (&k9, A119),
+                    (&k10, A1110),
+                ],
+                h,
+            ),
         );
         let k12 = f(
             t + h,
-            &(y + (k1 * A121
-                + k4 * A124
-                + k5 * A125
-                + k6 * A126
-                + k7 * A127
-                + k8 * A128
-                + k9 * A129
-                + k10 * A1210
-                + k11 * A1211)
-                * h),
+            &stage(
+                y,
+                &[
+                    (&k1, A121),
+                    (&k4, A124),
+                    (&k5, A125),
+                    (&k6, A126),
+                    (&k7, A127),
+                    (&k8, A128),
+                    (&k9, A129),
+                    (&k10, A1210),
+                    (&k11, A1211),
+                ],
+                h,
+            ),
         );
-        let incr =
-            k1 * B1 + k6 * B6 + k7 * B7 + k8 * B8 + k9 * B9 + k10 * B10 + k11 * B11 + k12 * B12;
-        let y1 = y + incr * h;
-        let e3 = incr - k1 * BHH1 - k9 * BHH2 - k12 * BHH3;
-        let e5 = k1 * ER1
-            + k6 * ER6
-            + k7 * ER7
-            + k8 * ER8
-            + k9 * ER9
-            + k10 * ER10
-            + k11 * ER11
-            + k12 * ER12;
+        let incr = combine(&[
+            (&k1, B1),
+            (&k6, B6),
+            (&k7, B7),
+            (&k8, B8),
+            (&k9, B9),
+            (&k10, B10),
+            (&k11, B11),
+            (&k12, B12),
+        ]);
+        let y1 = stage(y, &[(&incr, 1.0)], h);
+        let e5 = combine(&[
+            (&k1, ER1),
+            (&k6, ER6),
+            (&k7, ER7),
+            (&k8, ER8),
+            (&k9, ER9),
+            (&k10, ER10),
+            (&k11, ER11),
+            (&k12, ER12),
+        ]);
+        let n = y.len();
         let mut err2 = 0.0;
         let mut err = 0.0;
-        for i in 0..N {
+        for i in 0..n {
+            let e3 = incr[i] - k1[i] * BHH1 - k9[i] * BHH2 - k12[i] * BHH3;
             let sk = self.atol + self.rtol * y[i].abs().max(y1[i].abs());
-            err2 += (e3[i] / sk).powi(2);
+            err2 += (e3 / sk).powi(2);
             err += (e5[i] / sk).powi(2);
         }
         let mut deno = err + 0.01 * err2;
         if deno <= 0.0 {
             deno = 1.0;
         }
-        let err = h.abs() * err * (1.0 / (N as f64 * deno)).sqrt();
+        let err = h.abs() * err * (1.0 / (n as f64 * deno)).sqrt();
         Trial {
             t,
             h,
-            y0: *y,
+            y0: y.clone(),
             y1,
             err,
             k: [k1, k2, k3, k4, k5, k6, k7, k8, k9, k10, k11, k12],
@@ -270,7 +410,10 @@ impl Dop853 {
     }
 
     /// Whether a trial is acceptable (`err ≤ 1` and finite).
-    pub fn acceptable<const N: usize>(tr: &Trial<N>) -> bool {
+    pub fn acceptable<D: Dim>(tr: &Trial<D>) -> bool
+    where
+        DefaultAllocator: Allocator<D>,
+    {
         tr.err <= 1.0 && tr.y1.iter().all(|v| v.is_finite())
     }
 
@@ -318,67 +461,87 @@ impl Dop853 {
 
     /// The continuous extension of an accepted trial, given `f1 = f(t + h, y1)`:
     /// 3 more evaluations of f.
-    pub fn dense<const N: usize>(
+    pub fn dense<D: Dim>(
         &self,
-        f: &mut impl FnMut(f64, &SVector<f64, N>) -> SVector<f64, N>,
-        tr: &Trial<N>,
-        f1: &SVector<f64, N>,
-    ) -> Dense<N> {
+        f: &mut impl FnMut(f64, &Vector<D>) -> Vector<D>,
+        tr: &Trial<D>,
+        f1: &Vector<D>,
+    ) -> Dense<D>
+    where
+        DefaultAllocator: Allocator<D>,
+    {
         let (t, h, y) = (tr.t, tr.h, &tr.y0);
         let k = &tr.k;
-        let k13 = *f1;
+        let k13 = f1;
         let k14 = f(
             t + C14 * h,
-            &(y + (k[0] * A141
-                + k[6] * A147
-                + k[7] * A148
-                + k[8] * A149
-                + k[9] * A1410
-                + k[10] * A1411
-                + k[11] * A1412
-                + k13 * A1413)
-                * h),
+            &stage(
+                y,
+                &[
+                    (&k[0], A141),
+                    (&k[6], A147),
+                    (&k[7], A148),
+                    (&k[8], A149),
+                    (&k[9], A1410),
+                    (&k[10], A1411),
+                    (&k[11], A1412),
+                    (k13, A1413),
+                ],
+                h,
+            ),
         );
         let k15 = f(
             t + C15 * h,
-            &(y + (k[0] * A151
-                + k[5] * A156
-                + k[6] * A157
-                + k[7] * A158
-                + k[10] * A1511
-                + k[11] * A1512
-                + k13 * A1513
-                + k14 * A1514)
-                * h),
+            &stage(
+                y,
+                &[
+                    (&k[0], A151),
+                    (&k[5], A156),
+                    (&k[6], A157),
+                    (&k[7], A158),
+                    (&k[10], A1511),
+                    (&k[11], A1512),
+                    (k13, A1513),
+                    (&k14, A1514),
+                ],
+                h,
+            ),
         );
         let k16 = f(
             t + C16 * h,
-            &(y + (k[0] * A161
-                + k[5] * A166
-                + k[6] * A167
-                + k[7] * A168
-                + k[8] * A169
-                + k13 * A1613
-                + k14 * A1614
-                + k15 * A1615)
-                * h),
+            &stage(
+                y,
+                &[
+                    (&k[0], A161),
+                    (&k[5], A166),
+                    (&k[6], A167),
+                    (&k[7], A168),
+                    (&k[8], A169),
+                    (k13, A1613),
+                    (&k14, A1614),
+                    (&k15, A1615),
+                ],
+                h,
+            ),
         );
         let stages = [
-            k[0], k[5], k[6], k[7], k[8], k[9], k[10], k[11], k13, k14, k15, k16,
+            &k[0], &k[5], &k[6], &k[7], &k[8], &k[9], &k[10], &k[11], k13, &k14, &k15, &k16,
         ];
-        let ydiff = tr.y1 - y;
-        let bspl = k[0] * h - ydiff;
-        let mut c = [SVector::<f64, N>::zeros(); 8];
-        c[0] = *y;
-        c[1] = ydiff;
-        c[2] = bspl;
-        c[3] = ydiff - k13 * h - bspl;
-        for (r, row) in D.iter().enumerate() {
-            let mut acc = SVector::<f64, N>::zeros();
-            for (w, st) in row.iter().zip(stages.iter()) {
-                acc += st * *w;
+        let mut c: [Vector<D>; 8] = std::array::from_fn(|_| y.clone());
+        for i in 0..y.len() {
+            let ydiff = tr.y1[i] - y[i];
+            let bspl = k[0][i] * h - ydiff;
+            c[1][i] = ydiff;
+            c[2][i] = bspl;
+            c[3][i] = ydiff - k13[i] * h - bspl;
+            for (r, row) in crate::tableau::D.iter().enumerate() {
+                // From 0, as the vector sum it replaces (0 + x = x to the bit).
+                let mut acc = 0.0;
+                for (w, st) in row.iter().zip(stages.iter()) {
+                    acc += st[i] * *w;
+                }
+                c[4 + r][i] = acc * h;
             }
-            c[4 + r] = acc * h;
         }
         Dense { t0: t, h, c }
     }
@@ -402,16 +565,19 @@ pub struct Counts {
 /// (no dense output), returning the final state and the counts. `h0 = 0` selects the
 /// initial-step heuristic. For tests and simple smooth problems; the Filippov solver drives
 /// the stepper itself.
-pub fn integrate<const N: usize>(
+pub fn integrate<D: Dim>(
     ctl: &mut Dop853,
-    mut f: impl FnMut(f64, &SVector<f64, N>) -> SVector<f64, N>,
+    mut f: impl FnMut(f64, &Vector<D>) -> Vector<D>,
     t0: f64,
-    y0: SVector<f64, N>,
+    y0: Vector<D>,
     t1: f64,
     h0: f64,
-) -> (SVector<f64, N>, Counts) {
+) -> (Vector<D>, Counts)
+where
+    DefaultAllocator: Allocator<D>,
+{
     let mut n = Counts::default();
-    let mut fc = |t: f64, y: &SVector<f64, N>| {
+    let mut fc = |t: f64, y: &Vector<D>| {
         n.fcn += 1;
         f(t, y)
     };

@@ -4,6 +4,7 @@ use rotor_model::seam::{Event, EventKind, EventRef, SolveError, Stats};
 use rotor_model::{Disc, Mode, Model, State};
 
 use crate::filippov::{EventOptions, Integrator, Sink};
+use nalgebra::U3;
 
 /// Where a flow stops.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -40,7 +41,7 @@ struct FlowSink {
     events: Vec<Event>,
 }
 
-impl Sink for FlowSink {
+impl Sink<U3> for FlowSink {
     fn event(&mut self, e: EventRef<'_>) {
         self.events.push(e.to_event());
     }
@@ -67,7 +68,7 @@ pub fn flow(
     t_max: f64,
     stop: StopAt,
 ) -> Result<FlowEnd, SolveError> {
-    let mut integ = Integrator::new(model, u, tol, EventOptions::default());
+    let mut integ = Integrator::rig(model, u, tol, EventOptions::default());
     if let StopAt::Section(c) = stop {
         integ.section = Some(c);
     }

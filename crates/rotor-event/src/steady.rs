@@ -27,7 +27,7 @@
 use rotor_model::seam::{Event, EventKind, EventRef, MetricsAccumulator, RigSteady, SolveError};
 use rotor_model::{Disc, DiscMode, Mode, Model, SlipEquilibrium, State};
 
-use nalgebra::Complex;
+use nalgebra::{Complex, U3};
 
 use crate::filippov::{EventOptions, Integrator, RunEnd, Sink};
 
@@ -109,7 +109,7 @@ struct StopSink {
     lower_exits: u64,
 }
 
-impl Sink for StopSink {
+impl Sink<U3> for StopSink {
     fn event(&mut self, e: EventRef<'_>) {
         if e.kind == EventKind::StickEnd(Disc::LOWER) {
             self.lower_exits += 1;
@@ -144,8 +144,8 @@ impl Flow<'_> {
         extrema: bool,
         section: Option<f64>,
         acc: Option<MetricsAccumulator>,
-    ) -> Result<(RunEnd, StopSink), SolveError> {
-        let mut integ = Integrator::new(self.model, self.u, self.tol, self.ev);
+    ) -> Result<(RunEnd<U3>, StopSink), SolveError> {
+        let mut integ = Integrator::rig(self.model, self.u, self.tol, self.ev);
         integ.extrema = extrema;
         integ.section = section;
         let mut sink = StopSink {
@@ -169,7 +169,12 @@ impl Flow<'_> {
     }
 
     /// Return map at the lower disc's stick exit: ω_u at the next exit (and the mode there).
-    fn stick_exit_map(&self, alpha: f64, w: f64, upper: DiscMode) -> Result<RunEnd, SolveError> {
+    fn stick_exit_map(
+        &self,
+        alpha: f64,
+        w: f64,
+        upper: DiscMode,
+    ) -> Result<RunEnd<U3>, SolveError> {
         let (x, mode) = self.exit_state(alpha, w, upper);
         let (end, sink) = self.run(x, mode, 1e4, Stop::LowerStickExit, false, None, None)?;
         if sink.lower_exits == 0 {
@@ -406,7 +411,7 @@ impl Settling<'_> {
         loop {
             let acc = MetricsAccumulator::new(0.5 * self.opts.settle);
             let f = self.flow;
-            let mut integ = Integrator::new(f.model, f.u, f.tol, f.ev);
+            let mut integ = Integrator::rig(f.model, f.u, f.tol, f.ev);
             integ.extrema = true;
             let mut sink = LastExitSink {
                 acc,
@@ -438,7 +443,7 @@ struct LastExitSink {
     last_exit: Option<(Event, DiscMode)>,
 }
 
-impl Sink for LastExitSink {
+impl Sink<U3> for LastExitSink {
     fn event(&mut self, e: EventRef<'_>) {
         self.acc.push(e);
         if e.kind == EventKind::StickEnd(Disc::LOWER) {
@@ -651,7 +656,7 @@ fn refine_slipping(
     let x0 = State::new(z[0], z[1], c);
     let mode = flow.model.mode_at(&x0, flow.u);
     let acc = MetricsAccumulator::new(0.0);
-    let mut integ = Integrator::new(flow.model, flow.u, flow.tol, flow.ev);
+    let mut integ = Integrator::rig(flow.model, flow.u, flow.tol, flow.ev);
     integ.extrema = true;
     integ.section = Some(c);
     let mut sink = CountSections {
@@ -696,7 +701,7 @@ struct CountSections {
     stop_at: u32,
 }
 
-impl Sink for CountSections {
+impl Sink<U3> for CountSections {
     fn event(&mut self, e: EventRef<'_>) {
         self.acc.push(e);
     }

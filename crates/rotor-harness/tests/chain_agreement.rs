@@ -1,8 +1,9 @@
-//! Cross-validation on chains of N discs: the switch model (DOPRI5 on a band field, events
-//! located on its dense output) and Moreau–Jean (a θ-scheme on the Lagrangian form, N coupled
-//! contacts solved at once per step) share nothing but the chain's model, and must agree on
-//! every sample of every state over the whole run, within a gate derived from Moreau–Jean's
-//! own convergence.
+//! Cross-validation on chains of N discs: the event-driven solver (exact sliding, DOP853),
+//! the switch model (DOPRI5 on a band field, events located on its dense output) and
+//! Moreau–Jean (a θ-scheme on the Lagrangian form, N coupled contacts solved at once per
+//! step) share nothing but the chain's model, and must agree on every sample of every state
+//! and on every event over the whole run, within gates derived from each one's own
+//! convergence.
 
 use rotor_analysis::solvers::SolverKind;
 use rotor_model::seam::{Accuracy, EventKind, Output, Scene, Trajectory};
@@ -319,5 +320,105 @@ fn switch_and_moreau_find_the_same_events_at_converging_times() {
         }
         eprintln!("{name} with k_2 × 1.001: worst / gate = {worst_wrong:.1}");
         assert!(worst_wrong > 1.0, "{name}: {worst_wrong}");
+    }
+}
+
+/// The event-driven solver and the switch model at tol 1e-10, and each one's own error there,
+/// estimated per state component by its distance to its own run at tol 1e-13 (both are
+/// tolerance-proportional: 1000× tighter leaves a thousandth of the error).
+fn event_and_switch(model: &ChainModel) -> (Trajectory, Trajectory, Vec<f64>) {
+    let ev = run(SolverKind::EVENT, model, Accuracy::Tol(1e-10), 20.0);
+    let ev_tight = run(SolverKind::EVENT, model, Accuracy::Tol(1e-13), 20.0);
+    let sw = run(SolverKind::SWITCH, model, Accuracy::Tol(1e-10), 20.0);
+    let sw_tight = run(SolverKind::SWITCH, model, Accuracy::Tol(1e-13), 20.0);
+    let est: Vec<f64> = diffs(&ev, &ev_tight)
+        .iter()
+        .zip(diffs(&sw, &sw_tight))
+        .map(|(e, s)| e + s)
+        .collect();
+    (ev, sw, est)
+}
+
+/// The worst ratio, over the state's components, of `|ev − sw|` to its gate
+/// `2·(est_ev + est_sw) + FLOOR`: twice the sum of the two solvers' own errors, and the
+/// floor for the switch model's band, which no tolerance removes (its stuck discs keep up to
+/// η = 1e-10 rad/s; a first-order error in η, 10× below FLOOR).
+fn worst_event_switch(ev: &Trajectory, sw: &Trajectory, est: &[f64]) -> f64 {
+    diffs(ev, sw)
+        .iter()
+        .zip(est)
+        .map(|(d, e)| d / (2.0 * e + FLOOR))
+        .fold(0.0, f64::max)
+}
+
+/// The event-driven solver (exact sliding, events located and refined on DOP853's dense
+/// output) and the switch model (a band field on DOPRI5) share nothing but the chain's model,
+/// and agree on every sample of every state over 20 s of stick-slip, within twice the sum of
+/// their own errors, on both chains of the gate and on the Stribeck chain of four, whose
+/// discs also reverse. The negative control: the switch model on a chain whose second spring
+/// is 0.1 % stiffer fails the same gate.
+#[test]
+fn event_and_switch_agree_on_every_sample_of_every_chain() {
+    let mut all = chains();
+    all.push(("Stribeck chain of 4", stribeck_chain4()));
+    for (name, p) in all {
+        let model = ChainModel::new(&p);
+        let (ev, sw, est) = event_and_switch(&model);
+        let sticks = count(&ev, |k| matches!(k, EventKind::StickStart(_)));
+        assert!(sticks >= 3, "{name}: the chain sticks and slips ({sticks})");
+        let worst = worst_event_switch(&ev, &sw, &est);
+        eprintln!(
+            "{name}: {sticks} sticks, max |ev − sw| {:e}, worst / gate = {worst:.3}",
+            largest(&diffs(&ev, &sw))
+        );
+        assert!(worst <= 1.0, "{name}: {worst}");
+        let mut off = p.clone();
+        off.discs[1].k *= 1.001;
+        let sw_off = run(
+            SolverKind::SWITCH,
+            &ChainModel::new(&off),
+            Accuracy::Tol(1e-10),
+            20.0,
+        );
+        let worst = worst_event_switch(&ev, &sw_off, &est);
+        eprintln!("{name} with k_2 × 1.001: worst / gate = {worst:.1}");
+        assert!(worst > 1.0, "{name}: {worst}");
+    }
+}
+
+/// The two solvers find the same events, disc by disc and in order (stick onsets and exits,
+/// reversals), at times that agree within the same rule: twice the sum of each one's own
+/// error in the event's time, estimated against its run at tol 1e-13, plus the floor the
+/// switch model's band puts on a stick exit's time (1e-9 s: its stuck velocity, up to η,
+/// moves the spring torque at the exit by η·k·t_stick).
+#[test]
+fn event_and_switch_find_the_same_events() {
+    let mut all = chains();
+    all.push(("Stribeck chain of 4", stribeck_chain4()));
+    for (name, p) in all {
+        let model = ChainModel::new(&p);
+        let n = model.discs();
+        let at = |kind: SolverKind, tol: f64| {
+            events_by_disc(&run(kind, &model, Accuracy::Tol(tol), 20.0), n)
+        };
+        let (ev, ev_t) = (at(SolverKind::EVENT, 1e-10), at(SolverKind::EVENT, 1e-13));
+        let (sw, sw_t) = (at(SolverKind::SWITCH, 1e-10), at(SolverKind::SWITCH, 1e-13));
+        let mut worst = 0.0f64;
+        let mut total = 0;
+        for d in 0..n {
+            let kinds = |v: &[(EventKind, f64)]| v.iter().map(|e| e.0).collect::<Vec<_>>();
+            assert_eq!(kinds(&ev[d]), kinds(&sw[d]), "{name}: disc {}", d + 1);
+            assert_eq!(kinds(&ev[d]), kinds(&ev_t[d]), "{name}: disc {}", d + 1);
+            assert_eq!(kinds(&sw[d]), kinds(&sw_t[d]), "{name}: disc {}", d + 1);
+            for k in 0..ev[d].len() {
+                let est = (ev[d][k].1 - ev_t[d][k].1).abs() + (sw[d][k].1 - sw_t[d][k].1).abs();
+                let gate = 2.0 * est + FLOOR;
+                worst = worst.max((ev[d][k].1 - sw[d][k].1).abs() / gate);
+                total += 1;
+            }
+        }
+        eprintln!("{name}: {total} events, worst |t_ev − t_sw| / gate = {worst:.3}");
+        assert!(total >= 3, "{name}");
+        assert!(worst <= 1.0, "{name}: {worst}");
     }
 }

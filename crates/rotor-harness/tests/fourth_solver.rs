@@ -80,7 +80,7 @@ mod euler {
                 let (t0, x0) = (self.t, self.x);
                 let mut x1 = x0 + f * h;
                 let t1 = t0 + h;
-                check_finite(t1, &x1)?;
+                check_finite(t1, x1.as_slice())?;
                 let mode = self.mode_at(&x0, &mut x1);
                 self.steps += 1;
                 // The step's interpolant, written into the recorder's slice: linear.

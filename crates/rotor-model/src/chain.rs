@@ -604,11 +604,13 @@ impl ChainModel {
     }
 
     /// Number of discs N.
+    #[inline]
     pub fn discs(&self) -> usize {
         self.j.len()
     }
 
     /// Size of the state, `2N − 1`.
+    #[inline]
     pub fn dim(&self) -> usize {
         2 * self.j.len() - 1
     }
@@ -626,26 +628,31 @@ impl ChainModel {
     }
 
     /// Friction law of disc `i`.
+    #[inline]
     pub fn friction(&self, i: usize) -> &Friction {
         &self.friction[i]
     }
 
     /// Inertia of disc `i`.
+    #[inline]
     pub fn inertia(&self, i: usize) -> f64 {
         self.j[i]
     }
 
     /// Motor constant `k_m` (the motor drives disc 0).
+    #[inline]
     pub fn k_m(&self) -> f64 {
         self.k_m
     }
 
     /// Stiffness `k_i` of the spring between disc `i` and `i + 1`.
+    #[inline]
     pub fn spring(&self, i: usize) -> f64 {
         self.k[i]
     }
 
     /// Viscous coupling `c_i` between disc `i` and `i + 1` (0 where there is none).
+    #[inline]
     pub fn coupling(&self, i: usize) -> f64 {
         self.c[i]
     }
@@ -678,11 +685,13 @@ impl ChainModel {
 
     /// Torque on disc `i` from everything but its own friction (the velocities as stored in
     /// `x`; a solver stores a stuck disc's as 0).
+    #[inline]
     pub fn applied_torque(&self, i: usize, x: &[f64], u: f64) -> f64 {
         self.torque_with(i, x, u, |d| x[self.omega(d)])
     }
 
     /// Whether disc `i`'s applied torque lies inside its stick interval (so stick persists).
+    #[inline]
     pub fn can_stick(&self, i: usize, x: &[f64], u: f64) -> bool {
         let (lo, hi) = self.friction[i].static_interval();
         let t = self.applied_torque(i, x, u);
@@ -691,6 +700,7 @@ impl ChainModel {
 
     /// The slip direction stuck disc `i` leaves toward, if its applied torque is outside its
     /// stick interval: `SlipPos` above it, `SlipNeg` below it, `None` inside.
+    #[inline]
     pub fn stick_exit(&self, i: usize, x: &[f64], u: f64) -> Option<DiscMode> {
         let (lo, hi) = self.friction[i].static_interval();
         let t = self.applied_torque(i, x, u);
@@ -709,6 +719,10 @@ impl ChainModel {
     #[inline]
     pub fn rhs_into(&self, x: &[f64], u: f64, mode: Mode, out: &mut [f64]) {
         let n = self.j.len();
+        if n == 2 && self.c[0] == 0.0 {
+            return self.rig_rhs_into(x, u, mode, out);
+        }
+        let (x, out) = (&x[..2 * n - 1], &mut out[..2 * n - 1]);
         let w = |i: usize| {
             if mode.is_stuck(Disc::at(i)) {
                 0.0
@@ -728,6 +742,136 @@ impl ChainModel {
                 }
             };
         }
+    }
+
+    /// [`ChainModel::rhs_into`] on a chain of two discs without a viscous coupling (the rig):
+    /// the same operations unrolled, `[ω_1 − ω_2, (k_m u − k α − T_f,1)/J_1, (k α − T_f,2)/J_2]`
+    /// with a stuck disc's velocity and acceleration 0. The general loop costs twice the
+    /// instructions of this on the rig's hot path.
+    #[inline(always)]
+    fn rig_rhs_into(&self, x: &[f64], u: f64, mode: Mode, out: &mut [f64]) {
+        // One length check per list instead of one per element.
+        let (&[alpha, wu, wl], [d_alpha, d_wu, d_wl], [f_u, f_l], &[j_u, j_l], &[k]) = (
+            &x[..3],
+            &mut out[..3],
+            &self.friction[..],
+            &self.j[..],
+            &self.k[..],
+        ) else {
+            unreachable!("the caller checked a chain of two");
+        };
+        let (top, bottom) = (Disc::UPPER, Disc::LOWER);
+        let w0 = if mode.is_stuck(top) { 0.0 } else { wu };
+        let w1 = if mode.is_stuck(bottom) { 0.0 } else { wl };
+        *d_alpha = w0 - w1;
+        let spring = k * alpha;
+        *d_wu = match mode.of(top).branch() {
+            None => 0.0,
+            Some(s) => (self.k_m * u - spring - f_u.torque(wu, s)) / j_u,
+        };
+        *d_wl = match mode.of(bottom).branch() {
+            None => 0.0,
+            Some(s) => (spring - f_l.torque(wl, s)) / j_l,
+        };
+    }
+
+    /// Acceleration of disc `i` in `mode`, the component `ω_i` of [`ChainModel::rhs_into`]:
+    /// `(T_ex,i − T_f,i^s(ω_i))/J_i` with stuck discs' velocities taken as 0, or 0 if disc `i`
+    /// is stuck.
+    #[inline]
+    pub fn disc_accel(&self, i: usize, x: &[f64], u: f64, mode: Mode) -> f64 {
+        let n = self.j.len();
+        match mode.of(Disc::at(i)).branch() {
+            None => 0.0,
+            Some(s) => {
+                let w = |d: usize| {
+                    if mode.is_stuck(Disc::at(d)) {
+                        0.0
+                    } else {
+                        x[n - 1 + d]
+                    }
+                };
+                (self.torque_with(i, x, u, w) - self.friction[i].torque(x[n - 1 + i], s))
+                    / self.j[i]
+            }
+        }
+    }
+
+    /// Rate of disc `i`'s applied torque along a rate `v` of the state, at a fixed input (the
+    /// torque is linear in the state):
+    /// `k_{i−1} v_{α,i−1} + c_{i−1}(v_{ω,i−1} − v_{ω,i}) − k_i v_{α,i} − c_i(v_{ω,i} − v_{ω,i+1})`.
+    /// The input's own rate, `k_m·du/dt` on disc 0, is the caller's to add.
+    #[inline]
+    pub fn applied_torque_rate(&self, i: usize, v: &[f64]) -> f64 {
+        let n = self.j.len();
+        self.torque_with(i, v, 0.0, |d| v[n - 1 + d])
+    }
+
+    /// Row `ω_i` of the Jacobian times `v`, `(∂f_mode/∂x · v)_{ω_i}`, without forming the
+    /// matrix: the rate of disc `i`'s acceleration along `v`. The row's entries are those of
+    /// [`ChainModel::jacobian`], summed in column order (so a chain of two gives the rig's
+    /// matrix product to the bit).
+    #[inline]
+    pub fn accel_rate(&self, i: usize, x: &[f64], mode: Mode, v: &[f64]) -> f64 {
+        let n = self.j.len();
+        let Some(s) = mode.of(Disc::at(i)).branch() else {
+            return 0.0;
+        };
+        let slipping = |d: usize| !mode.is_stuck(Disc::at(d));
+        let (row, ji) = (n - 1 + i, self.j[i]);
+        let mut own = -self.friction[i].dtorque(x[row], s);
+        let mut acc = 0.0;
+        if i > 0 {
+            acc += self.k[i - 1] / ji * v[i - 1];
+            own -= self.c[i - 1];
+        }
+        if i + 1 < n {
+            acc += -self.k[i] / ji * v[i];
+            own -= self.c[i];
+        }
+        if i > 0 && slipping(i - 1) && self.c[i - 1] != 0.0 {
+            acc += self.c[i - 1] / ji * v[row - 1];
+        }
+        acc += own / ji * v[row];
+        if i + 1 < n && slipping(i + 1) && self.c[i] != 0.0 {
+            acc += self.c[i] / ji * v[row + 1];
+        }
+        acc
+    }
+
+    /// `∂f_mode/∂x · v` at `x`, written into `out`: [`ChainModel::jacobian`] applied to `v`
+    /// without forming it, each row summed in column order.
+    pub fn jacobian_times(&self, x: &[f64], mode: Mode, v: &[f64], out: &mut [f64]) {
+        let n = self.j.len();
+        let slipping = |d: usize| !mode.is_stuck(Disc::at(d));
+        for (i, o) in out[..n - 1].iter_mut().enumerate() {
+            let mut a = 0.0;
+            if slipping(i) {
+                a += v[n - 1 + i];
+            }
+            if slipping(i + 1) {
+                a += -v[n + i];
+            }
+            *o = a;
+        }
+        for i in 0..n {
+            out[n - 1 + i] = self.accel_rate(i, x, mode, v);
+        }
+    }
+
+    /// Disc `i`'s friction time scale `τ_fric,i = v_i/(T_i/J_i)` and its law's velocity scale
+    /// `v_i` (both ∞ for a law without a velocity scale), as [`crate::TimeScales`] defines them
+    /// for the rig.
+    pub fn friction_scales(&self, i: usize) -> (f64, f64) {
+        let f = &self.friction[i];
+        let v = f.velocity_scale().unwrap_or(f64::INFINITY);
+        let a = f.torque_scale() / self.j[i];
+        let tau = if v.is_finite() && a > 0.0 {
+            v / a
+        } else {
+            f64::INFINITY
+        };
+        (tau, v)
     }
 
     /// The Filippov-consistent mode of each disc at a state: slip by the sign of its velocity;

@@ -68,6 +68,7 @@ impl Disc {
     ///
     /// If `position ≥` [`Mode::MAX_DISCS`]: a mode's bit for it would wrap onto another
     /// disc's, so such a disc is a bug, never a value.
+    #[inline]
     pub const fn at(position: usize) -> Disc {
         assert!(
             position < Mode::MAX_DISCS,
@@ -77,11 +78,13 @@ impl Disc {
     }
 
     /// Position from the top, 0-based.
+    #[inline]
     pub const fn position(self) -> usize {
         self.0 as usize
     }
 
     /// The disc's number as a chain file counts it, 1-based.
+    #[inline]
     pub const fn number(self) -> usize {
         self.0 as usize + 1
     }

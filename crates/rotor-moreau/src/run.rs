@@ -265,7 +265,7 @@ impl Run<'_> {
                     .step_with_force(self.cur.t, &self.cur.x, &size, f)?
             }
         };
-        check_finite(t_next, &out.x)?;
+        check_finite(t_next, out.x.as_slice())?;
         let s = &mut self.stats;
         s.steps += 1;
         s.newton_iters += u64::from(out.newton_iters);
@@ -524,7 +524,7 @@ impl Solver for MoreauSolver {
         // The scene's step, or the default one from a scene that sets a tolerance.
         let h = scene.checked_step()?;
         let x0 = scene.x0_state()?;
-        check_finite(0.0, &x0)?;
+        check_finite(0.0, x0.as_slice())?;
         let o = &self.options;
         o.validate()?;
         let (u, t_end) = (scene.u_at(0.0), scene.t_end);

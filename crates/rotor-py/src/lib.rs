@@ -375,8 +375,8 @@ fn input_of(rows: Option<Vec<[f64; 2]>>) -> PyResult<Option<rotor_model::seam::I
 /// A chain of N discs (``params`` in the chain form: a file of ``[[disc]]`` tables, or a dict
 /// with a ``disc`` list) returns ``alpha`` ((N − 1) × len(t)) and ``omega`` (N × len(t)) as
 /// 2-D arrays instead, events naming the disc by its number (1 … N); ``x0`` then holds its
-/// 2N − 1 values ``alpha_1 … omega_N`` (the default, three zeros, is rest for any N). A
-/// chain longer than two runs on ``"switch"`` or ``"moreau"``.
+/// 2N − 1 values ``alpha_1 … omega_N`` (the default, three zeros, is rest for any N). Every
+/// solver runs chains; ``"moreau"`` takes a constant ``u`` on them.
 #[pyfunction]
 #[pyo3(
     signature = (solver="event", u=1.5, params=None, x0=vec![0.0; 3], t_end=100.0, dt=0.01, tol=None, h=None, input=None),
@@ -467,10 +467,9 @@ fn simulate_chain<'py>(
     if rig.is_none() {
         if kind.info().chain.is_none() {
             return Err(PyValueError::new_err(format!(
-                "solver = {:?}: a chain with {n} discs runs on \"switch\" or \"moreau\" so far \
-                 (\"{}\" runs the rig's two discs)",
+                "solver = {:?}: a chain with {n} discs runs on {}",
                 kind.name(),
-                kind.name()
+                rotor_analysis::solvers::SolverKind::chain_solver_names(", ")
             )));
         }
         if kind == rotor_analysis::solvers::SolverKind::MOREAU && scene.is_time_varying() {

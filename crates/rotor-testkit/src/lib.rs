@@ -382,7 +382,8 @@ pub fn bad_params_cases() -> Vec<BadFile> {
             &["\\u{7}"],
         ),
         too_large(),
-        // Chain form: a chain the solvers do not take yet, and a bad value of one disc.
+        // Chain form: a chain where the rig is read (the analysis commands), and a bad value
+        // of one disc.
         raw("a chain of three discs", CHAIN3, &["a chain with 3 discs"]),
         edited(
             "chain3",

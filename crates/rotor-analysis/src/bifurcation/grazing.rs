@@ -158,7 +158,14 @@ pub fn classify(model: &Model, u: f64, w: f64, tol: f64) -> Result<Feigin, BifEr
 }
 
 /// Root of `ω̇_l` on `[a, b]` along the dense output (bisection then secant, to rounding).
-fn root(d: &Dense<3>, acc: &impl Fn(&State) -> f64, a: f64, b: f64, fa: f64, fb: f64) -> f64 {
+fn root(
+    d: &Dense<nalgebra::U3>,
+    acc: &impl Fn(&State) -> f64,
+    a: f64,
+    b: f64,
+    fa: f64,
+    fb: f64,
+) -> f64 {
     let (mut a, mut b, mut fa, mut fb) = (a, b, fa, fb);
     for _ in 0..200 {
         let s = if fb != fa {

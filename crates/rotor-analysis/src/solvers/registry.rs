@@ -112,7 +112,7 @@ pub static EVENT: SolverInfo = SolverInfo {
     stuck_band: 0.0,
     steady_agreement: 1e-6,
     make: || Box::new(rotor_event::EventSolver::default()),
-    chain: None,
+    chain: Some(|model, scene| rotor_event::EventSolver::default().simulate_chain(model, scene)),
 };
 
 /// Leine's switch model as published (DOPRI5, band η = 1e-10).
@@ -186,10 +186,10 @@ impl SolverKind {
         SOLVERS.iter().copied().find(|k| k.name() == name)
     }
 
-    /// `scene` on a chain of N discs, by this solver's [`SolverInfo::chain`] (Moreau–Jean's
-    /// [`rotor_moreau::simulate_chain`], the switch model's
-    /// [`rotor_switch::SwitchSolver::simulate_chain`]); a solver without one (the
-    /// event-driven solver, so far) says so. Steady-state metrics are the rig's (they
+    /// `scene` on a chain of N discs, by this solver's [`SolverInfo::chain`] (the event-driven
+    /// solver's [`rotor_event::EventSolver::simulate_chain`], the switch model's
+    /// [`rotor_switch::SwitchSolver::simulate_chain`], Moreau–Jean's
+    /// [`rotor_moreau::simulate_chain`]); a solver without one says so. Steady-state metrics are the rig's (they
     /// read its two discs), so a chain refuses them by name.
     pub fn simulate_chain(
         self,
@@ -213,6 +213,17 @@ impl SolverKind {
         let tr = chain(model, scene)?;
         tr.check_finite()?;
         Ok(tr)
+    }
+
+    /// The names of the solvers that run chains of N discs ([`SolverInfo::chain`]), joined
+    /// by `sep`: what a refusal offers instead.
+    pub fn chain_solver_names(sep: &str) -> String {
+        SOLVERS
+            .iter()
+            .filter(|k| k.info().chain.is_some())
+            .map(|k| k.name())
+            .collect::<Vec<_>>()
+            .join(sep)
     }
 
     /// `"tol"` or `"h"`.

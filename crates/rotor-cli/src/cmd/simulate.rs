@@ -86,10 +86,11 @@ fn simulate_chain(
     let kind = rotor_analysis::solvers::solver_kind(&common.solver)?;
     if kind.info().chain.is_none() {
         return Err(unusable(format_args!(
-            "--solver {}: {} is a chain with {n} discs, which runs on --solver switch or \
-             moreau so far (event runs the rig's two discs)",
+            "--solver {}: {} is a chain with {n} discs, which {} does not run (--solver {})",
             kind.name(),
-            path.display()
+            path.display(),
+            kind.name(),
+            rotor_analysis::solvers::SolverKind::chain_solver_names(", ")
         )));
     }
     if kind == rotor_analysis::solvers::SolverKind::MOREAU && common.input.is_some() {

@@ -691,14 +691,11 @@ pub trait Solver: Sync {
 
 /// Checks a state for NaN/∞ and reports it as a [`SolveError::NonFinite`].
 #[inline]
-pub fn check_finite(t: f64, x: &State) -> Result<(), SolveError> {
+pub fn check_finite(t: f64, x: &[f64]) -> Result<(), SolveError> {
     if x.iter().all(|v| v.is_finite()) {
         Ok(())
     } else {
-        Err(SolveError::NonFinite {
-            t,
-            x: x.as_slice().to_vec(),
-        })
+        Err(SolveError::NonFinite { t, x: x.to_vec() })
     }
 }
 
