@@ -9,8 +9,9 @@
 //! few discs within the horizon: 6 of 64 in 20 s, and the others' contacts never change).
 //! For each N:
 //!
-//! 1. a reference: the switch model at `reference_tol` (its own error there is ~1e-10, its
-//!    chain tests' tolerance study);
+//! 1. a reference: the event-driven solver, the project's accuracy reference, at
+//!    `reference_tol` (its own error there is ~1e-10 over the horizon, its chain tests'
+//!    tolerance study; cross-validated on chains against the switch model and Moreau–Jean);
 //! 2. for each solver with a chain run ([`rotor_analysis::solvers::SolverInfo::chain`]), the
 //!    loosest setting of its ladder whose error is within `target` (the error: the largest
 //!    |Δ| over every sample of every state against the reference), timed `repeats` times (the
@@ -51,7 +52,7 @@ pub struct ScalingOptions {
     pub dt: f64,
     /// The error every solver's setting must reach.
     pub target: f64,
-    /// The reference's tolerance (switch model).
+    /// The reference's tolerance (event-driven solver).
     pub reference_tol: f64,
     /// Timed runs per point (the median is kept).
     pub repeats: usize,
@@ -216,13 +217,13 @@ pub fn run(
             ..Scene::default()
         };
         progress(&format!(
-            "N = {n}: reference (switch, tol {:e})",
+            "N = {n}: reference (event, tol {:e})",
             opts.reference_tol
         ));
         let (reference, _) = timed(
-            SolverKind::SWITCH,
+            SolverKind::EVENT,
             &model,
-            &scene(SolverKind::SWITCH.accuracy(opts.reference_tol), opts.t_end),
+            &scene(SolverKind::EVENT.accuracy(opts.reference_tol), opts.t_end),
         )?;
         let mut moreau_h = None;
         for kind in SOLVERS.iter().copied().filter(|k| k.info().chain.is_some()) {
@@ -543,7 +544,7 @@ impl ScalingReport {
         let mut s = format!(
             "Chains of N discs (the rig's top disc and N − 1 copies of its lower disc, Table 1), \
              {} V, every disc at {} rad/s with the springs relaxed at t = 0, over {} s; every solver at the loosest setting of its ladder within \
-             {:e} of the switch model at tol {:e} (largest |Δ| over every sample of every \
+             {:e} of the event-driven solver at tol {:e} (largest |Δ| over every sample of every \
              state). Siconos runs at Moreau–Jean's h on a shorter horizon (its error is \
              against the reference over that horizon).\n\n\
              | N | runner | setting | horizon [s] | steps | cost per simulated s [s] | cost \
