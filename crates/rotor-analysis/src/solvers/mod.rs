@@ -14,4 +14,7 @@ pub use registry::{
     Knob, SOLVERS, SolverInfo, SolverKind, all_pairs, load_scenario, load_scenario_for, pair_name,
     pairs,
 };
-pub use run::{RunResult, ScenarioResult, run_scenario, run_scenario_with, solver_setting};
+pub use run::{
+    RunResult, ScenarioResult, run_scenario, run_scenario_with, self_error, solver_setting,
+    tighter_settings, unstated,
+};

@@ -101,6 +101,8 @@ pub(crate) fn compare(
                 Some(RigSteady::Equilibrium { omega_l, .. }) => {
                     ("equilibrium", "-".into(), format!("{omega_l:.6}"))
                 }
+                // A run without a steady window has no metrics; only a failed run is an error.
+                None if run.result.is_ok() => ("-", "-".into(), "-".into()),
                 None => ("error", "-".into(), "-".into()),
             };
             out::line(format_args!(

@@ -84,6 +84,9 @@ pub struct GateResult {
     pub pair: String,
     /// Every quantity gated, passing or not.
     pub measured: Vec<Measured>,
+    /// Whether the tolerances are defaults derived from the two solvers' own errors on this
+    /// scene ([`derived_tolerance`]), the scenario file stating none for this pair.
+    pub derived: bool,
 }
 
 impl GateResult {
@@ -218,6 +221,7 @@ pub fn check_pair(
             return GateResult {
                 pair: pair.to_owned(),
                 measured: m,
+                derived: false,
             };
         };
         if sa.kind() != sb.kind() {
@@ -234,6 +238,7 @@ pub fn check_pair(
     GateResult {
         pair: pair.to_owned(),
         measured: m,
+        derived: false,
     }
 }
 
@@ -377,8 +382,10 @@ pub fn metrics(tr: &Trajectory) -> Option<RigSteady> {
     tr.rig_metrics()
 }
 
-/// Gates every pair of one scenario. A solver error, or a pair without a tolerance in the
-/// scenario file, is a failure too.
+/// Gates every pair of one scenario. A solver error is a failure too. A pair without a
+/// `[tolerance]` table in the scenario file (a scene the project never measured) is gated by
+/// defaults derived from the two solvers' own errors on it ([`derived_tolerance`]); where
+/// none can be derived, that is a failure.
 pub fn gate_scenario(r: &ScenarioResult) -> (Vec<GateResult>, Vec<Failure>) {
     let sc = &r.scenario;
     let mut gates = Vec::new();
@@ -398,34 +405,184 @@ pub fn gate_scenario(r: &ScenarioResult) -> (Vec<GateResult>, Vec<Failure>) {
     let reference = pairs(&kinds);
     for (a, b) in all_pairs(&kinds) {
         let pair = pair_name(a, b);
-        let Some(tol) = sc.tolerance.get(&pair) else {
-            fails.push(Failure {
-                scenario: sc.name.clone(),
-                pair: pair.clone(),
-                quantity: "no [tolerance] stated for this pair in the scenario file".into(),
-                diff: f64::INFINITY,
-                tol: 0.0,
-            });
-            continue;
-        };
         let (Some(ta), Some(tb)) = (r.traj(a), r.traj(b)) else {
             continue;
         };
+        let windows = reference.contains(&(a, b));
+        let (tol, derived) = match sc.tolerance.get(&pair) {
+            Some(tol) => (*tol, false),
+            None => match derived_tolerance(r, a, b, windows) {
+                Ok(tol) => (tol, true),
+                Err(why) => {
+                    fails.push(Failure {
+                        scenario: sc.name.clone(),
+                        pair: pair.clone(),
+                        quantity: format!(
+                            "no [tolerance] stated for this pair in the scenario file, and \
+                             none derived: {why}"
+                        ),
+                        diff: f64::INFINITY,
+                        tol: 0.0,
+                    });
+                    continue;
+                }
+            },
+        };
         let band = stuck_band(a, b);
-        let mut g = if reference.contains(&(a, b)) {
-            check_pair(&pair, ta, tb, sc.compare.transient, tol, band)
+        let mut g = if windows {
+            check_pair(&pair, ta, tb, sc.compare.transient, &tol, band)
         } else {
             GateResult {
                 pair: pair.clone(),
                 measured: Vec::new(),
+                derived,
             }
         };
+        g.derived = derived;
         g.measured
-            .extend(check_whole(&sc.model, sc.u, ta, tb, tol, band));
+            .extend(check_whole(&sc.model, sc.u, ta, tb, &tol, band));
         fails.extend(g.failures(&sc.name));
         gates.push(g);
     }
     (gates, fails)
+}
+
+/// The rounding floor of a derived gate: 1e-13 for a relative quantity, 1e-12 s, rad or
+/// rad/s for an absolute one (the floors of the suite's stated gates).
+fn rounding_floor(key: &str) -> f64 {
+    if key.ends_with("_rel") { 1e-13 } else { 1e-12 }
+}
+
+/// Every quantity a pair can gate on this scenario, each with an infinite tolerance: what a
+/// solver's run is measured against its own tighter run on. The transient keys where the
+/// file sets `compare.transient`, the steady keys where it sets `compare.steady_from`, the
+/// whole-run keys always.
+fn measure_everything(sc: &rotor_model::scenario::Scenario, windows: bool) -> PairTolerance {
+    use rotor_model::scenario::{CYCLE_KEYS, EQUILIBRIUM_KEYS, WHOLE_KEYS};
+    let mut all = PairTolerance::default();
+    let mut keys: Vec<&str> = WHOLE_KEYS.to_vec();
+    if windows && sc.compare.transient.is_some() {
+        keys.extend(["transient_max", "transient_rms", "event_time"]);
+    }
+    if windows && sc.compare.steady_from.is_some() {
+        keys.extend(CYCLE_KEYS);
+        keys.extend(EQUILIBRIUM_KEYS);
+    }
+    for k in keys {
+        if let Some(slot) = all.slot(k) {
+            *slot = Some(f64::INFINITY);
+        }
+    }
+    all
+}
+
+/// Default gates for a pair `(a, b)` that the scenario file does not state, derived from the
+/// two solvers' own errors on this scene: each solver also ran at its tighter settings
+/// ([`rotor_analysis::solvers::tighter_settings`]: tolerance/100; step/2 and step/4), and its
+/// own error in a quantity is [`rotor_analysis::solvers::self_error`] of that quantity
+/// measured between its successive runs (the difference for a tolerance; for a step the
+/// larger of twice the first and four times the second). The gate of each quantity is
+///
+/// ```text
+/// 2·(e_a + e_b) + floor + band
+/// ```
+///
+/// twice the sum of the two errors (the rule of the chain cross-validation), the rounding
+/// floor (1e-13 relative, 1e-12 absolute), and, for a solver that holds a stuck disc within a band η
+/// (the switch model), what the band moves that a tighter tolerance does not: the spring
+/// drifts by η per second of stick, so `(η_a + η_b)·max(1, t_end)` on an absolute quantity
+/// and `10·(η_a + η_b)` on a relative one (its steady metrics differ from the exact solution
+/// by at most 4η relative; `rotor_switch::SwitchOptions::eta`). `steady_abs` is the rounding
+/// floor, 1e-12. A solver whose two runs cannot be compared in some quantity (a failed run,
+/// different steady kinds, event sequences that differ) leaves no gate to derive: the error
+/// says which.
+pub fn derived_tolerance(
+    r: &ScenarioResult,
+    a: SolverKind,
+    b: SolverKind,
+    windows: bool,
+) -> Result<PairTolerance, String> {
+    let sc = &r.scenario;
+    let all = measure_everything(sc, windows);
+    // The events the pair matches over the whole run; each solver's own runs must match as
+    // many, or its own error in their times says nothing of some of them (maxima of ω_l on a
+    // decaying oscillation, which runs at two settings resolve in different numbers).
+    let (Some(ta), Some(tb)) = (r.traj(a), r.traj(b)) else {
+        return Err("a run did not finish".into());
+    };
+    let pair_events = whole_run(&sc.model, sc.u, ta, tb, stuck_band(a, b)).events;
+    let own = |k: SolverKind| -> Result<Vec<(&'static str, f64)>, String> {
+        let run = r
+            .traj(k)
+            .ok_or_else(|| format!("{} did not finish", k.name()))?;
+        let tight: Vec<&Trajectory> = r
+            .tight_runs(k)
+            .into_iter()
+            .map(|t| t.result.as_ref().ok())
+            .collect::<Option<_>>()
+            .filter(|v: &Vec<&Trajectory>| !v.is_empty())
+            .ok_or_else(|| format!("{} did not finish at its tighter settings", k.name()))?;
+        let band = k.info().stuck_band * 2.0;
+        // The quantities between each run and the next tighter one.
+        let mut steps: Vec<Vec<crate::compare::gate::Measured>> = Vec::new();
+        let mut prev = run;
+        for t in tight {
+            let own_events = whole_run(&sc.model, sc.u, prev, t, band).events;
+            if own_events < pair_events {
+                return Err(format!(
+                    "{}'s own runs match {own_events} of the {pair_events} events the pair \
+                     matches (maxima of ω_l its settings resolve differently), so its error \
+                     in their times is not estimated: state the pair's tolerances",
+                    k.name()
+                ));
+            }
+            let mut m = check_pair("", prev, t, sc.compare.transient, &all, band).measured;
+            m.extend(check_whole(&sc.model, sc.u, prev, t, &all, band));
+            steps.push(m);
+            prev = t;
+        }
+        steps[0]
+            .iter()
+            .enumerate()
+            .map(|(i, q)| {
+                let diffs: Vec<f64> = steps.iter().map(|m| m[i].diff).collect();
+                match q.key {
+                    Some(key) if diffs.iter().all(|d| d.is_finite()) => {
+                        Ok((key, rotor_analysis::solvers::self_error(k, &diffs)))
+                    }
+                    _ => Err(format!(
+                        "{}'s own runs at its setting and tighter ones differ in {}",
+                        k.name(),
+                        q.quantity
+                    )),
+                }
+            })
+            .collect()
+    };
+    let (ea, eb) = (own(a)?, own(b)?);
+    let eta = a.info().stuck_band + b.info().stuck_band;
+    let mut tol = PairTolerance::default();
+    for (key, e) in &ea {
+        let Some(&(_, f)) = eb.iter().find(|(k, _)| k == key) else {
+            return Err(format!(
+                "{} measures {key} and {} does not (their steady states differ in kind)",
+                a.name(),
+                b.name()
+            ));
+        };
+        let band = if key.ends_with("_rel") {
+            10.0 * eta
+        } else {
+            eta * sc.t_end.max(1.0)
+        };
+        if let Some(slot) = tol.slot(key) {
+            *slot = Some(2.0 * (e + f) + rounding_floor(key) + band);
+        }
+    }
+    if tol.gates_steady() {
+        tol.steady_abs = Some(1e-12);
+    }
+    Ok(tol)
 }
 
 #[cfg(test)]

@@ -15,7 +15,12 @@ use rotor_analysis::solvers::run::{ScenarioResult, solver_setting};
 
 /// One row of the report's gate table. A quantity that could not be measured (steady
 /// states of different kinds, or missing: `diff` not finite) has no numbers, only its FAIL.
-fn gate_row(scenario: &str, pair: &str, m: &crate::compare::gate::Measured) -> String {
+fn gate_row(
+    scenario: &str,
+    pair: &str,
+    m: &crate::compare::gate::Measured,
+    derived: bool,
+) -> String {
     let numbers = if m.diff.is_finite() {
         let margin = match (m.diff > 0.0, m.tol == 0.0) {
             (true, _) => format!("{:.1}", m.tol / m.diff),
@@ -28,6 +33,11 @@ fn gate_row(scenario: &str, pair: &str, m: &crate::compare::gate::Measured) -> S
     };
     let verdict = if m.passes() { "ok" } else { "**FAIL**" };
     let key = m.key.map_or("—".into(), |k| format!("`{k}`"));
+    let key = if derived {
+        format!("{key} (derived)")
+    } else {
+        key
+    };
     format!(
         "| {scenario} | {pair} | {} | {key} | {numbers} | {verdict} |",
         m.quantity
@@ -443,9 +453,15 @@ fn given_intro(results: &[ScenarioResult]) -> String {
          Each scene is run by three independent solvers (the event-driven Filippov solver, the \
          accuracy reference; Leine's switch model; Moreau–Jean time-stepping on the Lagrangian \
          form), and their θ̇_u, θ̇_l are compared under the tolerances each scene's file \
-         states.\n",
+         states{}.\n",
         if names.len() == 1 { "" } else { "s" },
-        names.join(", ")
+        names.join(", "),
+        if results.iter().any(|r| !r.tight.is_empty()) {
+            ", or, for a pair a file states none for, under defaults derived from the two \
+             solvers' own errors on the scene (the gates marked *derived*, next section)"
+        } else {
+            ""
+        }
     )
 }
 
@@ -517,8 +533,24 @@ pub fn write_report(
          10x it (tests/fixtures.rs). Relative for the steady metrics except the stick time \
          (s), rad/s for the transient, s for events; the `whole_*` gates cover every sample \
          and event of [0, t_end], phase-aligned (the next section), for every pair of \
-         solvers.\n\n\
-         | scenario | pair | quantity | key | difference | tolerance | margin | |\n|---|---|---|---|---|---|---|---|\n",
+         solvers.\n\n",
+    );
+    if results.iter().any(|r| !r.tight.is_empty()) {
+        md.push_str(
+            "A gate marked *derived* is a default for a pair whose scenario file states no \
+             tolerance (a scene never measured before): each of the two solvers ran again at \
+             tighter settings (its tolerance 100x tighter; its step halved and quartered), its \
+             own error in a quantity is that quantity between its runs (for a step the larger \
+             of twice the first difference and four times the second, which covers order 1 \
+             and a halving whose errors cancel by chance), and the gate is twice the two \
+             errors' sum, plus the rounding \
+             floor and, for the switch model, what its stick band moves that no tolerance \
+             does (`rotor_harness::compare::gate::derived_tolerance`). The margin of a \
+             derived gate says how far the two solvers agree beyond their own accuracy.\n\n",
+        );
+    }
+    md.push_str(
+        "| scenario | pair | quantity | key | difference | tolerance | margin | |\n|---|---|---|---|---|---|---|---|\n",
     );
     // Each scenario's trace and figure, rendered side by side (66 MB of CSV for the fixtures:
     // the main job's last step, which would otherwise leave a core idle).
@@ -533,7 +565,7 @@ pub fn write_report(
         let (gates, fails) = gate_scenario(r);
         for g in &gates {
             for m in &g.measured {
-                let _ = writeln!(md, "{}", gate_row(&r.scenario.name, &g.pair, m));
+                let _ = writeln!(md, "{}", gate_row(&r.scenario.name, &g.pair, m, g.derived));
             }
         }
         for f in unmeasured(&gates, &fails) {
@@ -596,15 +628,20 @@ mod tests {
             tol,
         };
         assert_eq!(
-            gate_row("s", "a-b", &m("period_rel", 2e-11, 1e-10)),
+            gate_row("s", "a-b", &m("period_rel", 2e-11, 1e-10), false),
             "| s | a-b | period_rel | `period_rel` | 2.00e-11 | 1e-10 | 5.0 | ok |"
         );
         assert_eq!(
-            gate_row("s", "a-b", &m("stick_time", 0.0, 0.0)),
+            gate_row("s", "a-b", &m("stick_time", 0.0, 0.0), false),
             "| s | a-b | stick_time | — | 0.00e0 | 0e0 | exact | ok |"
         );
         for d in [f64::NAN, f64::INFINITY] {
-            let row = gate_row("s", "a-b", &m("steady kind (cycle vs equilibrium)", d, 0.0));
+            let row = gate_row(
+                "s",
+                "a-b",
+                &m("steady kind (cycle vs equilibrium)", d, 0.0),
+                false,
+            );
             assert_eq!(
                 row,
                 "| s | a-b | steady kind (cycle vs equilibrium) | — | — | — | — | **FAIL** |"
@@ -631,6 +668,7 @@ mod tests {
         let gates = [GateResult {
             pair: "a-b".into(),
             measured: vec![m("period_rel", 2e-11, 1e-10), kinds],
+            derived: false,
         }];
         let mut fails = gates[0].failures("s");
         assert_eq!(fails.len(), 1);
