@@ -1459,7 +1459,55 @@ where
         let mut jf = self.zeros();
         self.model
             .jacobian_times(x.as_slice(), mode, f.as_slice(), jf.as_mut_slice());
-        self.guard_rate(g, x, &jf, mode) < 0.0
+        self.guard_rate(g, x, &jf, mode) < -self.second_noise(g, t, x, f, mode)
+    }
+
+    /// The rounding level of a guard's second derivative, the rate along `J·f`: the field's
+    /// own rounding (each velocity's `EPS·(|ω_i| + |ω_{i+1}|)` in α̇, each slipping disc's
+    /// `EPS·(|T_ex| + |T_f|)/J` in ω̇, and `EPS·|f|` for the product) carried through the
+    /// Jacobian's magnitudes, then through the guard's magnitudes (with the margin of
+    /// [`Integrator::moves_out`]). Without it a second derivative that is rounding of a
+    /// rounding-level first derivative decides: a viscous disc at rest beside a disc that has
+    /// just left stick at the edge of its interval (its ω̇ a few ulps either side of 0, a
+    /// coupling passing it on) was reversed on that sign, and the wrong branch it was left in
+    /// zeroed its velocity at the next switch. 0 on the rig's paths where nothing is at
+    /// rounding level.
+    fn second_noise(&self, g: Guard, t: f64, x: &Vector<D>, f: &Vector<D>, mode: Mode) -> f64 {
+        const MARGIN: f64 = 64.0 * f64::EPSILON;
+        let n = self.discs();
+        let w = |j: usize| x[n - 1 + j].abs();
+        let mut nf = vec![0.0; 2 * n - 1];
+        for (i, v) in nf[..n - 1].iter_mut().enumerate() {
+            *v = MARGIN * (w(i) + w(i + 1) + f[i].abs());
+        }
+        for j in 0..n {
+            let Some(s) = mode.of(Disc::at(j)).branch() else {
+                continue;
+            };
+            let tf = self.model.friction(j).torque(x[n - 1 + j], s);
+            let te = self.model.applied_torque(j, x.as_slice(), self.u(t));
+            nf[n - 1 + j] =
+                MARGIN * ((te.abs() + tf.abs()) / self.model.inertia(j) + f[n - 1 + j].abs());
+        }
+        let jac = self.model.jacobian(x.as_slice(), mode).abs();
+        let n2 = jac * nalgebra::DVector::from_vec(nf);
+        match g {
+            Guard::Velocity(d) => n2[n - 1 + d.position()],
+            Guard::ExitHi(d) | Guard::ExitLo(d) => {
+                let i = d.position();
+                let mut total = 0.0;
+                if i > 0 {
+                    total += self.model.spring(i - 1) * n2[i - 1]
+                        + self.model.coupling(i - 1) * (n2[n - 2 + i] + n2[n - 1 + i]);
+                }
+                if i + 1 < n {
+                    total += self.model.spring(i) * n2[i]
+                        + self.model.coupling(i) * (n2[n - 1 + i] + n2[n + i]);
+                }
+                total
+            }
+            _ => 0.0,
+        }
     }
 
     /// The mode after a terminal guard, and the event to report.

@@ -422,3 +422,186 @@ fn event_and_switch_find_the_same_events() {
         assert!(worst <= 1.0, "{name}: {worst}");
     }
 }
+
+/// A random chain of three to five discs: the rig's upper disc on top, below it discs with
+/// inertias, springs and (half of them) viscous couplings drawn around the rig's, each with
+/// Table 1's lower law, the Stribeck set's or a viscous law, the torques scaled by 0.5–1.5.
+fn random_chain() -> impl Strategy<Value = (ChainParams, f64)> {
+    use rotor_model::LowerFriction;
+    use rotor_model::chain::{ChainDisc, DiscLaw};
+    let stribeck = Params::from_toml_str(rotor_testkit::STRIBECK, std::path::Path::new("s"))
+        .expect("the Stribeck set loads")
+        .lower;
+    let table1 = Params::table1().lower;
+    let scaled = move |law: LowerFriction, s: f64| match law {
+        LowerFriction::Exponential {
+            t_s,
+            t_1,
+            t_2,
+            w_1,
+            w_2,
+            b,
+        } => LowerFriction::Exponential {
+            t_s: s * t_s,
+            t_1: s * t_1,
+            t_2: s * t_2,
+            w_1,
+            w_2,
+            b: s * b,
+        },
+        LowerFriction::Stribeck {
+            t_s,
+            t_c,
+            omega_s,
+            delta,
+            b,
+        } => LowerFriction::Stribeck {
+            t_s: s * t_s,
+            t_c: s * t_c,
+            omega_s,
+            delta,
+            b: s * b,
+        },
+    };
+    let disc = (
+        0.02f64..0.1,
+        0.04f64..0.2,
+        prop_oneof![Just(0.0), 0.0f64..0.005],
+        0usize..3,
+        0.5f64..1.5,
+    )
+        .prop_map(move |(j, k, c, family, s)| ChainDisc {
+            j,
+            k,
+            c,
+            law: match family {
+                0 => DiscLaw::Lower(scaled(table1, s)),
+                1 => DiscLaw::Lower(scaled(stribeck, s)),
+                _ => DiscLaw::Viscous { b: 0.01 * s },
+            },
+        });
+    (prop::collection::vec(disc, 2..=4), 0.5f64..3.0).prop_map(|(lower, u)| {
+        let rig = ChainParams::from_params(&Params::table1());
+        let mut discs = vec![rig.discs[0]];
+        discs.extend(lower);
+        (
+            ChainParams {
+                k_m: rig.k_m,
+                discs,
+            },
+            u,
+        )
+    })
+}
+
+use proptest::prelude::*;
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 48, ..ProptestConfig::default() })]
+
+    /// Stress: on random chains (three to five discs, every friction family below the rig's
+    /// upper disc, couplings or none) over 10 s from rest, the event-driven solver and the
+    /// switch model, which share only the chain's model, finish and agree on every sample of
+    /// every state within the gate of `event_and_switch_agree_on_every_sample_of_every_chain`
+    /// (twice the sum of their own errors, estimated against their runs at tol 1e-13, plus the
+    /// switch model's band floor).
+    #[test]
+    fn stress_random_chains_event_and_switch_agree((p, u) in random_chain()) {
+        prop_assume!(p.validate().is_ok());
+        let model = ChainModel::new(&p);
+        let at = |kind: SolverKind, tol: f64| {
+            let scene = Scene {
+                u,
+                x0: vec![0.0; model.dim()],
+                t_end: 10.0,
+                accuracy: Accuracy::Tol(tol),
+                output: Output::Grid { dt: 0.01 },
+                ..Scene::default()
+            };
+            kind.simulate_chain(&model, &scene)
+        };
+        let runs = [
+            at(SolverKind::EVENT, 1e-10),
+            at(SolverKind::EVENT, 1e-13),
+            at(SolverKind::SWITCH, 1e-10),
+            at(SolverKind::SWITCH, 1e-13),
+        ];
+        for r in &runs {
+            prop_assert!(r.is_ok(), "{:?}: {:?}", p, r.as_ref().err());
+        }
+        let [ev, ev_t, sw, sw_t] = runs.map(|r| r.unwrap());
+        let est: Vec<f64> = diffs(&ev, &ev_t)
+            .iter()
+            .zip(diffs(&sw, &sw_t))
+            .map(|(e, s)| e + s)
+            .collect();
+        let worst = worst_event_switch(&ev, &sw, &est);
+        prop_assert!(worst <= 1.0, "worst / gate {worst} on {p:?} at u = {u}");
+    }
+}
+
+/// The chain the random stress drew first (five discs; disc 4 viscous, coupled to disc 3):
+/// when disc 3 leaves stick at the edge of its interval, its ω̇ is a few ulps either side of
+/// 0 and the coupling passes that on as disc 4's second derivative. The event solver read
+/// that sign as disc 4 moving out of ω = 0, reversed it, and at the next switch zeroed its
+/// velocity in the wrong branch (ω_4 0.003 against 0.227 rad/s from t = 2.76 s). Now the
+/// second derivative must clear its own rounding level: disc 4 reverses only where the
+/// switch model says it does, and the run agrees with it within the gate.
+#[test]
+fn a_rounding_level_second_derivative_reverses_no_disc() {
+    let text = r#"
+k_m = 3.995
+[[disc]]
+j = 0.4765
+friction = { family = "upper", t_s = 0.0, dt_s = 0.0, b = 2.2247, db = 0.0 }
+[[disc]]
+j = 0.03837989370895407
+k = 0.13668924687779244
+friction = { family = "stribeck", t_s = 0.14776721682696103, t_c = 0.025132647809835516, omega_s = 1.4302, delta = 2.0575, b = 0.005579129006411689 }
+[[disc]]
+j = 0.02
+k = 0.1576278461229932
+friction = { family = "exponential", t_s = 0.17547818948589067, t_1 = 0.06444174680876497, t_2 = -0.24227104480177475, w_1 = 5.7468, w_2 = 0.2941, b = 0.011648673967090184 }
+[[disc]]
+j = 0.02
+k = 0.04
+c = 0.0027873278957248337
+friction = { family = "viscous", b = 0.005 }
+[[disc]]
+j = 0.02
+k = 0.04
+friction = { family = "exponential", t_s = 0.0821, t_1 = 0.03015, t_2 = -0.11335, w_1 = 5.7468, w_2 = 0.2941, b = 0.00545 }
+"#;
+    let p = ChainParams::from_toml_str(text, std::path::Path::new("drawn")).unwrap();
+    let model = ChainModel::new(&p);
+    let at = |kind: SolverKind, tol: f64| {
+        let scene = Scene {
+            u: 0.911599660096067,
+            x0: vec![0.0; model.dim()],
+            t_end: 10.0,
+            accuracy: Accuracy::Tol(tol),
+            output: Output::Grid { dt: 0.01 },
+            ..Scene::default()
+        };
+        kind.simulate_chain(&model, &scene).unwrap()
+    };
+    let (ev, ev_t) = (at(SolverKind::EVENT, 1e-10), at(SolverKind::EVENT, 1e-13));
+    let (sw, sw_t) = (at(SolverKind::SWITCH, 1e-10), at(SolverKind::SWITCH, 1e-13));
+    // Disc 4 reverses when the two solvers both say so (it does, twice, later), never at
+    // another disc's switch.
+    let kinds = |t: &Trajectory| -> Vec<(EventKind, f64)> { events_by_disc(t, 5)[3].clone() };
+    let (ke, ks) = (kinds(&ev), kinds(&sw));
+    assert_eq!(
+        ke.iter().map(|e| e.0).collect::<Vec<_>>(),
+        ks.iter().map(|e| e.0).collect::<Vec<_>>(),
+        "{ke:?} vs {ks:?}"
+    );
+    assert!(ke.iter().all(|e| e.1 > 3.0), "{ke:?}");
+    let est: Vec<f64> = diffs(&ev, &ev_t)
+        .iter()
+        .zip(diffs(&sw, &sw_t))
+        .map(|(e, s)| e + s)
+        .collect();
+    let worst = worst_event_switch(&ev, &sw, &est);
+    assert!(worst <= 1.0, "{worst}");
+}
