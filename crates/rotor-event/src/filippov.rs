@@ -1476,8 +1476,8 @@ where
         const MARGIN: f64 = 64.0 * f64::EPSILON;
         let n = self.discs();
         let w = |j: usize| x[n - 1 + j].abs();
-        let mut nf = vec![0.0; 2 * n - 1];
-        for (i, v) in nf[..n - 1].iter_mut().enumerate() {
+        let mut nf = self.zeros();
+        for (i, v) in nf.as_mut_slice()[..n - 1].iter_mut().enumerate() {
             *v = MARGIN * (w(i) + w(i + 1) + f[i].abs());
         }
         for j in 0..n {
@@ -1489,8 +1489,9 @@ where
             nf[n - 1 + j] =
                 MARGIN * ((te.abs() + tf.abs()) / self.model.inertia(j) + f[n - 1 + j].abs());
         }
-        let jac = self.model.jacobian(x.as_slice(), mode).abs();
-        let n2 = jac * nalgebra::DVector::from_vec(nf);
+        let mut n2 = self.zeros();
+        self.model
+            .jacobian_abs_times(x.as_slice(), mode, nf.as_slice(), n2.as_mut_slice());
         match g {
             Guard::Velocity(d) => n2[n - 1 + d.position()],
             Guard::ExitHi(d) | Guard::ExitLo(d) => {

@@ -859,6 +859,49 @@ impl ChainModel {
         }
     }
 
+    /// `|∂f_mode/∂x| · v` at `x` (for `v ≥ 0`), written into `out`: the magnitudes of
+    /// [`ChainModel::jacobian`]'s entries applied to `v`, without forming it. A bound on how
+    /// far errors `v` in the state move the field, for rounding levels.
+    pub fn jacobian_abs_times(&self, x: &[f64], mode: Mode, v: &[f64], out: &mut [f64]) {
+        let n = self.j.len();
+        let slipping = |d: usize| !mode.is_stuck(Disc::at(d));
+        for (i, o) in out[..n - 1].iter_mut().enumerate() {
+            let mut a = 0.0;
+            if slipping(i) {
+                a += v[n - 1 + i];
+            }
+            if slipping(i + 1) {
+                a += v[n + i];
+            }
+            *o = a;
+        }
+        for i in 0..n {
+            let row = n - 1 + i;
+            let Some(s) = mode.of(Disc::at(i)).branch() else {
+                out[row] = 0.0;
+                continue;
+            };
+            let ji = self.j[i];
+            let mut own = -self.friction[i].dtorque(x[row], s);
+            let mut acc = 0.0;
+            if i > 0 {
+                acc += (self.k[i - 1] / ji).abs() * v[i - 1];
+                own -= self.c[i - 1];
+                if slipping(i - 1) {
+                    acc += (self.c[i - 1] / ji).abs() * v[row - 1];
+                }
+            }
+            if i + 1 < n {
+                acc += (self.k[i] / ji).abs() * v[i];
+                own -= self.c[i];
+                if slipping(i + 1) {
+                    acc += (self.c[i] / ji).abs() * v[row + 1];
+                }
+            }
+            out[row] = acc + (own / ji).abs() * v[row];
+        }
+    }
+
     /// Disc `i`'s friction time scale `τ_fric,i = v_i/(T_i/J_i)` and its law's velocity scale
     /// `v_i` (both ∞ for a law without a velocity scale), as [`crate::TimeScales`] defines them
     /// for the rig.
@@ -1265,6 +1308,56 @@ friction = { family = "stribeck", t_s = 0.2, t_c = 0.1, omega_s = 1.5, delta = 2
                         jac[(r, k)]
                     );
                 }
+            }
+        }
+    }
+
+    /// The matrix-free products the event solver uses (`jacobian_times`, its rows
+    /// `accel_rate`, the magnitudes' `jacobian_abs_times`) are the Jacobian's, which the test
+    /// above holds to finite differences, in every mode of the coupled chain of four;
+    /// `disc_accel` is `rhs_into`'s component; `applied_torque_rate` is the applied torque's
+    /// change along the rate (it is linear). Sums in another order than the matrix product:
+    /// rounding, 1e-14 relative (the torques are O(10): 1e-13 absolute).
+    #[test]
+    fn matrix_free_products_are_the_jacobians() {
+        let m = coupled_chain();
+        let x = [0.4, -0.7, 1.1, 1.3, 0.6, -2.1, 0.9];
+        let v = [0.3, -1.2, 0.5, 2.0, -0.4, 0.8, -1.5];
+        let close = |a: f64, b: f64| (a - b).abs() <= 1e-14 * (1.0 + b.abs());
+        for modes in all_modes(4) {
+            let jac = m.jacobian(&x, modes);
+            let jv = &jac * nalgebra::DVector::from_column_slice(&v);
+            let jav = jac.abs() * nalgebra::DVector::from_column_slice(&v.map(f64::abs));
+            let (mut a, mut b) = ([0.0; 7], [0.0; 7]);
+            m.jacobian_times(&x, modes, &v, &mut a);
+            m.jacobian_abs_times(&x, modes, &v.map(f64::abs), &mut b);
+            let mut f = [0.0; 7];
+            m.rhs_into(&x, 1.5, modes, &mut f);
+            for r in 0..7 {
+                assert!(
+                    close(a[r], jv[r]),
+                    "{modes:?} row {r}: {} vs {}",
+                    a[r],
+                    jv[r]
+                );
+                assert!(
+                    close(b[r], jav[r]),
+                    "{modes:?} row {r}: {} vs {}",
+                    b[r],
+                    jav[r]
+                );
+            }
+            for i in 0..4 {
+                // The applied torque is linear in the state: its rate along v is its change.
+                let xv: Vec<f64> = x.iter().zip(&v).map(|(p, q)| p + q).collect();
+                let change = m.applied_torque(i, &xv, 1.5) - m.applied_torque(i, &x, 1.5);
+                assert!((m.applied_torque_rate(i, &v) - change).abs() <= 1e-14 * 10.0);
+                assert!(close(m.accel_rate(i, &x, modes, &v), jv[3 + i]));
+                assert_eq!(
+                    m.disc_accel(i, &x, 1.5, modes),
+                    f[3 + i],
+                    "{modes:?} disc {i}"
+                );
             }
         }
     }
