@@ -34,16 +34,7 @@ pub fn step_bound(model: &Model, tol: f64, k: f64) -> f64 {
 /// scale). On a chain of two it is the rig's bound to the last bit.
 pub fn chain_step_bound(model: &ChainModel, tol: f64, k: f64) -> f64 {
     let tau = (0..model.discs())
-        .map(|i| {
-            let f = model.friction(i);
-            let v = f.velocity_scale().unwrap_or(f64::INFINITY);
-            let a = f.torque_scale() / model.inertia(i);
-            if v.is_finite() && a > 0.0 {
-                v / a
-            } else {
-                f64::INFINITY
-            }
-        })
+        .map(|i| model.friction_scales(i).0)
         .fold(f64::INFINITY, f64::min);
     k * (tol / 1e-10).powf(1.0 / 5.0) * tau
 }
