@@ -135,25 +135,10 @@ where
     /// to rounding: the interpolant is Hermite at both ends.
     #[inline]
     pub(crate) fn eval_with_rate(&self, t: f64) -> (Vector<D>, Vector<D>) {
-        let s = (t - self.t0) / self.h;
-        let s1 = 1.0 - s;
-        let c = &self.c;
-        let mut x = c[0].clone();
-        let mut r = c[0].clone();
+        let mut x = self.c[0].clone();
+        let mut r = self.c[0].clone();
         for i in 0..x.len() {
-            let p7 = c[6][i] + c[7][i] * s;
-            let p6 = c[5][i] + p7 * s1;
-            let d6 = c[7][i] * s1 - p7;
-            let p5 = c[4][i] + p6 * s;
-            let d5 = d6 * s + p6;
-            let p4 = c[3][i] + p5 * s1;
-            let d4 = d5 * s1 - p5;
-            let p3 = c[2][i] + p4 * s;
-            let d3 = d4 * s + p4;
-            let p2 = c[1][i] + p3 * s1;
-            let d2 = d3 * s1 - p3;
-            x[i] = c[0][i] + p2 * s;
-            r[i] = (d2 * s + p2) / self.h;
+            (x[i], r[i]) = self.value_and_rate(t, i);
         }
         (x, r)
     }
@@ -161,6 +146,13 @@ where
     /// One component of the interpolant's time derivative at time t.
     #[inline]
     pub(crate) fn rate_of(&self, t: f64, i: usize) -> f64 {
+        self.value_and_rate(t, i).1
+    }
+
+    /// Component `i` of the interpolant and of its time derivative at time t: the nested form
+    /// of [`Dense::eval`] differentiated term by term in s (with ds₁/ds = −1), divided by h.
+    #[inline(always)]
+    fn value_and_rate(&self, t: f64, i: usize) -> (f64, f64) {
         let s = (t - self.t0) / self.h;
         let s1 = 1.0 - s;
         let c = &self.c;
@@ -175,7 +167,7 @@ where
         let d3 = d4 * s + p4;
         let p2 = c[1][i] + p3 * s1;
         let d2 = d3 * s1 - p3;
-        (d2 * s + p2) / self.h
+        (c[0][i] + p2 * s, (d2 * s + p2) / self.h)
     }
 
     /// The interpolant of a constant state on `[t0, t0 + h]`.
