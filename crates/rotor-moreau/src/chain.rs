@@ -28,9 +28,7 @@
 //! their stopping tolerance (a test).
 
 use rotor_model::chain::ChainModel;
-use rotor_model::seam::{
-    EventKind, EventRef, Output, Recorder, Scene, SolveError, Stats, Trajectory,
-};
+use rotor_model::seam::{EventKind, EventRef, Recorder, Scene, SolveError, Stats, Trajectory};
 use rotor_model::{Disc, DiscMode, Mode};
 
 use crate::contacts::{ContactError, ContactSolver, Tridiagonal};
@@ -284,12 +282,20 @@ struct ChainEvents<'a> {
     cur: StepEnd,
     next: StepEnd,
     pending: Vec<Found>,
+    /// Whether the extrema of the velocities are located too (for the metrics).
+    extrema: bool,
 }
 
 impl<'a> ChainEvents<'a> {
     /// The locator of a run of `model` at input `u` and weight `theta` from `x0` at t = 0,
     /// each disc in its Filippov-consistent mode there.
-    fn new(model: &'a ChainModel, u: f64, theta: f64, x0: &[f64]) -> ChainEvents<'a> {
+    fn new(
+        model: &'a ChainModel,
+        u: f64,
+        theta: f64,
+        x0: &[f64],
+        extrema: bool,
+    ) -> ChainEvents<'a> {
         let start = model.mode_at(x0, u);
         let cur = StepEnd {
             t: 0.0,
@@ -304,6 +310,7 @@ impl<'a> ChainEvents<'a> {
             next: cur.clone(),
             cur,
             pending: Vec::new(),
+            extrema,
         }
     }
 
@@ -406,7 +413,64 @@ impl<'a> ChainEvents<'a> {
                 }
                 _ => {}
             }
+            if self.extrema {
+                self.extremum(i, cur, next);
+            }
         }
+    }
+
+    /// An extremum of disc `i`'s velocity while it slips over the last three step ends: the
+    /// vertex of the parabola through them (the rig's rule). The state there is the parabola's
+    /// too, except for a disc whose mode changes over the three ends, whose velocity is
+    /// interpolated on the step holding the vertex (a parabola across a stick onset would
+    /// overshoot ω = 0).
+    fn extremum(&mut self, i: usize, cur: &StepEnd, next: &StepEnd) {
+        let Some(p) = self.back.as_ref() else {
+            return;
+        };
+        if [p.modes[i], cur.modes[i], next.modes[i]].contains(&DiscMode::Stick) {
+            return;
+        }
+        let k = self.model.omega(i);
+        let (y0, y1, y2) = (p.x[k], cur.x[k], next.x[k]);
+        let (d1, d2) = (y1 - y0, y2 - y1);
+        let d = Disc::at(i);
+        let kind = if d1 > 0.0 && d2 <= 0.0 {
+            EventKind::Max(d)
+        } else if d1 < 0.0 && d2 >= 0.0 {
+            EventKind::Min(d)
+        } else {
+            return;
+        };
+        // Rounding noise filter: increments of a few ulps are no extremum.
+        if d1.abs().max(d2.abs()) <= 8.0 * f64::EPSILON * (1.0 + y1.abs()) {
+            return;
+        }
+        let (ha, hb) = (cur.t - p.t, next.t - cur.t);
+        let (s1, s2) = (d1 / ha, d2 / hb);
+        let curv = (s2 - s1) / (0.5 * (ha + hb));
+        let t = if curv != 0.0 {
+            (p.t + 0.5 * ha - s1 / curv).clamp(p.t, next.t)
+        } else {
+            cur.t
+        };
+        let weight = |a: f64, b: f64, c: f64| (t - b) * (t - c) / ((a - b) * (a - c));
+        let (la, lb, lc) = (
+            weight(p.t, cur.t, next.t),
+            weight(cur.t, p.t, next.t),
+            weight(next.t, p.t, cur.t),
+        );
+        let mut x: Vec<f64> = (0..p.x.len())
+            .map(|c| p.x[c] * la + cur.x[c] * lb + next.x[c] * lc)
+            .collect();
+        let (a, b) = if t <= cur.t { (p, cur) } else { (cur, next) };
+        for j in 0..self.model.discs() {
+            if p.modes[j] != cur.modes[j] || cur.modes[j] != next.modes[j] {
+                let kj = self.model.omega(j);
+                x[kj] = Self::lerp(a, b, t)[kj];
+            }
+        }
+        self.push(t, x, kind, None);
     }
 
     /// Stick onset of disc `i` from `slip` within the step `cur → next`: the zero of
@@ -445,8 +509,9 @@ impl<'a> ChainEvents<'a> {
 /// the rig's run).
 ///
 /// Its stick onsets and exits and reversals are read off the steps disc by disc, with the
-/// rig's run's rules (crate docs, "Events"). What the chain's run does not do yet is refused by name: a
-/// time-varying input and steady-state metrics (`metrics_from`, [`Output::Metrics`]).
+/// rig's run's rules (crate docs, "Events"), and, when metrics are asked, each slipping
+/// disc's velocity extrema (the vertex of the parabola through three step ends). What the
+/// chain's run does not do yet is refused by name: a time-varying input.
 pub fn simulate_chain(model: &ChainModel, scene: &Scene) -> Result<Trajectory, SolveError> {
     scene.validate_chain(model)?;
     let n = model.discs();
@@ -457,9 +522,6 @@ pub fn simulate_chain(model: &ChainModel, scene: &Scene) -> Result<Trajectory, S
     };
     if scene.is_time_varying() {
         return unsupported("an input that changes in time");
-    }
-    if scene.metrics_from.is_some() || scene.output == Output::Metrics {
-        return unsupported("steady-state metrics");
     }
     let h = scene.checked_step()?;
     let (u, t_end) = (scene.u_at(0.0), scene.t_end);
@@ -481,7 +543,7 @@ pub fn simulate_chain(model: &ChainModel, scene: &Scene) -> Result<Trajectory, S
     let mut modes = vec![DiscMode::Stick; n];
     let mut events = rec
         .wants_events()
-        .then(|| ChainEvents::new(model, u, 0.5, &x));
+        .then(|| ChainEvents::new(model, u, 0.5, &x, rec.wants_extrema()));
     let failed = |t: f64, e: ChainStepError| SolveError::Complementarity {
         t,
         detail: e.to_string(),
@@ -529,6 +591,7 @@ mod tests {
     use super::*;
     use crate::contacts::residual;
     use rotor_model::chain::ChainParams;
+    use rotor_model::seam::Output;
     use rotor_model::{Model, Params, State};
 
     fn stribeck() -> Params {
@@ -620,10 +683,10 @@ mod tests {
         );
         refused(
             Scene {
-                metrics_from: Some(0.5),
+                input: Some(rotor_model::seam::Input::new(&[[0.0, 1.0], [1.0, 2.0]]).unwrap()),
                 ..scene.clone()
             },
-            "steady-state metrics on a chain of 3 discs",
+            "an input that changes in time on a chain of 3 discs",
         );
         // A horizon of more steps than the rig's run allows is refused before it starts.
         refused(

@@ -189,26 +189,22 @@ impl SolverKind {
     /// `scene` on a chain of N discs, by this solver's [`SolverInfo::chain`] (the event-driven
     /// solver's [`rotor_event::EventSolver::simulate_chain`], the switch model's
     /// [`rotor_switch::SwitchSolver::simulate_chain`], Moreau–Jean's
-    /// [`rotor_moreau::simulate_chain`]); a solver without one says so. Steady-state metrics are the rig's (they
-    /// read its two discs), so a chain refuses them by name.
+    /// [`rotor_moreau::simulate_chain`]); a solver without one says so. Steady-state metrics are
+    /// every disc's, the cycle read off the bottom disc ([`rotor_model::seam::MetricsAccumulator`]).
     pub fn simulate_chain(
         self,
         model: &rotor_model::ChainModel,
         scene: &rotor_model::seam::Scene,
     ) -> Result<rotor_model::seam::Trajectory, rotor_model::seam::SolveError> {
-        use rotor_model::seam::{Output, SolveError};
-        let unsupported = |what: &str| SolveError::Unsupported {
-            detail: format!(
-                "{what} on a chain with {} discs by {} (not yet: the rig only)",
-                model.discs(),
-                self.name()
-            ),
-        };
-        if scene.metrics_from.is_some() || scene.output == Output::Metrics {
-            return Err(unsupported("steady-state metrics"));
-        }
+        use rotor_model::seam::SolveError;
         let Some(chain) = self.0.chain else {
-            return Err(unsupported("a run"));
+            return Err(SolveError::Unsupported {
+                detail: format!(
+                    "a run on a chain with {} discs by {} (not yet: the rig only)",
+                    model.discs(),
+                    self.name()
+                ),
+            });
         };
         let tr = chain(model, scene)?;
         tr.check_finite()?;

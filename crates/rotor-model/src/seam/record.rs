@@ -17,7 +17,7 @@ use crate::seam::fast_forward::{FastForward, Verdict};
 use crate::seam::samples::Samples;
 use crate::seam::scene::{Output, OutputGrid, Scene, SolveError, Stats, Trajectory};
 use crate::seam::steady::MetricsAccumulator;
-use crate::{Disc, Mode, State};
+use crate::{Disc, Mode};
 
 /// What a scene keeps of a run, collected as the solver goes.
 #[derive(Debug, Clone)]
@@ -89,7 +89,9 @@ impl Recorder {
             samples,
             scratch: vec![0.0; x0.len()],
             events: Vec::new(),
-            metrics: scene.metrics_start().map(MetricsAccumulator::new),
+            metrics: scene
+                .metrics_start()
+                .map(|t| MetricsAccumulator::for_discs(t, x0.len().div_ceil(2))),
             fast_forward: FastForward::for_scene(scene, ff_tol)
                 .map(|f| f.verify_within(skip_verify)),
             count: 0,
@@ -301,14 +303,7 @@ impl Recorder {
                 g.advance();
             }
         }
-        let metrics = self.metrics.as_ref().map(|m| {
-            assert_eq!(
-                x_final.len(),
-                3,
-                "the steady-state metrics read the rig's state"
-            );
-            m.finish(&State::from_column_slice(x_final)).into()
-        });
+        let metrics = self.metrics.as_ref().map(|m| m.finish_lists(x_final));
         Trajectory {
             samples: self.samples,
             events: self.events,
@@ -332,7 +327,7 @@ mod tests {
     use super::*;
     use crate::seam::event::EventKind;
     use crate::seam::steady::RigSteady;
-    use crate::{Disc, DiscMode};
+    use crate::{Disc, DiscMode, State};
 
     /// A triangle wave of period 4 and amplitude 1 (exact in binary arithmetic).
     fn tri(t: f64) -> f64 {

@@ -1,14 +1,15 @@
 //! Steady-state metrics, accumulated from a run's events in O(1) memory.
 //!
 //! Solvers push their located events into a [`MetricsAccumulator`] (stick onsets and exits,
-//! and the extrema of ω_u and ω_l, located between steps). A cycle is the interval between two
-//! successive *anchors*: exits of the lower disc from stick when the orbit sticks, maxima of
-//! ω_l otherwise. The metrics of the last complete cycle are reported.
+//! and the extrema of every disc's velocity, located between steps). A cycle is the interval
+//! between two successive *anchors*: exits of the bottom disc (the rig's lower one) from
+//! stick when it sticks, maxima of its velocity otherwise. The metrics of the last complete
+//! cycle are reported, for every disc.
 
 use serde::{Deserialize, Serialize};
 
 use crate::seam::event::{Event, EventKind, EventRef};
-use crate::{Disc, OMEGA_L, OMEGA_U, State};
+use crate::{Disc, Mode, State};
 
 /// A steady state of a chain of discs, as per-disc lists (disc order: 0 is the driven
 /// disc at the top).
@@ -268,19 +269,23 @@ impl std::fmt::Display for SteadyKind {
     }
 }
 
-/// Summary of one cycle between two anchors.
+/// The largest chain the metrics hold: the mode's bit sets' ([`Mode::MAX_DISCS`]), so that
+/// the accumulator is a plain value, copied (not allocated) when a run saves it.
+const DISCS: usize = Mode::MAX_DISCS;
+
+/// Summary of one cycle between two anchors, per disc (the first `n` entries of each list).
 #[derive(Debug, Clone, Copy, PartialEq)]
 struct Cycle {
     start: f64,
     end: f64,
-    wl_max: f64,
-    wl_min: f64,
-    wu_max: f64,
-    wu_min: f64,
-    stick: f64,
+    max: [f64; DISCS],
+    min: [f64; DISCS],
+    /// Time stuck within the cycle.
+    stick: [f64; DISCS],
 }
 
-/// One anchor stream (stick exits, or ω_l maxima) with the cycle in progress.
+/// One anchor stream (stick exits, or maxima, of the bottom disc) with the cycle in
+/// progress.
 #[derive(Debug, Clone, Copy)]
 struct Stream {
     open: Option<Cycle>,
@@ -297,44 +302,57 @@ impl Stream {
         }
     }
 
-    fn anchor(&mut self, t: f64, x: &[f64]) {
+    fn anchor(&mut self, t: f64, x: &[f64], n: usize) {
         if let Some(mut c) = self.open.take() {
             c.end = t;
-            c.include(x);
+            c.include(x, n);
             self.last = [Some(c), self.last[0]];
             self.count += 1;
         }
         let mut c = Cycle {
             start: t,
             end: t,
-            wl_max: f64::NEG_INFINITY,
-            wl_min: f64::INFINITY,
-            wu_max: f64::NEG_INFINITY,
-            wu_min: f64::INFINITY,
-            stick: 0.0,
+            max: [f64::NEG_INFINITY; DISCS],
+            min: [f64::INFINITY; DISCS],
+            stick: [0.0; DISCS],
         };
-        c.include(x);
+        c.include(x, n);
         self.open = Some(c);
     }
 }
 
 impl Cycle {
-    fn include(&mut self, x: &[f64]) {
-        self.wl_max = self.wl_max.max(x[OMEGA_L]);
-        self.wl_min = self.wl_min.min(x[OMEGA_L]);
-        self.wu_max = self.wu_max.max(x[OMEGA_U]);
-        self.wu_min = self.wu_min.min(x[OMEGA_U]);
+    /// Takes in the velocities of a state of a chain of `n` discs (`[α_1 … α_{n−1}, ω_1 … ω_n]`).
+    fn include(&mut self, x: &[f64], n: usize) {
+        let omega = &x[n - 1..];
+        for (i, &w) in omega.iter().enumerate() {
+            self.max[i] = self.max[i].max(w);
+            self.min[i] = self.min[i].min(w);
+        }
+    }
+
+    /// The ω range of the bottom disc over the cycle.
+    fn bottom_amplitude(&self, n: usize) -> f64 {
+        self.max[n - 1] - self.min[n - 1]
     }
 }
 
-/// Accumulates steady-state metrics from events, in constant memory.
+/// Accumulates steady-state metrics from events, in constant memory, for a chain of any
+/// number of discs (the rig is the chain of two).
+///
+/// The cycles are read off the bottom disc (the rig's lower one): between its stick exits
+/// when it sticks, else between its maxima. Each cycle holds every disc's largest and
+/// smallest velocity and time stuck. The accumulator is a plain value (its lists are sized
+/// for [`Mode::MAX_DISCS`]), so a run saves and restores it without allocating.
 #[derive(Debug, Clone, Copy)]
 pub struct MetricsAccumulator {
     t_from: f64,
+    /// The number of discs.
+    n: usize,
     stick_exits: Stream,
     maxima: Stream,
-    /// Start of the lower disc's current stick phase (if stuck).
-    stick_since: Option<f64>,
+    /// Start of each disc's current stick phase (NaN while it slips).
+    stick_since: [f64; DISCS],
 }
 
 /// Amplitude of ω_l [rad/s] below which an oscillation counts as an equilibrium: far below
@@ -343,14 +361,34 @@ pub struct MetricsAccumulator {
 pub const EQUILIBRIUM_AMPLITUDE: f64 = 1e-6;
 
 impl MetricsAccumulator {
-    /// Metrics over events at `t ≥ t_from`.
+    /// Metrics of the rig (two discs) over events at `t ≥ t_from`.
     pub fn new(t_from: f64) -> MetricsAccumulator {
+        MetricsAccumulator::for_discs(t_from, 2)
+    }
+
+    /// Metrics of a chain of `discs` discs (2 ≤ discs ≤ [`Mode::MAX_DISCS`]) over events at
+    /// `t ≥ t_from`.
+    ///
+    /// # Panics
+    ///
+    /// If `discs` is outside that range: a chain is refused beyond it where it is read.
+    pub fn for_discs(t_from: f64, discs: usize) -> MetricsAccumulator {
+        assert!(
+            (2..=DISCS).contains(&discs),
+            "a chain of {discs} discs: the metrics hold 2 to {DISCS}"
+        );
         MetricsAccumulator {
             t_from,
+            n: discs,
             stick_exits: Stream::new(),
             maxima: Stream::new(),
-            stick_since: None,
+            stick_since: [f64::NAN; DISCS],
         }
+    }
+
+    /// The number of discs.
+    pub fn discs(&self) -> usize {
+        self.n
     }
 
     /// Feeds one event (in time order).
@@ -359,24 +397,30 @@ impl MetricsAccumulator {
         if e.t < self.t_from {
             return;
         }
+        let n = self.n;
         for s in [&mut self.stick_exits, &mut self.maxima] {
             if let Some(c) = s.open.as_mut() {
-                c.include(e.x);
+                c.include(e.x, n);
             }
         }
+        let bottom = Disc::at(n - 1);
         match e.kind {
-            EventKind::StickStart(Disc::LOWER) => self.stick_since = Some(e.t),
-            EventKind::StickEnd(Disc::LOWER) => {
-                if let Some(t0) = self.stick_since.take() {
+            EventKind::StickStart(d) => self.stick_since[d.position()] = e.t,
+            EventKind::StickEnd(d) => {
+                let i = d.position();
+                let t0 = std::mem::replace(&mut self.stick_since[i], f64::NAN);
+                if !t0.is_nan() {
                     for s in [&mut self.stick_exits, &mut self.maxima] {
                         if let Some(c) = s.open.as_mut() {
-                            c.stick += e.t - t0.max(c.start);
+                            c.stick[i] += e.t - t0.max(c.start);
                         }
                     }
                 }
-                self.stick_exits.anchor(e.t, e.x);
+                if d == bottom {
+                    self.stick_exits.anchor(e.t, e.x, n);
+                }
             }
-            EventKind::Max(Disc::LOWER) => self.maxima.anchor(e.t, e.x),
+            EventKind::Max(d) if d == bottom => self.maxima.anchor(e.t, e.x, n),
             _ => {}
         }
     }
@@ -399,13 +443,13 @@ impl MetricsAccumulator {
                 c.end += dt;
             }
         }
-        if let Some(t) = self.stick_since.as_mut() {
-            *t += dt;
+        for t in &mut self.stick_since[..self.n] {
+            *t += dt; // NaN (slipping) stays NaN
         }
     }
 
-    /// The cycles the metrics are read from: between stick exits if the lower disc sticks,
-    /// else between ω_l maxima.
+    /// The cycles the metrics are read from: between stick exits if the bottom disc sticks,
+    /// else between its maxima.
     fn stream(&self) -> &Stream {
         if self.stick_exits.count >= 1 {
             &self.stick_exits
@@ -414,33 +458,46 @@ impl MetricsAccumulator {
         }
     }
 
-    /// The steady state after a run ending at `(t, x)`: the last complete cycle if the orbit
-    /// still oscillates with amplitude above [`EQUILIBRIUM_AMPLITUDE`], else the final state.
-    pub fn finish(&self, x_final: &State) -> RigSteady {
+    /// The steady state after a run ending at `x_final` (of the chain's size): the last
+    /// complete cycle if the bottom disc still oscillates with amplitude above
+    /// [`EQUILIBRIUM_AMPLITUDE`], else the final state. Every disc's stick time is measured.
+    pub fn finish_lists(&self, x_final: &[f64]) -> SteadyState {
+        let n = self.n;
         match self.stream().last[0] {
-            Some(c) if c.wl_max - c.wl_min > EQUILIBRIUM_AMPLITUDE => RigSteady::LimitCycle {
+            Some(c) if c.bottom_amplitude(n) > EQUILIBRIUM_AMPLITUDE => SteadyState::LimitCycle {
                 period: c.end - c.start,
-                omega_l_max: c.wl_max,
-                omega_l_min: c.wl_min,
-                omega_u_max: c.wu_max,
-                omega_u_min: c.wu_min,
-                stick_time: c.stick,
+                omega_max: c.max[..n].to_vec(),
+                omega_min: c.min[..n].to_vec(),
+                stick_time: c.stick[..n].iter().copied().map(Some).collect(),
             },
-            _ => RigSteady::Equilibrium {
-                omega_u: x_final[OMEGA_U],
-                omega_l: x_final[OMEGA_L],
-                alpha: x_final[0],
+            _ => SteadyState::Equilibrium {
+                alpha: x_final[..n - 1].to_vec(),
+                omega: x_final[n - 1..].to_vec(),
             },
         }
     }
 
-    /// Relative change of the ω_l amplitude (max − min) between the last two complete cycles,
-    /// if two exist: a focus decaying near a Hopf point keeps its period but not its amplitude.
+    /// The rig's steady state after a run ending at `(t, x)`: [`MetricsAccumulator::finish_lists`]
+    /// in the rig's named view.
+    ///
+    /// # Panics
+    ///
+    /// If the accumulator is not the rig's (two discs).
+    pub fn finish(&self, x_final: &State) -> RigSteady {
+        assert_eq!(self.n, 2, "the rig's view of a chain of {} discs", self.n);
+        self.finish_lists(x_final.as_slice())
+            .rig()
+            .expect("two discs with every stick time measured")
+    }
+
+    /// Relative change of the bottom disc's ω amplitude (max − min) between the last two
+    /// complete cycles, if two exist: a focus decaying near a Hopf point keeps its period but
+    /// not its amplitude.
     pub fn amplitude_drift(&self) -> Option<f64> {
         let [Some(a), Some(b)] = self.stream().last else {
             return None;
         };
-        let (ra, rb) = (a.wl_max - a.wl_min, b.wl_max - b.wl_min);
+        let (ra, rb) = (a.bottom_amplitude(self.n), b.bottom_amplitude(self.n));
         Some((ra - rb).abs() / ra.abs().max(rb.abs()).max(EQUILIBRIUM_AMPLITUDE))
     }
 
@@ -665,6 +722,53 @@ mod tests {
                 omega_u: 2.0,
                 omega_l: 2.0,
                 alpha: 1.0
+            }
+        );
+    }
+    /// A chain of three: the cycle is anchored on the bottom disc (disc 3), every disc's
+    /// extremes are kept, and each disc's stick time is its own; a stick exit of another disc
+    /// is no anchor.
+    #[test]
+    fn a_chain_of_three_keeps_every_disc_and_anchors_on_the_bottom_one() {
+        let mut m = MetricsAccumulator::for_discs(0.0, 3);
+        let [d1, d2, d3] = [Disc::at(0), Disc::at(1), Disc::at(2)];
+        // x = [α_1, α_2, ω_1, ω_2, ω_3]
+        let x = |w1: f64, w2: f64, w3: f64| [0.1, 0.2, w1, w2, w3];
+        let period = |k: f64| {
+            let t = 10.0 * k;
+            [
+                Event::new(t, &x(1.0, 0.5, 0.0), EventKind::StickEnd(d3)),
+                Event::new(t + 1.0, &x(1.2, 0.0, 0.4), EventKind::StickStart(d2)),
+                Event::new(t + 3.0, &x(1.1, 0.0, 0.6), EventKind::StickEnd(d2)),
+                Event::new(t + 4.0, &x(0.9, 2.0, 3.0), EventKind::Max(d3)),
+                Event::new(t + 5.0, &x(0.8, 1.0, 2.0), EventKind::Max(d1)),
+                Event::new(t + 6.0, &x(1.3, 0.7, 0.0), EventKind::StickStart(d3)),
+            ]
+        };
+        for k in 0..4 {
+            period(f64::from(k)).iter().for_each(|e| m.push(e));
+        }
+        m.push(&period(4.0)[0]);
+        assert_eq!(
+            m.finish_lists(&[0.0; 5]),
+            SteadyState::LimitCycle {
+                period: 10.0,
+                omega_max: vec![1.3, 2.0, 3.0],
+                omega_min: vec![0.8, 0.0, 0.0],
+                stick_time: vec![Some(0.0), Some(2.0), Some(4.0)],
+            }
+        );
+        assert_eq!(
+            (m.period_drift(), m.amplitude_drift()),
+            (Some(0.0), Some(0.0))
+        );
+        // Without events, the final state in the chain's lists.
+        let rest = MetricsAccumulator::for_discs(0.0, 3);
+        assert_eq!(
+            rest.finish_lists(&x(1.0, 1.0, 1.0)),
+            SteadyState::Equilibrium {
+                alpha: vec![0.1, 0.2],
+                omega: vec![1.0; 3],
             }
         );
     }
