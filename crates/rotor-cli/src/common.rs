@@ -3,7 +3,7 @@
 
 use std::path::{Path, PathBuf};
 
-use anyhow::{Result, anyhow};
+use anyhow::{Context, Result, anyhow};
 use rotor_analysis::solvers::SolverKind;
 use rotor_model::{Model, Params};
 
@@ -413,3 +413,58 @@ macro_rules! refuse {
     };
 }
 pub(crate) use refuse;
+
+/// The chain a `--params` file in chain form gives, with its path (`None` for a file in the
+/// rig's form, or no `--params`). A chain of two is the rig, and runs as the rig; its trace
+/// is headed with the chain's names, as any chain file's.
+pub(crate) fn chain_file(common: &Common) -> Result<Option<(PathBuf, rotor_model::ChainParams)>> {
+    let Some(p) = common.params.as_deref() else {
+        return Ok(None);
+    };
+    let path = fixture_path("--params", p, "params")?;
+    let chain = rotor_model::ChainParams::from_file(&path)?;
+    // The file loaded, so it is a small text file: read again to tell its form.
+    let text = std::fs::read_to_string(&path)
+        .with_context(|| format!("{}: cannot read", path.display()))?;
+    Ok(rotor_model::ChainParams::is_chain_form(&text).then_some((path, chain)))
+}
+
+/// The solver `--solver` names for a chain of `n` discs read from `path`: one that runs
+/// chains, with its own setting only (`--tol` or `--h`; the other would be silently unused).
+pub(crate) fn chain_solver(
+    common: &Common,
+    path: &Path,
+    n: usize,
+) -> Result<rotor_analysis::solvers::SolverKind> {
+    let kind = rotor_analysis::solvers::solver_kind(&common.solver)?;
+    if kind.info().chain.is_none() {
+        return Err(unusable(format_args!(
+            "--solver {}: {} is a chain with {n} discs, which {} does not run (--solver {})",
+            kind.name(),
+            path.display(),
+            kind.name(),
+            rotor_analysis::solvers::SolverKind::chain_solver_names(", ")
+        )));
+    }
+    // Each solver's own setting only: the other one would be silently unused.
+    match (
+        kind.is_fixed_step(),
+        common.tol.is_some(),
+        common.h.is_some(),
+    ) {
+        (true, true, _) => {
+            return Err(unusable(format_args!(
+                "--tol: {} takes a step, --h",
+                kind.name()
+            )));
+        }
+        (false, _, true) => {
+            return Err(unusable(format_args!(
+                "--h: {} takes a tolerance, --tol",
+                kind.name()
+            )));
+        }
+        _ => {}
+    }
+    Ok(kind)
+}

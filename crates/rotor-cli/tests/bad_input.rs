@@ -61,18 +61,31 @@ fn bad_parameter_files_are_named_with_field_and_value() {
         let fs = f.to_str().unwrap();
         let mut needles = c.needles.clone();
         needles.push(fs);
-        let o = rotor(&["steady", "--solver", "event", "--u", "1", "--params", fs]);
-        assert_clean_error(&o, what, &needles);
         let csv = dir.join(format!("p{i}.csv"));
-        // A good chain of three is bad only where the rig is read (`steady` above): every
-        // solver simulates it.
+        // A good chain of three is bad only where the rig is read (the sweep): every solver
+        // simulates it and finds its steady state.
         let good_chain = std::str::from_utf8(&c.contents)
             .ok()
             .and_then(|t| rotor_model::ChainParams::from_toml_str(t, Path::new("c")).ok())
             .is_some_and(|p| p.len() > 2);
         if good_chain {
+            let o = rotor(&[
+                "sweep",
+                "--u",
+                "1:1:1",
+                "--param",
+                "k_m=3:3:1",
+                "--params",
+                fs,
+                "--csv",
+                csv.to_str().unwrap(),
+            ]);
+            assert_clean_error(&o, what, &needles);
+            assert!(!csv.exists(), "{what}");
             continue;
         }
+        let o = rotor(&["steady", "--solver", "event", "--u", "1", "--params", fs]);
+        assert_clean_error(&o, what, &needles);
         let o = rotor(&[
             "simulate",
             "--solver",

@@ -374,9 +374,9 @@ impl ChainParams {
             (None, why) => Err(ParamsError::Parse {
                 path: path.to_owned(),
                 message: format!(
-                    "a chain with {}: the solvers take the two-disc rig's shape only (2 discs, \
-                     no viscous coupling, disc 1 'upper' or 'viscous', disc 2 'exponential' \
-                     or 'stribeck')",
+                    "a chain with {}: this reads the two-disc rig's shape only (2 discs, no \
+                     viscous coupling, disc 1 'upper' or 'viscous', disc 2 'exponential' or \
+                     'stribeck'); `rotor simulate` and `rotor steady` take any chain",
                     why.unwrap_or_default()
                 ),
             }),

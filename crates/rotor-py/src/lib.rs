@@ -525,6 +525,13 @@ fn simulate_chain<'py>(
 /// the others simulate until the metrics stop changing. Arguments as for ``simulate``; an
 /// ``input`` that changes in time is refused (ValueError naming ``input``): a steady state
 /// needs a constant input.
+///
+/// A chain of N discs (``params`` in the chain form) returns the chain's lists, read off the
+/// solver's own run (``method`` ``"simulated"``): ``kind`` ``"equilibrium"`` (``alpha``,
+/// ``omega``), ``"limit_cycle"`` (``period``, ``omega_max``, ``omega_min``, ``stick_time``
+/// of N entries, ``crossings`` of its section per period, the ``return_distance`` it was
+/// checked by) or ``"aperiodic"`` (the closest return and how runs at two settings part
+/// ways), as ``rotor steady`` prints it.
 #[pyfunction]
 #[pyo3(
     signature = (solver="event", u=1.5, params=None, x0=vec![0.0; 3], tol=None, h=None, input=None),
@@ -541,6 +548,46 @@ fn steady<'py>(
     h: Option<f64>,
     input: Option<Vec<[f64; 2]>>,
 ) -> PyResult<Bound<'py, PyAny>> {
+    if let Some(chain) = chain_of(params)? {
+        // The default, rest, is rest for a chain of any size.
+        let rest = x0.len() == 3 && x0.iter().all(|&v| v == 0.0);
+        let x0 = if rest {
+            vec![0.0; 2 * chain.len() - 1]
+        } else {
+            x0
+        };
+        let req = Request {
+            solver,
+            u,
+            input: input_of(input)?,
+            x0,
+            tol,
+            h,
+        };
+        let (kind, scene, _) = req.steady().map_err(bad)?;
+        if kind.info().chain.is_none() {
+            return Err(PyValueError::new_err(format!(
+                "solver = {solver:?}: a chain with {} discs runs on {}",
+                chain.len(),
+                rotor_analysis::solvers::SolverKind::chain_solver_names(", ")
+            )));
+        }
+        warn_ignored(py, &req)?;
+        let model = ChainModel::new(&chain);
+        let answer = detached(py, move || {
+            rotor_analysis::steady::chain::chain_steady(
+                kind,
+                &model,
+                &scene,
+                &rotor_analysis::steady::chain::ChainSteadyOptions::default(),
+            )
+        })?
+        .map_err(|e| match e {
+            rotor_analysis::steady::chain::ChainSteadyError::Solve(e) => from_solve(py, e),
+            e => solve_error(py, e.to_string(), None, None),
+        })?;
+        return to_py(py, &answer);
+    }
     let req = Request {
         solver,
         u,

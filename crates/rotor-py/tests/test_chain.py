@@ -93,3 +93,23 @@ def test_a_chain_refuses_what_it_cannot_take_by_name(chain3):
         rotorbench.simulate("switch", 1.5, params=str(chain3), x0=(0.0, 0.1, 0.0), t_end=1.0)
     with pytest.raises(TypeError, match=r"params\['disc'\]\[0\]"):
         rotorbench.simulate("switch", 1.5, params={"k_m": 1.0, "disc": [1.0, 2.0]}, t_end=1.0)
+
+
+def test_steady_on_a_chain_gives_the_clis_lists(cli_json, tmp_path):
+    """``steady`` of a chain returns the chain's lists, the same JSON as ``rotor steady``: the
+    rig's top disc with two copies of its lower disc, at 2.5 V a cycle of 22 s."""
+    params = {"k_m": 3.995, "disc": [DISCS[0], DISCS[1], DISCS[1]]}
+    st = rotorbench.steady("event", 2.5, params=params)
+    assert st["kind"] == "limit_cycle"
+    assert all(len(st[k]) == 3 for k in ("omega_max", "omega_min", "stick_time"))
+    assert st["return_distance"] <= st["return_tolerance"]
+    path = tmp_path / "rig-like3.toml"
+    disc = lambda d: "[[disc]]\nj = {}\n{}friction = {{ {} }}\n".format(
+        d["j"],
+        f"k = {d['k']}\n" if "k" in d else "",
+        ", ".join(f'{k} = "{v}"' if isinstance(v, str) else f"{k} = {v}" for k, v in d["friction"].items()),
+    )
+    path.write_text('name = "rig-like3"\nk_m = 3.995\n' + disc(DISCS[0]) + disc(DISCS[1]) + disc(DISCS[1]))
+    assert cli_json("steady", "--params", path, "--u", "2.5", "--solver", "event") == st
+    with pytest.raises(ValueError, match="input"):
+        rotorbench.steady("event", params=params, input=[[0, 1.5], [1, 2.5]])

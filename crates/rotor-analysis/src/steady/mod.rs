@@ -5,6 +5,7 @@
 #![warn(missing_docs)]
 
 pub mod by_solver;
+pub mod chain;
 pub mod checked;
 mod compute;
 pub mod figure3;

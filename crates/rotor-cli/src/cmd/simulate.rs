@@ -56,21 +56,6 @@ pub(crate) fn check_grid(t_end: f64, dt: f64, given: bool) -> Result<()> {
     Ok(())
 }
 
-/// The chain a `--params` file in chain form gives, with its path (`None` for a file in the
-/// rig's form, or no `--params`). A chain of two is the rig, and runs as the rig; its trace
-/// is headed with the chain's names, as any chain file's.
-fn chain_file(common: &Common) -> Result<Option<(PathBuf, rotor_model::ChainParams)>> {
-    let Some(p) = common.params.as_deref() else {
-        return Ok(None);
-    };
-    let path = crate::common::fixture_path("--params", p, "params")?;
-    let chain = rotor_model::ChainParams::from_file(&path)?;
-    // The file loaded, so it is a small text file: read again to tell its form.
-    let text = std::fs::read_to_string(&path)
-        .with_context(|| format!("{}: cannot read", path.display()))?;
-    Ok(rotor_model::ChainParams::is_chain_form(&text).then_some((path, chain)))
-}
-
 /// `rotor simulate` of a chain of N discs: `--x0` of the chain's 2N − 1 values, the switch
 /// model at `--tol` (a constant `--u` or an `--input` in time) or Moreau–Jean at `--h` (a
 /// constant `--u`); the trace headed with the chain's state names (`t,alpha_1,…,omega_N`).
@@ -82,43 +67,14 @@ fn simulate_chain(
     dt: Option<f64>,
     csv_path: &Path,
 ) -> Result<()> {
-    let n = chain.discs();
-    let kind = rotor_analysis::solvers::solver_kind(&common.solver)?;
-    if kind.info().chain.is_none() {
-        return Err(unusable(format_args!(
-            "--solver {}: {} is a chain with {n} discs, which {} does not run (--solver {})",
-            kind.name(),
-            path.display(),
-            kind.name(),
-            rotor_analysis::solvers::SolverKind::chain_solver_names(", ")
-        )));
-    }
+    let kind = crate::common::chain_solver(common, path, chain.discs())?;
     if kind == rotor_analysis::solvers::SolverKind::MOREAU && common.input.is_some() {
         return Err(unusable(format_args!(
-            "--input: the chain of {} (a chain with {n} discs) takes a constant --u on \
+            "--input: the chain of {} (a chain with {} discs) takes a constant --u on \
              --solver moreau so far (--solver switch takes an input in time)",
-            path.display()
+            path.display(),
+            chain.discs()
         )));
-    }
-    // Each solver's own setting only: the other one would be silently unused.
-    match (
-        kind.is_fixed_step(),
-        common.tol.is_some(),
-        common.h.is_some(),
-    ) {
-        (true, true, _) => {
-            return Err(unusable(format_args!(
-                "--tol: {} takes a step, --h",
-                kind.name()
-            )));
-        }
-        (false, _, true) => {
-            return Err(unusable(format_args!(
-                "--h: {} takes a tolerance, --tol",
-                kind.name()
-            )));
-        }
-        _ => {}
     }
     let input = common
         .input
@@ -161,7 +117,7 @@ pub(crate) fn simulate(
     csv_path: &Path,
 ) -> Result<()> {
     let chain = match common.scenario {
-        None => chain_file(common)?,
+        None => crate::common::chain_file(common)?,
         Some(_) => None,
     };
     if let Some((path, params)) = &chain

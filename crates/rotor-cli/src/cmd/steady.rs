@@ -21,6 +21,9 @@ pub struct Args {
     /// crossing, unchecked: the orbit stable or not (docs/methods.md, 4b). Every answer is
     /// checked against the model's equations before it is printed (an equilibrium's field
     /// vanishes, a cycle returns to its start after one period); one that fails is refused.
+    /// A parameter file in chain form is answered from the solver's own run, as the chain's
+    /// lists: an equilibrium, a cycle of any number of returns to its section, or
+    /// "aperiodic" with the evidence (`shoot` is refused for it).
     #[arg(long, value_name = "shoot|simulate")]
     pub method: Option<String>,
     /// Not taken (hidden from the help): `steady` runs as long as its answer needs. Given,
@@ -64,6 +67,11 @@ pub(crate) fn steady(common: &Common, method: Option<&str>) -> Result<()> {
             )));
         }
     };
+    if common.scenario.is_none()
+        && let Some((path, chain)) = crate::common::chain_file(common)?
+    {
+        return steady_chain(common, method, &path, &chain);
+    }
     let start = start(common)?;
     let (kind, scene, opts) = request(common, &start)?
         .steady()
@@ -84,4 +92,56 @@ pub(crate) fn steady(common: &Common, method: Option<&str>) -> Result<()> {
 
 pub(crate) fn steady_json(st: &rotor_analysis::steady::SteadyAnswer) -> String {
     serde_json::to_string(st).expect("plain floats and strings serialize")
+}
+
+/// `rotor steady` of a parameter file in chain form: the steady state read off the solver's
+/// own run ([`rotor_analysis::steady::chain`]), as the chain's lists (`omega_max: [N]`, ...):
+/// an equilibrium, a cycle of any number of section crossings, or "aperiodic" with its
+/// evidence. A chain's cycle is not shot: `--method shoot` is refused by name.
+fn steady_chain(
+    common: &Common,
+    method: Option<&str>,
+    path: &std::path::Path,
+    chain: &rotor_model::ChainParams,
+) -> Result<()> {
+    if method == Some("shoot") {
+        return Err(unusable(format_args!(
+            "--method shoot: {} is a chain of {} discs, whose steady state is read off the \
+             solver's run (--method simulate), not shot",
+            path.display(),
+            chain.len()
+        )));
+    }
+    let model = rotor_model::ChainModel::new(chain);
+    let kind = crate::common::chain_solver(common, path, model.discs())?;
+    let input = common
+        .input
+        .as_deref()
+        .map(crate::common::read_input)
+        .transpose()?;
+    let names = model.state_names();
+    let refs: Vec<&str> = names.iter().map(String::as_str).collect();
+    let x0 = crate::common::parse_x0(common.x0.as_deref(), &refs)?;
+    let request = rotor_harness::jobs::request::Request {
+        solver: &common.solver,
+        // clap requires --u without a scenario or --input.
+        u: common.u.unwrap_or(f64::NAN),
+        input,
+        x0,
+        tol: common.tol,
+        h: common.h,
+    };
+    let (_, scene, _) = request.steady().map_err(crate::common::flagged)?;
+    let answer = rotor_analysis::steady::chain::chain_steady(
+        kind,
+        &model,
+        &scene,
+        &rotor_analysis::steady::chain::ChainSteadyOptions::default(),
+    )
+    .with_context(|| format!("solver {}", kind.name()))?;
+    out::line(format_args!(
+        "{}",
+        serde_json::to_string(&answer).expect("plain floats and strings serialize")
+    ))?;
+    Ok(())
 }

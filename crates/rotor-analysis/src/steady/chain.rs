@@ -1,0 +1,664 @@
+//! The steady state of a chain of N discs, by any solver: an equilibrium, a cycle of any
+//! number of section crossings, or, where the run shows no cycle, "aperiodic" with the
+//! evidence.
+//!
+//! A chain's cycles are rarely the rig's one-crossing cycle: a stick-slip wave running down
+//! the chain can take dozens of returns to its Poincaré section before it repeats. So the
+//! steady state is read off the solver's own run, not off one return:
+//!
+//! 1. **The run.** The solver runs from the start over horizons `T = first, 2·first, …`
+//!    up to `horizon`, each from the start (no restart inside a run, so no event is lost or
+//!    doubled at a seam), keeping every event (stick onsets and exits, reversals, each disc's
+//!    velocity extrema) and the state once per second.
+//! 2. **Equilibrium.** Over the run's last quarter every disc's velocity stays within
+//!    [`EQUILIBRIUM_AMPLITUDE`] `= δ`: the final state must then satisfy the Filippov system
+//!    (slipping discs' rates, within what a state δ away has, `2 |∂f/∂x| δ`; stuck discs'
+//!    torques inside their stick intervals, within `k δ`).
+//! 3. **A cycle of k crossings.** The section is the bottom disc's stick exit (if it sticks in
+//!    the run's second half), else its velocity maxima. The cycle is the smallest `k ≤
+//!    max_crossings` for which each of the last `repeats · k` crossings returns to the state
+//!    of the crossing `k` before it within `ρ (1 + |x|∞)`, `ρ` the solver's
+//!    [`return_tolerance`].
+//!    This is the cycle's check against the model: the solver's own run of one period from a
+//!    state on it returns to that state, `repeats` periods over. The metrics (period, each
+//!    disc's velocity range and time stuck) are those of the last period.
+//! 4. **Aperiodic.** No cycle by `horizon`. The answer is "aperiodic" only if no return
+//!    comes near (the closest, over every `k`, is farther than [`APERIODIC_GAP`]) *and* a
+//!    second run at a tighter setting (tol/10, or h/2) from the same start parts ways with it
+//!    by a tenth of the velocities' range although the two agree early on: the orbit is
+//!    sensitive to its start (chaos). Divergence alone is no evidence: on a cycle, runs at
+//!    two settings part ways too, as their periods differ and the phase drifts. Otherwise
+//!    (a near return, or runs that still agree) the answer is refused: a transient longer
+//!    than the run, or a cycle the setting does not resolve.
+
+use serde::Serialize;
+
+use rotor_model::seam::steady::EQUILIBRIUM_AMPLITUDE;
+use rotor_model::seam::{Accuracy, Event, EventKind, Output, Scene, SolveError, Trajectory};
+use rotor_model::{ChainModel, Disc, DiscMode};
+
+use crate::solvers::SolverKind;
+use crate::steady::verify::answer_accuracy;
+
+/// Settings of [`chain_steady`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ChainSteadyOptions {
+    /// The first run's horizon \[s\]; each next run doubles it.
+    pub first: f64,
+    /// The longest run \[s\] before the answer is "aperiodic" (or refused as unsettled).
+    pub horizon: f64,
+    /// The longest cycle, in section crossings.
+    pub max_crossings: usize,
+    /// How many periods in a row must return within the accuracy.
+    pub repeats: usize,
+}
+
+impl Default for ChainSteadyOptions {
+    fn default() -> Self {
+        ChainSteadyOptions {
+            // 2000 s: a chain of eight rig-like discs at 1.5 V repeats after some 1,000 s; a
+            // chain of three needs 3,500 s (4,000 s, the second run).
+            first: 2000.0,
+            // 16,000 s: a chain of eight at 2.5 V shows no cycle within 15,000 s.
+            horizon: 16_000.0,
+            // 400 crossings: three times the longest cycle seen on these chains (129
+            // crossings, a chain of eight at 4.5 V).
+            max_crossings: 400,
+            // Two periods in a row: a coincidental near-return of one crossing is not a cycle.
+            repeats: 2,
+        }
+    }
+}
+
+/// What a chain settles on.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+#[serde(tag = "kind", rename_all = "snake_case")]
+pub enum ChainSteady {
+    /// A rest point.
+    Equilibrium {
+        /// The springs' twists α_i \[rad\] (N − 1).
+        alpha: Vec<f64>,
+        /// The discs' velocities \[rad/s\] (N; a stuck disc's 0).
+        omega: Vec<f64>,
+        /// The largest residual of the Filippov system at the state, as a fraction of its
+        /// allowance (≤ 1).
+        residual: f64,
+    },
+    /// A periodic orbit of `crossings` returns to its section.
+    LimitCycle {
+        /// Period \[s\].
+        period: f64,
+        /// Largest ω_i over the period \[rad/s\].
+        omega_max: Vec<f64>,
+        /// Smallest ω_i over the period \[rad/s\].
+        omega_min: Vec<f64>,
+        /// Time disc i spends stuck per period \[s\].
+        stick_time: Vec<f64>,
+        /// Section crossings per period.
+        crossings: usize,
+        /// The section (`"stick exit of disc N"` or `"maximum of omega_N"`).
+        section: String,
+        /// The largest `|x_j − x_{j−k}|∞ / (1 + |x_j|∞)` over the periods checked.
+        return_distance: f64,
+        /// The accuracy it is held to (ρ).
+        return_tolerance: f64,
+        /// The start of the periods checked \[s\]: the run is on the cycle from there.
+        settled_by: f64,
+    },
+    /// No cycle: the run never repeats, and runs at neighbouring settings part ways.
+    Aperiodic {
+        /// The run's length \[s\].
+        horizon: f64,
+        /// Section crossings in the run's second half.
+        crossings: usize,
+        /// The section.
+        section: String,
+        /// The closest return found: the number of crossings and the distance (relative,
+        /// as for a cycle) over the last ones.
+        closest_return: ClosestReturn,
+        /// How the runs at the solver's setting and at a tighter one parted.
+        divergence: Divergence,
+    },
+}
+
+/// The best candidate period of an orbit that has none.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct ClosestReturn {
+    /// Section crossings.
+    pub crossings: usize,
+    /// The largest relative return distance over the crossings checked.
+    pub distance: f64,
+    /// The accuracy a cycle would have to return within.
+    pub tolerance: f64,
+}
+
+/// Two runs from one start, at the solver's setting and a tighter one.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Divergence {
+    /// The tighter run's setting (`"tol 1e-11"`, `"h 5e-4"`).
+    pub tighter: String,
+    /// Their largest velocity difference over the first 100 s \[rad/s\].
+    pub early: f64,
+    /// Their largest velocity difference over the run's last quarter \[rad/s\].
+    pub late: f64,
+    /// The first time they differ by a tenth of the velocities' range \[s\].
+    pub parted_at: f64,
+}
+
+/// A chain's steady state as `rotor steady` prints it.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct ChainSteadyAnswer {
+    /// What the chain settles on.
+    #[serde(flatten)]
+    pub state: ChainSteady,
+    /// How: always `"simulated"` (the solver's own run).
+    pub method: &'static str,
+}
+
+/// Why a chain's steady state is not given.
+#[derive(Debug, thiserror::Error)]
+pub enum ChainSteadyError {
+    /// A run failed, or the scene is inadmissible.
+    #[error(transparent)]
+    Solve(#[from] SolveError),
+    /// A time-varying input has no steady state.
+    #[error("input: the steady state of a time-varying input is not defined (give a constant --u)")]
+    TimeVarying,
+    /// No cycle and no equilibrium by the horizon, but a near return (within
+    /// [`APERIODIC_GAP`]) or a tighter run that agrees: a transient longer than the horizon,
+    /// or a cycle the setting does not resolve.
+    #[error(
+        "no steady state confirmed within {horizon} s: no cycle of up to {max_crossings} \
+         section crossings returns within {tolerance:.1e} (the closest, {closest} crossings, \
+         returns within {distance:.2e}; a run at {tighter} differs from it by {late:.2e} rad/s \
+         over the last quarter): a transient longer than the run or a cycle not resolved at \
+         this setting, not an aperiodic orbit (which returns nowhere within 1e-2)"
+    )]
+    Unsettled {
+        /// The run's length \[s\].
+        horizon: f64,
+        /// The longest cycle looked for.
+        max_crossings: usize,
+        /// The accuracy a cycle must return within.
+        tolerance: f64,
+        /// The closest return's crossings.
+        closest: usize,
+        /// Its distance.
+        distance: f64,
+        /// The tighter run's setting.
+        tighter: String,
+        /// The runs' difference over the last quarter \[rad/s\].
+        late: f64,
+    },
+    /// An equilibrium read off a run fails the Filippov system.
+    #[error("the equilibrium found is refuted by the model's own equations: {detail}")]
+    Refuted {
+        /// The condition that failed, with its residual and the allowance.
+        detail: String,
+    },
+}
+
+/// The steady state `kind` reaches on `model` from `scene.x0` at the constant `scene.u`, at the
+/// scene's setting (its `t_end`, `output` and `metrics_from` are not used): see the module
+/// docs.
+pub fn chain_steady(
+    kind: SolverKind,
+    model: &ChainModel,
+    scene: &Scene,
+    opts: &ChainSteadyOptions,
+) -> Result<ChainSteadyAnswer, ChainSteadyError> {
+    if scene.is_time_varying() {
+        return Err(ChainSteadyError::TimeVarying);
+    }
+    let rho = return_tolerance(kind, scene);
+    let mut t_end = opts.first.min(opts.horizon);
+    loop {
+        let run = run_for(kind, model, scene, scene.accuracy, t_end)?;
+        if let Some(eq) = at_rest(&run, model, scene.u, kind.info().stuck_band)? {
+            return Ok(ChainSteadyAnswer {
+                state: eq,
+                method: "simulated",
+            });
+        }
+        let section = Section::of(&run, model.discs());
+        let closest = match section.cycle(opts, rho) {
+            Ok(cycle) => {
+                return Ok(ChainSteadyAnswer {
+                    state: cycle.metrics(&run, &section, model, rho),
+                    method: "simulated",
+                });
+            }
+            Err(closest) => closest,
+        };
+        if t_end >= opts.horizon {
+            let tighter = tighter(kind, scene);
+            let other = run_for(kind, model, scene, tighter, t_end)?;
+            let divergence = diverge(&run, &other, model, kind, tighter);
+            let range = velocity_range(&run, model);
+            // On a cycle, two runs at different settings part ways too: their periods differ,
+            // and the phase drifts. So the orbit is aperiodic only if no return comes near
+            // (the closest farther than APERIODIC_GAP), and the runs part ways as well.
+            if closest.distance <= APERIODIC_GAP || divergence.late < 0.1 * range {
+                return Err(ChainSteadyError::Unsettled {
+                    horizon: t_end,
+                    max_crossings: opts.max_crossings,
+                    tolerance: rho,
+                    closest: closest.crossings,
+                    distance: closest.distance,
+                    tighter: divergence.tighter,
+                    late: divergence.late,
+                });
+            }
+            return Ok(ChainSteadyAnswer {
+                state: ChainSteady::Aperiodic {
+                    horizon: t_end,
+                    crossings: section.crossings.len(),
+                    section: section.name,
+                    closest_return: closest,
+                    divergence,
+                },
+                method: "simulated",
+            });
+        }
+        t_end = (2.0 * t_end).min(opts.horizon);
+    }
+}
+
+/// The run of `kind` over `[0, t_end]` at `accuracy`, keeping every event (extrema
+/// included) and the state once per second.
+fn run_for(
+    kind: SolverKind,
+    model: &ChainModel,
+    scene: &Scene,
+    accuracy: Accuracy,
+    t_end: f64,
+) -> Result<Trajectory, SolveError> {
+    let run = Scene {
+        t_end,
+        accuracy,
+        output: Output::Grid { dt: 1.0 },
+        metrics_from: Some(0.0),
+        ..scene.clone()
+    };
+    kind.simulate_chain(model, &run)
+}
+
+/// The relative distance within which a chain's crossing must return to count as a cycle:
+/// the accuracy every steady answer of the solver is held to ([`answer_accuracy`]), and for
+/// Moreau–Jean at least `0.1·h`. Its located stick exits fall between steps differently
+/// from one return to the next, more so on a chain than on the rig (measured: returns within
+/// 1.1e-5 on the chain of eight rig-like discs at 1.5 V and h = 1e-3, against 2.5e-7 on the
+/// rig); 0.1·h keeps the rig's tenfold margin over that jitter.
+pub fn return_tolerance(kind: SolverKind, scene: &Scene) -> f64 {
+    let rho = answer_accuracy(kind, scene);
+    if kind.is_fixed_step() {
+        rho.max(0.1 * scene.step())
+    } else {
+        rho
+    }
+}
+
+/// The closest return (relative) above which an orbit without a cycle is called aperiodic:
+/// 1e-2, a thousand times the adaptive solvers' return tolerance and a hundred times
+/// Moreau–Jean's at h = 1e-3. Between the tolerance and this gap the orbit nearly repeats;
+/// it may be a cycle converging too slowly for the horizon, or one at the solver's
+/// resolution, and the answer is refused rather than called either.
+pub const APERIODIC_GAP: f64 = 1e-2;
+
+/// The setting next to the scene's, tighter: tol/10 (at least the smallest admissible), or
+/// h/2.
+fn tighter(kind: SolverKind, scene: &Scene) -> Accuracy {
+    if kind.is_fixed_step() {
+        Accuracy::Step(scene.step() / 2.0)
+    } else {
+        // Rounded to three digits, so that it prints as it reads (1e-11, not 1.0000000000000001e-11).
+        let tol = format!("{:.2e}", scene.tol() / 10.0)
+            .parse::<f64>()
+            .unwrap_or(scene.tol() / 10.0);
+        Accuracy::Tol(tol.max(rotor_model::seam::scene::MIN_TOL))
+    }
+}
+
+/// The largest velocity range of any disc over the run's second half \[rad/s\].
+fn velocity_range(run: &Trajectory, model: &ChainModel) -> f64 {
+    let n = model.discs();
+    let half = 0.5 * run.t_final;
+    (0..n)
+        .map(|i| {
+            let k = model.omega(i);
+            let (lo, hi) = run
+                .samples
+                .iter()
+                .filter(|r| r.t >= half)
+                .map(|r| r.x[k])
+                .chain(run.events.iter().filter(|e| e.t >= half).map(|e| e.x[k]))
+                .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), w| {
+                    (lo.min(w), hi.max(w))
+                });
+            hi - lo
+        })
+        .fold(0.0, f64::max)
+}
+
+/// How two runs on one grid part ways.
+fn diverge(
+    a: &Trajectory,
+    b: &Trajectory,
+    model: &ChainModel,
+    kind: SolverKind,
+    tighter: Accuracy,
+) -> Divergence {
+    let n = model.discs();
+    let range = velocity_range(a, model);
+    let (mut early, mut late, mut parted_at) = (0.0f64, 0.0f64, f64::INFINITY);
+    let late_from = 0.75 * a.t_final;
+    for (r, s) in a.samples.iter().zip(b.samples.iter()) {
+        let d = (0..n)
+            .map(|i| (r.x[model.omega(i)] - s.x[model.omega(i)]).abs())
+            .fold(0.0, f64::max);
+        if r.t <= 100.0 {
+            early = early.max(d);
+        }
+        if r.t >= late_from {
+            late = late.max(d);
+        }
+        if d >= 0.1 * range && parted_at.is_infinite() {
+            parted_at = r.t;
+        }
+    }
+    Divergence {
+        tighter: kind.setting_label(tighter.value()),
+        early,
+        late,
+        parted_at,
+    }
+}
+
+/// The run's final state as an equilibrium, if every disc's velocity stays within δ over its
+/// last quarter: checked against the Filippov system (module docs), refused if it fails.
+fn at_rest(
+    run: &Trajectory,
+    model: &ChainModel,
+    u: f64,
+    band: f64,
+) -> Result<Option<ChainSteady>, ChainSteadyError> {
+    let n = model.discs();
+    let from = 0.75 * run.t_final;
+    let still = (0..n).all(|i| {
+        let k = model.omega(i);
+        let (lo, hi) = run
+            .samples
+            .iter()
+            .filter(|r| r.t >= from)
+            .map(|r| r.x[k])
+            .chain(run.events.iter().filter(|e| e.t >= from).map(|e| e.x[k]))
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), w| {
+                (lo.min(w), hi.max(w))
+            });
+        hi - lo <= EQUILIBRIUM_AMPLITUDE
+    });
+    if !still {
+        return Ok(None);
+    }
+    let mut x = run.x_final.clone();
+    // A disc within the solver's stuck band on a set-valued law is stuck: at rest, exactly.
+    for i in 0..n {
+        let k = model.omega(i);
+        if model.friction(i).is_set_valued() && x[k].abs() <= band {
+            x[k] = 0.0;
+        }
+    }
+    let residual = equilibrium_residual(model, &x, u, band)?;
+    Ok(Some(ChainSteady::Equilibrium {
+        alpha: x[..n - 1].to_vec(),
+        omega: x[n - 1..].to_vec(),
+        residual,
+    }))
+}
+
+/// The Filippov system at `x`, against its allowance for a state known within δ: the largest
+/// residual over its allowance (≤ 1), or the refusal naming the condition that fails.
+fn equilibrium_residual(
+    model: &ChainModel,
+    x: &[f64],
+    u: f64,
+    band: f64,
+) -> Result<f64, ChainSteadyError> {
+    let n = model.discs();
+    let delta = EQUILIBRIUM_AMPLITUDE;
+    let mode = model.mode_at(x, u);
+    let mut f = vec![0.0; model.dim()];
+    model.rhs_into(x, u, mode, &mut f);
+    let mut allow = vec![0.0; model.dim()];
+    model.jacobian_abs_times(x, mode, &vec![delta; model.dim()], &mut allow);
+    let mut worst = 0.0f64;
+    for (c, (fc, a)) in f.iter().zip(&allow).enumerate() {
+        // Twice the first-order bound, plus the solvers' stuck bands in α̇.
+        let allowance = 2.0 * a + 2.0 * band + f64::EPSILON * (1.0 + x[c].abs());
+        let r = fc.abs() / allowance;
+        if r > 1.0 {
+            let what = if c < n - 1 {
+                format!("alpha_{} rate", c + 1)
+            } else {
+                format!("omega_{} rate", c - (n - 1) + 1)
+            };
+            return Err(ChainSteadyError::Refuted {
+                detail: format!("{what} = {fc:.3e}, beyond {allowance:.3e}"),
+            });
+        }
+        worst = worst.max(r);
+    }
+    for i in 0..n {
+        if mode.of(Disc::at(i)) != DiscMode::Stick {
+            continue;
+        }
+        let (lo, hi) = model.friction(i).static_interval();
+        let ta = model.applied_torque(i, x, u);
+        // The torque moves by the attached springs' and couplings' stiffness times δ.
+        let attached = |j: usize| model.spring(j) + model.coupling(j);
+        let stiffness =
+            if i > 0 { attached(i - 1) } else { 0.0 } + if i + 1 < n { attached(i) } else { 0.0 };
+        let slack = 2.0 * stiffness * delta;
+        let over = (lo - ta).max(ta - hi);
+        if over > slack {
+            return Err(ChainSteadyError::Refuted {
+                detail: format!(
+                    "disc {} is stuck with applied torque {ta:.6e} outside [{lo:.6e}, {hi:.6e}] \
+                     by {over:.3e}, beyond {slack:.3e}",
+                    i + 1
+                ),
+            });
+        }
+    }
+    Ok(worst)
+}
+
+/// A run's returns to its section.
+struct Section {
+    name: String,
+    /// Each crossing's time and state, in the run's second half.
+    crossings: Vec<(f64, Vec<f64>)>,
+}
+
+impl Section {
+    /// The bottom disc's stick exits if it sticks in the run's second half, else its maxima.
+    fn of(run: &Trajectory, n: usize) -> Section {
+        let bottom = Disc::at(n - 1);
+        let half = 0.5 * run.t_final;
+        let pick = |kind: EventKind| -> Vec<(f64, Vec<f64>)> {
+            run.events
+                .iter()
+                .filter(|e| e.t >= half && e.kind == kind)
+                .map(|e| (e.t, e.x.clone()))
+                .collect()
+        };
+        let exits = pick(EventKind::StickEnd(bottom));
+        if !exits.is_empty() {
+            return Section {
+                name: format!("stick exit of disc {n}"),
+                crossings: exits,
+            };
+        }
+        Section {
+            name: format!("maximum of omega_{n}"),
+            crossings: pick(EventKind::Max(bottom)),
+        }
+    }
+
+    /// The smallest number of crossings `k` after which each of the last `repeats · k`
+    /// crossings returns within `rho`; else the closest return.
+    fn cycle(&self, opts: &ChainSteadyOptions, rho: f64) -> Result<Cycle, ClosestReturn> {
+        let m = self.crossings.len();
+        let mut closest = ClosestReturn {
+            crossings: 0,
+            distance: f64::INFINITY,
+            tolerance: rho,
+        };
+        for k in 1..=opts.max_crossings {
+            let checked = opts.repeats * k;
+            if checked + k > m {
+                break;
+            }
+            let mut d = 0.0f64;
+            for j in m - checked..m {
+                let (a, b) = (&self.crossings[j].1, &self.crossings[j - k].1);
+                let scale = 1.0 + a.iter().fold(0.0f64, |s, v| s.max(v.abs()));
+                let dist = a
+                    .iter()
+                    .zip(b)
+                    .map(|(p, q)| (p - q).abs())
+                    .fold(0.0, f64::max);
+                d = d.max(dist / scale);
+                if d > rho && d > closest.distance {
+                    break;
+                }
+            }
+            if d <= rho {
+                return Ok(Cycle {
+                    k,
+                    distance: d,
+                    start: self.crossings[m - 1 - checked].0,
+                });
+            }
+            if d < closest.distance {
+                closest = ClosestReturn {
+                    crossings: k,
+                    distance: d,
+                    tolerance: rho,
+                };
+            }
+        }
+        Err(closest)
+    }
+}
+
+/// A cycle found on a section.
+struct Cycle {
+    k: usize,
+    distance: f64,
+    start: f64,
+}
+
+impl Cycle {
+    /// The metrics of the run's last period: from the crossing `k` before the last to the
+    /// last, each disc's velocity extremes over the events and samples there and its time
+    /// stuck.
+    fn metrics(&self, run: &Trajectory, s: &Section, model: &ChainModel, rho: f64) -> ChainSteady {
+        let n = model.discs();
+        let m = s.crossings.len();
+        let (ta, tb) = (s.crossings[m - 1 - self.k].0, s.crossings[m - 1].0);
+        let mut max = vec![f64::NEG_INFINITY; n];
+        let mut min = vec![f64::INFINITY; n];
+        let mut take = |x: &[f64]| {
+            for i in 0..n {
+                let w = x[model.omega(i)];
+                max[i] = max[i].max(w);
+                min[i] = min[i].min(w);
+            }
+        };
+        take(&s.crossings[m - 1 - self.k].1);
+        take(&s.crossings[m - 1].1);
+        let within = |e: &&Event| e.t >= ta && e.t <= tb;
+        run.events.iter().filter(within).for_each(|e| take(&e.x));
+        run.samples
+            .iter()
+            .filter(|r| r.t >= ta && r.t <= tb)
+            .for_each(|r| take(r.x));
+        // Time stuck: each disc's stick phases clipped to [ta, tb]; a disc stuck at ta was
+        // stuck since its last onset before it.
+        let mut since: Vec<Option<f64>> = vec![None; n];
+        let mut stick = vec![0.0; n];
+        for e in run.events.iter().filter(|e| e.t <= tb) {
+            match e.kind {
+                EventKind::StickStart(d) => since[d.position()] = Some(e.t),
+                EventKind::StickEnd(d) => {
+                    if let Some(t0) = since[d.position()].take()
+                        && e.t > ta
+                    {
+                        stick[d.position()] += e.t - t0.max(ta);
+                    }
+                }
+                _ => {}
+            }
+        }
+        for (i, t0) in since.iter().enumerate() {
+            if let Some(t0) = t0 {
+                stick[i] += tb - t0.max(ta);
+            }
+        }
+        ChainSteady::LimitCycle {
+            period: tb - ta,
+            omega_max: max,
+            omega_min: min,
+            stick_time: stick,
+            crossings: self.k,
+            section: s.name.clone(),
+            return_distance: self.distance,
+            return_tolerance: rho,
+            settled_by: self.start,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use rotor_model::{ChainParams, Params};
+
+    fn chain3() -> ChainModel {
+        ChainModel::new(&ChainParams::rig_copies(&Params::table1(), 3))
+    }
+
+    /// The check refuses states that are not equilibria, naming the condition: a twist
+    /// 1e-3 rad off the 6 V equilibrium (a spring rate no δ explains), and the 0.02 V rest
+    /// with the first spring wound past the second disc's static friction. The equilibria
+    /// themselves (read off a run at tol 1e-10) pass.
+    #[test]
+    fn the_equilibrium_check_refuses_what_is_not_one() {
+        let model = chain3();
+        let slipping = [
+            3.6551602493454567,
+            1.8275801246727403,
+            10.655041061658956,
+            10.655041061658912,
+            10.655041061658931,
+        ];
+        assert!(equilibrium_residual(&model, &slipping, 6.0, 0.0).unwrap() <= 1.0);
+        let mut off = slipping;
+        off[0] += 1e-3;
+        let e = equilibrium_residual(&model, &off, 6.0, 0.0)
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("omega_1 rate"), "{e}");
+        let stuck = [1.0990371389270943, 0.0, 0.0, 0.0, 0.0];
+        assert!(equilibrium_residual(&model, &stuck, 0.02, 0.0).unwrap() <= 1.0);
+        // k α = 0.0727 · 3 = 0.22 N m on disc 2, beyond its static 0.1642 N m: it cannot
+        // stick (the Filippov mode slips it, and its rate is then far from 0).
+        let mut wound = stuck;
+        wound[0] = 3.0;
+        let e = equilibrium_residual(&model, &wound, 0.02, 0.0)
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("rate"), "{e}");
+    }
+}
