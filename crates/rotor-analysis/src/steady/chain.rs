@@ -51,6 +51,9 @@ pub struct ChainSteadyOptions {
     pub max_crossings: usize,
     /// How many periods in a row must return within the accuracy.
     pub repeats: usize,
+    /// Whether a cycle found is refined by shooting on the solver's own k-th return map
+    /// (with its multipliers).
+    pub shoot: bool,
 }
 
 impl Default for ChainSteadyOptions {
@@ -66,6 +69,7 @@ impl Default for ChainSteadyOptions {
             max_crossings: 400,
             // Two periods in a row: a coincidental near-return of one crossing is not a cycle.
             repeats: 2,
+            shoot: true,
         }
     }
 }
@@ -104,6 +108,13 @@ pub enum ChainSteady {
         return_tolerance: f64,
         /// The start of the periods checked \[s\]: the run is on the cycle from there.
         settled_by: f64,
+        /// Floquet multipliers `[re, im]` of the cycle, by decreasing modulus: the eigenvalues
+        /// of the k-th return map's Jacobian in the section's coordinates (shooting); `None`
+        /// when the cycle was not shot.
+        multipliers: Option<Vec<[f64; 2]>>,
+        /// Whether every multiplier lies inside the unit circle (shooting); absent otherwise.
+        #[serde(skip_serializing_if = "Option::is_none")]
+        stable: Option<bool>,
     },
     /// No cycle: the run never repeats, and runs at neighbouring settings part ways.
     Aperiodic {
@@ -151,8 +162,13 @@ pub struct ChainSteadyAnswer {
     /// What the chain settles on.
     #[serde(flatten)]
     pub state: ChainSteady,
-    /// How: always `"simulated"` (the solver's own run).
+    /// How: `"simulated"` (read off the solver's run), or `"shoot"` (a cycle so found, then
+    /// refined by Newton on the solver's own k-th return map, with its multipliers).
     pub method: &'static str,
+    /// Why a cycle found by simulation was not refined by shooting (the simulated answer
+    /// stands); absent otherwise.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub not_shot: Option<String>,
 }
 
 /// Why a chain's steady state is not given.
@@ -218,14 +234,32 @@ pub fn chain_steady(
             return Ok(ChainSteadyAnswer {
                 state: eq,
                 method: "simulated",
+                not_shot: None,
             });
         }
         let section = Section::of(&run, model.discs());
         let closest = match section.cycle(opts, rho) {
             Ok(cycle) => {
-                return Ok(ChainSteadyAnswer {
-                    state: cycle.metrics(&run, &section, model, rho),
-                    method: "simulated",
+                let simulated = cycle.metrics(&run, &section, model, rho);
+                if !opts.shoot {
+                    return Ok(ChainSteadyAnswer {
+                        state: simulated,
+                        method: "simulated",
+                        not_shot: None,
+                    });
+                }
+                let shooter = Shooter::new(kind, model, scene, &section, &cycle, rho);
+                return Ok(match shooter.and_then(|s| s.shoot()) {
+                    Ok(state) => ChainSteadyAnswer {
+                        state,
+                        method: "shoot",
+                        not_shot: None,
+                    },
+                    Err(why) => ChainSteadyAnswer {
+                        state: simulated,
+                        method: "simulated",
+                        not_shot: Some(why),
+                    },
                 });
             }
             Err(closest) => closest,
@@ -258,6 +292,7 @@ pub fn chain_steady(
                     divergence,
                 },
                 method: "simulated",
+                not_shot: None,
             });
         }
         t_end = (2.0 * t_end).min(opts.horizon);
@@ -476,6 +511,8 @@ fn equilibrium_residual(
 /// A run's returns to its section.
 struct Section {
     name: String,
+    /// The event that is a crossing.
+    kind: EventKind,
     /// Each crossing's time and state, in the run's second half.
     crossings: Vec<(f64, Vec<f64>)>,
 }
@@ -496,11 +533,13 @@ impl Section {
         if !exits.is_empty() {
             return Section {
                 name: format!("stick exit of disc {n}"),
+                kind: EventKind::StickEnd(bottom),
                 crossings: exits,
             };
         }
         Section {
             name: format!("maximum of omega_{n}"),
+            kind: EventKind::Max(bottom),
             crossings: pick(EventKind::Max(bottom)),
         }
     }
@@ -561,53 +600,13 @@ struct Cycle {
 
 impl Cycle {
     /// The metrics of the run's last period: from the crossing `k` before the last to the
-    /// last, each disc's velocity extremes over the events and samples there and its time
-    /// stuck.
+    /// last.
     fn metrics(&self, run: &Trajectory, s: &Section, model: &ChainModel, rho: f64) -> ChainSteady {
-        let n = model.discs();
         let m = s.crossings.len();
-        let (ta, tb) = (s.crossings[m - 1 - self.k].0, s.crossings[m - 1].0);
-        let mut max = vec![f64::NEG_INFINITY; n];
-        let mut min = vec![f64::INFINITY; n];
-        let mut take = |x: &[f64]| {
-            for i in 0..n {
-                let w = x[model.omega(i)];
-                max[i] = max[i].max(w);
-                min[i] = min[i].min(w);
-            }
-        };
-        take(&s.crossings[m - 1 - self.k].1);
-        take(&s.crossings[m - 1].1);
-        let within = |e: &&Event| e.t >= ta && e.t <= tb;
-        run.events.iter().filter(within).for_each(|e| take(&e.x));
-        run.samples
-            .iter()
-            .filter(|r| r.t >= ta && r.t <= tb)
-            .for_each(|r| take(r.x));
-        // Time stuck: each disc's stick phases clipped to [ta, tb]; a disc stuck at ta was
-        // stuck since its last onset before it.
-        let mut since: Vec<Option<f64>> = vec![None; n];
-        let mut stick = vec![0.0; n];
-        for e in run.events.iter().filter(|e| e.t <= tb) {
-            match e.kind {
-                EventKind::StickStart(d) => since[d.position()] = Some(e.t),
-                EventKind::StickEnd(d) => {
-                    if let Some(t0) = since[d.position()].take()
-                        && e.t > ta
-                    {
-                        stick[d.position()] += e.t - t0.max(ta);
-                    }
-                }
-                _ => {}
-            }
-        }
-        for (i, t0) in since.iter().enumerate() {
-            if let Some(t0) = t0 {
-                stick[i] += tb - t0.max(ta);
-            }
-        }
+        let (a, b) = (&s.crossings[m - 1 - self.k], &s.crossings[m - 1]);
+        let (max, min, stick) = period_metrics(run, (a.0, &a.1), (b.0, &b.1), model);
         ChainSteady::LimitCycle {
-            period: tb - ta,
+            period: b.0 - a.0,
             omega_max: max,
             omega_min: min,
             stick_time: stick,
@@ -616,7 +615,339 @@ impl Cycle {
             return_distance: self.distance,
             return_tolerance: rho,
             settled_by: self.start,
+            multipliers: None,
+            stable: None,
         }
+    }
+}
+
+/// Each disc's largest and smallest velocity and time stuck over `[ta, tb]` of `run`, whose
+/// states at the ends are `xa` and `xb`: the extremes over the end states and the events and
+/// samples between, the stick phases clipped to the interval (a disc stuck at `ta` was
+/// stuck since its last onset before it).
+#[allow(clippy::type_complexity)]
+fn period_metrics(
+    run: &Trajectory,
+    (ta, xa): (f64, &[f64]),
+    (tb, xb): (f64, &[f64]),
+    model: &ChainModel,
+) -> (Vec<f64>, Vec<f64>, Vec<f64>) {
+    let n = model.discs();
+    let mut max = vec![f64::NEG_INFINITY; n];
+    let mut min = vec![f64::INFINITY; n];
+    let mut take = |x: &[f64]| {
+        for i in 0..n {
+            let w = x[model.omega(i)];
+            max[i] = max[i].max(w);
+            min[i] = min[i].min(w);
+        }
+    };
+    take(xa);
+    take(xb);
+    let within = |e: &&Event| e.t >= ta && e.t <= tb;
+    run.events.iter().filter(within).for_each(|e| take(&e.x));
+    run.samples
+        .iter()
+        .filter(|r| r.t >= ta && r.t <= tb)
+        .for_each(|r| take(r.x));
+    let mut since: Vec<Option<f64>> = vec![None; n];
+    let mut stick = vec![0.0; n];
+    for e in run.events.iter().filter(|e| e.t <= tb) {
+        match e.kind {
+            EventKind::StickStart(d) => since[d.position()] = Some(e.t),
+            EventKind::StickEnd(d) => {
+                if let Some(t0) = since[d.position()].take()
+                    && e.t > ta
+                {
+                    stick[d.position()] += e.t - t0.max(ta);
+                }
+            }
+            _ => {}
+        }
+    }
+    for (i, t0) in since.iter().enumerate() {
+        if let Some(t0) = t0 {
+            stick[i] += tb - t0.max(ta);
+        }
+    }
+    (max, min, stick)
+}
+
+/// Newton on the solver's own k-th return map to the section, from a cycle found by
+/// simulation.
+///
+/// The map `P^k` runs the solver from a state on the section until its k-th crossing. For the
+/// bottom disc's stick exit the section's coordinates `z` are the state without the bottom
+/// disc's velocity (0 there) and twist (its spring then holds the applied torque at the
+/// limit the disc leaves at), so the map is smooth in them; for its maxima they are the whole
+/// state. Newton solves `P^k(z) = z` with the Jacobian by forward differences of step
+/// `√ν (1 + |z_j|)`, ν the map's reproducibility (1e3·tol for the adaptive solvers, ρ/10 for
+/// Moreau–Jean), until the return is within `max(ν, ρ/100)·(1 + |z|∞)`. The multipliers are
+/// the eigenvalues of `∂P^k/∂z` at the fixed point; the cycle is stable when every one lies
+/// inside the unit circle. The metrics are those of the period the last map run covers.
+struct Shooter<'a> {
+    kind: SolverKind,
+    model: &'a ChainModel,
+    scene: &'a Scene,
+    anchor: EventKind,
+    k: usize,
+    period: f64,
+    rho: f64,
+    nu: f64,
+    /// The bottom disc's applied torque at the exit (the stick-exit section), else `None`.
+    exit_torque: Option<f64>,
+    /// The state the shooting starts from (the run's last crossing).
+    x0: Vec<f64>,
+    section: String,
+    /// When the simulation was on the cycle \[s\].
+    settled_by: f64,
+}
+
+impl<'a> Shooter<'a> {
+    fn new(
+        kind: SolverKind,
+        model: &'a ChainModel,
+        scene: &'a Scene,
+        section: &Section,
+        cycle: &Cycle,
+        rho: f64,
+    ) -> Result<Shooter<'a>, String> {
+        let m = section.crossings.len();
+        let (tb, x0) = section.crossings[m - 1].clone();
+        let period = tb - section.crossings[m - 1 - cycle.k].0;
+        let n = model.discs();
+        let exit_torque = match section.kind {
+            EventKind::StickEnd(_) => {
+                if model.spring(n - 2) <= 0.0 {
+                    return Err("the bottom spring is 0: no section coordinates".to_owned());
+                }
+                let (lo, hi) = model.friction(n - 1).static_interval();
+                let ta = model.applied_torque(n - 1, &x0, scene.u);
+                // The limit it left at, biased by a few roundings outward so that a run from
+                // the section leaves stick at once.
+                let bound = if (ta - hi).abs() <= (ta - lo).abs() {
+                    hi
+                } else {
+                    lo
+                };
+                Some(bound + 4.0 * f64::EPSILON * bound.abs().max(1.0) * bound.signum())
+            }
+            _ => None,
+        };
+        let nu = if kind.is_fixed_step() {
+            0.1 * rho
+        } else {
+            1e3 * scene.tol()
+        };
+        Ok(Shooter {
+            kind,
+            model,
+            scene,
+            anchor: section.kind,
+            k: cycle.k,
+            period,
+            rho,
+            nu,
+            exit_torque,
+            x0,
+            section: section.name.clone(),
+            settled_by: cycle.start,
+        })
+    }
+
+    /// The state components that are the section's coordinates.
+    fn free(&self) -> Vec<usize> {
+        let n = self.model.discs();
+        (0..self.model.dim())
+            .filter(|&c| self.exit_torque.is_none() || (c != n - 2 && c != 2 * n - 2))
+            .collect()
+    }
+
+    /// The state on the section with coordinates `z`.
+    fn lift(&self, z: &[f64], free: &[usize]) -> Vec<f64> {
+        let n = self.model.discs();
+        let mut x = self.x0.clone();
+        for (&c, v) in free.iter().zip(z) {
+            x[c] = *v;
+        }
+        if let Some(t) = self.exit_torque {
+            x[2 * n - 2] = 0.0;
+            // T = k α + c (ω_{N−1} − ω_N), ω_N = 0.
+            let c = self.model.coupling(n - 2) * x[2 * n - 3];
+            x[n - 2] = (t - c) / self.model.spring(n - 2);
+        }
+        x
+    }
+
+    /// `P^k(x)`: the run from `x` to its k-th crossing, the state there and the run (kept
+    /// with extrema when `metrics`).
+    fn map(&self, x: &[f64], metrics: bool) -> Result<(Vec<f64>, f64, Trajectory), String> {
+        let mut t_end = 1.5 * self.period;
+        for _ in 0..3 {
+            let scene = Scene {
+                x0: x.to_vec(),
+                t_end,
+                output: if metrics {
+                    Output::Grid { dt: 1.0 }
+                } else {
+                    Output::Events
+                },
+                metrics_from: metrics.then_some(0.0),
+                ..self.scene.clone()
+            };
+            let run = self
+                .kind
+                .simulate_chain(self.model, &scene)
+                .map_err(|e| format!("a run of the return map failed: {e}"))?;
+            // A crossing at the very start is the start itself, not a return.
+            let skip = 1e-6 * self.period;
+            if let Some(e) = run
+                .events
+                .iter()
+                .filter(|e| e.kind == self.anchor && e.t > skip)
+                .nth(self.k - 1)
+            {
+                let (x, t) = (e.x.clone(), e.t);
+                return Ok((x, t, run));
+            }
+            t_end *= 2.0;
+        }
+        Err(format!(
+            "a run from the section does not return {} times within {:.0} s",
+            self.k, t_end
+        ))
+    }
+
+    /// `∂P^k/∂z` at `z` (where `P^k` lands at `p`) by one-sided differences, forward
+    /// (`sign` 1) or backward (−1), of step `scale · √ν (1 + |z_j|)`.
+    fn jacobian(
+        &self,
+        z: &[f64],
+        p: &[f64],
+        free: &[usize],
+        sign: f64,
+        scale: f64,
+    ) -> Result<nalgebra::DMatrix<f64>, String> {
+        let dim = free.len();
+        let mut jac = nalgebra::DMatrix::<f64>::zeros(dim, dim);
+        for j in 0..dim {
+            let eps = sign * scale * self.nu.sqrt() * (1.0 + z[j].abs());
+            let mut zj = z.to_vec();
+            zj[j] += eps;
+            let (pj, _, _) = self.map(&self.lift(&zj, free), false)?;
+            for i in 0..dim {
+                jac[(i, j)] = (pj[free[i]] - p[free[i]]) / eps;
+            }
+        }
+        Ok(jac)
+    }
+
+    fn shoot(self) -> Result<ChainSteady, String> {
+        let free = self.free();
+        let pick = |x: &[f64]| -> Vec<f64> { free.iter().map(|&c| x[c]).collect() };
+        let norm = |v: &[f64]| v.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+        let mut z = pick(&self.x0);
+        let target = self.nu.max(0.01 * self.rho);
+        let dim = free.len();
+        for _ in 0..12 {
+            let (p, _, _) = self.map(&self.lift(&z, &free), false)?;
+            let f: Vec<f64> = pick(&p).iter().zip(&z).map(|(a, b)| a - b).collect();
+            if norm(&f) <= target * (1.0 + norm(&z)) {
+                return self.finish(&z, &p, &free);
+            }
+            let jac = self.jacobian(&z, &p, &free, 1.0, 1.0)?;
+            let a = &jac - nalgebra::DMatrix::<f64>::identity(dim, dim);
+            let rhs = nalgebra::DVector::from_iterator(dim, f.iter().map(|v| -v));
+            let step = a
+                .lu()
+                .solve(&rhs)
+                .ok_or("the return map's Jacobian has a multiplier at 1")?;
+            for (zi, d) in z.iter_mut().zip(step.iter()) {
+                *zi += d;
+            }
+        }
+        Err(format!(
+            "Newton on the {}-th return map did not converge in 12 steps",
+            self.k
+        ))
+    }
+
+    /// The multipliers at the fixed point `z` (where `P^k` lands at `p`): the eigenvalues of
+    /// the central-difference Jacobian at the first of the steps `√ν`, `√ν/10`, `√ν/100` at
+    /// which they are resolved. The forward and backward Jacobians differ by the map's
+    /// curvature and noise over the step, and by a jump where a step crosses into another
+    /// sequence of events (a disc that sticks instead of reversing): their largest entry
+    /// difference, times the dimension, bounds how far a multiplier may move (Bauer–Fike,
+    /// up to the eigenvectors' conditioning), and the multipliers count as resolved when
+    /// that is below a tenth and below the largest one's distance to the unit circle.
+    fn multipliers(&self, z: &[f64], p: &[f64], free: &[usize]) -> Result<Vec<[f64; 2]>, String> {
+        let mut last = String::new();
+        for scale in [1.0, 0.1, 0.01] {
+            let forward = self.jacobian(z, p, free, 1.0, scale)?;
+            let backward = self.jacobian(z, p, free, -1.0, scale)?;
+            let jac = (&forward + &backward) * 0.5;
+            let bound = (&forward - &backward).abs().max() * jac.nrows() as f64;
+            let mut mu: Vec<[f64; 2]> = jac
+                .complex_eigenvalues()
+                .iter()
+                .map(|c| [c.re, c.im])
+                .collect();
+            mu.sort_by(|a, b| b[0].hypot(b[1]).total_cmp(&a[0].hypot(a[1])));
+            let largest = mu.first().map_or(0.0, |m| m[0].hypot(m[1]));
+            if bound < 0.1 && bound < (largest - 1.0).abs() {
+                return Ok(mu);
+            }
+            last = format!(
+                "the multipliers are not resolved: at the smallest difference step the \
+                 one-sided Jacobians differ by up to {bound:.1e} (times the dimension), the \
+                 largest multiplier being {largest:.3}"
+            );
+        }
+        Err(last)
+    }
+
+    /// The shot cycle: its metrics over the period from the fixed point, its return distance
+    /// (checked against ρ) and its multipliers (stable, as the run that found it converged
+    /// to it: a multiplier outside the unit circle contradicts the run and is refused).
+    fn finish(&self, z: &[f64], p: &[f64], free: &[usize]) -> Result<ChainSteady, String> {
+        let mu = self.multipliers(z, p, free)?;
+        let largest = mu.first().map_or(0.0, |m| m[0].hypot(m[1]));
+        if largest >= 1.0 {
+            return Err(format!(
+                "shooting puts a multiplier at {largest:.3}, outside the unit circle, on the \
+                 cycle the run converged to: the return map's differences are not to be \
+                 trusted here"
+            ));
+        }
+        let x = self.lift(z, free);
+        let (p, period, run) = self.map(&x, true)?;
+        let scale = 1.0 + x.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+        let distance = x
+            .iter()
+            .zip(&p)
+            .map(|(a, b)| (a - b).abs())
+            .fold(0.0, f64::max)
+            / scale;
+        if distance > self.rho {
+            return Err(format!(
+                "the shot cycle returns within {distance:.2e}, beyond {:.1e}",
+                self.rho
+            ));
+        }
+        let (max, min, stick) = period_metrics(&run, (0.0, &x), (period, &p), self.model);
+        Ok(ChainSteady::LimitCycle {
+            period,
+            omega_max: max,
+            omega_min: min,
+            stick_time: stick,
+            crossings: self.k,
+            section: self.section.clone(),
+            return_distance: distance,
+            return_tolerance: self.rho,
+            settled_by: self.settled_by,
+            multipliers: Some(mu),
+            stable: Some(true),
+        })
     }
 }
 

@@ -22,8 +22,9 @@ pub struct Args {
     /// checked against the model's equations before it is printed (an equilibrium's field
     /// vanishes, a cycle returns to its start after one period); one that fails is refused.
     /// A parameter file in chain form is answered from the solver's own run, as the chain's
-    /// lists: an equilibrium, a cycle of any number of returns to its section, or
-    /// "aperiodic" with the evidence (`shoot` is refused for it).
+    /// lists: an equilibrium, a cycle of any number of returns to its section (then shot on
+    /// the solver's k-th return map for its multipliers, unless `simulate`; with `shoot` the
+    /// shooting must succeed), or "aperiodic" with the evidence.
     #[arg(long, value_name = "shoot|simulate")]
     pub method: Option<String>,
     /// Not taken (hidden from the help): `steady` runs as long as its answer needs. Given,
@@ -97,21 +98,15 @@ pub(crate) fn steady_json(st: &rotor_analysis::steady::SteadyAnswer) -> String {
 /// `rotor steady` of a parameter file in chain form: the steady state read off the solver's
 /// own run ([`rotor_analysis::steady::chain`]), as the chain's lists (`omega_max: [N]`, ...):
 /// an equilibrium, a cycle of any number of section crossings, or "aperiodic" with its
-/// evidence. A chain's cycle is not shot: `--method shoot` is refused by name.
+/// evidence. A cycle is then shot on the solver's own k-th return map for its multipliers
+/// (without `--method`: if that fails, the simulated cycle stands and says why;
+/// `--method shoot`: it must succeed; `--method simulate`: not shot).
 fn steady_chain(
     common: &Common,
     method: Option<&str>,
     path: &std::path::Path,
     chain: &rotor_model::ChainParams,
 ) -> Result<()> {
-    if method == Some("shoot") {
-        return Err(unusable(format_args!(
-            "--method shoot: {} is a chain of {} discs, whose steady state is read off the \
-             solver's run (--method simulate), not shot",
-            path.display(),
-            chain.len()
-        )));
-    }
     let model = rotor_model::ChainModel::new(chain);
     let kind = crate::common::chain_solver(common, path, model.discs())?;
     let input = common
@@ -132,13 +127,26 @@ fn steady_chain(
         h: common.h,
     };
     let (_, scene, _) = request.steady().map_err(crate::common::flagged)?;
-    let answer = rotor_analysis::steady::chain::chain_steady(
-        kind,
-        &model,
-        &scene,
-        &rotor_analysis::steady::chain::ChainSteadyOptions::default(),
-    )
-    .with_context(|| format!("solver {}", kind.name()))?;
+    let opts = rotor_analysis::steady::chain::ChainSteadyOptions {
+        shoot: method != Some("simulate"),
+        ..Default::default()
+    };
+    let answer = rotor_analysis::steady::chain::chain_steady(kind, &model, &scene, &opts)
+        .with_context(|| format!("solver {}", kind.name()))?;
+    // Asked to shoot, a cycle that could not be shot is no answer.
+    if method == Some("shoot")
+        && let Some(why) = &answer.not_shot
+    {
+        return Err(anyhow::anyhow!(
+            "solver {}: the cycle the run found (period {}) was not shot: {why}",
+            kind.name(),
+            match &answer.state {
+                rotor_analysis::steady::chain::ChainSteady::LimitCycle { period, .. } =>
+                    format!("{period:.6} s"),
+                _ => "?".to_owned(),
+            }
+        ));
+    }
     out::line(format_args!(
         "{}",
         serde_json::to_string(&answer).expect("plain floats and strings serialize")
