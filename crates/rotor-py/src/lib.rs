@@ -376,7 +376,7 @@ fn input_of(rows: Option<Vec<[f64; 2]>>) -> PyResult<Option<rotor_model::seam::I
 /// with a ``disc`` list) returns ``alpha`` ((N − 1) × len(t)) and ``omega`` (N × len(t)) as
 /// 2-D arrays instead, events naming the disc by its number (1 … N); ``x0`` then holds its
 /// 2N − 1 values ``alpha_1 … omega_N`` (the default, three zeros, is rest for any N). Every
-/// solver runs chains; ``"moreau"`` takes a constant ``u`` on them.
+/// solver runs chains, with a constant ``u`` or an ``input`` in time.
 #[pyfunction]
 #[pyo3(
     signature = (solver="event", u=1.5, params=None, x0=vec![0.0; 3], t_end=100.0, dt=0.01, tol=None, h=None, input=None),
@@ -464,20 +464,12 @@ fn simulate_chain<'py>(
     warn_ignored(py, req)?;
     let n = chain.len();
     let rig = chain.to_params();
-    if rig.is_none() {
-        if kind.info().chain.is_none() {
-            return Err(PyValueError::new_err(format!(
-                "solver = {:?}: a chain with {n} discs runs on {}",
-                kind.name(),
-                rotor_analysis::solvers::SolverKind::chain_solver_names(", ")
-            )));
-        }
-        if kind == rotor_analysis::solvers::SolverKind::MOREAU && scene.is_time_varying() {
-            return Err(PyValueError::new_err(format!(
-                "input: a chain with {n} discs takes a constant u on \"moreau\" so far \
-                 (\"switch\" takes an input in time)"
-            )));
-        }
+    if rig.is_none() && kind.info().chain.is_none() {
+        return Err(PyValueError::new_err(format!(
+            "solver = {:?}: a chain with {n} discs runs on {}",
+            kind.name(),
+            rotor_analysis::solvers::SolverKind::chain_solver_names(", ")
+        )));
     }
     let model = ChainModel::new(chain);
     let tr = detached(py, move || match rig {

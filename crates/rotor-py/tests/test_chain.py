@@ -86,9 +86,18 @@ def test_a_chain_of_two_in_chain_form_is_the_rig():
     assert {e["disc"] for e in chain["events"]} <= {1, 2}
 
 
+def test_a_chain_takes_an_input_in_time_on_every_solver(chain3):
+    """A step of u at 1 s: up to it the run is the 1.5 V run to 1 s, bit for bit (both end
+    a step on 1 s), and after it another than the constant one."""
+    for solver in ("event", "switch", "moreau"):
+        stepped = rotorbench.simulate(solver, params=str(chain3), t_end=2.0, input=[[0, 1.5], [1, 1.5], [1, 2.5]])
+        before = rotorbench.simulate(solver, 1.5, params=str(chain3), t_end=1.0)
+        assert np.array_equal(stepped["omega"][:, :101], before["omega"]), solver
+        constant = rotorbench.simulate(solver, 1.5, params=str(chain3), t_end=2.0)
+        assert not np.array_equal(stepped["omega"][:, -1], constant["omega"][:, -1]), solver
+
+
 def test_a_chain_refuses_what_it_cannot_take_by_name(chain3):
-    with pytest.raises(ValueError, match="^input: a chain with 3 discs"):
-        rotorbench.simulate("moreau", params=str(chain3), t_end=1.0, input=[[0, 1.5], [1, 2.5]])
     with pytest.raises(ValueError, match="x0"):
         rotorbench.simulate("switch", 1.5, params=str(chain3), x0=(0.0, 0.1, 0.0), t_end=1.0)
     with pytest.raises(TypeError, match=r"params\['disc'\]\[0\]"):

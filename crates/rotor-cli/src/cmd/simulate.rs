@@ -56,10 +56,9 @@ pub(crate) fn check_grid(t_end: f64, dt: f64, given: bool) -> Result<()> {
     Ok(())
 }
 
-/// `rotor simulate` of a chain of N discs: `--x0` of the chain's 2N − 1 values, the switch
-/// model at `--tol` (a constant `--u` or an `--input` in time) or Moreau–Jean at `--h` (a
-/// constant `--u`); the trace headed with the chain's state names (`t,alpha_1,…,omega_N`).
-/// What a chain does not take yet is refused by name.
+/// `rotor simulate` of a chain of N discs: `--x0` of the chain's 2N − 1 values, any solver
+/// at its own setting (`--tol`, or `--h` for Moreau–Jean), a constant `--u` or an `--input`
+/// in time; the trace headed with the chain's state names (`t,alpha_1,…,omega_N`).
 fn simulate_chain(
     common: &Common,
     (path, chain): (&Path, &rotor_model::ChainModel),
@@ -68,14 +67,6 @@ fn simulate_chain(
     csv_path: &Path,
 ) -> Result<()> {
     let kind = crate::common::chain_solver(common, path, chain.discs())?;
-    if kind == rotor_analysis::solvers::SolverKind::MOREAU && common.input.is_some() {
-        return Err(unusable(format_args!(
-            "--input: the chain of {} (a chain with {} discs) takes a constant --u on \
-             --solver moreau so far (--solver switch takes an input in time)",
-            path.display(),
-            chain.discs()
-        )));
-    }
     let input = common
         .input
         .as_deref()
