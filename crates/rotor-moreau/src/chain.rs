@@ -469,10 +469,12 @@ impl<'a> ChainEvents<'a> {
             .map(|c| p.x[c] * la + cur.x[c] * lb + next.x[c] * lc)
             .collect();
         let (a, b) = if t <= cur.t { (p, cur) } else { (cur, next) };
-        for j in 0..self.model.discs() {
-            if p.modes[j] != cur.modes[j] || cur.modes[j] != next.modes[j] {
+        let changes = |j: usize| p.modes[j] != cur.modes[j] || cur.modes[j] != next.modes[j];
+        if (0..self.model.discs()).any(changes) {
+            let on_step = Self::lerp(a, b, t);
+            for j in (0..self.model.discs()).filter(|&j| changes(j)) {
                 let kj = self.model.omega(j);
-                x[kj] = Self::lerp(a, b, t)[kj];
+                x[kj] = on_step[kj];
             }
         }
         self.push(t, x, kind, None);

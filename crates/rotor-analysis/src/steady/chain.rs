@@ -28,8 +28,14 @@
 //!    by a tenth of the velocities' range although the two agree early on: the orbit is
 //!    sensitive to its start (chaos). Divergence alone is no evidence: on a cycle, runs at
 //!    two settings part ways too, as their periods differ and the phase drifts. Otherwise
-//!    (a near return, or runs that still agree) the answer is refused: a transient longer
-//!    than the run, or a cycle the setting does not resolve.
+//!    (a near return, runs that still agree, or runs that differ from the start) the answer
+//!    is refused: a transient longer than the run, or a cycle the setting does not resolve.
+//! 5. **Settled, not just returning.** Next to a Hopf point a cycle's multiplier is near 1,
+//!    and returns differ by little while the orbit is still far from the cycle; the run's
+//!    own contraction per period must bound the rest of the transient (`Section::cycle`).
+//! 6. **Shot.** A cycle so found is refined by Newton on the solver's own k-th return map,
+//!    with its Floquet multipliers and a bound on their error (`Shooter`); where that fails,
+//!    the simulated cycle stands and says why.
 
 use serde::Serialize;
 
@@ -185,14 +191,16 @@ pub enum ChainSteadyError {
     #[error("input: the steady state of a time-varying input is not defined (give a constant --u)")]
     TimeVarying,
     /// No cycle and no equilibrium by the horizon, but a near return (within
-    /// [`APERIODIC_GAP`]) or a tighter run that agrees: a transient longer than the horizon,
-    /// or a cycle the setting does not resolve.
+    /// [`APERIODIC_GAP`]), a tighter run that agrees, or one that differs from the start: a
+    /// transient longer than the horizon, or a cycle the setting does not resolve.
     #[error(
         "no steady state confirmed within {horizon} s: no cycle of up to {max_crossings} \
          section crossings returns within {tolerance:.1e} (the closest, {closest} crossings, \
-         returns within {distance:.2e}; a run at {tighter} differs from it by {late:.2e} rad/s \
-         over the last quarter): a transient longer than the run or a cycle not resolved at \
-         this setting, not an aperiodic orbit (which returns nowhere within 1e-2)"
+         returns within {distance:.2e}; a run at {tighter} differs from it by {early:.2e} rad/s \
+         over the first 100 s and {late:.2e} over the last quarter): a transient longer than \
+         the run or a cycle not resolved at this setting, not an aperiodic orbit (which \
+         returns nowhere within 1e-2, its runs at two settings close at first and parting \
+         later)"
     )]
     Unsettled {
         /// The run's length \[s\].
@@ -207,9 +215,14 @@ pub enum ChainSteadyError {
         distance: f64,
         /// The tighter run's setting.
         tighter: String,
+        /// The runs' difference over the first 100 s \[rad/s\].
+        early: f64,
         /// The runs' difference over the last quarter \[rad/s\].
         late: f64,
     },
+    /// An option is out of its range.
+    #[error("{0}")]
+    Options(String),
     /// An equilibrium read off a run fails the Filippov system.
     #[error("the equilibrium found is refuted by the model's own equations: {detail}")]
     Refuted {
@@ -229,6 +242,18 @@ pub fn chain_steady(
 ) -> Result<ChainSteadyAnswer, ChainSteadyError> {
     if scene.is_time_varying() {
         return Err(ChainSteadyError::TimeVarying);
+    }
+    if !(opts.first > 0.0 && opts.first <= opts.horizon && opts.horizon.is_finite()) {
+        return Err(ChainSteadyError::Options(format!(
+            "first = {}, horizon = {}: expected 0 < first <= horizon, finite",
+            opts.first, opts.horizon
+        )));
+    }
+    if opts.repeats == 0 || opts.max_crossings == 0 {
+        return Err(ChainSteadyError::Options(format!(
+            "repeats = {}, max_crossings = {}: each must be at least 1",
+            opts.repeats, opts.max_crossings
+        )));
     }
     let rho = return_tolerance(kind, scene);
     let mut t_end = opts.first.min(opts.horizon);
@@ -276,7 +301,13 @@ pub fn chain_steady(
             // On a cycle, two runs at different settings part ways too: their periods differ,
             // and the phase drifts. So the orbit is aperiodic only if no return comes near
             // (the closest farther than APERIODIC_GAP), and the runs part ways as well.
-            if closest.distance <= APERIODIC_GAP || divergence.late < 0.1 * range {
+            // They must also have followed one orbit at first (within 1 % of the velocities'
+            // range over the first 100 s): runs that differ from the start say the setting is
+            // too coarse, not that the orbit is sensitive.
+            if closest.distance <= APERIODIC_GAP
+                || divergence.late < 0.1 * range
+                || divergence.early > 0.01 * range
+            {
                 return Err(ChainSteadyError::Unsettled {
                     horizon: t_end,
                     max_crossings: opts.max_crossings,
@@ -284,6 +315,7 @@ pub fn chain_steady(
                     closest: closest.crossings,
                     distance: closest.distance,
                     tighter: divergence.tighter,
+                    early: divergence.early,
                     late: divergence.late,
                 });
             }
@@ -1048,5 +1080,42 @@ mod tests {
             .unwrap_err()
             .to_string();
         assert!(e.contains("rate"), "{e}");
+    }
+    /// Options out of range are refused by name, before any run.
+    #[test]
+    fn options_out_of_range_are_refused() {
+        let model = chain3();
+        let scene = Scene {
+            x0: vec![0.0; 5],
+            ..Scene::default()
+        };
+        for (opts, needle) in [
+            (
+                ChainSteadyOptions {
+                    repeats: 0,
+                    ..ChainSteadyOptions::default()
+                },
+                "repeats = 0",
+            ),
+            (
+                ChainSteadyOptions {
+                    first: 5e4,
+                    ..ChainSteadyOptions::default()
+                },
+                "first = 50000",
+            ),
+            (
+                ChainSteadyOptions {
+                    horizon: f64::NAN,
+                    ..ChainSteadyOptions::default()
+                },
+                "horizon = NaN",
+            ),
+        ] {
+            let e = chain_steady(SolverKind::EVENT, &model, &scene, &opts)
+                .unwrap_err()
+                .to_string();
+            assert!(e.contains(needle), "{e}");
+        }
     }
 }

@@ -725,6 +725,7 @@ mod tests {
             }
         );
     }
+
     /// A chain of three: the cycle is anchored on the bottom disc (disc 3), every disc's
     /// extremes are kept, and each disc's stick time is its own; a stick exit of another disc
     /// is no anchor.
