@@ -14,8 +14,8 @@
 //!    [`EQUILIBRIUM_AMPLITUDE`] `= δ`: the final state must then satisfy the Filippov system
 //!    (slipping discs' rates, within what a state δ away has, `2 |∂f/∂x| δ`; stuck discs'
 //!    torques inside their stick intervals, within `k δ`).
-//! 3. **A cycle of k crossings.** The section is the bottom disc's stick exit (if it sticks in
-//!    the run's second half), else its velocity maxima. The cycle is the smallest `k ≤
+//! 3. **A cycle of k crossings.** The section is the maxima of the bottom disc's velocity
+//!    (where a stick-slip wave arrives, once or many times a period). The cycle is the smallest `k ≤
 //!    max_crossings` for which each of the last `repeats · k` crossings returns to the state
 //!    of the crossing `k` before it within `ρ (1 + |x|∞)`, `ρ` the solver's
 //!    [`return_tolerance`].
@@ -106,7 +106,7 @@ pub enum ChainSteady {
         stick_time: Vec<f64>,
         /// Section crossings per period.
         crossings: usize,
-        /// The section (`"stick exit of disc N"` or `"maximum of omega_N"`).
+        /// The section (`"maximum of omega_N"`).
         section: String,
         /// The largest `|x_j − x_{j−k}|∞ / (1 + |x_j|∞)` over the periods checked.
         return_distance: f64,
@@ -277,7 +277,7 @@ pub fn chain_steady(
                         not_shot: None,
                     });
                 }
-                let shooter = Shooter::new(kind, model, scene, &section, &cycle, rho);
+                let shooter = Shooter::new(kind, model, scene, (&run, &section), &cycle, rho);
                 return Ok(match shooter.and_then(|s| s.shoot()) {
                     Ok(state) => ChainSteadyAnswer {
                         state,
@@ -566,9 +566,9 @@ struct Section {
 }
 
 impl Section {
-    /// The bottom disc's stick exits if it sticks in the run's second half, else its maxima.
+    /// The maxima of the bottom disc's velocity in the run's second half (of the lowest disc
+    /// that has any, should the bottom one rest).
     fn of(run: &Trajectory, n: usize) -> Section {
-        let bottom = Disc::at(n - 1);
         let half = 0.5 * run.t_final;
         let pick = |kind: EventKind| -> Vec<(f64, Vec<f64>)> {
             run.events
@@ -577,18 +577,18 @@ impl Section {
                 .map(|e| (e.t, e.x.clone()))
                 .collect()
         };
-        let exits = pick(EventKind::StickEnd(bottom));
-        if !exits.is_empty() {
-            return Section {
-                name: format!("stick exit of disc {n}"),
-                kind: EventKind::StickEnd(bottom),
-                crossings: exits,
-            };
-        }
-        Section {
-            name: format!("maximum of omega_{n}"),
-            kind: EventKind::Max(bottom),
-            crossings: pick(EventKind::Max(bottom)),
+        let mut lowest = n;
+        loop {
+            let kind = EventKind::Max(Disc::at(lowest - 1));
+            let crossings = pick(kind);
+            if !crossings.is_empty() || lowest == 1 {
+                return Section {
+                    name: format!("maximum of omega_{lowest}"),
+                    kind,
+                    crossings,
+                };
+            }
+            lowest -= 1;
         }
     }
 
@@ -752,8 +752,10 @@ fn period_metrics(
 /// Newton on the solver's own k-th return map to the section, from a cycle found by
 /// simulation.
 ///
-/// The map `P^k` runs the solver from a state on the section until its k-th crossing. For the
-/// bottom disc's stick exit the section's coordinates `z` are the state without the bottom
+/// The map `P^k` runs the solver from a state on a section until its k-th crossing. The
+/// section shot on is the bottom disc's stick exit where it sticks within the period (k its
+/// exits per period), else the run's own section of maxima. For the stick exit the
+/// section's coordinates `z` are the state without the bottom
 /// disc's velocity (0 there) and twist (its spring then holds the applied torque at the
 /// limit the disc leaves at), so the map is smooth in them; for its maxima they are the whole
 /// state. Newton solves `P^k(z) = z` with the Jacobian by forward differences of step
@@ -765,14 +767,17 @@ struct Shooter<'a> {
     kind: SolverKind,
     model: &'a ChainModel,
     scene: &'a Scene,
+    /// The section shot on, and its returns per period.
     anchor: EventKind,
     k: usize,
+    /// The run's section crossings per period (what the answer reports).
+    crossings: usize,
     period: f64,
     rho: f64,
     nu: f64,
     /// The bottom disc's applied torque at the exit (the stick-exit section), else `None`.
     exit_torque: Option<f64>,
-    /// The state the shooting starts from (the run's last crossing).
+    /// The state the shooting starts from (the run's last crossing of the section shot on).
     x0: Vec<f64>,
     section: String,
     /// When the simulation was on the cycle \[s\].
@@ -780,19 +785,35 @@ struct Shooter<'a> {
 }
 
 impl<'a> Shooter<'a> {
+    /// The shooting of the cycle the run found: on the bottom disc's stick exits if it sticks
+    /// within the period (from the last exit, with as many returns as the period holds exits),
+    /// else on the run's own section.
     fn new(
         kind: SolverKind,
         model: &'a ChainModel,
         scene: &'a Scene,
-        section: &Section,
+        (run, section): (&Trajectory, &Section),
         cycle: &Cycle,
         rho: f64,
     ) -> Result<Shooter<'a>, String> {
         let m = section.crossings.len();
-        let (tb, x0) = section.crossings[m - 1].clone();
-        let period = tb - section.crossings[m - 1 - cycle.k].0;
+        let (ta, tb) = (
+            section.crossings[m - 1 - cycle.k].0,
+            section.crossings[m - 1].0,
+        );
+        let period = tb - ta;
         let n = model.discs();
-        let exit_torque = match section.kind {
+        let exit = EventKind::StickEnd(Disc::at(n - 1));
+        let exits: Vec<&Event> = run
+            .events
+            .iter()
+            .filter(|e| e.kind == exit && e.t > ta && e.t <= tb)
+            .collect();
+        let (anchor, k, x0) = match exits.last() {
+            Some(last) => (exit, exits.len(), last.x.clone()),
+            None => (section.kind, cycle.k, section.crossings[m - 1].1.clone()),
+        };
+        let exit_torque = match anchor {
             EventKind::StickEnd(_) => {
                 if model.spring(n - 2) <= 0.0 {
                     return Err("the bottom spring is 0: no section coordinates".to_owned());
@@ -819,8 +840,9 @@ impl<'a> Shooter<'a> {
             kind,
             model,
             scene,
-            anchor: section.kind,
-            k: cycle.k,
+            anchor,
+            k,
+            crossings: cycle.k,
             period,
             rho,
             nu,
@@ -1028,7 +1050,7 @@ impl<'a> Shooter<'a> {
             omega_max: max,
             omega_min: min,
             stick_time: stick,
-            crossings: self.k,
+            crossings: self.crossings,
             section: self.section.clone(),
             return_distance: distance,
             return_tolerance: self.rho,
