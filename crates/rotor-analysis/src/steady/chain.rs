@@ -126,7 +126,9 @@ pub enum ChainSteady {
         #[serde(skip_serializing_if = "Option::is_none")]
         stable: Option<bool>,
     },
-    /// No cycle: the run never repeats, and runs at neighbouring settings part ways.
+    /// No cycle within the horizon: the run never comes back near a state it passed, and
+    /// runs at neighbouring settings part ways. A chaotic attractor, or a chaotic transient
+    /// longer than the horizon (which the answer states).
     Aperiodic {
         /// The run's length \[s\].
         horizon: f64,
