@@ -415,8 +415,8 @@ macro_rules! refuse {
 pub(crate) use refuse;
 
 /// The chain a `--params` file in chain form gives, with its path (`None` for a file in the
-/// rig's form, or no `--params`). A chain of two is the rig, and runs as the rig; its trace
-/// is headed with the chain's names, as any chain file's.
+/// rig's form, or no `--params`). `simulate` runs a chain of two as the rig, its trace headed
+/// with the chain's names; `steady` answers any chain file with the chain's lists.
 pub(crate) fn chain_file(common: &Common) -> Result<Option<(PathBuf, rotor_model::ChainParams)>> {
     let Some(p) = common.params.as_deref() else {
         return Ok(None);
