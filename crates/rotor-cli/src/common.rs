@@ -468,3 +468,27 @@ pub(crate) fn chain_solver(
     }
     Ok(kind)
 }
+
+/// A chain run's request from the command line: the solver (as [`chain_solver`] admits it),
+/// `--input` read, `--x0` of the chain's 2N − 1 values.
+pub(crate) fn chain_request<'a>(
+    common: &'a Common,
+    path: &Path,
+    model: &rotor_model::ChainModel,
+) -> Result<(SolverKind, rotor_harness::jobs::request::Request<'a>)> {
+    let kind = chain_solver(common, path, model.discs())?;
+    let input = common.input.as_deref().map(read_input).transpose()?;
+    let names = model.state_names();
+    let refs: Vec<&str> = names.iter().map(String::as_str).collect();
+    let x0 = parse_x0(common.x0.as_deref(), &refs)?;
+    let request = rotor_harness::jobs::request::Request {
+        solver: &common.solver,
+        // clap requires --u without a scenario or --input.
+        u: common.u.unwrap_or(f64::NAN),
+        input,
+        x0,
+        tol: common.tol,
+        h: common.h,
+    };
+    Ok((kind, request))
+}

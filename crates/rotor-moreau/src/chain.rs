@@ -32,7 +32,7 @@ use rotor_model::seam::{EventKind, EventRef, Recorder, Scene, SolveError, Stats,
 use rotor_model::{Disc, DiscMode, Mode};
 
 use crate::contacts::{ContactError, ContactSolver, Tridiagonal};
-use crate::run::{exit_time, onset_time};
+use crate::run::{exit_time, onset_time, vertex};
 
 /// Fixed-point iterations per step before the step is refused.
 const MAX_ITERATIONS: usize = 60;
@@ -437,27 +437,12 @@ impl<'a> ChainEvents<'a> {
             return;
         }
         let k = self.model.omega(i);
-        let (y0, y1, y2) = (p.x[k], cur.x[k], next.x[k]);
-        let (d1, d2) = (y1 - y0, y2 - y1);
-        let d = Disc::at(i);
-        let kind = if d1 > 0.0 && d2 <= 0.0 {
-            EventKind::Max(d)
-        } else if d1 < 0.0 && d2 >= 0.0 {
-            EventKind::Min(d)
-        } else {
+        let Some((kind, t)) = vertex(
+            Disc::at(i),
+            [p.t, cur.t, next.t],
+            [p.x[k], cur.x[k], next.x[k]],
+        ) else {
             return;
-        };
-        // Rounding noise filter: increments of a few ulps are no extremum.
-        if d1.abs().max(d2.abs()) <= 8.0 * f64::EPSILON * (1.0 + y1.abs()) {
-            return;
-        }
-        let (ha, hb) = (cur.t - p.t, next.t - cur.t);
-        let (s1, s2) = (d1 / ha, d2 / hb);
-        let curv = (s2 - s1) / (0.5 * (ha + hb));
-        let t = if curv != 0.0 {
-            (p.t + 0.5 * ha - s1 / curv).clamp(p.t, next.t)
-        } else {
-            cur.t
         };
         let weight = |a: f64, b: f64, c: f64| (t - b) * (t - c) / ((a - b) * (a - c));
         let (la, lb, lc) = (

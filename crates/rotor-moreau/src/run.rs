@@ -151,6 +151,37 @@ fn quad(p: [&Point; 3], t: f64) -> State {
     a.x * la + b.x * lb + c.x * lc
 }
 
+/// The extremum of disc `d`'s velocity `y` over three step ends at times `t`: a maximum or
+/// minimum where the increments change sign (not by a few ulps, rounding noise), at the vertex
+/// of the parabola through the three points (its slope between the first two taken at their
+/// midpoint), clamped to the three ends. The rig's run and the chain's share it.
+pub(crate) fn vertex(d: Disc, t: [f64; 3], y: [f64; 3]) -> Option<(EventKind, f64)> {
+    let (d1, d2) = (y[1] - y[0], y[2] - y[1]);
+    // Rounding noise filter: increments of a few ulps are no extremum.
+    let noise = 8.0 * f64::EPSILON * (1.0 + y[1].abs());
+    let kind = if d1 > 0.0 && d2 <= 0.0 {
+        EventKind::Max(d)
+    } else if d1 < 0.0 && d2 >= 0.0 {
+        EventKind::Min(d)
+    } else {
+        return None;
+    };
+    if d1.abs().max(d2.abs()) <= noise {
+        return None;
+    }
+    let (ha, hb) = (t[1] - t[0], t[2] - t[1]);
+    let s1 = d1 / ha;
+    let s2 = d2 / hb;
+    let curv = (s2 - s1) / (0.5 * (ha + hb));
+    let at = if curv != 0.0 {
+        let tm1 = t[0] + 0.5 * ha; // slope s1 at the midpoint
+        (tm1 - s1 / curv).clamp(t[0], t[2])
+    } else {
+        t[1]
+    };
+    Some((kind, at))
+}
+
 fn to_mode(m: &[DiscMode; 2]) -> Mode {
     Mode::rig(m[0], m[1])
 }
@@ -400,29 +431,9 @@ impl Run<'_> {
             return;
         }
         let wi = d.index();
-        let (y0, y1, y2) = (p.x[wi], cur.x[wi], next.x[wi]);
-        let (d1, d2) = (y1 - y0, y2 - y1);
-        // Rounding noise filter: increments of a few ulps are no extremum.
-        let noise = 8.0 * f64::EPSILON * (1.0 + y1.abs());
-        let kind = if d1 > 0.0 && d2 <= 0.0 {
-            EventKind::Max(d)
-        } else if d1 < 0.0 && d2 >= 0.0 {
-            EventKind::Min(d)
-        } else {
+        let Some((kind, t)) = vertex(d, [p.t, cur.t, next.t], [p.x[wi], cur.x[wi], next.x[wi]])
+        else {
             return;
-        };
-        if d1.abs().max(d2.abs()) <= noise {
-            return;
-        }
-        let (ha, hb) = (cur.t - p.t, next.t - cur.t);
-        let s1 = d1 / ha;
-        let s2 = d2 / hb;
-        let curv = (s2 - s1) / (0.5 * (ha + hb));
-        let t = if curv != 0.0 {
-            let tm1 = p.t + 0.5 * ha; // slope s1 at the midpoint
-            (tm1 - s1 / curv).clamp(p.t, next.t)
-        } else {
-            cur.t
         };
         let mut x = quad([&p, &cur, next], t);
         // The other disc's velocity is smooth over the three points only if its mode is:

@@ -396,13 +396,7 @@ fn simulate<'py>(
     input: Option<Vec<[f64; 2]>>,
 ) -> PyResult<Bound<'py, PyDict>> {
     if let Some(chain) = chain_of(params)? {
-        // The default, rest, is rest for a chain of any size.
-        let rest = x0.len() == 3 && x0.iter().all(|&v| v == 0.0);
-        let x0 = if rest {
-            vec![0.0; 2 * chain.len() - 1]
-        } else {
-            x0
-        };
+        let x0 = chain_x0(x0, &chain);
         let req = Request {
             solver,
             u,
@@ -447,6 +441,17 @@ fn simulate<'py>(
     out.set_item("events", events)?;
     out.set_item("stats", to_py(py, &columns.stats)?)?;
     Ok(out)
+}
+
+/// A chain's initial state: the signature's default (three zeros, rest) is rest for a chain
+/// of any size; any other list is the caller's.
+fn chain_x0(x0: Vec<f64>, chain: &ChainParams) -> Vec<f64> {
+    let rest = x0.len() == 3 && x0.iter().all(|&v| v == 0.0);
+    if rest {
+        vec![0.0; 2 * chain.len() - 1]
+    } else {
+        x0
+    }
 }
 
 /// ``simulate`` of a chain given in the chain form: ``alpha`` ((N − 1) rows) and ``omega`` (N
@@ -541,13 +546,7 @@ fn steady<'py>(
     input: Option<Vec<[f64; 2]>>,
 ) -> PyResult<Bound<'py, PyAny>> {
     if let Some(chain) = chain_of(params)? {
-        // The default, rest, is rest for a chain of any size.
-        let rest = x0.len() == 3 && x0.iter().all(|&v| v == 0.0);
-        let x0 = if rest {
-            vec![0.0; 2 * chain.len() - 1]
-        } else {
-            x0
-        };
+        let x0 = chain_x0(x0, &chain);
         let req = Request {
             solver,
             u,

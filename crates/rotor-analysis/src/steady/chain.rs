@@ -404,24 +404,25 @@ fn tighter(kind: SolverKind, scene: &Scene) -> Accuracy {
     }
 }
 
+/// The range of state component `k` over the run's samples and events from `from` on.
+fn range_from(run: &Trajectory, k: usize, from: f64) -> f64 {
+    let (lo, hi) = run
+        .samples
+        .iter()
+        .filter(|r| r.t >= from)
+        .map(|r| r.x[k])
+        .chain(run.events.iter().filter(|e| e.t >= from).map(|e| e.x[k]))
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), w| {
+            (lo.min(w), hi.max(w))
+        });
+    hi - lo
+}
+
 /// The largest velocity range of any disc over the run's second half \[rad/s\].
 fn velocity_range(run: &Trajectory, model: &ChainModel) -> f64 {
-    let n = model.discs();
     let half = 0.5 * run.t_final;
-    (0..n)
-        .map(|i| {
-            let k = model.omega(i);
-            let (lo, hi) = run
-                .samples
-                .iter()
-                .filter(|r| r.t >= half)
-                .map(|r| r.x[k])
-                .chain(run.events.iter().filter(|e| e.t >= half).map(|e| e.x[k]))
-                .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), w| {
-                    (lo.min(w), hi.max(w))
-                });
-            hi - lo
-        })
+    (0..model.discs())
+        .map(|i| range_from(run, model.omega(i), half))
         .fold(0.0, f64::max)
 }
 
@@ -469,19 +470,7 @@ fn at_rest(
 ) -> Result<Option<ChainSteady>, ChainSteadyError> {
     let n = model.discs();
     let from = 0.75 * run.t_final;
-    let still = (0..n).all(|i| {
-        let k = model.omega(i);
-        let (lo, hi) = run
-            .samples
-            .iter()
-            .filter(|r| r.t >= from)
-            .map(|r| r.x[k])
-            .chain(run.events.iter().filter(|e| e.t >= from).map(|e| e.x[k]))
-            .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), w| {
-                (lo.min(w), hi.max(w))
-            });
-        hi - lo <= EQUILIBRIUM_AMPLITUDE
-    });
+    let still = (0..n).all(|i| range_from(run, model.omega(i), from) <= EQUILIBRIUM_AMPLITUDE);
     if !still {
         return Ok(None);
     }

@@ -66,28 +66,11 @@ fn simulate_chain(
     dt: Option<f64>,
     csv_path: &Path,
 ) -> Result<()> {
-    let kind = crate::common::chain_solver(common, path, chain.discs())?;
-    let input = common
-        .input
-        .as_deref()
-        .map(crate::common::read_input)
-        .transpose()?;
-    let names = chain.state_names();
-    let refs: Vec<&str> = names.iter().map(String::as_str).collect();
-    let x0 = crate::common::parse_x0(common.x0.as_deref(), &refs)?;
+    let (kind, request) = crate::common::chain_request(common, path, chain)?;
     let t_end = t_end.unwrap_or(DEFAULT_T_END);
     let given = dt.is_some();
     let dt = dt.unwrap_or(DEFAULT_DT);
     check_grid(t_end, dt, given)?;
-    let request = rotor_harness::jobs::request::Request {
-        solver: &common.solver,
-        // clap requires --u without a scenario or --input.
-        u: common.u.unwrap_or(f64::NAN),
-        input,
-        x0,
-        tol: common.tol,
-        h: common.h,
-    };
     let scene = request
         .scene(kind, t_end, rotor_model::seam::Output::Grid { dt })
         .map_err(crate::common::flagged)?;
@@ -95,7 +78,12 @@ fn simulate_chain(
         .simulate_chain(chain, &scene)
         .with_context(|| format!("solver {}", kind.name()))?;
     rotor_harness::compare::report::write_output_with(csv_path, |w| {
-        rotor_harness::grade::trace::write_named_trace_to(w, &names, &traj.samples, dt)
+        rotor_harness::grade::trace::write_named_trace_to(
+            w,
+            &chain.state_names(),
+            &traj.samples,
+            dt,
+        )
     })
     .with_context(|| format!("{}: cannot write", csv_path.display()))?;
     Ok(())

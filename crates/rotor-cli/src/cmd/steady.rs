@@ -108,24 +108,7 @@ fn steady_chain(
     chain: &rotor_model::ChainParams,
 ) -> Result<()> {
     let model = rotor_model::ChainModel::new(chain);
-    let kind = crate::common::chain_solver(common, path, model.discs())?;
-    let input = common
-        .input
-        .as_deref()
-        .map(crate::common::read_input)
-        .transpose()?;
-    let names = model.state_names();
-    let refs: Vec<&str> = names.iter().map(String::as_str).collect();
-    let x0 = crate::common::parse_x0(common.x0.as_deref(), &refs)?;
-    let request = rotor_harness::jobs::request::Request {
-        solver: &common.solver,
-        // clap requires --u without a scenario or --input.
-        u: common.u.unwrap_or(f64::NAN),
-        input,
-        x0,
-        tol: common.tol,
-        h: common.h,
-    };
+    let (kind, request) = crate::common::chain_request(common, path, &model)?;
     let (_, scene, _) = request.steady().map_err(crate::common::flagged)?;
     let opts = rotor_analysis::steady::chain::ChainSteadyOptions {
         shoot: method != Some("simulate"),
