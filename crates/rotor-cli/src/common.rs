@@ -156,6 +156,31 @@ pub(crate) fn fixture_path(flag: &str, p: &Path, kind: &str) -> Result<PathBuf> 
     })
 }
 
+/// A scene argument: a scenario file, or a name of the suite's rig tier (`fixtures/scenarios`)
+/// or chain tier (`fixtures/chain/scenarios`). The path, and whether it is a chain scene.
+pub(crate) fn scene_path(flag: &str, p: &Path) -> Result<(PathBuf, bool)> {
+    let fixtures = fixtures_dir()?;
+    let rig = fixtures.join("scenarios");
+    let chain = fixtures.join("chain/scenarios");
+    let found = rotor_analysis::solvers::fixtures::resolve(p, Some(&rig))
+        .or_else(|| rotor_analysis::solvers::fixtures::resolve(p, Some(&chain)));
+    let Some(path) = found else {
+        let mut names = rotor_analysis::solvers::fixtures::names(&rig);
+        names.extend(rotor_analysis::solvers::fixtures::names(&chain));
+        return Err(unusable(format_args!(
+            "{flag} {}: no such file, nor a name of the suite in {} (names: {})",
+            p.display(),
+            fixtures
+                .canonicalize()
+                .unwrap_or_else(|_| fixtures.clone())
+                .display(),
+            names.join(", ")
+        )));
+    };
+    let is_chain = rotor_model::scenario::ChainScenario::is_chain_scene(&path);
+    Ok((path, is_chain))
+}
+
 /// `--x0`: the initial state as comma-separated numbers, one per component of the model's
 /// state (`names`: the rig's `alpha,omega_u,omega_l`); rest when not given.
 pub(crate) fn parse_x0(s: Option<&str>, names: &[&str]) -> Result<Vec<f64>> {

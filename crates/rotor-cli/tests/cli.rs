@@ -1249,8 +1249,11 @@ fn an_installed_rotor_grades_by_name_from_an_empty_directory() {
     let json: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(dir.join("list.json")).unwrap()).unwrap();
     assert_eq!(json["benchmark"], version);
+    assert_eq!(json["chain_benchmark"], rotor_suite::CHAIN_VERSION);
     let scenes = json["scenarios"].as_array().unwrap();
-    assert_eq!(scenes.len(), 23);
+    let in_tier = |t: &str| scenes.iter().filter(|s| s["tier"] == t).count();
+    assert_eq!(scenes.len() - in_tier("chain"), 23);
+    assert_eq!(in_tier("chain"), 3);
     let tier = |n: &str| {
         scenes.iter().find(|s| s["name"] == n).unwrap()["tier"]
             .as_str()
@@ -1277,8 +1280,30 @@ fn an_installed_rotor_grades_by_name_from_an_empty_directory() {
         verdict.contains("PASSED") && verdict.contains(version),
         "{verdict}"
     );
-    // The cache holds the suite under its version, whole.
-    assert!(dir.join("cache").join(version).join(".complete").is_file());
+    // The chain tier from the embedded suite: listed with its own version, its job in chain
+    // form, its reference's own trace graded by name.
+    let chain = scene("chain3-u1.5-rest");
+    assert_eq!(chain["version"], rotor_suite::CHAIN_VERSION);
+    assert_eq!(chain["discs"], 3);
+    assert_eq!(scene("t1-u1.5-rest")["version"], version);
+    let job: serde_json::Value =
+        serde_json::from_str(&ok(&run(&["job", "chain3-u1.5-rest", "--tol", "1e-8"]))).unwrap();
+    assert_eq!(job["benchmark"], rotor_suite::CHAIN_VERSION);
+    assert_eq!(job["x0"].as_array().unwrap().len(), 5);
+    assert_eq!(job["params"]["disc"].as_array().unwrap().len(), 3);
+    let cached = dir.join("cache").join(rotor_suite::CACHE_NAME);
+    std::fs::copy(
+        cached.join("chain/reference/chain3-u1.5-rest.csv"),
+        dir.join("C.csv"),
+    )
+    .unwrap();
+    let verdict = ok(&run(&["check", "chain3-u1.5-rest", "--trace", "C.csv"]));
+    assert!(
+        verdict.contains("PASSED") && verdict.contains(rotor_suite::CHAIN_VERSION),
+        "{verdict}"
+    );
+    // The cache holds both tiers under their versions, whole.
+    assert!(cached.join(".complete").is_file());
     std::fs::remove_dir_all(&dir).ok();
 }
 
@@ -1843,5 +1868,90 @@ fn steady_on_a_chain_prints_the_chains_lists() {
     ]);
     assert_eq!(o.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&o.stderr).contains("input"));
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+/// `rotor check` on a chain scene by name: a solver's trace and events in the chain's format
+/// pass (exit 0), a trace off in one disc fails naming it (exit 1), and the rig's header or a
+/// disc the chain does not have is unusable (exit 2, the file and line named).
+#[test]
+fn check_grades_a_chain_scene_with_exit_codes_0_1_2() {
+    let dir = rotor_testkit::tmp_dir("rotor-cli-check-chain");
+    let (trace, events) = (dir.join("t.csv"), dir.join("e.csv"));
+    // The event solver at tol 1e-10 through `rotor simulate` (the chain's header), its
+    // events from the reference's own file: both pass at loose.
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
+    let o = rotor(&[
+        "simulate",
+        "--solver",
+        "event",
+        "--tol",
+        "1e-10",
+        "--params",
+        root.join("fixtures/chain/params/chain3.toml")
+            .to_str()
+            .unwrap(),
+        "--u",
+        "1.5",
+        "--t-end",
+        "100",
+        "--csv",
+        trace.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    std::fs::copy(
+        root.join("fixtures/chain/reference/chain3-u1.5-rest.events.csv"),
+        &events,
+    )
+    .unwrap();
+    let check = |t: &std::path::Path, e: &std::path::Path| {
+        rotor(&[
+            "check",
+            "chain3-u1.5-rest",
+            "--trace",
+            t.to_str().unwrap(),
+            "--events",
+            e.to_str().unwrap(),
+        ])
+    };
+    let o = check(&trace, &events);
+    assert_eq!(
+        o.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    let out = String::from_utf8_lossy(&o.stdout);
+    assert!(out.contains("stick_3") && out.contains("omega_3"), "{out}");
+    // omega_2 off by 1 at one row.
+    let text = std::fs::read_to_string(&trace).unwrap();
+    let mut lines: Vec<String> = text.lines().map(str::to_owned).collect();
+    let mut f: Vec<String> = lines[5001].split(',').map(str::to_owned).collect();
+    f[4] = (f[4].parse::<f64>().unwrap() + 1.0).to_string();
+    lines[5001] = f.join(",");
+    let wrong = dir.join("wrong.csv");
+    std::fs::write(&wrong, lines.join("\n") + "\n").unwrap();
+    let o = check(&wrong, &events);
+    assert_eq!(o.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("failing: omega_2"));
+    // Unusable: the rig's header; a disc the chain does not have.
+    let rig = dir.join("rig.csv");
+    std::fs::write(&rig, "t,alpha,omega_u,omega_l\n0,0,0,0\n").unwrap();
+    let o = check(&rig, &events);
+    assert_eq!(o.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        err.contains("expected \"t,alpha_1,alpha_2,omega_1,omega_2,omega_3\""),
+        "{err}"
+    );
+    let bad_events = dir.join("bad.events.csv");
+    std::fs::write(&bad_events, "t,disc,kind\n1.0,lower,stick_start\n").unwrap();
+    let o = check(&trace, &bad_events);
+    assert_eq!(o.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        err.contains("line 2, column 2 (disc)") && err.contains("1 to 3"),
+        "{err}"
+    );
     std::fs::remove_dir_all(&dir).ok();
 }

@@ -9,8 +9,9 @@ use rotor_harness::grade::reference;
 
 #[derive(clap::Args, Debug)]
 pub struct Args {
-    /// Scenario file, or a name in fixtures/scenarios (`t1-u1.5-rest`); its reference is
-    /// read from the reference directory beside it.
+    /// Scenario file, or a name of the suite (`t1-u1.5-rest`, or a chain scene such as
+    /// `chain3-u1.5-rest`); its reference is read from the reference directory beside it. A
+    /// chain's trace is headed `t,alpha_1,…,omega_N` and its events name discs `1` … `N`.
     pub scenario: PathBuf,
     /// The trace to grade.
     #[arg(long)]
@@ -76,16 +77,28 @@ fn verdict(
     }
     .map_err(crate::common::flagged)?;
     // The scenario and its reference first: the trace is read up to one row past their grid.
-    let scenario = crate::common::fixture_path("scenario", scenario, "scenarios")?;
-    let sc = rotor_analysis::solvers::load_scenario(&scenario)?;
-    let r = reference::read(&reference::dir_for(&scenario), &sc.name)?;
-    let t = rotor_harness::grade::trace::read_trace(trace, r.samples.len() + 1)
-        .map_err(CheckError::from)?;
-    let ev = events
-        .map(rotor_harness::grade::trace::read_events)
-        .transpose()
-        .map_err(CheckError::from)?;
-    let report = check(&sc, &r, &t, ev.as_ref(), level)?;
+    let (scenario, is_chain) = crate::common::scene_path("scenario", scenario)?;
+    let report = if is_chain {
+        let (sc, r) = rotor_harness::grade::chain::load(&scenario)?;
+        let names = sc.model().state_names();
+        let t = rotor_harness::grade::trace::read_chain_trace(trace, &names, r.samples.len() + 1)
+            .map_err(CheckError::from)?;
+        let ev = events
+            .map(|p| rotor_harness::grade::trace::read_chain_events(p, sc.discs()))
+            .transpose()
+            .map_err(CheckError::from)?;
+        rotor_harness::grade::chain::check_chain(&sc, &r, &t, ev.as_ref(), level)?
+    } else {
+        let sc = rotor_analysis::solvers::load_scenario(&scenario)?;
+        let r = reference::read(&reference::dir_for(&scenario), &sc.name)?;
+        let t = rotor_harness::grade::trace::read_trace(trace, r.samples.len() + 1)
+            .map_err(CheckError::from)?;
+        let ev = events
+            .map(rotor_harness::grade::trace::read_events)
+            .transpose()
+            .map_err(CheckError::from)?;
+        check(&sc, &r, &t, ev.as_ref(), level)?
+    };
     if let Some(path) = json {
         let text = serde_json::to_string_pretty(&report)? + "\n";
         // A closed pipe on `--json -` does not hide the verdict's exit status.

@@ -4,12 +4,13 @@ use std::path::{Path, PathBuf};
 
 use anyhow::Result;
 
-use crate::common::{check, fixture_path};
+use crate::common::{check, scene_path};
 use crate::out;
 
 #[derive(clap::Args, Debug)]
 pub struct Args {
-    /// Scenario file, or a name in fixtures/scenarios (`t1-u1.5-rest`).
+    /// Scenario file, or a name of the suite (`t1-u1.5-rest`, or a chain scene such as
+    /// `chain3-u1.5-rest`).
     pub scenario: PathBuf,
     /// The tolerance of a client with a tolerance (the job's `h` is null).
     #[arg(
@@ -62,14 +63,25 @@ pub(crate) fn job(
             crate::common::refuse!("{flag} \"\": an empty path");
         }
     }
-    let path = fixture_path("scenario", scenario, "scenarios")?;
-    let job = rotor_harness::bench::job_for_scenario(
-        &path,
-        fixed_step,
-        setting,
-        trace.to_owned(),
-        events.to_owned(),
-    )?;
+    let (path, is_chain) = scene_path("scenario", scenario)?;
+    let job = if is_chain {
+        let sc = rotor_model::scenario::ChainScenario::from_file(&path)?;
+        rotor_harness::protocol::Job::for_chain(
+            &sc,
+            fixed_step,
+            setting,
+            trace.to_owned(),
+            events.to_owned(),
+        )
+    } else {
+        rotor_harness::bench::job_for_scenario(
+            &path,
+            fixed_step,
+            setting,
+            trace.to_owned(),
+            events.to_owned(),
+        )?
+    };
     out::print(&(job.to_json() + "\n"))?;
     Ok(())
 }

@@ -32,6 +32,10 @@ pub fn run(a: &Args) -> Result<()> {
 struct Row<'a> {
     name: &'a str,
     tier: &'static str,
+    /// The version of the scene's tier (the rig's suite, or the chain tier's own).
+    version: &'static str,
+    /// Number of discs (2 for the rig).
+    discs: usize,
     description: &'a str,
     /// The constant input \[V\], or null for an input that changes in time (as in the job
     /// file).
@@ -46,13 +50,17 @@ struct Row<'a> {
 struct Listing<'a> {
     benchmark: &'static str,
     checksum: &'static str,
+    /// The chain tier's version and checksum.
+    chain_benchmark: &'static str,
+    chain_checksum: &'static str,
     source: &'static str,
     dir: String,
     scenarios: Vec<Row<'a>>,
 }
 
-/// Lists every scenario of the suite (name, tier, what it tests), with the suite's version and
-/// where its files were found; `--json` writes the same as JSON.
+/// Lists every scenario of the suite (name, tier, version, what it tests): the rig's scenes,
+/// then the chain tier's (`tier` = `chain`, with their own version), with where the files were
+/// found; `--json` writes the same as JSON.
 pub fn scenarios(json: Option<&Path>) -> Result<()> {
     let (dir, source) = match std::env::var_os("ROTORBENCH_SUITE") {
         None if Path::new("fixtures/scenarios").is_dir() => {
@@ -69,11 +77,18 @@ pub fn scenarios(json: Option<&Path>) -> Result<()> {
         .iter()
         .map(|f| rotor_analysis::solvers::load_scenario(f))
         .collect::<Result<Vec<_>, _>>()?;
-    let rows: Vec<Row> = scenarios
+    let chain_files = Scenario::list_dir(&dir.join("chain/scenarios")).unwrap_or_default();
+    let chains = chain_files
+        .iter()
+        .map(|f| rotor_model::scenario::ChainScenario::from_file(f))
+        .collect::<Result<Vec<_>, _>>()?;
+    let mut rows: Vec<Row> = scenarios
         .iter()
         .map(|sc| Row {
             name: &sc.name,
             tier: tier(sc),
+            version: rotor_suite::VERSION,
+            discs: 2,
             description: &sc.description,
             u: sc.input.is_none().then_some(sc.u),
             input: sc
@@ -83,11 +98,29 @@ pub fn scenarios(json: Option<&Path>) -> Result<()> {
             t_end: sc.t_end,
         })
         .collect();
+    rows.extend(chains.iter().map(|sc| {
+        Row {
+            name: &sc.name,
+            tier: "chain",
+            version: rotor_suite::CHAIN_VERSION,
+            discs: sc.discs(),
+            description: &sc.description,
+            u: sc.input.is_none().then_some(sc.u),
+            input: sc
+                .input
+                .as_ref()
+                .map(|i| i.rows().iter().map(|&(t, u)| [t, u]).collect()),
+            t_end: sc.t_end,
+        }
+    }));
+    let width = rows.iter().map(|r| r.name.len()).max().unwrap_or(4).max(18);
     let mut text = format!(
-        "{} ({} scenarios; {source}: {})\n{:<18} {:<7} {:>5} {:>6}  {}\n",
+        "{} ({} scenarios; {source}: {})\nchain tier {} ({} scenes)\n{:<width$} {:<7} {:>5} {:>6}  {}\n",
         rotor_suite::VERSION,
-        rows.len(),
+        scenarios.len(),
         dir.display(),
+        rotor_suite::CHAIN_VERSION,
+        chains.len(),
         "name",
         "tier",
         "u [V]",
@@ -96,7 +129,7 @@ pub fn scenarios(json: Option<&Path>) -> Result<()> {
     );
     for r in &rows {
         text.push_str(&format!(
-            "{:<18} {:<7} {:>5} {:>6}  {}\n",
+            "{:<width$} {:<7} {:>5} {:>6}  {}\n",
             r.name,
             r.tier,
             // an input that changes in time: its description says how
@@ -110,6 +143,8 @@ pub fn scenarios(json: Option<&Path>) -> Result<()> {
         let listing = Listing {
             benchmark: rotor_suite::VERSION,
             checksum: rotor_suite::CHECKSUM,
+            chain_benchmark: rotor_suite::CHAIN_VERSION,
+            chain_checksum: rotor_suite::CHAIN_CHECKSUM,
             source,
             dir: dir.display().to_string(),
             scenarios: rows,

@@ -229,7 +229,7 @@ impl CheckReport {
                 v.push_str(" (no events file)");
             }
         }
-        v + &format!(" [{BENCHMARK}]")
+        v + &format!(" [{}]", self.benchmark)
     }
 
     /// A table for the terminal.
@@ -371,35 +371,50 @@ pub(crate) const TIME_TOL: f64 = 1e-9;
 
 /// Checks that the trace has exactly the reference's grid times.
 fn check_grid(trace: &Trace, reference: &[Sample], dt: f64, t_end: f64) -> Result<(), CheckError> {
-    let path = || trace.path.clone();
-    for (i, s) in trace.samples.iter().enumerate() {
-        let line = trace.lines[i];
-        let Some(r) = reference.get(i) else {
+    let times: Vec<f64> = trace.samples.iter().map(|s| s.t).collect();
+    let ref_times: Vec<f64> = reference.iter().map(|s| s.t).collect();
+    check_times(&trace.path, &trace.lines, &times, &ref_times, dt, t_end)
+}
+
+/// Checks that a trace's times (`times`, from the file `path`, row `k` on line `lines[k]`)
+/// are exactly the reference's grid times `reference`.
+pub(crate) fn check_times(
+    path: &std::path::Path,
+    lines: &[u64],
+    times: &[f64],
+    reference: &[f64],
+    dt: f64,
+    t_end: f64,
+) -> Result<(), CheckError> {
+    let path = || path.to_owned();
+    for (i, &t) in times.iter().enumerate() {
+        let line = lines[i];
+        let Some(&r) = reference.get(i) else {
             return Err(CheckError::Extra {
                 path: path(),
                 line,
-                found: s.t,
+                found: t,
                 t_end,
             });
         };
-        if (s.t - r.t).abs() > TIME_TOL {
+        if (t - r).abs() > TIME_TOL {
             return Err(CheckError::OffGrid {
                 path: path(),
                 line,
-                found: s.t,
-                expected: r.t,
+                found: t,
+                expected: r,
                 dt,
                 t_end,
             });
         }
     }
-    if trace.samples.len() < reference.len() {
-        let i = trace.samples.len();
+    if times.len() < reference.len() {
+        let i = times.len();
         return Err(CheckError::Missing {
             path: path(),
-            line: trace.lines.last().copied().unwrap_or(1),
-            last: trace.samples.last().map_or(f64::NAN, |s| s.t),
-            missing: reference[i].t,
+            line: lines.last().copied().unwrap_or(1),
+            last: times.last().copied().unwrap_or(f64::NAN),
+            missing: reference[i],
         });
     }
     Ok(())
@@ -435,7 +450,7 @@ pub fn digits(diff: f64, scale: f64) -> f64 {
 }
 
 /// A quantity graded at `level`.
-fn graded(name: &str, difference: f64, scale: f64, level: Level) -> Graded {
+pub(crate) fn graded(name: &str, difference: f64, scale: f64, level: Level) -> Graded {
     let tolerance = scale * 10f64.powi(-(level.digits() as i32));
     Graded {
         name: name.to_owned(),
@@ -530,18 +545,21 @@ fn sample_differences(trace: &[Sample], reference: &[Sample]) -> [(f64, f64); 3]
     d
 }
 
-/// An event as the files name it: `lower stick_start at 4.7677 s`.
-fn describe(e: &Event) -> String {
-    let (disc, kind) = event_row(e.kind).map_or(("?".into(), "?"), |(d, k)| (disc_name(d), k));
+/// An event as the files name it: `lower stick_start at 4.7677 s` (`disc 3 ...` in a chain
+/// of `n` > 2 discs).
+fn describe(e: &Event, n: usize) -> String {
+    let (disc, kind) = event_row(e.kind).map_or(("?".into(), "?"), |(d, k)| {
+        (if n == 2 { disc_name(d) } else { d.name_in(n) }, k)
+    });
     format!("{disc} {kind} at {} s", e.t)
 }
 
-/// Names the first few of `events`, and how many more there are.
-fn name_some(what: &str, events: &[Event]) -> Option<String> {
+/// Names the first few of `events` (of a chain of `n` discs), and how many more there are.
+fn name_some(what: &str, events: &[Event], n: usize) -> Option<String> {
     if events.is_empty() {
         return None;
     }
-    let shown: Vec<String> = events.iter().take(3).map(describe).collect();
+    let shown: Vec<String> = events.iter().take(3).map(|e| describe(e, n)).collect();
     let more = if events.len() > 3 {
         format!(" and {} more", events.len() - 3)
     } else {
@@ -579,10 +597,16 @@ fn match_in_order(reference: &[f64], trace: &[f64], window: f64) -> (f64, Vec<us
     (worst, missing, extra)
 }
 
-/// The `events` quantity: every mode switch of either disc over the run, matched one to one
-/// by disc and kind, each within half the shortest gap between two reference events of its
-/// class (so that a match is never ambiguous).
-fn grade_events(reference: &[Event], trace: &[Event], t_scale: f64, level: Level) -> Graded {
+/// The `events` quantity: every mode switch of any disc (of `n`) over the run, matched one to
+/// one by disc and kind, each within half the shortest gap between two reference events of
+/// its class (so that a match is never ambiguous).
+pub(crate) fn grade_events(
+    reference: &[Event],
+    trace: &[Event],
+    n: usize,
+    t_scale: f64,
+    level: Level,
+) -> Graded {
     let switches = |ev: &[Event]| -> Vec<Event> {
         ev.iter()
             .filter(|e| event_row(e.kind).is_some())
@@ -619,8 +643,8 @@ fn grade_events(reference: &[Event], trace: &[Event], t_scale: f64, level: Level
         level,
     );
     let notes: Vec<String> = [
-        name_some("missing from the trace's events", &missing),
-        name_some("extra (not in the reference)", &extra),
+        name_some("missing from the trace's events", &missing, n),
+        name_some("extra (not in the reference)", &extra, n),
     ]
     .into_iter()
     .flatten()
@@ -649,12 +673,12 @@ pub fn stuck_threshold(scale: f64, level: Level) -> f64 {
     scale * 10f64.powi(-(level.digits() as i32))
 }
 
-/// Runs of consecutive stuck samples of velocity `i` (|x_i| ≤ `stuck`), as index pairs.
-fn stuck_runs(samples: &[Sample], i: usize, stuck: f64) -> Vec<(usize, usize)> {
+/// Runs of consecutive stuck samples of a velocity (|ω| ≤ `stuck`), as index pairs.
+fn stuck_runs(omega: &[f64], stuck: f64) -> Vec<(usize, usize)> {
     let mut runs = Vec::new();
     let mut start = None;
-    for (k, s) in samples.iter().enumerate() {
-        match (s.x[i].abs() <= stuck, start) {
+    for (k, w) in omega.iter().enumerate() {
+        match (w.abs() <= stuck, start) {
             (true, None) => start = Some(k),
             (false, Some(a)) => {
                 runs.push((a, k - 1));
@@ -664,7 +688,7 @@ fn stuck_runs(samples: &[Sample], i: usize, stuck: f64) -> Vec<(usize, usize)> {
         }
     }
     if let Some(a) = start {
-        runs.push((a, samples.len() - 1));
+        runs.push((a, omega.len() - 1));
     }
     runs
 }
@@ -680,10 +704,34 @@ fn grade_stick(
     level: Level,
 ) -> Option<Graded> {
     let i = disc.index();
-    let stuck = stuck_threshold(scale[i], level);
-    let name = format!("stick_{}", disc_name(disc));
-    let rs = &reference.samples;
-    let (ref_runs, runs) = (stuck_runs(rs, i, stuck), stuck_runs(trace, i, stuck));
+    let column = |s: &[Sample]| -> (Vec<f64>, Vec<f64>) { s.iter().map(|r| (r.t, r.x[i])).unzip() };
+    grade_stick_of(
+        &format!("stick_{}", disc_name(disc)),
+        disc,
+        column(trace),
+        column(&reference.samples),
+        &reference.events,
+        scale[i],
+        t_scale,
+        level,
+    )
+}
+
+/// The stick intervals of `disc` (named `name`): the trace's and the reference's samples of
+/// its velocity as `(times, ω)`, the reference's exact events, the disc's velocity scale.
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn grade_stick_of(
+    name: &str,
+    disc: Disc,
+    (trace, trace_w): (Vec<f64>, Vec<f64>),
+    (rs, rs_w): (Vec<f64>, Vec<f64>),
+    events: &[Event],
+    scale: f64,
+    t_scale: f64,
+    level: Level,
+) -> Option<Graded> {
+    let stuck = stuck_threshold(scale, level);
+    let (ref_runs, runs) = (stuck_runs(&rs_w, stuck), stuck_runs(&trace_w, stuck));
     if ref_runs.is_empty() && runs.is_empty() {
         return None;
     }
@@ -692,8 +740,7 @@ fn grade_stick(
     // the run's first and last stuck sample (0 and t_end at the run's ends).
     let exact = |(a, b): (usize, usize)| -> (f64, f64) {
         let find = |kind: EventKind, lo: f64, hi: f64, fallback: f64| {
-            reference
-                .events
+            events
                 .iter()
                 .find(|e| e.kind == kind && e.t > lo - 1e-12 && e.t <= hi + 1e-12)
                 .map_or(fallback, |e| e.t)
@@ -701,12 +748,12 @@ fn grade_stick(
         let on = if a == 0 {
             0.0
         } else {
-            find(EventKind::StickStart(disc), rs[a - 1].t, rs[a].t, rs[a].t)
+            find(EventKind::StickStart(disc), rs[a - 1], rs[a], rs[a])
         };
         let off = if b == last {
-            rs[last].t
+            rs[last]
         } else {
-            find(EventKind::StickEnd(disc), rs[b].t, rs[b + 1].t, rs[b].t)
+            find(EventKind::StickEnd(disc), rs[b], rs[b + 1], rs[b])
         };
         (on, off)
     };
@@ -715,12 +762,12 @@ fn grade_stick(
         let on = if a == 0 {
             (0.0, 0.0)
         } else {
-            (trace[a - 1].t, trace[a].t)
+            (trace[a - 1], trace[a])
         };
         let off = if b + 1 >= trace.len() {
-            (trace[b].t, trace[b].t)
+            (trace[b], trace[b])
         } else {
-            (trace[b].t, trace[b + 1].t)
+            (trace[b], trace[b + 1])
         };
         (on, off)
     };
@@ -741,7 +788,7 @@ fn grade_stick(
             k += 1;
             m += 1;
         } else if tb < ra {
-            extra.push(trace[ta].t);
+            extra.push(trace[ta]);
             m += 1;
         } else {
             missing.push(exact(ref_runs[k]).0);
@@ -749,10 +796,10 @@ fn grade_stick(
         }
     }
     missing.extend(ref_runs[k..].iter().map(|&r| exact(r).0));
-    extra.extend(runs[m..].iter().map(|&(a, _)| trace[a].t));
+    extra.extend(runs[m..].iter().map(|&(a, _)| trace[a]));
     let unmatched = !missing.is_empty() || !extra.is_empty();
     let mut g = graded(
-        &name,
+        name,
         if unmatched { f64::INFINITY } else { worst },
         t_scale,
         level,
@@ -934,7 +981,13 @@ pub fn check(
     }
     let mut not_graded = Vec::new();
     match events {
-        Some(f) => q.push(grade_events(&reference.events, &f.events, t_scale, level)),
+        Some(f) => q.push(grade_events(
+            &reference.events,
+            &f.events,
+            2,
+            t_scale,
+            level,
+        )),
         None => not_graded.push("events".to_owned()),
     }
     for disc in [Disc::LOWER, Disc::UPPER] {

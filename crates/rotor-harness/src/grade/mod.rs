@@ -4,6 +4,7 @@
 
 #![warn(missing_docs)]
 
+pub mod chain;
 pub mod check;
 pub mod gridmetrics;
 pub mod orbit;

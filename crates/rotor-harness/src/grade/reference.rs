@@ -55,7 +55,7 @@ pub const ERROR_MARGIN: f64 = 2.0;
 /// about 1.1e-15 of the scale (its step-halving estimate on t1-u4.5-eq-pert's ω_u: 8.9e-15
 /// of 8.1 rad/s, rounding-dominated). 1e-14 sat below ten times that once the event solver's
 /// steps were bounded by the friction scale and its differences fell to the floor.
-const FLOOR_REL: f64 = 2e-14;
+pub(crate) const FLOOR_REL: f64 = 2e-14;
 
 /// Tolerance of the reference run of a scenario whose reference at [`REFERENCE_TOL`] is
 /// verified to fewer than [`REQUIRED_DIGITS`] on some graded quantity: the three that start
@@ -216,7 +216,7 @@ fn event_run(sc: &Scenario, tol: f64) -> Result<rotor_model::seam::Trajectory, R
 }
 
 /// Mode-switch events (no extrema), as the events file holds them.
-fn switches(events: &[Event]) -> Vec<Event> {
+pub(crate) fn switches(events: &[Event]) -> Vec<Event> {
     events
         .iter()
         .filter(|e| crate::grade::trace::event_row(e.kind).is_some())
@@ -226,7 +226,7 @@ fn switches(events: &[Event]) -> Vec<Event> {
 
 /// Largest |a − b| of each state component over two runs on the same grid (∞ if the grids
 /// differ).
-fn trace_differences(a: &Samples, b: &Samples) -> Vec<f64> {
+pub(crate) fn trace_differences(a: &Samples, b: &Samples) -> Vec<f64> {
     if a.len() != b.len() || a.dim() != b.dim() {
         return vec![f64::INFINITY; a.dim().max(b.dim())];
     }
@@ -240,7 +240,7 @@ fn trace_differences(a: &Samples, b: &Samples) -> Vec<f64> {
 }
 
 /// Largest |Δt| of the events matched in order (∞ if their sequences differ).
-fn event_difference(a: &[Event], b: &[Event]) -> f64 {
+pub(crate) fn event_difference(a: &[Event], b: &[Event]) -> f64 {
     if a.len() != b.len() || a.iter().zip(b).any(|(x, y)| x.kind != y.kind) {
         return f64::INFINITY;
     }

@@ -133,8 +133,8 @@ pub enum TraceError {
         line: u64,
         /// The header as found, its fields joined by commas.
         found: String,
-        /// The header expected (`t,alpha,omega_u,omega_l` or `t,disc,kind`).
-        expected: &'static str,
+        /// The header expected (`t,alpha,omega_u,omega_l`, a chain's, or `t,disc,kind`).
+        expected: String,
     },
     /// A field that must be a number is not a finite one.
     #[error("{}: line {line}, column {column} ({name}): {value:?} is not a finite number", .path.display())]
@@ -146,7 +146,7 @@ pub enum TraceError {
         /// The field's column (1-based).
         column: usize,
         /// The column's name in the header (`t`, `alpha`, ...).
-        name: &'static str,
+        name: String,
         /// The field as written.
         value: String,
     },
@@ -163,8 +163,8 @@ pub enum TraceError {
         name: &'static str,
         /// The field as written.
         value: String,
-        /// The words allowed (`upper, lower`; `stick_start, stick_end, reversal`).
-        expected: &'static str,
+        /// The words allowed (`upper, lower`; `1 … N`; `stick_start, stick_end, reversal`).
+        expected: String,
     },
     /// A row has the wrong number of fields.
     #[error("{}: line {line}: {found} fields, expected {expected}", .path.display())]
@@ -176,7 +176,7 @@ pub enum TraceError {
         /// The number of fields in the row.
         found: usize,
         /// The number expected, with the header (`4 (t,alpha,omega_u,omega_l)`).
-        expected: &'static str,
+        expected: String,
     },
     /// The CSV reader refused the file (an unterminated quote, invalid UTF-8, ...).
     #[error("{}: line {line}: {message}", .path.display())]
@@ -413,8 +413,6 @@ fn trace_from(input: impl Read, path: &Path, max_rows: usize) -> Result<Trace, T
     let mut most = 0u32;
     let layout = Layout {
         header: &TRACE_HEADER,
-        joined: "t,alpha,omega_u,omega_l",
-        fields: "4 (t,alpha,omega_u,omega_l)",
     };
     csv_rows(input, path, layout, max_rows, |line, rec| {
         let mut v = [0.0; 4];
@@ -423,7 +421,7 @@ fn trace_from(input: impl Read, path: &Path, max_rows: usize) -> Result<Trace, T
                 path: path.to_owned(),
                 line,
                 column: k + 1,
-                name: TRACE_HEADER[k],
+                name: TRACE_HEADER[k].to_owned(),
                 value: field.to_owned(),
             })?;
             if k > 0 {
@@ -443,6 +441,100 @@ fn trace_from(input: impl Read, path: &Path, max_rows: usize) -> Result<Trace, T
         });
     }
     Ok(Trace {
+        path: path.to_owned(),
+        samples,
+        lines,
+        digits: file_digits(most),
+    })
+}
+
+/// A chain's trace as read (`t,alpha_1,…,alpha_{N−1},omega_1,…,omega_N`): the samples
+/// with the line each came from.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ChainTrace {
+    /// The file it was read from.
+    pub path: PathBuf,
+    /// Its rows: time \[s\] and the state of 2N − 1 values.
+    pub samples: Samples,
+    /// The file line of each sample (1-based; the header is line 1).
+    pub lines: Vec<u64>,
+    /// Significant digits the values are written with, as [`Trace::digits`].
+    pub digits: u32,
+}
+
+impl ChainTrace {
+    /// A run's grid samples as a trace, numbered as a file written from them.
+    pub fn of_run(path: &str, samples: Samples) -> ChainTrace {
+        ChainTrace {
+            path: path.into(),
+            lines: (2..samples.len() as u64 + 2).collect(),
+            samples,
+            digits: FULL_DIGITS,
+        }
+    }
+}
+
+/// Reads a chain's trace file, its columns named `names` after `t` (the chain's state names),
+/// streaming and capped at `max_rows` rows as [`read_trace`] is.
+pub fn read_chain_trace(
+    path: &Path,
+    names: &[String],
+    max_rows: usize,
+) -> Result<ChainTrace, TraceError> {
+    chain_trace_from(open(path)?, path, names, max_rows)
+}
+
+/// Parses a chain's trace bytes; `path` names the file in messages.
+pub fn parse_chain_trace(
+    bytes: &[u8],
+    path: &Path,
+    names: &[String],
+) -> Result<ChainTrace, TraceError> {
+    chain_trace_from(bytes, path, names, usize::MAX)
+}
+
+fn chain_trace_from(
+    input: impl Read,
+    path: &Path,
+    names: &[String],
+    max_rows: usize,
+) -> Result<ChainTrace, TraceError> {
+    let header: Vec<&str> = std::iter::once("t")
+        .chain(names.iter().map(String::as_str))
+        .collect();
+    let mut samples = Samples::new(names.len());
+    let mut lines = Vec::new();
+    let mut most = 0u32;
+    let mut v = vec![0.0; header.len()];
+    csv_rows(
+        input,
+        path,
+        Layout { header: &header },
+        max_rows,
+        |line, rec| {
+            for (k, field) in rec.iter().enumerate() {
+                v[k] = number(field).ok_or_else(|| TraceError::Value {
+                    path: path.to_owned(),
+                    line,
+                    column: k + 1,
+                    name: header[k].to_owned(),
+                    value: field.to_owned(),
+                })?;
+                if k > 0 {
+                    most = most.max(written_digits(field));
+                }
+            }
+            samples.push(v[0], &v[1..]);
+            lines.push(line);
+            Ok(())
+        },
+    )?;
+    if samples.is_empty() {
+        return Err(TraceError::NoRows {
+            path: path.to_owned(),
+        });
+    }
+    Ok(ChainTrace {
         path: path.to_owned(),
         samples,
         lines,
@@ -524,10 +616,20 @@ impl<R: Read> Read for LineCap<R> {
 /// The shape of a CSV file: its header, the header as written in messages, and the field
 /// count as written in messages.
 #[derive(Clone, Copy)]
-struct Layout {
-    header: &'static [&'static str],
-    joined: &'static str,
-    fields: &'static str,
+struct Layout<'a> {
+    header: &'a [&'a str],
+}
+
+impl Layout<'_> {
+    /// The header as a line, `t,alpha,omega_u,omega_l`.
+    fn joined(&self) -> String {
+        self.header.join(",")
+    }
+
+    /// The number of fields with the header, `4 (t,alpha,omega_u,omega_l)`.
+    fn fields(&self) -> String {
+        format!("{} ({})", self.header.len(), self.joined())
+    }
 }
 
 /// Hands each data row of a CSV file laid out as `layout` to `row` with its file line
@@ -537,7 +639,7 @@ struct Layout {
 fn csv_rows(
     input: impl Read,
     path: &Path,
-    layout: Layout,
+    layout: Layout<'_>,
     max_rows: usize,
     mut row: impl FnMut(u64, &csv::StringRecord) -> Result<(), TraceError>,
 ) -> Result<(), TraceError> {
@@ -585,7 +687,7 @@ fn csv_rows(
             path: p(),
             line: line_of(&header),
             found: header.iter().collect::<Vec<_>>().join(","),
-            expected: layout.joined,
+            expected: layout.joined(),
         });
     }
     drop(records);
@@ -604,7 +706,7 @@ fn csv_rows(
                 path: p(),
                 line,
                 found: rec.len(),
-                expected: layout.fields,
+                expected: layout.fields(),
             });
         }
         row(line, &rec)?;
@@ -700,14 +802,89 @@ pub fn parse_events(bytes: &[u8], path: &Path) -> Result<EventsFile, TraceError>
     events_from(bytes, path, MAX_EVENTS)
 }
 
+/// How an events file names its discs.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum DiscWords {
+    /// The rig's `upper`, `lower`.
+    Rig,
+    /// A chain's numbers `1` … `N`.
+    Chain(usize),
+}
+
+impl DiscWords {
+    /// The disc `word` names.
+    fn parse(self, word: &str) -> Option<Disc> {
+        match self {
+            DiscWords::Rig => disc_of(word),
+            DiscWords::Chain(n) => word
+                .parse::<usize>()
+                .ok()
+                .filter(|k| (1..=n).contains(k))
+                .map(|k| Disc::at(k - 1)),
+        }
+    }
+
+    /// The words allowed, for messages.
+    fn words(self) -> String {
+        match self {
+            DiscWords::Rig => DISC_WORDS.into(),
+            DiscWords::Chain(n) => format!("the disc numbers 1 to {n}"),
+        }
+    }
+
+    /// The word of disc `d`.
+    pub fn name(self, d: Disc) -> std::borrow::Cow<'static, str> {
+        match self {
+            DiscWords::Rig => disc_name(d),
+            DiscWords::Chain(_) => d.number().to_string().into(),
+        }
+    }
+}
+
 /// Parses an events file from `input`; `path` names it in messages.
 fn events_from(input: impl Read, path: &Path, limit: usize) -> Result<EventsFile, TraceError> {
+    events_with(input, path, limit, DiscWords::Rig)
+}
+
+/// Reads an events file of a chain of `n` discs (disc numbers `1` … `n`), streaming as
+/// [`read_events`] does.
+pub fn read_chain_events(path: &Path, n: usize) -> Result<EventsFile, TraceError> {
+    events_with(open(path)?, path, MAX_EVENTS, DiscWords::Chain(n))
+}
+
+/// Parses an events file of a chain of `n` discs; `path` names it in messages.
+pub fn parse_chain_events(bytes: &[u8], path: &Path, n: usize) -> Result<EventsFile, TraceError> {
+    events_with(bytes, path, MAX_EVENTS, DiscWords::Chain(n))
+}
+
+/// The events file of a chain's run: as [`write_events`], discs by number.
+pub fn write_chain_events(events: &[Event]) -> Vec<u8> {
+    let mut out = String::from("t,disc,kind\n");
+    let mut b = zmij::Buffer::new();
+    for e in events {
+        if let Some((d, k)) = event_row(e.kind) {
+            out.push_str(b.format(e.t));
+            out.push(',');
+            out.push_str(&d.number().to_string());
+            out.push(',');
+            out.push_str(k);
+            out.push('\n');
+        }
+    }
+    out.into_bytes()
+}
+
+/// Parses an events file from `input` whose discs are named as `discs` says.
+fn events_with(
+    input: impl Read,
+    path: &Path,
+    limit: usize,
+    discs: DiscWords,
+) -> Result<EventsFile, TraceError> {
     let mut out = Vec::new();
     let mut lines = Vec::new();
     let layout = Layout {
         header: &EVENTS_HEADER,
-        joined: "t,disc,kind",
-        fields: "3 (t,disc,kind)",
     };
     csv_rows(input, path, layout, limit.saturating_add(1), |line, rec| {
         if out.len() == limit {
@@ -721,10 +898,10 @@ fn events_from(input: impl Read, path: &Path, limit: usize) -> Result<EventsFile
             path: path.to_owned(),
             line,
             column: 1,
-            name: "t",
+            name: "t".into(),
             value: rec[0].to_owned(),
         })?;
-        let word = |column: usize, name: &'static str, expected: &'static str| TraceError::Word {
+        let word = |column: usize, name: &'static str, expected: String| TraceError::Word {
             path: path.to_owned(),
             line,
             column,
@@ -732,8 +909,10 @@ fn events_from(input: impl Read, path: &Path, limit: usize) -> Result<EventsFile
             value: rec[column - 1].to_owned(),
             expected,
         };
-        let disc = disc_of(&rec[1]).ok_or_else(|| word(2, "disc", DISC_WORDS))?;
-        let kind = kind_of(&rec[2], disc).ok_or_else(|| word(3, "kind", KIND_WORDS))?;
+        let disc = discs
+            .parse(&rec[1])
+            .ok_or_else(|| word(2, "disc", discs.words()))?;
+        let kind = kind_of(&rec[2], disc).ok_or_else(|| word(3, "kind", KIND_WORDS.into()))?;
         out.push(Event::new(t, &[0.0; 3], kind));
         lines.push(line);
         Ok(())

@@ -156,7 +156,8 @@ pub(crate) fn split_words(s: &str) -> Result<Vec<String>, String> {
 /// The job file of one run (BENCHMARK.md).
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Job {
-    /// The suite's version ([`crate::grade::check::BENCHMARK`]).
+    /// The suite's version ([`crate::grade::check::BENCHMARK`]; a chain scene's, the chain
+    /// tier's [`crate::grade::chain::CHAIN_BENCHMARK`]).
     pub benchmark: &'static str,
     /// The scenario's name.
     pub scenario: String,
@@ -169,8 +170,8 @@ pub struct Job {
     /// time is a breakpoint. Absent for a constant input.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub input: Option<Vec<[f64; 2]>>,
-    /// Initial state, at full precision: `[α, ω_u, ω_l]` (rad, rad/s, rad/s) on the rig; its
-    /// length is the model's state size.
+    /// Initial state, at full precision: `[α, ω_u, ω_l]` (rad, rad/s, rad/s) on the rig,
+    /// `[α_1 … α_{N−1}, ω_1 … ω_N]` on a chain of N.
     pub x0: Vec<f64>,
     /// Horizon (s): the trace covers `[0, t_end]`.
     pub t_end: f64,
@@ -180,9 +181,10 @@ pub struct Job {
     pub tol: Option<f64>,
     /// Step to run at (s), for a fixed-step client (else `null`).
     pub h: Option<f64>,
-    /// Where to write the trace (`t,alpha,omega_u,omega_l`).
+    /// Where to write the trace (`t,alpha,omega_u,omega_l`; a chain's `t,alpha_1,…,omega_N`).
     pub trace: PathBuf,
-    /// Where to write the events (`t,disc,kind`), if the client locates them.
+    /// Where to write the events (`t,disc,kind`; a chain names discs `1` … `N`), if the
+    /// client locates them.
     pub events: PathBuf,
 }
 
@@ -210,6 +212,35 @@ impl Job {
             x0: sc.x0.clone(),
             t_end,
             dt,
+            tol: (!fixed_step).then_some(setting),
+            h: fixed_step.then_some(setting),
+            trace,
+            events,
+        }
+    }
+
+    /// The job of a chain scene (the chain tier): its parameters in chain form (`k_m` and the
+    /// `disc` list), u or its input rows, x0 of 2N − 1 values, the scene's horizon and grid,
+    /// and the client's knob; `benchmark` names the chain tier's version.
+    pub fn for_chain(
+        sc: &rotor_model::scenario::ChainScenario,
+        fixed_step: bool,
+        setting: f64,
+        trace: PathBuf,
+        events: PathBuf,
+    ) -> Job {
+        Job {
+            benchmark: crate::grade::chain::CHAIN_BENCHMARK,
+            scenario: sc.name.clone(),
+            params: serde_json::to_value(&sc.params).expect("plain numbers and strings"),
+            u: sc.input.is_none().then_some(sc.u),
+            input: sc
+                .input
+                .as_ref()
+                .map(|i| i.rows().iter().map(|&(t, u)| [t, u]).collect()),
+            x0: sc.x0.clone(),
+            t_end: sc.t_end,
+            dt: sc.dt,
             tol: (!fixed_step).then_some(setting),
             h: fixed_step.then_some(setting),
             trace,

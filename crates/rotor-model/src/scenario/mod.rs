@@ -7,11 +7,13 @@
 
 #![warn(missing_docs)]
 
+pub mod chain_scene;
 pub mod compare;
 pub mod error;
 pub mod scene_file;
 pub mod tolerance;
 
+pub use chain_scene::ChainScenario;
 pub use compare::CompareSpec;
 pub use error::ScenarioError;
 pub use scene_file::Scenario;

@@ -67,7 +67,7 @@ struct RawScenario {
 /// `input = [[t, u], ...]` (the rows inline).
 #[derive(Debug, Deserialize)]
 #[serde(untagged)]
-enum RawInput {
+pub(crate) enum RawInput {
     File(PathBuf),
     Rows(Vec<[f64; 2]>),
 }
@@ -164,10 +164,10 @@ impl Scenario {
             error,
         })?;
         let model = Model::new(params);
-        let (u, input) = check_input(&raw, path, bad)?;
+        let (u, input) = check_input(raw.u, raw.input.as_ref(), path, bad)?;
         let mut raw = raw;
         raw.u = Some(u);
-        check_run(&raw, bad)?;
+        check_run(u, raw.t_end, raw.tol, raw.h, bad)?;
         let x0 = initial_state(&raw, &model, bad)?;
         raw.compare.check(raw.t_end, bad)?;
         // The steady window of a time-varying input lies after its last breakpoint: a steady
@@ -285,7 +285,7 @@ impl Scenario {
 
 /// `name`: it becomes the report's file names (`<name>.csv`, `<name>.svg`), so a path
 /// separator or a leading dot would write outside the report or hide the file.
-fn check_name(name: &str, bad: Bad) -> Result<(), ScenarioError> {
+pub(crate) fn check_name(name: &str, bad: Bad) -> Result<(), ScenarioError> {
     let name_ok = !name.is_empty()
         && name.len() <= 100
         && !name.starts_with('.')
@@ -304,24 +304,29 @@ fn check_name(name: &str, bad: Bad) -> Result<(), ScenarioError> {
 
 /// The run settings: `u` finite, `t_end` positive and finite, `tol` in
 /// `[MIN_TOL, 1)`, `h` in `(0, t_end]`, and without `h` a horizon that holds the default step.
-fn check_run(raw: &RawScenario, bad: Bad) -> Result<(), ScenarioError> {
-    let u = raw.u.unwrap_or(f64::NAN);
+pub(crate) fn check_run(
+    u: f64,
+    t_end: f64,
+    tol: Option<f64>,
+    h: Option<f64>,
+    bad: Bad,
+) -> Result<(), ScenarioError> {
     if !u.is_finite() {
         return Err(bad.at("u", Num(u).to_string(), "must be finite"));
     }
-    if !(raw.t_end > 0.0 && raw.t_end.is_finite()) {
+    if !(t_end > 0.0 && t_end.is_finite()) {
         return Err(bad.at(
             "t_end",
-            Num(raw.t_end).to_string(),
+            Num(t_end).to_string(),
             "must be positive and finite",
         ));
     }
-    if let Some(tol) = raw.tol
+    if let Some(tol) = tol
         && !(tol > 0.0 && tol < 1.0)
     {
         return Err(bad.at("tol", Num(tol).to_string(), "must lie in (0, 1)"));
     }
-    if let Some(tol) = raw.tol
+    if let Some(tol) = tol
         && tol < MIN_TOL
     {
         return Err(bad.at(
@@ -330,18 +335,18 @@ fn check_run(raw: &RawScenario, bad: Bad) -> Result<(), ScenarioError> {
             "is below 1.1e-15 (10 unit roundoffs): double precision cannot deliver it",
         ));
     }
-    if let Some(h) = raw.h
-        && !(h > 0.0 && h <= raw.t_end)
+    if let Some(h) = h
+        && !(h > 0.0 && h <= t_end)
     {
         return Err(bad.at("h", Num(h).to_string(), "must lie in (0, t_end]"));
     }
     // Without `h`, the time-stepping solver takes the default step, which must fit in
     // the horizon (Scene::validate), or every run of the scenario would fail.
     let h_default = DEFAULT_STEP;
-    if raw.h.is_none() && raw.t_end < h_default {
+    if h.is_none() && t_end < h_default {
         return Err(bad.at(
             "t_end",
-            Num(raw.t_end).to_string(),
+            Num(t_end).to_string(),
             &format!("is shorter than the default step h = {h_default}: set h"),
         ));
     }
@@ -351,12 +356,13 @@ fn check_run(raw: &RawScenario, bad: Bad) -> Result<(), ScenarioError> {
 /// The input: `u = V`, or `input = "NAME.csv"` (relative to the scenario file) or
 /// `input = [[t, u], ...]`, exactly one of them. Returns u at t = 0 and the input if it
 /// changes in time (a table of one value is the constant u).
-fn check_input(
-    raw: &RawScenario,
+pub(crate) fn check_input(
+    u: Option<f64>,
+    input: Option<&RawInput>,
     path: &Path,
     bad: Bad,
 ) -> Result<(f64, Option<Input>), ScenarioError> {
-    let input = match (&raw.u, &raw.input) {
+    let input = match (&u, input) {
         (Some(u), None) => return Ok((*u, None)),
         (None, None) => {
             return Err(bad.at(
