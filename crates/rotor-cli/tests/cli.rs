@@ -1955,3 +1955,38 @@ fn check_grades_a_chain_scene_with_exit_codes_0_1_2() {
     );
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// `rotor bench --tier chain`: the chain scenes' work-precision table with the chain tier's
+/// version, its files written; a rig scene or a rig-only flag is refused by name.
+#[test]
+fn bench_tier_chain_grades_the_chain_scenes() {
+    let dir = rotor_testkit::tmp_dir("rotor-cli-bench-chain");
+    let json = dir.join("b.json");
+    let o = rotor(&[
+        "bench",
+        "--tier",
+        "chain",
+        "--quick",
+        "--scenario",
+        "chain3-u1.5-rest",
+        "--json",
+        json.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let out = String::from_utf8_lossy(&o.stdout);
+    assert!(out.contains(rotor_suite::CHAIN_VERSION) && out.contains("| moreau |"), "{out}");
+    let v: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    assert_eq!(v["benchmark"], rotor_suite::CHAIN_VERSION);
+    assert_eq!(v["scenes"][0]["discs"], 3);
+    for (args, needle) in [
+        (&["bench", "--tier", "chain", "--scenario", "t1-u1.5-rest"][..], "a rig scene"),
+        (&["bench", "--tier", "chain", "--shard", "1/2"][..], "--shard"),
+    ] {
+        let o = rotor(args);
+        assert_eq!(o.status.code(), Some(2), "{args:?}");
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert!(err.contains(needle), "{args:?}: {err}");
+    }
+    std::fs::remove_dir_all(&dir).ok();
+}

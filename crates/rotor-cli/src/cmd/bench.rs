@@ -40,7 +40,10 @@ pub struct Args {
     #[arg(long = "scenario", value_name = "SCENARIO.toml")]
     pub scenario: Vec<PathBuf>,
     /// Only the scenes of this tier: table1 (only the lower disc sticks) or full (every
-    /// scene).
+    /// rig scene); or chain: the chain tier's scenes (chains of N discs), each solver over
+    /// its ladder and each --external client graded as `rotor check` grades a chain's trace
+    /// (digits, loose, strict, run time), the table on stdout and --json, --svg, --csv
+    /// written.
     #[arg(long, value_name = "TIER")]
     pub tier: Option<String>,
     /// Also write the published-results page (Markdown: digits per setting, cheapest
@@ -88,6 +91,19 @@ pub fn run(a: &Args) -> Result<()> {
     }
     if a.scaling {
         return scaling(outputs, a.quick, a.no_peers, a.timeout);
+    }
+    if a.tier.as_deref() == Some("chain") {
+        for (flag, given) in [
+            ("--shard", a.shard.is_some()),
+            ("--results", a.results.is_some()),
+            ("--keep", a.keep.is_some()),
+            ("--jobs", a.jobs.is_some()),
+        ] {
+            if given {
+                crate::common::refuse!("{flag}: not with --tier chain (the rig's suite only)");
+            }
+        }
+        return chain_tier(outputs, a);
     }
     bench(
         outputs,
@@ -302,6 +318,71 @@ fn scaling(
     let report = report?;
     crate::common::say(&report.to_markdown(), [json, svg, csv])?;
     let json_text = serde_json::to_string_pretty(&report)?;
+    for (path, text) in [
+        (json, json_text),
+        (svg, report.to_svg()),
+        (csv, report.to_csv()),
+    ] {
+        if let Some(path) = path {
+            rotor_harness::compare::report::write_output(path, text.as_bytes())
+                .with_context(|| format!("{}: cannot write", path.display()))?;
+        }
+    }
+    Ok(())
+}
+
+/// `rotor bench --tier chain`: the chain tier's work-precision bench
+/// ([`rotor_harness::bench::chain_tier`]), its table on stdout and its files written.
+fn chain_tier([json, svg, csv]: [Option<&Path>; 3], a: &Args) -> Result<()> {
+    use rotor_harness::bench::chain_tier::{ChainTierOptions, chain_scenes, run};
+    check(
+        "timeout",
+        a.timeout,
+        a.timeout > 0.0,
+        "must be positive and finite",
+    )?;
+    let scenes = if a.scenario.is_empty() {
+        chain_scenes(&fixtures_dir()?)?
+    } else {
+        let mut v = Vec::new();
+        for p in &a.scenario {
+            let (path, is_chain) = crate::common::scene_path("--scenario", p)?;
+            if !is_chain {
+                crate::common::refuse!(
+                    "--scenario {}: a rig scene; --tier chain runs chain scenes",
+                    p.display()
+                );
+            }
+            v.push(path);
+        }
+        v
+    };
+    let mut opts = if a.quick {
+        ChainTierOptions::quick(scenes)
+    } else {
+        ChainTierOptions::new(scenes)
+    };
+    opts.timeout = a.timeout;
+    for e in &a.external {
+        opts.clients.push(
+            rotor_harness::bench::ClientSpec::parse(e, &a.fixed_step)
+                .map_err(crate::common::flagged)?,
+        );
+    }
+    for name in &a.fixed_step {
+        if !opts.clients.iter().any(|c| &c.name == name) {
+            crate::common::refuse!("--fixed-step {name:?}: no --external client of that name");
+        }
+    }
+    eprintln!(
+        "bench --tier chain: {} scene(s), {} settings of the solvers, {} external client(s)",
+        opts.scenes.len(),
+        opts.ladders.iter().map(|(_, l)| l.len()).sum::<usize>(),
+        opts.clients.len()
+    );
+    let report = run(&opts, &mut |m| eprintln!("{m}"))?;
+    crate::common::say(&report.to_markdown(), [json, svg, csv])?;
+    let json_text = serde_json::to_string_pretty(&report)? + "\n";
     for (path, text) in [
         (json, json_text),
         (svg, report.to_svg()),

@@ -274,7 +274,7 @@ pub fn job_for_scenario(
 }
 
 /// Runs once: writes the job, starts the client. `Err` is the failure of the run.
-fn run_once(
+pub(crate) fn run_once(
     spec: &ClientSpec,
     job: &Job,
     dir: &Path,

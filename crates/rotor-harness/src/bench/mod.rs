@@ -32,6 +32,7 @@
 
 #![warn(missing_docs)]
 
+pub mod chain_tier;
 mod clients;
 pub mod colors;
 mod figures;
