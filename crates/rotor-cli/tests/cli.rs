@@ -1974,14 +1974,23 @@ fn bench_tier_chain_grades_the_chain_scenes() {
     ]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let out = String::from_utf8_lossy(&o.stdout);
-    assert!(out.contains(rotor_suite::CHAIN_VERSION) && out.contains("| moreau |"), "{out}");
+    assert!(
+        out.contains(rotor_suite::CHAIN_VERSION) && out.contains("| moreau |"),
+        "{out}"
+    );
     let v: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
     assert_eq!(v["benchmark"], rotor_suite::CHAIN_VERSION);
     assert_eq!(v["scenes"][0]["discs"], 3);
     for (args, needle) in [
-        (&["bench", "--tier", "chain", "--scenario", "t1-u1.5-rest"][..], "a rig scene"),
-        (&["bench", "--tier", "chain", "--shard", "1/2"][..], "--shard"),
+        (
+            &["bench", "--tier", "chain", "--scenario", "t1-u1.5-rest"][..],
+            "a rig scene",
+        ),
+        (
+            &["bench", "--tier", "chain", "--shard", "1/2"][..],
+            "--shard",
+        ),
     ] {
         let o = rotor(args);
         assert_eq!(o.status.code(), Some(2), "{args:?}");

@@ -956,3 +956,50 @@ proptest! {
         }
     }
 }
+
+/// The suite's chain scenes through `rotor compare`'s cross-validation
+/// (`rotor_harness::compare::chain`): the three solvers agree pair by pair on every sample of
+/// every state and on every event time, within gates derived from each one's own accuracy on
+/// the scene (measured: the worst quantity at 0.18–0.48 of its gate). The negative controls: a
+/// solver run on the chain with one spring 1 % stiffer fails its pair with the event-driven
+/// solver, for the switch model and for Moreau–Jean (measured 9.4× its gate at the least,
+/// Moreau–Jean on the chain of eight, whose own error at h = 1e-3 is large; elsewhere 3000× or
+/// event sequences that differ). A gate a wrong chain passes would check nothing.
+#[test]
+fn the_chain_tiers_scenes_agree_under_derived_gates_and_a_wrong_chain_fails() {
+    use rotor_harness::compare::chain::{chain_run, compare_chain, gates_of};
+    use rotor_model::scenario::ChainScenario;
+    let dir =
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../fixtures/chain/scenarios");
+    for f in rotor_model::scenario::Scenario::list_dir(&dir).unwrap() {
+        let sc = ChainScenario::from_file(&f).unwrap();
+        let c = compare_chain(&sc).unwrap();
+        for pair in ["event-switch", "event-moreau", "switch-moreau"] {
+            let (q, r) = c.worst(pair).unwrap();
+            eprintln!("{} {pair}: worst {q} at {r:.2} of its gate", sc.name);
+        }
+        assert!(c.passed(), "{:?}", c.failures());
+        let event = &c.runs[0];
+        let mut wrong = sc.clone();
+        wrong.params.discs[2].k *= 1.01;
+        for kind in [SolverKind::SWITCH, SolverKind::MOREAU] {
+            let off = chain_run(kind, &wrong).unwrap();
+            let gates = gates_of(&sc, event, &off);
+            let worst = gates
+                .iter()
+                .map(|g| g.difference / g.gate)
+                .fold(0.0, f64::max);
+            eprintln!(
+                "{} {} with k_3 x 1.01: worst / gate = {worst:.1}",
+                sc.name,
+                kind.name()
+            );
+            assert!(
+                gates.iter().any(|g| !g.passed),
+                "{} {}",
+                sc.name,
+                kind.name()
+            );
+        }
+    }
+}

@@ -8,12 +8,13 @@ use anyhow::{Context, Result, bail};
 use rotor_model::Params;
 use rotor_model::seam::RigSteady;
 
-use crate::common::{fixture_path, fixtures_dir, progress_bar, thread_pool, threads_arg};
+use crate::common::{fixtures_dir, progress_bar, scene_path, thread_pool, threads_arg};
 use crate::out;
 
 #[derive(clap::Args, Debug)]
 pub struct Args {
-    /// Scenario files or names in fixtures/scenarios (default: every one there).
+    /// Scenario files or names of the suite, rig or chain scenes (default: every scene of
+    /// both tiers).
     pub scenarios: Vec<PathBuf>,
     /// Report directory.
     #[arg(long, default_value = "reports")]
@@ -47,16 +48,27 @@ pub(crate) fn compare(
     } else {
         rotor_harness::compare::report::Scenes::Given
     };
-    let files = if files.is_empty() {
-        let dir = fixtures_dir()?.join("scenarios");
-        rotor_model::scenario::Scenario::list_dir(&dir)
-            .with_context(|| format!("{}: cannot list scenarios", dir.display()))?
+    // The rig's scenes and the chain tier's: every one of both by default.
+    let (files, chain_files): (Vec<PathBuf>, Vec<PathBuf>) = if files.is_empty() {
+        let list = |sub: &str| -> Result<Vec<PathBuf>> {
+            let dir = fixtures_dir()?.join(sub);
+            rotor_model::scenario::Scenario::list_dir(&dir)
+                .with_context(|| format!("{}: cannot list scenarios", dir.display()))
+        };
+        (list("scenarios")?, list("chain/scenarios")?)
     } else {
-        files
-            .iter()
-            .map(|f| fixture_path("scenario", f, "scenarios"))
-            .collect::<Result<_>>()?
+        let mut rig = Vec::new();
+        let mut chain = Vec::new();
+        for f in files {
+            let (path, is_chain) = scene_path("scenario", f)?;
+            if is_chain { &mut chain } else { &mut rig }.push(path);
+        }
+        (rig, chain)
     };
+    let chains = chain_files
+        .iter()
+        .map(|f| rotor_model::scenario::ChainScenario::from_file(f))
+        .collect::<Result<Vec<_>, _>>()?;
     let scenarios = files
         .iter()
         .map(|f| rotor_analysis::solvers::load_scenario(f))
@@ -66,13 +78,21 @@ pub(crate) fn compare(
     let stribeck = Params::from_file(&fixtures_dir()?.join("params/stribeck.toml"))?;
     let threads = thread_pool(threads)?;
     eprintln!(
-        "{} scenarios x {} solvers ({} runs){} on {threads}",
+        "{} scenarios x {} solvers ({} runs){}{} on {threads}",
         scenarios.len(),
         rotor_analysis::solvers::SOLVERS.len(),
         scenarios.len() * rotor_analysis::solvers::SOLVERS.len(),
+        if chains.is_empty() {
+            String::new()
+        } else {
+            format!(
+                ", {} chain scene(s) x 3 solvers at three settings each",
+                chains.len()
+            )
+        },
         if main_job {
             ", then both bifurcation diagrams, the plane, the probes and the stress table \
-             (about 11 s on 2 idle cores)"
+             and the chain tier (about 13 s on 2 idle cores)"
         } else {
             ""
         }
@@ -80,8 +100,14 @@ pub(crate) fn compare(
     let t0 = std::time::Instant::now();
     let bar = progress_bar(scenarios.len() as u64, "scenarios");
     let sets = rotor_harness::report::param_sets(stribeck);
-    let compared = rotor_harness::report::run(&scenarios, &sets, main_job, &|| bar.inc(1))?;
+    // The chain tier beside the rig's scenes and sections, so both cores stay busy.
+    let (compared, chain) = rayon::join(
+        || rotor_harness::report::run(&scenarios, &sets, main_job, &|| bar.inc(1)),
+        || (!chains.is_empty()).then(|| rotor_harness::report::chain_section(&chains)),
+    );
+    let mut compared = compared?;
     bar.finish_and_clear();
+    compared.sections.extend(chain);
     let wall = t0.elapsed().as_secs_f64();
     let fails = rotor_harness::report::write(report, &compared, stribeck, scenes)?;
     let (results, sections) = (&compared.results, &compared.sections);

@@ -253,8 +253,8 @@ fn client_point(
     };
     let mut times = vec![seconds(&first)];
     if first.wall_s < opts.time_budget {
-        let n = ((opts.time_budget / first.wall_s.max(1e-9)).floor() as usize)
-            .clamp(1, opts.repeats);
+        let n =
+            ((opts.time_budget / first.wall_s.max(1e-9)).floor() as usize).clamp(1, opts.repeats);
         times.clear();
         for _ in 0..n {
             match crate::bench::clients::run_once(spec, &job, &dir, opts.timeout) {
@@ -286,15 +286,19 @@ pub fn run(
     }
     let mut scenes = Vec::new();
     for path in &opts.scenes {
-        let (sc, r) = crate::grade::chain::load(path).map_err(|e| {
-            BenchError::Options(format!("{}: {e}", path.display()))
-        })?;
+        let (sc, r) = crate::grade::chain::load(path)
+            .map_err(|e| BenchError::Options(format!("{}: {e}", path.display())))?;
         let mut points = Vec::new();
         for (kind, ladder) in &opts.ladders {
             for &s in ladder {
                 points.push(solver_point(opts, &sc, &r, *kind, s));
             }
-            say(format!("{}: {} over {} settings", sc.name, kind.name(), ladder.len()));
+            say(format!(
+                "{}: {} over {} settings",
+                sc.name,
+                kind.name(),
+                ladder.len()
+            ));
         }
         for spec in &opts.clients {
             let ladder = if spec.fixed_step {
@@ -305,7 +309,12 @@ pub fn run(
             for &s in ladder {
                 points.push(client_point(opts, &sc, &r, spec, s));
             }
-            say(format!("{}: {} over {} settings", sc.name, spec.name, ladder.len()));
+            say(format!(
+                "{}: {} over {} settings",
+                sc.name,
+                spec.name,
+                ladder.len()
+            ));
         }
         scenes.push(ChainSceneReport {
             scenario: sc.name.clone(),
@@ -378,7 +387,9 @@ impl ChainTierReport {
                         .replace('|', "/")
                 ));
             }
-            out.push_str("\n| runner | cheapest loose [s] | cheapest strict [s] |\n|---|---:|---:|\n");
+            out.push_str(
+                "\n| runner | cheapest loose [s] | cheapest strict [s] |\n|---|---:|---:|\n",
+            );
             for r in self.runners() {
                 out.push_str(&format!(
                     "| {r} | {} | {} |\n",
@@ -393,7 +404,9 @@ impl ChainTierReport {
 
     /// CSV: one row per point.
     pub fn to_csv(&self) -> String {
-        let mut out = String::from("scenario,discs,runner,knob,setting,digits,loose,strict,seconds,failure\n");
+        let mut out = String::from(
+            "scenario,discs,runner,knob,setting,digits,loose,strict,seconds,failure\n",
+        );
         for s in &self.scenes {
             for p in &s.points {
                 out.push_str(&format!(
@@ -425,9 +438,10 @@ impl ChainTierReport {
                 let series = runners
                     .iter()
                     .map(|r| {
-                        let (color, dash) = SolverKind::by_name(r).map_or(("#7a3e9d", Some("2 3")), |k| {
-                            (k.info().style.color, k.info().style.dash)
-                        });
+                        let (color, dash) = SolverKind::by_name(r)
+                            .map_or(("#7a3e9d", Some("2 3")), |k| {
+                                (k.info().style.color, k.info().style.dash)
+                            });
                         let mut pts: Vec<(f64, f64)> = s
                             .points
                             .iter()
@@ -459,8 +473,12 @@ impl ChainTierReport {
 /// The chain scenes of a suite directory (`chain/scenarios/*.toml`).
 pub fn chain_scenes(fixtures: &Path) -> Result<Vec<PathBuf>, BenchError> {
     let dir = crate::grade::chain::tier_dir(fixtures).join("scenarios");
-    rotor_model::scenario::Scenario::list_dir(&dir)
-        .map_err(|e| BenchError::Options(format!("{}: cannot list the chain scenes: {e}", dir.display())))
+    rotor_model::scenario::Scenario::list_dir(&dir).map_err(|e| {
+        BenchError::Options(format!(
+            "{}: cannot list the chain scenes: {e}",
+            dir.display()
+        ))
+    })
 }
 
 #[cfg(test)]
@@ -478,7 +496,8 @@ mod tests {
     fn a_quick_chain_bench_grades_every_runner_and_records_failures() {
         let scene = fixtures().join("chain/scenarios/chain3-u1.5-rest.toml");
         let mut opts = ChainTierOptions::quick(vec![scene]);
-        opts.clients.push(ClientSpec::parse("ghost=/nonexistent/solver", &[]).unwrap());
+        opts.clients
+            .push(ClientSpec::parse("ghost=/nonexistent/solver", &[]).unwrap());
         opts.client_tols = vec![1e-6];
         let r = run(&opts, &mut |_| {}).unwrap();
         assert_eq!(r.benchmark, rotor_suite::CHAIN_VERSION);

@@ -4,6 +4,7 @@
 
 #![warn(missing_docs)]
 
+pub mod chain;
 pub mod gate;
 pub mod html;
 pub mod margins;

@@ -10,6 +10,7 @@
 #![warn(missing_docs)]
 
 pub mod bifurcation;
+pub mod chain;
 pub mod figure3;
 mod job;
 pub mod plane;
@@ -19,6 +20,7 @@ pub mod stress;
 use std::path::PathBuf;
 
 pub use bifurcation::bifurcation_section;
+pub use chain::chain_section;
 pub use figure3::figure3_section;
 pub use job::{Compared, ParamSet, check_names, param_sets, run, sections, write};
 pub use plane::plane_section;

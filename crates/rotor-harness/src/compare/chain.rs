@@ -1,0 +1,284 @@
+//! Cross-validation of a chain scene: the three solvers, which share nothing but the chain's
+//! model, must agree on every sample of every α_i and ω_i over the whole run and on the time
+//! of every stick onset, stick exit and reversal, within gates derived from each one's own
+//! accuracy on the scene.
+//!
+//! Each solver runs at its comparison setting (the scene's `tol` or `h` where it states one)
+//! and at its tighter settings ([`rotor_analysis::solvers::tighter_settings`]: tolerance/100;
+//! step/2 and step/4); its own error in a quantity is
+//! [`rotor_analysis::solvers::self_error`] of that quantity between its successive runs. The
+//! gate of a pair `(a, b)` in a quantity is the rule of the rig's derived gates
+//! ([`crate::compare::gate::derived_tolerance`]):
+//!
+//! ```text
+//! 2·(e_a + e_b) + 1e-12 + (η_a + η_b)·max(1, t_end)
+//! ```
+//!
+//! twice the two own errors, the rounding floor, and what a stick band η moves (the switch
+//! model holds a stuck disc within η, and the spring drifts by η per second of stick). Event
+//! times are compared between runs whose event sequences agree (disc and kind, in order); runs
+//! with different sequences cannot be compared there, which fails the pair and says so.
+//!
+//! On a chain the band's term alone does not bound what the band moves: on the chain of four
+//! with a Stribeck disc in the middle the switch model (tol 1e-10, η = 1e-10) differed from
+//! the event-driven solver by 1.0e-7 rad/s in ω_3, 2.2× the gate with that term, while its own
+//! runs at tol 1e-10 and 1e-12 (the same η) agreed far closer: the band's error is first
+//! order in η and a tighter tolerance does not see it. The switch model's own error here
+//! therefore adds its band's, measured: its run at η/10 ([`SWITCH_ETA_STUDY`]), the
+//! difference times 10/9 (an error `C·η` differs from `C·η/10` by 0.9 of itself).
+
+use std::collections::BTreeMap;
+
+use rotor_analysis::solvers::{SOLVERS, SolverKind, self_error, tighter_settings};
+use rotor_model::scenario::ChainScenario;
+use rotor_model::seam::{Output, Scene, SolveError, Trajectory};
+use serde::Serialize;
+
+use crate::grade::reference::{event_difference, switches, trace_differences};
+
+/// The rounding floor of a gate: 1e-12 (s, rad, rad/s).
+pub const FLOOR: f64 = 1e-12;
+
+/// The switch model's band is measured by a run at η divided by this.
+pub const SWITCH_ETA_STUDY: f64 = 10.0;
+
+/// One solver's runs of a chain scene.
+#[derive(Debug, Clone)]
+pub struct ChainRun {
+    /// The solver.
+    pub kind: SolverKind,
+    /// Its setting (tolerance, or step in s).
+    pub setting: f64,
+    /// The run at the setting.
+    pub run: Trajectory,
+    /// Its own error per quantity (each column's name, `event_time`): from its runs at the
+    /// tighter settings.
+    pub own: BTreeMap<String, f64>,
+    /// Wall time of the run at the setting \[s\].
+    pub seconds: f64,
+}
+
+/// One gated quantity of one pair.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct ChainGate {
+    /// `event-switch`, `event-moreau`, `switch-moreau`.
+    pub pair: String,
+    /// A column's name, or `event_time`.
+    pub quantity: String,
+    /// The largest difference of the pair's runs (∞ where they cannot be compared).
+    pub difference: f64,
+    /// The gate.
+    pub gate: f64,
+    /// `difference ≤ gate`.
+    pub passed: bool,
+}
+
+/// A chain scene through the three solvers.
+#[derive(Debug, Clone)]
+pub struct ChainComparison {
+    /// The scene.
+    pub scenario: ChainScenario,
+    /// Each solver's runs.
+    pub runs: Vec<ChainRun>,
+    /// Every pair's gates, pair by pair, quantities in the state's order then `event_time`.
+    pub gates: Vec<ChainGate>,
+}
+
+impl ChainComparison {
+    /// Whether every gate passes.
+    pub fn passed(&self) -> bool {
+        self.gates.iter().all(|g| g.passed)
+    }
+
+    /// One line per failed gate.
+    pub fn failures(&self) -> Vec<String> {
+        self.gates
+            .iter()
+            .filter(|g| !g.passed)
+            .map(|g| {
+                format!(
+                    "{} {} {}: difference {:.3e} > gate {:.3e}",
+                    self.scenario.name, g.pair, g.quantity, g.difference, g.gate
+                )
+            })
+            .collect()
+    }
+
+    /// The worst gate of a pair: (quantity, difference/gate).
+    pub fn worst(&self, pair: &str) -> Option<(&str, f64)> {
+        self.gates
+            .iter()
+            .filter(|g| g.pair == pair)
+            .map(|g| (g.quantity.as_str(), g.difference / g.gate))
+            .max_by(|a, b| a.1.total_cmp(&b.1))
+    }
+}
+
+/// A solver's setting on a chain scene: the event solver's comparison tolerance; the others'
+/// from the scene (`tol`, `h`) or their comparison settings.
+pub fn chain_setting(kind: SolverKind, sc: &ChainScenario) -> f64 {
+    let info = kind.info();
+    if kind == SOLVERS[0] {
+        return info.comparison;
+    }
+    let stated = if kind.is_fixed_step() { sc.h } else { sc.tol };
+    stated.unwrap_or(info.comparison)
+}
+
+/// Each quantity's difference of two runs: every column (largest over the samples) and
+/// `event_time` (∞ where the event sequences differ).
+fn differences(names: &[String], a: &Trajectory, b: &Trajectory) -> Vec<(String, f64)> {
+    let mut out: Vec<(String, f64)> = names
+        .iter()
+        .cloned()
+        .zip(trace_differences(&a.samples, &b.samples))
+        .collect();
+    out.push((
+        "event_time".into(),
+        event_difference(&switches(&a.events), &switches(&b.events)),
+    ));
+    out
+}
+
+fn solve(kind: SolverKind, sc: &ChainScenario, setting: f64) -> Result<Trajectory, SolveError> {
+    let scene = Scene {
+        accuracy: kind.accuracy(setting),
+        ..sc.scene(Output::Grid { dt: sc.dt })
+    };
+    kind.simulate_chain(&sc.model(), &scene)
+}
+
+/// One solver's runs: at its setting and the tighter ones, and its own error from them.
+pub fn chain_run(kind: SolverKind, sc: &ChainScenario) -> Result<ChainRun, SolveError> {
+    let names = sc.model().state_names();
+    let setting = chain_setting(kind, sc);
+    let t0 = std::time::Instant::now();
+    let run = solve(kind, sc, setting)?;
+    let seconds = t0.elapsed().as_secs_f64();
+    let mut steps: Vec<Vec<(String, f64)>> = Vec::new();
+    let mut prev = run.clone();
+    for s in tighter_settings(kind, setting) {
+        let t = solve(kind, sc, s)?;
+        steps.push(differences(&names, &prev, &t));
+        prev = t;
+    }
+    // The switch model's band error, first order in η: its run at η/10 differs from the run
+    // at η by 0.9 of it.
+    let band: Option<Vec<(String, f64)>> = if kind.info().stuck_band > 0.0 {
+        let mut options = rotor_switch::SwitchOptions::default();
+        options.eta /= SWITCH_ETA_STUDY;
+        let scene = Scene {
+            accuracy: kind.accuracy(setting),
+            ..sc.scene(Output::Grid { dt: sc.dt })
+        };
+        let narrow = rotor_switch::SwitchSolver { options }.simulate_chain(&sc.model(), &scene)?;
+        Some(differences(&names, &run, &narrow))
+    } else {
+        None
+    };
+    let own = (0..steps[0].len())
+        .map(|i| {
+            let diffs: Vec<f64> = steps.iter().map(|m| m[i].1).collect();
+            let band = band.as_ref().map_or(0.0, |b| {
+                b[i].1 * SWITCH_ETA_STUDY / (SWITCH_ETA_STUDY - 1.0)
+            });
+            (steps[0][i].0.clone(), self_error(kind, &diffs) + band)
+        })
+        .collect();
+    Ok(ChainRun {
+        kind,
+        setting,
+        run,
+        own,
+        seconds,
+    })
+}
+
+/// The gates of two runs.
+pub fn gates_of(sc: &ChainScenario, a: &ChainRun, b: &ChainRun) -> Vec<ChainGate> {
+    let names = sc.model().state_names();
+    let pair = rotor_analysis::solvers::pair_name(a.kind, b.kind);
+    let band = (a.kind.info().stuck_band + b.kind.info().stuck_band) * sc.t_end.max(1.0);
+    differences(&names, &a.run, &b.run)
+        .into_iter()
+        .map(|(quantity, difference)| {
+            let gate = 2.0 * (a.own[&quantity] + b.own[&quantity]) + FLOOR + band;
+            ChainGate {
+                pair: pair.clone(),
+                // A NaN difference or gate fails: `!(d > g)` would pass it.
+                passed: difference <= gate,
+                quantity,
+                difference,
+                gate,
+            }
+        })
+        .collect()
+}
+
+/// A chain scene through the three solvers, gated pair by pair.
+pub fn compare_chain(sc: &ChainScenario) -> Result<ChainComparison, SolveError> {
+    use rayon::prelude::*;
+    let runs = SOLVERS
+        .par_iter()
+        .map(|&k| chain_run(k, sc))
+        .collect::<Result<Vec<_>, _>>()?;
+    let mut gates = Vec::new();
+    for (i, a) in runs.iter().enumerate() {
+        for b in &runs[i + 1..] {
+            gates.extend(gates_of(sc, a, b));
+        }
+    }
+    Ok(ChainComparison {
+        scenario: sc.clone(),
+        runs,
+        gates,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn scene(name: &str) -> ChainScenario {
+        let p = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join(format!("../../fixtures/chain/scenarios/{name}.toml"));
+        ChainScenario::from_file(&p).unwrap()
+    }
+
+    /// The gate's pieces: a tolerance's own error is the difference to its tighter run, a
+    /// step's the larger of 2·d₁ and 4·d₂; the band adds η·t_end for the switch model.
+    #[test]
+    fn a_gate_is_twice_the_own_errors_plus_floor_and_band() {
+        let sc = scene("chain3-u1.5-rest");
+        let run = |kind: SolverKind, own: f64| ChainRun {
+            kind,
+            setting: 1.0,
+            run: solve(SolverKind::EVENT, &sc, 1e-6).unwrap(),
+            own: sc
+                .model()
+                .state_names()
+                .into_iter()
+                .chain(["event_time".to_owned()])
+                .map(|n| (n, own))
+                .collect(),
+            seconds: 0.0,
+        };
+        let g = gates_of(
+            &sc,
+            &run(SolverKind::EVENT, 1e-9),
+            &run(SolverKind::MOREAU, 1e-6),
+        );
+        assert!(g.iter().all(|g| g.difference == 0.0 && g.passed));
+        assert!(
+            g.iter()
+                .all(|g| (g.gate - (2.0 * (1e-9 + 1e-6) + FLOOR)).abs() < 1e-20)
+        );
+        let eta = SolverKind::SWITCH.info().stuck_band;
+        let g = gates_of(
+            &sc,
+            &run(SolverKind::EVENT, 0.0),
+            &run(SolverKind::SWITCH, 0.0),
+        );
+        assert!(g.iter().all(|g| g.gate == FLOOR + eta * sc.t_end));
+    }
+}
