@@ -16,7 +16,7 @@ use std::ffi::CString;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-use numpy::{AllowTypeChange, PyArray1, PyArray2, PyArrayLike1};
+use numpy::{AllowTypeChange, PyArray1, PyArray2, PyArrayLike1, PyArrayLike2};
 use pyo3::exceptions::{PyOSError, PyRuntimeError, PyTypeError, PyUserWarning, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::{PyBool, PyDict, PyList, PyString};
@@ -735,9 +735,16 @@ fn bifurcation<'py>(
 }
 
 /// Events given to `check`: dicts ``{"t", "disc", "kind"}`` (as ``simulate`` returns them)
-/// or tuples ``(t, disc, kind)``.
-fn events_of(events: &Bound<'_, PyAny>) -> PyResult<EventsFile> {
+/// or tuples ``(t, disc, kind)``; a chain's (of `chain` discs) name the disc by its number, an
+/// int or its digits.
+fn events_of(events: &Bound<'_, PyAny>, chain: Option<usize>) -> PyResult<EventsFile> {
     let mut rows: Vec<(f64, String, String)> = Vec::new();
+    // A disc given as a number reads as its digits.
+    let disc_of = |v: Bound<'_, PyAny>| -> Option<String> {
+        v.extract::<String>()
+            .ok()
+            .or_else(|| v.extract::<i64>().ok().map(|d| d.to_string()))
+    };
     for (i, item) in events.try_iter()?.enumerate() {
         let item = item?;
         let shape_error = || {
@@ -751,11 +758,13 @@ fn events_of(events: &Bound<'_, PyAny>) -> PyResult<EventsFile> {
             let get = |k: &str| d.get_item(k).ok().flatten().ok_or_else(shape_error);
             (
                 get("t")?.extract().map_err(|_| shape_error())?,
-                get("disc")?.extract().map_err(|_| shape_error())?,
+                disc_of(get("disc")?).ok_or_else(shape_error)?,
                 get("kind")?.extract().map_err(|_| shape_error())?,
             )
         } else {
-            item.extract().map_err(|_| shape_error())?
+            let (t, d, k): (f64, Bound<'_, PyAny>, String) =
+                item.extract().map_err(|_| shape_error())?;
+            (t, disc_of(d).ok_or_else(shape_error)?, k)
         };
         rows.push(row);
     }
@@ -763,41 +772,175 @@ fn events_of(events: &Bound<'_, PyAny>) -> PyResult<EventsFile> {
         .iter()
         .map(|(t, d, k)| (*t, d.as_str(), k.as_str()))
         .collect();
-    EventsFile::from_rows(&refs).map_err(value_error)
+    match chain {
+        Some(n) => EventsFile::from_chain_rows(&refs, n),
+        None => EventsFile::from_rows(&refs),
+    }
+    .map_err(value_error)
 }
 
 /// Grades a trace against the benchmark's reference, as ``rotor check --json`` does.
 ///
-/// ``scenario`` is a scenario file's path or its name (``"t1-u1.5-rest"``; see
-/// ``rotorbench.scenario``); the trace is the four arrays on the scenario's grid
-/// (``scenario(...)["dt"]``, from 0 to ``t_end``); ``gate`` is ``"loose"`` (3 significant
-/// digits), ``"strict"`` (7) or ``"digits=N"``; ``events`` optionally the trace's events (as
-/// ``simulate`` returns them) to grade every event, else ``not_graded`` names them. Returns
-/// the dict of ``rotor check --json``: ``scenario``, ``benchmark``, ``passed``, ``gate``,
-/// ``digits``, ``not_graded``, ``file_digits`` and ``quantities`` (each with ``name``,
-/// ``difference`` (None where it cannot be measured), ``scale``, ``tolerance``, ``passed``
-/// and ``digits``, the correct significant digits). A trace that cannot be graded (off the
-/// grid, too short, a NaN) raises ValueError naming the index.
+/// ``scenario`` is a scenario file's path or its name (``"t1-u1.5-rest"``, or a chain scene
+/// such as ``"chain3-u1.5-rest"``; see ``rotorbench.scenario``); the trace is the arrays on the
+/// scenario's grid (``scenario(...)["dt"]``, from 0 to ``t_end``): ``t``, ``alpha``,
+/// ``omega_u``, ``omega_l`` for the rig; for a chain of N discs ``t``, ``alpha`` ((N − 1) rows)
+/// and ``omega`` (N rows) as 2-D arrays, as ``simulate`` returns them. ``gate`` is
+/// ``"loose"`` (3 significant digits), ``"strict"`` (7) or ``"digits=N"``; ``events``
+/// optionally the trace's events (as ``simulate`` returns them; a chain's discs by number) to
+/// grade every event, else ``not_graded`` names them. Returns the dict of ``rotor check
+/// --json``: ``scenario``, ``benchmark``, ``passed``, ``gate``, ``digits``, ``not_graded``,
+/// ``file_digits`` and ``quantities`` (each with ``name``, ``difference`` (None where it cannot
+/// be measured), ``scale``, ``tolerance``, ``passed`` and ``digits``, the correct significant
+/// digits). A trace that cannot be graded (off the grid, too short, a NaN) raises ValueError
+/// naming the index.
 #[pyfunction]
-#[pyo3(signature = (scenario, t, alpha, omega_u, omega_l, gate="loose", events=None))]
+#[pyo3(signature = (scenario, t, alpha, omega_u=None, omega_l=None, gate="loose", events=None, omega=None))]
+#[allow(clippy::too_many_arguments)]
 fn check<'py>(
     py: Python<'py>,
     scenario: &Bound<'py, PyAny>,
     t: PyArrayLike1<'py, f64, AllowTypeChange>,
-    alpha: PyArrayLike1<'py, f64, AllowTypeChange>,
-    omega_u: PyArrayLike1<'py, f64, AllowTypeChange>,
-    omega_l: PyArrayLike1<'py, f64, AllowTypeChange>,
+    alpha: &Bound<'py, PyAny>,
+    omega_u: Option<&Bound<'py, PyAny>>,
+    omega_l: Option<&Bound<'py, PyAny>>,
     gate: &str,
     events: Option<&Bound<'py, PyAny>>,
+    omega: Option<&Bound<'py, PyAny>>,
 ) -> PyResult<Bound<'py, PyAny>> {
     let level = Level::parse(gate).map_err(bad)?;
-    let path = resolve("scenario", scenario, "scenarios")?;
-    let cols = [&t, &alpha, &omega_u, &omega_l].map(|c| c.as_array().to_vec());
+    let path = scene_path(scenario)?;
+    let events = events.filter(|e| !e.is_none());
+    if rotor_model::scenario::ChainScenario::is_chain_scene(&path) {
+        let omega = match (omega, omega_u, omega_l) {
+            (Some(w), None, None) | (None, Some(w), None) => w,
+            _ => {
+                return Err(PyTypeError::new_err(
+                    "a chain scene's trace is t, alpha ((N − 1) rows) and omega (N rows): give                      omega=, not omega_u and omega_l",
+                ));
+            }
+        };
+        return check_chain_arrays(py, &path, t, alpha, omega, level, events);
+    }
+    let (Some(omega_u), Some(omega_l), None) = (omega_u, omega_l, omega) else {
+        return Err(PyTypeError::new_err(
+            "a rig scene's trace is t, alpha, omega_u and omega_l (omega= is a chain's)",
+        ));
+    };
+    let column = |name: &str, c: &Bound<'py, PyAny>| -> PyResult<Vec<f64>> {
+        let a: PyArrayLike1<'py, f64, AllowTypeChange> = c.extract().map_err(|_| {
+            PyTypeError::new_err(format!(
+                "{name}: expected a 1-D array of numbers, got {}",
+                type_name(c)
+            ))
+        })?;
+        Ok(a.as_array().to_vec())
+    };
+    let cols = [
+        t.as_array().to_vec(),
+        column("alpha", alpha)?,
+        column("omega_u", omega_u)?,
+        column("omega_l", omega_l)?,
+    ];
     let trace =
         Trace::from_columns([&cols[0], &cols[1], &cols[2], &cols[3]]).map_err(value_error)?;
-    let events = events.filter(|e| !e.is_none()).map(events_of).transpose()?;
+    let events = events.map(|e| events_of(e, None)).transpose()?;
     let report = detached(py, move || {
         rotor_harness::grade::check::grade(&path, &trace, events.as_ref(), level)
+    })?
+    .map_err(from_grade)?;
+    to_py(py, &report)
+}
+
+/// A scene argument: a path, or a name of the rig's tier or the chain tier.
+fn scene_path(scenario: &Bound<'_, PyAny>) -> PyResult<PathBuf> {
+    match resolve("scenario", scenario, "scenarios") {
+        Ok(p) => Ok(p),
+        Err(rig) => resolve("scenario", scenario, "chain/scenarios").map_err(|_| rig),
+    }
+}
+
+/// `check` of a chain scene: the 2-D arrays into a chain's trace, graded as `rotor check`
+/// grades a chain's trace file.
+fn check_chain_arrays<'py>(
+    py: Python<'py>,
+    path: &Path,
+    t: PyArrayLike1<'py, f64, AllowTypeChange>,
+    alpha: &Bound<'py, PyAny>,
+    omega: &Bound<'py, PyAny>,
+    level: Level,
+    events: Option<&Bound<'py, PyAny>>,
+) -> PyResult<Bound<'py, PyAny>> {
+    let sc = rotor_model::scenario::ChainScenario::from_file(path).map_err(value_error)?;
+    let n = sc.discs();
+    let t = t.as_array().to_vec();
+    let rows = |name: &str, v: &Bound<'py, PyAny>, want: usize| -> PyResult<Vec<Vec<f64>>> {
+        let a: PyArrayLike2<'py, f64, AllowTypeChange> = v.extract().map_err(|_| {
+            PyTypeError::new_err(format!(
+                "{name}: expected a 2-D array of numbers ({want} rows), got {}",
+                type_name(v)
+            ))
+        })?;
+        let a = a.as_array();
+        if a.nrows() != want || a.ncols() != t.len() {
+            return Err(PyValueError::new_err(format!(
+                "{name}: shape ({}, {}), expected ({want}, {}) for a chain of {n} discs and {} \
+                 times",
+                a.nrows(),
+                a.ncols(),
+                t.len(),
+                t.len()
+            )));
+        }
+        Ok(a.rows().into_iter().map(|r| r.to_vec()).collect())
+    };
+    let alpha = rows("alpha", alpha, n - 1)?;
+    let omega = rows("omega", omega, n)?;
+    if t.is_empty() {
+        return Err(PyValueError::new_err("t: the arrays are empty"));
+    }
+    let mut samples = rotor_model::seam::Samples::with_capacity(2 * n - 1, t.len());
+    let mut x = vec![0.0; 2 * n - 1];
+    for (k, &tk) in t.iter().enumerate() {
+        let row = alpha.iter().chain(&omega).map(|r| r[k]);
+        for (slot, v) in x.iter_mut().zip(row) {
+            *slot = v;
+        }
+        if !tk.is_finite() {
+            return Err(PyValueError::new_err(format!(
+                "t[{k}] = {tk}: not a finite number"
+            )));
+        }
+        if let Some(i) = x.iter().position(|v| !v.is_finite()) {
+            let (name, row) = if i < n - 1 {
+                ("alpha", i)
+            } else {
+                ("omega", i - (n - 1))
+            };
+            return Err(PyValueError::new_err(format!(
+                "{name}[{row}][{k}] = {}: not a finite number",
+                x[i]
+            )));
+        }
+        samples.push(tk, &x);
+    }
+    let trace = rotor_harness::grade::trace::ChainTrace {
+        path: rotor_harness::grade::trace::ARRAYS.into(),
+        lines: (0..t.len() as u64).collect(),
+        samples,
+        digits: rotor_harness::grade::trace::FULL_DIGITS,
+    };
+    let events = events.map(|e| events_of(e, Some(n))).transpose()?;
+    let path = path.to_owned();
+    let report = detached(py, move || {
+        let (sc, r) = rotor_harness::grade::chain::load(&path)?;
+        Ok::<_, GradeError>(rotor_harness::grade::chain::check_chain(
+            &sc,
+            &r,
+            &trace,
+            events.as_ref(),
+            level,
+        )?)
     })?
     .map_err(from_grade)?;
     to_py(py, &report)
@@ -815,9 +958,34 @@ fn params<'py>(py: Python<'py>, source: Option<&Bound<'py, PyAny>>) -> PyResult<
 /// ``u``, ``x0``, ``t_end``, ``dt`` (the grid a trace is graded on), ``transient`` (the
 /// compared window ``[t0, t1]`` or None) and ``steady_from`` (where the steady-state metrics
 /// start, or None). ``source`` is a scenario file's path or name (``"t1-u1.5-rest"``).
+///
+/// A chain scene (``"chain3-u1.5-rest"``) gives ``name``, ``description``, ``path``,
+/// ``params`` (the chain form: ``k_m`` and a ``disc`` list), ``discs``, ``u`` (None for an
+/// input in time), ``input`` (its ``[t, u]`` rows, or None), ``x0`` (2N − 1 values),
+/// ``t_end``, ``dt`` and ``benchmark`` (the chain tier's version).
 #[pyfunction]
 fn scenario<'py>(py: Python<'py>, source: &Bound<'py, PyAny>) -> PyResult<Bound<'py, PyDict>> {
-    let path = resolve("scenario", source, "scenarios")?;
+    let path = scene_path(source)?;
+    if rotor_model::scenario::ChainScenario::is_chain_scene(&path) {
+        let sc = rotor_model::scenario::ChainScenario::from_file(&path).map_err(value_error)?;
+        let d = PyDict::new(py);
+        d.set_item("name", &sc.name)?;
+        d.set_item("description", &sc.description)?;
+        d.set_item("path", sc.path.to_string_lossy().into_owned())?;
+        d.set_item("params", to_py(py, &sc.params)?)?;
+        d.set_item("discs", sc.discs())?;
+        d.set_item("u", sc.input.is_none().then_some(sc.u))?;
+        let rows: Option<Vec<[f64; 2]>> = sc
+            .input
+            .as_ref()
+            .map(|i| i.rows().iter().map(|&(t, u)| [t, u]).collect());
+        d.set_item("input", rows)?;
+        d.set_item("x0", pyo3::types::PyTuple::new(py, &sc.x0)?)?;
+        d.set_item("t_end", sc.t_end)?;
+        d.set_item("dt", sc.dt)?;
+        d.set_item("benchmark", rotor_suite::CHAIN_VERSION)?;
+        return Ok(d);
+    }
     let sc = rotor_analysis::solvers::load_scenario(&path).map_err(value_error)?;
     let d = PyDict::new(py);
     d.set_item("name", &sc.name)?;

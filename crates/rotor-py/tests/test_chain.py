@@ -122,3 +122,41 @@ def test_steady_on_a_chain_gives_the_clis_lists(cli_json, tmp_path):
     assert cli_json("steady", "--params", path, "--u", "2.5", "--solver", "event") == st
     with pytest.raises(ValueError, match="input"):
         rotorbench.steady("event", params=params, input=[[0, 1.5], [1, 2.5]])
+
+
+def test_a_chain_scene_of_the_suite_is_graded_from_arrays():
+    """`check` of a chain scene takes simulate's 2-D arrays and events (discs by number) and
+    grades them as `rotor check` grades a chain's trace; a trace off in one disc fails that
+    disc's column; the rig's arrays, wrong shapes and a NaN are refused by name."""
+    sc = rotorbench.scenario("chain3-u1.5-rest")
+    assert sc["discs"] == 3 and len(sc["x0"]) == 5
+    assert sc["benchmark"].startswith("rotorbench-chain-1.0+")
+    r = rotorbench.simulate(solver="event", u=sc["u"], params=sc["params"], x0=sc["x0"],
+                            t_end=sc["t_end"], dt=sc["dt"], tol=1e-10)
+    v = rotorbench.check("chain3-u1.5-rest", r["t"], r["alpha"], omega=r["omega"],
+                         events=r["events"], gate="strict")
+    assert v["passed"], v
+    assert v["benchmark"] == sc["benchmark"] and v["not_graded"] == []
+    names = [q["name"] for q in v["quantities"]]
+    assert names[:5] == ["alpha_1", "alpha_2", "omega_1", "omega_2", "omega_3"]
+    assert "events" in names and "stick_3" in names
+    # Positionally, omega takes omega_u's place.
+    assert rotorbench.check("chain3-u1.5-rest", r["t"], r["alpha"], r["omega"])["passed"]
+    wrong = r["omega"].copy()
+    wrong[1, 5000] += 1.0
+    v = rotorbench.check("chain3-u1.5-rest", r["t"], r["alpha"], omega=wrong)
+    assert not v["passed"]
+    assert [q["name"] for q in v["quantities"] if not q["passed"]] == ["omega_2"]
+    with pytest.raises(TypeError, match="omega="):
+        rotorbench.check("chain3-u1.5-rest", r["t"], r["alpha"][0], r["omega"][0], r["omega"][1])
+    with pytest.raises(ValueError, match=r"omega: shape \(2, 10001\), expected \(3, 10001\)"):
+        rotorbench.check("chain3-u1.5-rest", r["t"], r["alpha"], omega=r["omega"][:2])
+    nan = r["alpha"].copy()
+    nan[1, 7] = np.nan
+    with pytest.raises(ValueError, match=r"alpha\[1\]\[7\] = NaN"):
+        rotorbench.check("chain3-u1.5-rest", r["t"], nan, omega=r["omega"])
+    with pytest.raises(ValueError, match="the disc numbers 1 to 3"):
+        rotorbench.check("chain3-u1.5-rest", r["t"], r["alpha"], omega=r["omega"],
+                         events=[(1.0, "lower", "stick_start")])
+    with pytest.raises(TypeError, match="omega_u and omega_l"):
+        rotorbench.check("t1-u1.5-rest", r["t"], r["alpha"][0], omega=r["omega"])

@@ -228,7 +228,7 @@ pub enum TraceError {
         /// The field's value as given.
         value: String,
         /// What it must be: the words allowed, or `the finite numbers` for `t`.
-        expected: &'static str,
+        expected: String,
     },
     /// A trace given as arrays: the arrays are empty or of different lengths.
     #[error("{message}")]
@@ -360,6 +360,18 @@ impl EventsFile {
     /// `upper|lower` and kind `stick_start|stick_end|reversal`, as in an events file. Named by
     /// index ([`ARRAYS`]); the times are checked by [`crate::grade::check::check_events`].
     pub fn from_rows(rows: &[(f64, &str, &str)]) -> Result<EventsFile, TraceError> {
+        EventsFile::from_rows_with(rows, DiscWords::Rig)
+    }
+
+    /// [`EventsFile::from_rows`] of a chain of `n` discs: discs by number, `"1"` … `"n"`.
+    pub fn from_chain_rows(rows: &[(f64, &str, &str)], n: usize) -> Result<EventsFile, TraceError> {
+        EventsFile::from_rows_with(rows, DiscWords::Chain(n))
+    }
+
+    fn from_rows_with(
+        rows: &[(f64, &str, &str)],
+        discs: DiscWords,
+    ) -> Result<EventsFile, TraceError> {
         let mut events = Vec::with_capacity(rows.len());
         for (index, &(t, disc, kind)) in rows.iter().enumerate() {
             let bad = |name, value: &str, expected| TraceError::Entry {
@@ -373,11 +385,13 @@ impl EventsFile {
                     index,
                     name: "t",
                     value: t.to_string(),
-                    expected: "the finite numbers",
+                    expected: "the finite numbers".into(),
                 });
             }
-            let disc = disc_of(disc).ok_or_else(|| bad("disc", disc, DISC_WORDS))?;
-            let kind = kind_of(kind, disc).ok_or_else(|| bad("kind", kind, KIND_WORDS))?;
+            let disc = discs
+                .parse(disc)
+                .ok_or_else(|| bad("disc", disc, discs.words()))?;
+            let kind = kind_of(kind, disc).ok_or_else(|| bad("kind", kind, KIND_WORDS.into()))?;
             // An events file carries no state: the rig's zeros stand for it.
             events.push(Event::new(t, &[0.0; 3], kind));
         }

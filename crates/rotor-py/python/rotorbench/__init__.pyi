@@ -135,12 +135,17 @@ def check(
     scenario: Union[str, "os.PathLike[str]"],
     t: ArrayLike,
     alpha: ArrayLike,
-    omega_u: ArrayLike,
-    omega_l: ArrayLike,
+    omega_u: Optional[ArrayLike] = None,
+    omega_l: Optional[ArrayLike] = None,
     gate: str = "loose",
-    events: Optional[Sequence[Union[Event, Tuple[float, str, str]]]] = None,
+    events: Optional[Sequence[Union[Event, Tuple[float, Union[str, int], str]]]] = None,
+    omega: Optional[ArrayLike] = None,
 ) -> Dict[str, Any]:
     """Grades a trace on the scenario's grid against the reference, as ``rotor check --json``.
+
+    A rig scene takes ``t, alpha, omega_u, omega_l``; a chain scene of the suite's chain tier
+    (``"chain3-u1.5-rest"``) takes ``t``, ``alpha`` ((N - 1) rows) and ``omega`` (N rows) as
+    2-D arrays, as ``simulate`` returns them for a chain, its events naming discs by number.
 
     ``gate`` is ``"loose"``, ``"strict"`` or ``"digits=N"``. Keys: scenario, benchmark,
     passed, gate, digits, not_graded, file_digits, quantities (name, difference, scale,
@@ -153,4 +158,5 @@ def params(source: ParamsLike = None) -> Dict[str, Any]:
 
 def scenario(source: Union[str, "os.PathLike[str]"]) -> Dict[str, Any]:
     """A benchmark scenario: name, description, path, params, u, x0, t_end, dt, transient,
-    steady_from."""
+    steady_from; a chain scene: name, description, path, params (chain form), discs, u, input,
+    x0, t_end, dt, benchmark."""
