@@ -1999,3 +1999,55 @@ fn bench_tier_chain_grades_the_chain_scenes() {
     }
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// `rotor simulate` of a chain scene by name runs its chain, input, x0, horizon and grid
+/// (the stepped input of the chain of eight), the trace headed with the chain's names, and
+/// `rotor check` takes it; the solver's own setting only, as for a chain file.
+#[test]
+fn simulate_runs_a_chain_scene_by_name() {
+    let dir = rotor_testkit::tmp_dir("rotor-cli-simulate-chain-scene");
+    let trace = dir.join("t.csv");
+    let o = rotor(&[
+        "simulate",
+        "chain8-stribeck-steps",
+        "--solver",
+        "switch",
+        "--tol",
+        "1e-10",
+        "--csv",
+        trace.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let text = std::fs::read_to_string(&trace).unwrap();
+    assert!(text.starts_with("t,alpha_1,"), "{}", &text[..80]);
+    assert_eq!(
+        text.lines().count(),
+        6002,
+        "60 s on the 0.01 s grid and the header"
+    );
+    let o = rotor(&[
+        "check",
+        "chain8-stribeck-steps",
+        "--trace",
+        trace.to_str().unwrap(),
+    ]);
+    assert_eq!(
+        o.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&o.stdout)
+    );
+    let o = rotor(&[
+        "simulate",
+        "chain8-stribeck-steps",
+        "--solver",
+        "moreau",
+        "--tol",
+        "1e-10",
+        "--csv",
+        trace.to_str().unwrap(),
+    ]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("--tol: moreau takes a step"));
+    std::fs::remove_dir_all(&dir).ok();
+}

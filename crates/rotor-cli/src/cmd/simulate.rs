@@ -60,16 +60,18 @@ pub(crate) fn check_grid(t_end: f64, dt: f64, given: bool) -> Result<()> {
 /// at its own setting (`--tol`, or `--h` for Moreau–Jean), a constant `--u` or an `--input`
 /// in time; the trace headed with the chain's state names (`t,alpha_1,…,omega_N`).
 fn simulate_chain(
-    common: &Common,
-    (path, chain): (&Path, &rotor_model::ChainModel),
-    t_end: Option<f64>,
-    dt: Option<f64>,
+    (kind, request): (
+        rotor_analysis::solvers::SolverKind,
+        rotor_harness::jobs::request::Request<'_>,
+    ),
+    chain: &rotor_model::ChainModel,
+    (t_end, dt): (Option<f64>, Option<f64>),
+    (scene_t_end, scene_dt): (f64, f64),
     csv_path: &Path,
 ) -> Result<()> {
-    let (kind, request) = crate::common::chain_request(common, path, chain)?;
-    let t_end = t_end.unwrap_or(DEFAULT_T_END);
+    let t_end = t_end.unwrap_or(scene_t_end);
     let given = dt.is_some();
-    let dt = dt.unwrap_or(DEFAULT_DT);
+    let dt = dt.unwrap_or(scene_dt);
     check_grid(t_end, dt, given)?;
     let scene = request
         .scene(kind, t_end, rotor_model::seam::Output::Grid { dt })
@@ -95,15 +97,47 @@ pub(crate) fn simulate(
     dt: Option<f64>,
     csv_path: &Path,
 ) -> Result<()> {
-    let chain = match common.scenario {
+    let chain = match &common.scenario {
         None => crate::common::chain_file(common)?,
-        Some(_) => None,
+        Some(p) => {
+            // A scene of the chain tier: its chain, input, x0, horizon and grid, the solver's
+            // own setting from the flags.
+            let (path, is_chain) = crate::common::scene_path("SCENARIO", p)?;
+            if is_chain {
+                let sc = rotor_model::scenario::ChainScenario::from_file(&path)?;
+                let model = sc.model();
+                let kind = crate::common::chain_solver(common, &path, model.discs())?;
+                let request = rotor_harness::jobs::request::Request {
+                    solver: &common.solver,
+                    u: sc.u,
+                    input: sc.input.clone(),
+                    x0: sc.x0.clone(),
+                    tol: common.tol,
+                    h: common.h,
+                };
+                return simulate_chain(
+                    (kind, request),
+                    &model,
+                    (t_end, dt),
+                    (sc.t_end, sc.dt),
+                    csv_path,
+                );
+            }
+            None
+        }
     };
     if let Some((path, params)) = &chain
         && params.len() > 2
     {
         let model = rotor_model::ChainModel::new(params);
-        return simulate_chain(common, (path, &model), t_end, dt, csv_path);
+        let request = crate::common::chain_request(common, path, &model)?;
+        return simulate_chain(
+            request,
+            &model,
+            (t_end, dt),
+            (DEFAULT_T_END, DEFAULT_DT),
+            csv_path,
+        );
     }
     let start = start(common)?;
     let sc = start.scenario.as_ref();
