@@ -1253,7 +1253,7 @@ fn an_installed_rotor_grades_by_name_from_an_empty_directory() {
     let scenes = json["scenarios"].as_array().unwrap();
     let in_tier = |t: &str| scenes.iter().filter(|s| s["tier"] == t).count();
     assert_eq!(scenes.len() - in_tier("chain"), 23);
-    assert_eq!(in_tier("chain"), 3);
+    assert_eq!(in_tier("chain"), 4);
     let tier = |n: &str| {
         scenes.iter().find(|s| s["name"] == n).unwrap()["tier"]
             .as_str()

@@ -95,7 +95,7 @@ fn the_chain_scenes_stick_on_several_contacts() {
             })
             .collect();
         assert!(stuck.len() >= 2, "{}: discs that stick {stuck:?}", sc.name);
-        if sc.name.starts_with("chain8") {
+        if sc.name == "chain8-stribeck-steps" {
             assert!(stuck.contains(&1), "{}: the top disc sticks", sc.name);
         }
     }
@@ -108,7 +108,7 @@ fn the_chain_scenes_stick_on_several_contacts() {
 /// digits). Events are graded too.
 #[test]
 fn honest_solvers_of_every_kind_pass_every_chain_scene() {
-    for (sc, r) in scenes() {
+    for (sc, r) in scenes().into_iter().filter(|(sc, _)| sc.chaos.is_none()) {
         for (kind, setting, level) in [
             (SolverKind::EVENT, 1e-10, Level::Strict),
             (SolverKind::SWITCH, 1e-11, Level::Strict),
@@ -297,4 +297,64 @@ fn strict_is_a_full_digit_inside_every_chain_reference() {
             sc.name
         );
     }
+}
+
+/// The chaotic scene, graded both ways. Its reference holds the trace and events up to the
+/// derived horizon and the statistics beyond. The event solver at tol 1e-10 and the switch
+/// model at 1e-11 pass strict (sample by sample to the horizon, statistics beyond); Moreau–Jean
+/// at h = 1e-3 passes every statistic but not the samples at loose, as it must (its error
+/// reaches some 0.09 rad/s by the horizon, against the loose level's 0.017: measured; it
+/// passes at h = 1e-4, 0.011, not run here for its 8·10⁷ steps). The negative control: the
+/// bottom disc's static friction 5 % higher fails the statistics alone (its samples part
+/// early too, but the statistics are what a chaotic scene is graded on beyond the horizon).
+#[test]
+fn a_chaotic_scene_is_graded_to_its_horizon_then_on_statistics() {
+    let (sc, r) = scene("chain8-u2.5-chaos");
+    let chaos = r
+        .json
+        .chaos
+        .as_ref()
+        .expect("the chaotic scene's reference has its horizon");
+    let last = r.samples.iter().next_back().unwrap().t;
+    assert!(
+        last <= chaos.horizon && chaos.horizon - last < sc.dt,
+        "{last} {}",
+        chaos.horizon
+    );
+    assert!(r.events.iter().all(|e| e.t <= chaos.horizon));
+    assert_eq!(chaos.statistics.len(), 2 * sc.discs());
+    let is_stat = |n: &str| n.starts_with("mean_omega_") || n.starts_with("stick_fraction_");
+    for (kind, setting, level) in [
+        (SolverKind::EVENT, 1e-10, Level::Strict),
+        (SolverKind::SWITCH, 1e-11, Level::Strict),
+    ] {
+        let (trace, events) = run(kind, setting, &sc);
+        let rep = check_chain(&sc, &r, &trace, Some(&events), level).unwrap();
+        eprintln!("{}: {}", kind.name(), rep.verdict());
+        assert!(rep.passed, "{}", rep.table());
+        assert_eq!(
+            rep.quantities.iter().filter(|q| is_stat(&q.name)).count(),
+            2 * sc.discs()
+        );
+    }
+    let (trace, events) = run(SolverKind::MOREAU, 1e-3, &sc);
+    let rep = check_chain(&sc, &r, &trace, Some(&events), Level::Loose).unwrap();
+    eprintln!("moreau h 1e-3: failing {:?}", rep.failing());
+    assert!(!rep.passed);
+    assert!(rep.failing().iter().all(|n| !is_stat(n)), "{}", rep.table());
+    let mut wrong = sc.clone();
+    let bottom = wrong.params.discs.len() - 1;
+    if let rotor_model::chain::DiscLaw::Lower(rotor_model::LowerFriction::Exponential {
+        t_s, ..
+    }) = &mut wrong.params.discs[bottom].law
+    {
+        *t_s *= 1.05;
+    } else {
+        panic!("the bottom disc has the exponential law");
+    }
+    let (trace, events) = run(SolverKind::EVENT, 1e-10, &wrong);
+    let rep = check_chain(&sc, &r, &trace, Some(&events), Level::Loose).unwrap();
+    let stats_failing: Vec<&str> = rep.failing().into_iter().filter(|n| is_stat(n)).collect();
+    eprintln!("bottom disc's t_s x 1.05: failing statistics {stats_failing:?}");
+    assert!(!stats_failing.is_empty(), "{}", rep.table());
 }

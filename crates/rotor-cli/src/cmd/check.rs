@@ -81,7 +81,7 @@ fn verdict(
     let report = if is_chain {
         let (sc, r) = rotor_harness::grade::chain::load(&scenario)?;
         let names = sc.model().state_names();
-        let t = rotor_harness::grade::trace::read_chain_trace(trace, &names, r.samples.len() + 1)
+        let t = rotor_harness::grade::trace::read_chain_trace(trace, &names, r.grid_rows() + 1)
             .map_err(CheckError::from)?;
         let ev = events
             .map(|p| rotor_harness::grade::trace::read_chain_events(p, sc.discs()))

@@ -226,7 +226,7 @@ fn client_point(
         }
     };
     let names = sc.model().state_names();
-    let graded = read_chain_trace(&job.trace, &names, r.samples.len() + 1)
+    let graded = read_chain_trace(&job.trace, &names, r.grid_rows() + 1)
         .map_err(|e| e.to_string())
         .and_then(|t| {
             let ev = if job.events.exists() {
@@ -470,15 +470,26 @@ impl ChainTierReport {
     }
 }
 
-/// The chain scenes of a suite directory (`chain/scenarios/*.toml`).
+/// The chain scenes of a suite directory (`chain/scenarios/*.toml`) that a default bench runs:
+/// all but the chaotic ones, whose 8,000 s at every rung of a ladder (Moreau–Jean at h = 1e-5:
+/// 8·10⁸ steps) would take hours; name one with `--scenario` to bench it.
 pub fn chain_scenes(fixtures: &Path) -> Result<Vec<PathBuf>, BenchError> {
     let dir = crate::grade::chain::tier_dir(fixtures).join("scenarios");
-    rotor_model::scenario::Scenario::list_dir(&dir).map_err(|e| {
+    let all = rotor_model::scenario::Scenario::list_dir(&dir).map_err(|e| {
         BenchError::Options(format!(
             "{}: cannot list the chain scenes: {e}",
             dir.display()
         ))
-    })
+    })?;
+    let mut out = Vec::new();
+    for p in all {
+        let sc = ChainScenario::from_file(&p)
+            .map_err(|e| BenchError::Options(format!("{}: {e}", p.display())))?;
+        if sc.chaos.is_none() {
+            out.push(p);
+        }
+    }
+    Ok(out)
 }
 
 #[cfg(test)]

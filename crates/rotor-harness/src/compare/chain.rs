@@ -26,6 +26,12 @@
 //! order in η and a tighter tolerance does not see it. The switch model's own error here
 //! therefore adds its band's, measured: its run at η/10 ([`SWITCH_ETA_STUDY`]), the
 //! difference times 10/9 (an error `C·η` differs from `C·η/10` by 0.9 of itself).
+//!
+//! A chaotic scene (`[chaos]`) is compared as it is graded
+//! ([`crate::grade::chain`]): the samples and events up to its predictability horizon H under
+//! the gates above (each solver's own error from its runs cut at H), and beyond, each disc's
+//! mean velocity and fraction of time stuck over `[statistics_from, t_end]` within
+//! [`crate::grade::chain::STATISTICS_SIGMA`] standard errors of the difference.
 
 use std::collections::BTreeMap;
 
@@ -34,7 +40,9 @@ use rotor_model::scenario::ChainScenario;
 use rotor_model::seam::{Output, Scene, SolveError, Trajectory};
 use serde::Serialize;
 
-use crate::grade::reference::{event_difference, switches, trace_differences};
+use crate::grade::chain::{
+    STATISTICS_SIGMA, differences as diff_map, statistics, stuck_thresholds, until,
+};
 
 /// The rounding floor of a gate: 1e-12 (s, rad, rad/s).
 pub const FLOOR: f64 = 1e-12;
@@ -51,6 +59,9 @@ pub struct ChainRun {
     pub setting: f64,
     /// The run at the setting.
     pub run: Trajectory,
+    /// The run up to a chaotic scene's horizon (the whole run otherwise): what is compared
+    /// sample by sample.
+    pub cut: Trajectory,
     /// Its own error per quantity (each column's name, `event_time`): from its runs at the
     /// tighter settings.
     pub own: BTreeMap<String, f64>,
@@ -80,8 +91,11 @@ pub struct ChainComparison {
     pub scenario: ChainScenario,
     /// Each solver's runs.
     pub runs: Vec<ChainRun>,
-    /// Every pair's gates, pair by pair, quantities in the state's order then `event_time`.
+    /// Every pair's gates, pair by pair, quantities in the state's order then `event_time`
+    /// (then, on a chaotic scene, the statistics).
     pub gates: Vec<ChainGate>,
+    /// A chaotic scene's predictability horizon \[s\].
+    pub horizon: Option<f64>,
 }
 
 impl ChainComparison {
@@ -96,10 +110,18 @@ impl ChainComparison {
             .iter()
             .filter(|g| !g.passed)
             .map(|g| {
-                format!(
-                    "{} {} {}: difference {:.3e} > gate {:.3e}",
-                    self.scenario.name, g.pair, g.quantity, g.difference, g.gate
-                )
+                if g.difference.is_finite() {
+                    format!(
+                        "{} {} {}: difference {:.3e} > gate {:.3e}",
+                        self.scenario.name, g.pair, g.quantity, g.difference, g.gate
+                    )
+                } else {
+                    format!(
+                        "{} {} {}: the two runs cannot be compared (another sequence of \
+                         events, or a run that failed)",
+                        self.scenario.name, g.pair, g.quantity
+                    )
+                }
             })
             .collect()
     }
@@ -126,39 +148,51 @@ pub fn chain_setting(kind: SolverKind, sc: &ChainScenario) -> f64 {
 }
 
 /// Each quantity's difference of two runs: every column (largest over the samples) and
-/// `event_time` (∞ where the event sequences differ).
+/// `event_time` (∞ where the event sequences differ), in the state's order.
 fn differences(names: &[String], a: &Trajectory, b: &Trajectory) -> Vec<(String, f64)> {
+    let mut m = diff_map(names, a, b);
     let mut out: Vec<(String, f64)> = names
         .iter()
-        .cloned()
-        .zip(trace_differences(&a.samples, &b.samples))
+        .map(|n| (n.clone(), m.remove(n).unwrap_or(f64::INFINITY)))
         .collect();
-    out.push((
-        "event_time".into(),
-        event_difference(&switches(&a.events), &switches(&b.events)),
-    ));
+    out.extend(m);
     out
 }
 
-fn solve(kind: SolverKind, sc: &ChainScenario, setting: f64) -> Result<Trajectory, SolveError> {
+fn solve(
+    kind: SolverKind,
+    sc: &ChainScenario,
+    setting: f64,
+    t_end: f64,
+) -> Result<Trajectory, SolveError> {
     let scene = Scene {
         accuracy: kind.accuracy(setting),
+        t_end,
         ..sc.scene(Output::Grid { dt: sc.dt })
     };
     kind.simulate_chain(&sc.model(), &scene)
 }
 
-/// One solver's runs: at its setting and the tighter ones, and its own error from them.
-pub fn chain_run(kind: SolverKind, sc: &ChainScenario) -> Result<ChainRun, SolveError> {
+/// One solver's runs: at its setting and the tighter ones, and its own error from them; on a
+/// chaotic scene (`horizon` given) the tighter runs end at the first grid time past it, and
+/// every run is compared up to it.
+pub fn chain_run(
+    kind: SolverKind,
+    sc: &ChainScenario,
+    horizon: Option<f64>,
+) -> Result<ChainRun, SolveError> {
     let names = sc.model().state_names();
     let setting = chain_setting(kind, sc);
+    let cut = |tr: Trajectory| horizon.map_or(tr.clone(), |h| until(&tr, h));
+    let short = horizon.map_or(sc.t_end, |h| ((h / sc.dt).ceil() * sc.dt).min(sc.t_end));
     let t0 = std::time::Instant::now();
-    let run = solve(kind, sc, setting)?;
+    let run = solve(kind, sc, setting, sc.t_end)?;
     let seconds = t0.elapsed().as_secs_f64();
+    let head = cut(run.clone());
     let mut steps: Vec<Vec<(String, f64)>> = Vec::new();
-    let mut prev = run.clone();
+    let mut prev = head.clone();
     for s in tighter_settings(kind, setting) {
-        let t = solve(kind, sc, s)?;
+        let t = cut(solve(kind, sc, s, short)?);
         steps.push(differences(&names, &prev, &t));
         prev = t;
     }
@@ -169,10 +203,11 @@ pub fn chain_run(kind: SolverKind, sc: &ChainScenario) -> Result<ChainRun, Solve
         options.eta /= SWITCH_ETA_STUDY;
         let scene = Scene {
             accuracy: kind.accuracy(setting),
+            t_end: short,
             ..sc.scene(Output::Grid { dt: sc.dt })
         };
         let narrow = rotor_switch::SwitchSolver { options }.simulate_chain(&sc.model(), &scene)?;
-        Some(differences(&names, &run, &narrow))
+        Some(differences(&names, &head, &cut(narrow)))
     } else {
         None
     };
@@ -189,38 +224,79 @@ pub fn chain_run(kind: SolverKind, sc: &ChainScenario) -> Result<ChainRun, Solve
         kind,
         setting,
         run,
+        cut: head,
         own,
         seconds,
     })
 }
 
-/// The gates of two runs.
+/// The gates of two runs: every quantity up to the horizon (the whole run where there is
+/// none), and a chaotic scene's statistics beyond.
 pub fn gates_of(sc: &ChainScenario, a: &ChainRun, b: &ChainRun) -> Vec<ChainGate> {
-    let names = sc.model().state_names();
+    let model = sc.model();
+    let names = model.state_names();
     let pair = rotor_analysis::solvers::pair_name(a.kind, b.kind);
-    let band = (a.kind.info().stuck_band + b.kind.info().stuck_band) * sc.t_end.max(1.0);
-    differences(&names, &a.run, &b.run)
+    let span = a.cut.samples.iter().next_back().map_or(sc.t_end, |r| r.t);
+    let band = (a.kind.info().stuck_band + b.kind.info().stuck_band) * span.max(1.0);
+    let mut gates: Vec<ChainGate> = differences(&names, &a.cut, &b.cut)
         .into_iter()
         .map(|(quantity, difference)| {
             let gate = 2.0 * (a.own[&quantity] + b.own[&quantity]) + FLOOR + band;
             ChainGate {
                 pair: pair.clone(),
-                // A NaN difference or gate fails: `!(d > g)` would pass it.
-                passed: difference <= gate,
+                // A NaN difference fails (`!(d > g)` would pass it), and so does one that
+                // cannot be measured (event sequences that differ), even against a gate that
+                // cannot be derived either: ∞ ≤ ∞ is no agreement.
+                passed: difference.is_finite() && difference <= gate,
                 quantity,
                 difference,
                 gate,
             }
         })
-        .collect()
+        .collect();
+    if let Some(c) = sc.chaos {
+        let stuck = stuck_thresholds(&model, &a.cut.samples);
+        let window = (c.statistics_from, sc.t_end, c.batches);
+        let (sa, sb) = (
+            statistics(&model, &a.run.samples, window, &stuck),
+            statistics(&model, &b.run.samples, window, &stuck),
+        );
+        for (p, q) in sa.iter().zip(&sb) {
+            let difference = (p.mean - q.mean).abs();
+            let gate = STATISTICS_SIGMA * p.standard_error.hypot(q.standard_error);
+            gates.push(ChainGate {
+                pair: pair.clone(),
+                quantity: p.name.clone(),
+                difference,
+                gate,
+                passed: difference <= gate,
+            });
+        }
+    }
+    gates
 }
 
 /// A chain scene through the three solvers, gated pair by pair.
 pub fn compare_chain(sc: &ChainScenario) -> Result<ChainComparison, SolveError> {
     use rayon::prelude::*;
+    // A chaotic scene's horizon, from the event solver's run at its setting.
+    let horizon = match sc.chaos {
+        None => None,
+        Some(_) => {
+            let event = solve(SOLVERS[0], sc, chain_setting(SOLVERS[0], sc), sc.t_end)?;
+            Some(
+                crate::grade::chain::horizon(sc, &event).map_err(|e| match e {
+                    crate::grade::reference::ReferenceError::Solve { source, .. } => source,
+                    other => SolveError::NoConvergence {
+                        detail: other.to_string(),
+                    },
+                })?,
+            )
+        }
+    };
     let runs = SOLVERS
         .par_iter()
-        .map(|&k| chain_run(k, sc))
+        .map(|&k| chain_run(k, sc, horizon))
         .collect::<Result<Vec<_>, _>>()?;
     let mut gates = Vec::new();
     for (i, a) in runs.iter().enumerate() {
@@ -232,6 +308,7 @@ pub fn compare_chain(sc: &ChainScenario) -> Result<ChainComparison, SolveError> 
         scenario: sc.clone(),
         runs,
         gates,
+        horizon,
     })
 }
 
@@ -250,10 +327,12 @@ mod tests {
     #[test]
     fn a_gate_is_twice_the_own_errors_plus_floor_and_band() {
         let sc = scene("chain3-u1.5-rest");
+        let tr = solve(SolverKind::EVENT, &sc, 1e-6, sc.t_end).unwrap();
         let run = |kind: SolverKind, own: f64| ChainRun {
             kind,
             setting: 1.0,
-            run: solve(SolverKind::EVENT, &sc, 1e-6).unwrap(),
+            run: tr.clone(),
+            cut: tr.clone(),
             own: sc
                 .model()
                 .state_names()

@@ -15,6 +15,18 @@
 //!   scene has no steady cycle to give a period), and each disc's stick intervals seen on the
 //!   grid (`stick_<i>`), as the rig's are. The levels are the rig's, and none asks more digits
 //!   than the reference is verified to, less one.
+//! * **A chaotic scene** (`[chaos]`): no run, not even the reference, can be followed sample by
+//!   sample for long, since any two runs part at the rate of the largest Lyapunov exponent. So
+//!   it is graded as above up to its **predictability horizon** H, and on **statistics**
+//!   beyond. H is derived, not chosen: the first time at which the event solver's runs at tol
+//!   1e-10 and 1e-11 (two honest runs of a well-converged adaptive integrator) differ by
+//!   [`HORIZON_SPREAD`] of the largest |ω|, a tenth of what the strict level allows a sample,
+//!   moved to the middle of the gap between two events of the reference around it. The
+//!   reference's files hold its trace and events on `[0, H]`; its JSON holds H and, per disc,
+//!   the mean velocity and the fraction of samples stuck over `[statistics_from, t_end]`, each
+//!   with its standard error from the means of equal batches. A trace's statistics, computed
+//!   the same way from its own samples, pass when within [`STATISTICS_SIGMA`] standard errors
+//!   of the difference of the reference's.
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -45,6 +57,51 @@ pub const CHAIN_BENCHMARK: &str = rotor_suite::CHAIN_VERSION;
 /// whose period could be the scale, as a rig scene's transient to an equilibrium.
 pub const CHAIN_TIME_SCALE: f64 = 1.0;
 
+/// The predictability horizon is where runs at tol 1e-10 and 1e-11 first differ by this much
+/// of the largest |ω| of the run: a tenth of the strict level's sample tolerance (1e-7 of it),
+/// so that an adaptive solver at tol 1e-10 stays within strict up to it.
+pub const HORIZON_SPREAD: f64 = 1e-8;
+
+/// The tolerances of the two runs whose spread gives the horizon.
+pub const HORIZON_TOLS: [f64; 2] = [1e-10, 1e-11];
+
+/// A statistic passes within this many standard errors of the difference: a family-wise
+/// confidence above 99.8 % over the 16 statistics of a chain of eight (two-sided normal tail
+/// at 4σ: 6.3e-5 each, by Bonferroni), so that an honest solver fails by chance about once in
+/// 1000 gradings.
+pub const STATISTICS_SIGMA: f64 = 4.0;
+
+/// A sample counts stuck in the statistics when |ω_i| is within this much of the disc's
+/// largest |ω| on `[0, H]`: the loose level's threshold, which every level's samples meet
+/// (the statistics do not change with the level).
+pub const STUCK_FRACTION: f64 = 1e-3;
+
+/// One statistic of a chaotic scene.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Statistic {
+    /// `mean_omega_<i>` \[rad/s\] or `stick_fraction_<i>` (of the samples).
+    pub name: String,
+    /// Its value: the mean of the batches' values.
+    pub mean: f64,
+    /// Its standard error: the batches' standard deviation over √(batches).
+    pub standard_error: f64,
+}
+
+/// What a chaotic scene's reference states beyond its horizon (`<name>.json`'s `chaos`).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ChaosReference {
+    /// The predictability horizon H \[s\]: the trace and events are graded on `[0, H]`.
+    pub horizon: f64,
+    /// How H was derived, in words.
+    pub horizon_method: String,
+    /// Start of the statistics' window \[s\].
+    pub statistics_from: f64,
+    /// Number of batches.
+    pub batches: usize,
+    /// The statistics, disc by disc: mean velocity, then fraction stuck.
+    pub statistics: Vec<Statistic>,
+}
+
 /// The `<name>.json` of a chain reference.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct ChainReferenceJson {
@@ -71,6 +128,10 @@ pub struct ChainReferenceJson {
     /// the reference, per quantity as in `error`; `null` where not comparable (another event
     /// sequence).
     pub cross_check: BTreeMap<String, CrossCheck>,
+    /// A chaotic scene's horizon and statistics (absent for a scene graded over the whole
+    /// run).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub chaos: Option<ChaosReference>,
 }
 
 /// A chain reference: what its three files hold.
@@ -85,6 +146,16 @@ pub struct ChainReference {
 }
 
 impl ChainReference {
+    /// The rows of the scene's grid, `t_end/dt + 1`: what a trace must hold (a chaotic
+    /// scene's reference holds only those up to its horizon). A reader reads one more, to name
+    /// a trace that runs on past the grid.
+    pub fn grid_rows(&self) -> usize {
+        match self.json.chaos {
+            None => self.samples.len(),
+            Some(_) => (self.json.t_end / self.json.dt).round() as usize + 1,
+        }
+    }
+
     /// The stated error of a graded quantity: a column's own, `event_time` for the events
     /// and the stick intervals.
     pub fn error_of(&self, quantity: &str) -> Option<f64> {
@@ -117,7 +188,11 @@ fn event_run(
 
 /// Each quantity's difference of run `a` from run `b`: every column, and `event_time` (∞
 /// where the event sequences differ).
-fn differences(names: &[String], a: &Trajectory, b: &Trajectory) -> BTreeMap<String, f64> {
+pub(crate) fn differences(
+    names: &[String],
+    a: &Trajectory,
+    b: &Trajectory,
+) -> BTreeMap<String, f64> {
     let mut out: BTreeMap<String, f64> = names
         .iter()
         .cloned()
@@ -142,17 +217,125 @@ fn column_scales(samples: &Samples, floor: f64) -> Vec<f64> {
 }
 
 /// The fewest digits to which any graded quantity of `r` is verified, as the grade's scales
-/// measure them.
+/// measure them (on `[0, H]` for a chaotic scene).
 pub fn verified_digits(sc: &ChainScenario, r: &ChainReference) -> f64 {
-    let trace = ChainTrace::of_run("reference", r.samples.clone());
     let events = EventsFile::of_run("reference.events", &r.events);
-    let Ok(rep) = check_chain(sc, r, &trace, Some(&events), Level::Digits(1)) else {
+    let Ok(q) = pointwise(sc, r, &r.samples, Some(&events), Level::Digits(1)) else {
         return 0.0;
     };
-    rep.quantities
-        .iter()
+    q.iter()
         .filter_map(|q| r.error_of(&q.name).map(|e| -(e / q.scale).log10()))
         .fold(f64::INFINITY, f64::min)
+}
+
+/// A run cut at `h`: its samples and events at t ≤ h.
+pub(crate) fn until(tr: &Trajectory, h: f64) -> Trajectory {
+    let mut samples = Samples::with_capacity(tr.samples.dim(), tr.samples.len());
+    for r in tr.samples.iter().filter(|r| r.t <= h) {
+        samples.push(r.t, r.x);
+    }
+    Trajectory {
+        samples,
+        events: tr.events.iter().filter(|e| e.t <= h).cloned().collect(),
+        ..tr.clone()
+    }
+}
+
+/// The predictability horizon of a chaotic scene (see the module docs): where the event
+/// solver's runs at [`HORIZON_TOLS`] first differ by [`HORIZON_SPREAD`] of the largest |ω|,
+/// moved to the middle of the gap between the reference's events around it. An error where
+/// they never part that far: the scene is not chaotic over its run.
+pub fn horizon(sc: &ChainScenario, reference: &Trajectory) -> Result<f64, ReferenceError> {
+    let model = sc.model();
+    let [a, b] = HORIZON_TOLS.map(|tol| event_run(sc, &model, tol));
+    let (a, b) = (a?, b?);
+    let omegas: Vec<usize> = (0..model.discs()).map(|d| model.omega(d)).collect();
+    let largest = reference
+        .samples
+        .iter()
+        .flat_map(|r| omegas.iter().map(move |&i| r.x[i].abs()))
+        .fold(0.0, f64::max);
+    let parted = a.samples.iter().zip(b.samples.iter()).find(|(p, q)| {
+        omegas
+            .iter()
+            .any(|&i| (p.x[i] - q.x[i]).abs() > HORIZON_SPREAD * largest)
+    });
+    let Some((at, _)) = parted else {
+        return Err(ReferenceError::Solve {
+            scenario: sc.name.clone(),
+            source: SolveError::NoConvergence {
+                detail: format!(
+                    "[chaos]: the runs at tol {:e} and {:e} stay within {HORIZON_SPREAD:e} of \
+                     the largest |omega| over the whole run; the scene is graded over the whole \
+                     run without [chaos]",
+                    HORIZON_TOLS[0], HORIZON_TOLS[1]
+                ),
+            },
+        });
+    };
+    let h0 = at.t;
+    let times: Vec<f64> = switches(&reference.events).iter().map(|e| e.t).collect();
+    Ok(match times.iter().position(|&t| t > h0) {
+        Some(k) if k > 0 => 0.5 * (times[k - 1] + times[k]),
+        _ => h0,
+    })
+}
+
+/// Per disc, the mean velocity and the fraction of samples stuck (|ω_i| ≤ `stuck[i]`) over
+/// `[from, t_end]`, each with its standard error from `batches` equal batches.
+pub fn statistics(
+    model: &ChainModel,
+    samples: &Samples,
+    (from, t_end, batches): (f64, f64, usize),
+    stuck: &[f64],
+) -> Vec<Statistic> {
+    let len = (t_end - from) / batches as f64;
+    let n = model.discs();
+    // Per batch and disc: (sum of ω, stuck samples, samples).
+    let mut acc = vec![vec![(0.0, 0usize, 0usize); n]; batches];
+    for r in samples.iter().filter(|r| r.t >= from - 1e-9) {
+        let b = (((r.t - from) / len).floor() as usize).min(batches - 1);
+        for (d, a) in acc[b].iter_mut().enumerate() {
+            let w = r.x[model.omega(d)];
+            a.0 += w;
+            a.1 += usize::from(w.abs() <= stuck[d]);
+            a.2 += 1;
+        }
+    }
+    let summary = |name: String, v: Vec<f64>| {
+        let k = v.len() as f64;
+        let mean = v.iter().sum::<f64>() / k;
+        let var = v.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / (k - 1.0);
+        Statistic {
+            name,
+            mean,
+            standard_error: (var / k).sqrt(),
+        }
+    };
+    let mut out = Vec::with_capacity(2 * n);
+    for d in 0..n {
+        let of = |f: &dyn Fn(&(f64, usize, usize)) -> f64| -> Vec<f64> {
+            acc.iter().map(|b| f(&b[d])).collect()
+        };
+        out.push(summary(
+            format!("mean_omega_{}", d + 1),
+            of(&|a| a.0 / a.2.max(1) as f64),
+        ));
+        out.push(summary(
+            format!("stick_fraction_{}", d + 1),
+            of(&|a| a.1 as f64 / a.2.max(1) as f64),
+        ));
+    }
+    out
+}
+
+/// The thresholds of the statistics' stuck samples: [`STUCK_FRACTION`] of each disc's largest
+/// |ω| in the (stored) reference trace.
+pub(crate) fn stuck_thresholds(model: &ChainModel, reference: &Samples) -> Vec<f64> {
+    let scales = column_scales(reference, FLOOR);
+    (0..model.discs())
+        .map(|d| STUCK_FRACTION * scales[model.omega(d)])
+        .collect()
 }
 
 /// Computes a chain scene's reference at [`REFERENCE_TOL`], or at [`TIGHT_REFERENCE_TOL`]
@@ -172,8 +355,15 @@ fn compute_at(
 ) -> Result<ChainReference, ReferenceError> {
     let model = sc.model();
     let names = model.state_names();
-    let r = event_run(sc, &model, tol)?;
-    let tight = event_run(sc, &model, check_tol)?;
+    let full = event_run(sc, &model, tol)?;
+    // A chaotic scene: the reference on [0, H], its statistics over the whole window.
+    let horizon = sc.chaos.map(|_| horizon(sc, &full)).transpose()?;
+    let cut = |tr: Trajectory| match horizon {
+        Some(h) => until(&tr, h),
+        None => tr,
+    };
+    let r = cut(full.clone());
+    let tight = cut(event_run(sc, &model, check_tol)?);
     // As the rig's: columns against their largest |value| (at least 1), event times against
     // t_end (their rounding is relative to the time they happen at).
     let scales = column_scales(&r.samples, 1.0);
@@ -218,8 +408,11 @@ fn compute_at(
     let mut cross_check = BTreeMap::new();
     for kind in [SolverKind::SWITCH, SolverKind::MOREAU] {
         let setting = kind.info().comparison;
+        // A chaotic scene's cross-check runs to the grid time past H only.
+        let t_end = horizon.map_or(sc.t_end, |h| ((h / sc.dt).ceil() * sc.dt).min(sc.t_end));
         let scene = Scene {
             accuracy: kind.accuracy(setting),
+            t_end,
             ..sc.scene(Output::Grid { dt: sc.dt })
         };
         let run = kind
@@ -228,6 +421,7 @@ fn compute_at(
                 scenario: format!("{} ({})", sc.name, kind.name()),
                 source,
             })?;
+        let run = cut(run);
         cross_check.insert(
             kind.name().to_owned(),
             CrossCheck {
@@ -243,6 +437,42 @@ fn compute_at(
         .into_iter()
         .map(|(n, e)| (n, round_sig(e, 2, Rounding::Up)))
         .collect();
+    let chaos = match (sc.chaos, horizon) {
+        (Some(c), Some(h)) => {
+            let stuck = stuck_thresholds(&model, &samples);
+            let statistics = statistics(
+                &model,
+                &full.samples,
+                (c.statistics_from, sc.t_end, c.batches),
+                &stuck,
+            )
+            .into_iter()
+            .map(|s| Statistic {
+                mean: round_sig(s.mean, 6, Rounding::Scaled),
+                standard_error: round_sig(s.standard_error, 2, Rounding::Up),
+                ..s
+            })
+            .collect();
+            Some(ChaosReference {
+                horizon: h,
+                horizon_method: format!(
+                    "the first grid time at which the event-driven solver's runs at tol {:e} and \
+                     {:e} differ by {HORIZON_SPREAD:e} of the largest |omega| of the run (a tenth \
+                     of the strict level's sample tolerance), moved to the middle of the gap \
+                     between the reference's events around it; statistics: each disc's mean \
+                     omega and fraction of samples with |omega| <= {STUCK_FRACTION:e} of its \
+                     largest |omega| on [0, horizon], over [statistics_from, t_end] in equal \
+                     batches, the standard error the batch means' standard deviation over \
+                     sqrt(batches); the reference's run itself at tol {tol:e}",
+                    HORIZON_TOLS[0], HORIZON_TOLS[1]
+                ),
+                statistics_from: c.statistics_from,
+                batches: c.batches,
+                statistics,
+            })
+        }
+        _ => None,
+    };
     Ok(ChainReference {
         samples,
         events: switches(&r.events),
@@ -265,6 +495,7 @@ fn compute_at(
                  by step halving): crates/rotor-harness/tests/chain_reference_verified.rs"
             ),
             cross_check,
+            chaos,
         },
     })
 }
@@ -303,7 +534,8 @@ pub fn read(dir: &Path, sc: &ChainScenario) -> Result<ChainReference, ReferenceE
 }
 
 /// Grades a chain's trace (and events, if given) against the reference at `level`: every
-/// column over every sample, the events, each disc's stick intervals.
+/// column over every sample, the events, each disc's stick intervals; for a chaotic scene
+/// those on `[0, H]`, and the statistics beyond.
 pub fn check_chain(
     sc: &ChainScenario,
     reference: &ChainReference,
@@ -311,16 +543,17 @@ pub fn check_chain(
     events: Option<&EventsFile>,
     level: Level,
 ) -> Result<CheckReport, CheckError> {
-    let times = |s: &Samples| s.iter().map(|r| r.t).collect::<Vec<f64>>();
-    let ref_times = times(&reference.samples);
-    check_times(
-        &trace.path,
-        &trace.lines,
-        &times(&trace.samples),
-        &ref_times,
-        sc.dt,
-        sc.t_end,
-    )?;
+    let times: Vec<f64> = trace.samples.iter().map(|r| r.t).collect();
+    // The scene's grid: the reference's rows, or, for a chaotic scene whose reference ends at
+    // its horizon, every k·dt to t_end.
+    let grid: Vec<f64> = match reference.json.chaos {
+        None => reference.samples.iter().map(|r| r.t).collect(),
+        Some(_) => {
+            let n = (sc.t_end / sc.dt).round() as usize;
+            (0..=n).map(|k| k as f64 * sc.dt).collect()
+        }
+    };
+    check_times(&trace.path, &trace.lines, &times, &grid, sc.dt, sc.t_end)?;
     if let Some(f) = events {
         check_events(f, sc.t_end)?;
     }
@@ -333,13 +566,99 @@ pub fn check_chain(
             needed,
         });
     }
+    // The samples and events graded one by one: the reference's span.
+    let mut head = Samples::with_capacity(trace.samples.dim(), reference.samples.len());
+    for r in trace.samples.iter().take(reference.samples.len()) {
+        head.push(r.t, r.x);
+    }
+    let horizon = reference.json.chaos.as_ref().map(|c| c.horizon);
+    let cut_events = events.map(|f| EventsFile {
+        events: f
+            .events
+            .iter()
+            .filter(|e| horizon.is_none_or(|h| e.t <= h))
+            .cloned()
+            .collect(),
+        ..f.clone()
+    });
+    let mut q = pointwise(sc, reference, &head, cut_events.as_ref(), level)?;
+    // The fewest digits of the quantities graded one by one: a statistic passes or fails on
+    // its standard errors, and its digits say how closely it was measured, not the trace.
+    let digits = q.iter().map(|g| g.digits).fold(16.0, f64::min);
+    if let Some(c) = &reference.json.chaos {
+        let model = sc.model();
+        let stuck = stuck_thresholds(&model, &reference.samples);
+        let mine = statistics(
+            &model,
+            &trace.samples,
+            (c.statistics_from, sc.t_end, c.batches),
+            &stuck,
+        );
+        let scales = column_scales(&reference.samples, FLOOR);
+        for (s, r) in mine.iter().zip(&c.statistics) {
+            let scale = if s.name.starts_with("mean_omega_") {
+                let d: usize = s.name["mean_omega_".len()..].parse().unwrap_or(1);
+                scales[model.omega(d - 1)]
+            } else {
+                1.0
+            };
+            let sigma = s.standard_error.hypot(r.standard_error);
+            let difference = (s.mean - r.mean).abs();
+            let tolerance = STATISTICS_SIGMA * sigma;
+            q.push(Graded {
+                name: s.name.clone(),
+                difference,
+                scale,
+                tolerance,
+                passed: difference <= tolerance,
+                digits: crate::grade::check::digits(difference, scale),
+                at: None,
+                note: Some(format!(
+                    "over [{}, {}] s beyond the horizon {:.1} s: {:.6} against the \
+                     reference's {:.6}, {:.1} standard errors of the difference",
+                    c.statistics_from,
+                    sc.t_end,
+                    c.horizon,
+                    s.mean,
+                    r.mean,
+                    difference / sigma.max(f64::MIN_POSITIVE)
+                )),
+            });
+        }
+    }
+    let mut not_graded = Vec::new();
+    if events.is_none() {
+        not_graded.push("events".to_owned());
+    }
+    Ok(CheckReport {
+        scenario: sc.name.clone(),
+        benchmark: CHAIN_BENCHMARK,
+        passed: q.iter().all(|g| g.passed),
+        gate: level,
+        digits,
+        not_graded,
+        file_digits: trace.digits,
+        quantities: q,
+    })
+}
+
+/// The quantities graded one by one on the reference's span: every column over every
+/// sample, the events (when given), each disc's stick intervals; refused where the level asks
+/// more digits than the reference is verified to, less one.
+fn pointwise(
+    sc: &ChainScenario,
+    reference: &ChainReference,
+    trace: &Samples,
+    events: Option<&EventsFile>,
+    level: Level,
+) -> Result<Vec<Graded>, CheckError> {
     let model = sc.model();
     let names = model.state_names();
     let scale = column_scales(&reference.samples, FLOOR);
     let mut q: Vec<Graded> = Vec::new();
     for (i, name) in names.iter().enumerate() {
         let (mut worst, mut at) = (0.0f64, 0.0);
-        for (a, r) in trace.samples.iter().zip(&reference.samples) {
+        for (a, r) in trace.iter().zip(&reference.samples) {
             let e = (a.x[i] - r.x[i]).abs();
             if e.is_nan() || e > worst {
                 (worst, at) = (e, r.t);
@@ -350,16 +669,14 @@ pub fn check_chain(
         q.push(g);
     }
     let n = model.discs();
-    let mut not_graded = Vec::new();
-    match events {
-        Some(f) => q.push(grade_events(
+    if let Some(f) = events {
+        q.push(grade_events(
             &reference.events,
             &f.events,
             n,
             CHAIN_TIME_SCALE,
             level,
-        )),
-        None => not_graded.push("events".to_owned()),
+        ));
     }
     let column =
         |s: &Samples, i: usize| -> (Vec<f64>, Vec<f64>) { s.iter().map(|r| (r.t, r.x[i])).unzip() };
@@ -368,7 +685,7 @@ pub fn check_chain(
         q.extend(grade_stick_of(
             &format!("stick_{}", disc.number()),
             disc,
-            column(&trace.samples, i),
+            column(trace, i),
             column(&reference.samples, i),
             &reference.events,
             scale[i],
@@ -393,16 +710,7 @@ pub fn check_chain(
             });
         }
     }
-    Ok(CheckReport {
-        scenario: sc.name.clone(),
-        benchmark: CHAIN_BENCHMARK,
-        passed: q.iter().all(|g| g.passed),
-        gate: level,
-        digits: q.iter().map(|g| g.digits).fold(16.0, f64::min),
-        not_graded,
-        file_digits: trace.digits,
-        quantities: q,
-    })
+    Ok(q)
 }
 
 /// The chain scene and its reference for a scenario file (the reference from `reference/`

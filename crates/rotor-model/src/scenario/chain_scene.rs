@@ -12,6 +12,14 @@
 //! dt = 0.01                          # s, the reference grid (default 0.01)
 //! ```
 //!
+//! A chaotic scene adds
+//!
+//! ```toml
+//! [chaos]
+//! statistics_from = 1000.0           # s: statistics over [statistics_from, t_end]
+//! batches = 10                       # equal batches, for the statistics' standard errors
+//! ```
+//!
 //! The keys mean what they mean in the rig's files ([`crate::scenario::scene_file`]), with the
 //! chain's state of 2N − 1 values. A chain scene states no agreement gates: its references are
 //! graded by the levels of `rotor check`, and the solvers' agreement on it by gates derived from
@@ -49,6 +57,26 @@ struct RawChainScenario {
     h: Option<f64>,
     #[serde(default)]
     compare: RawChainCompare,
+    #[serde(default)]
+    chaos: Option<RawChaos>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawChaos {
+    statistics_from: f64,
+    batches: usize,
+}
+
+/// A chaotic scene's grade beyond its predictability horizon (`[chaos]`): statistics over
+/// `[statistics_from, t_end]` from `batches` equal batches.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Chaos {
+    /// Start of the statistics' window \[s\].
+    pub statistics_from: f64,
+    /// Number of equal batches the window is cut into (their means give each statistic's
+    /// standard error).
+    pub batches: usize,
 }
 
 #[derive(Debug, Deserialize)]
@@ -98,6 +126,9 @@ pub struct ChainScenario {
     pub h: Option<f64>,
     /// The grid step of the reference trace \[s\].
     pub dt: f64,
+    /// `[chaos]`: the scene is chaotic, graded sample by sample up to its predictability
+    /// horizon and on statistics beyond; `None` for a scene graded over the whole run.
+    pub chaos: Option<Chaos>,
 }
 
 impl ChainScenario {
@@ -231,6 +262,30 @@ impl ChainScenario {
                 ),
             });
         }
+        let chaos = match raw.chaos {
+            None => None,
+            Some(c) => {
+                if !(c.statistics_from >= 0.0 && c.statistics_from < raw.t_end) {
+                    return Err(bad.at(
+                        "chaos.statistics_from",
+                        Num(c.statistics_from).to_string(),
+                        "must lie in [0, t_end)",
+                    ));
+                }
+                let per_batch = (raw.t_end - c.statistics_from) / c.batches.max(1) as f64;
+                if !(2..=1000).contains(&c.batches) || per_batch < 2.0 * dt {
+                    return Err(bad.at(
+                        "chaos.batches",
+                        c.batches.to_string(),
+                        "must be 2 to 1000, each batch at least two grid steps long",
+                    ));
+                }
+                Some(Chaos {
+                    statistics_from: c.statistics_from,
+                    batches: c.batches,
+                })
+            }
+        };
         Ok(ChainScenario {
             name: raw.name,
             description: raw.description.unwrap_or_default(),
@@ -244,6 +299,7 @@ impl ChainScenario {
             tol: raw.tol,
             h: raw.h,
             dt,
+            chaos,
         })
     }
 }
@@ -328,6 +384,16 @@ mod tests {
             ("chain3", "../../params/table1", "rig's form"),
             ("chain3", "nothere", "nothere.toml"),
             ("u = 1.5", "uu = 1.5", "uu"),
+            (
+                "t_end = 10.0",
+                "t_end = 10.0\n[chaos]\nstatistics_from = 10.0\nbatches = 4",
+                "chaos.statistics_from = 10",
+            ),
+            (
+                "t_end = 10.0",
+                "t_end = 10.0\n[chaos]\nstatistics_from = 5.0\nbatches = 1",
+                "chaos.batches = 1",
+            ),
         ] {
             let text = OK.replace(from, to);
             let e = load(&text).unwrap_err();
