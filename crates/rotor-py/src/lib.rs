@@ -962,7 +962,8 @@ fn params<'py>(py: Python<'py>, source: Option<&Bound<'py, PyAny>>) -> PyResult<
 /// A chain scene (``"chain3-u1.5-rest"``) gives ``name``, ``description``, ``path``,
 /// ``params`` (the chain form: ``k_m`` and a ``disc`` list), ``discs``, ``u`` (None for an
 /// input in time), ``input`` (its ``[t, u]`` rows, or None), ``x0`` (2N − 1 values),
-/// ``t_end``, ``dt`` and ``benchmark`` (the chain tier's version).
+/// ``t_end``, ``dt``, ``benchmark`` (the chain tier's version) and ``chaos`` (a chaotic
+/// scene's ``statistics_from`` and ``batches``, else None).
 #[pyfunction]
 fn scenario<'py>(py: Python<'py>, source: &Bound<'py, PyAny>) -> PyResult<Bound<'py, PyDict>> {
     let path = scene_path(source)?;
@@ -984,6 +985,13 @@ fn scenario<'py>(py: Python<'py>, source: &Bound<'py, PyAny>) -> PyResult<Bound<
         d.set_item("t_end", sc.t_end)?;
         d.set_item("dt", sc.dt)?;
         d.set_item("benchmark", rotor_suite::CHAIN_VERSION)?;
+        let chaos = sc.chaos.map(|c| {
+            let c_d = PyDict::new(py);
+            c_d.set_item("statistics_from", c.statistics_from)?;
+            c_d.set_item("batches", c.batches)?;
+            Ok::<_, PyErr>(c_d)
+        });
+        d.set_item("chaos", chaos.transpose()?)?;
         return Ok(d);
     }
     let sc = rotor_analysis::solvers::load_scenario(&path).map_err(value_error)?;

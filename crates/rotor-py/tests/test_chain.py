@@ -129,7 +129,9 @@ def test_a_chain_scene_of_the_suite_is_graded_from_arrays():
     grades them as `rotor check` grades a chain's trace; a trace off in one disc fails that
     disc's column; the rig's arrays, wrong shapes and a NaN are refused by name."""
     sc = rotorbench.scenario("chain3-u1.5-rest")
-    assert sc["discs"] == 3 and len(sc["x0"]) == 5
+    assert sc["discs"] == 3 and len(sc["x0"]) == 5 and sc["chaos"] is None
+    chaos = rotorbench.scenario("chain8-u2.5-chaos")["chaos"]
+    assert chaos == {"statistics_from": 1000.0, "batches": 10}
     assert sc["benchmark"].startswith("rotorbench-chain-1.0+")
     r = rotorbench.simulate(solver="event", u=sc["u"], params=sc["params"], x0=sc["x0"],
                             t_end=sc["t_end"], dt=sc["dt"], tol=1e-10)

@@ -159,4 +159,4 @@ def params(source: ParamsLike = None) -> Dict[str, Any]:
 def scenario(source: Union[str, "os.PathLike[str]"]) -> Dict[str, Any]:
     """A benchmark scenario: name, description, path, params, u, x0, t_end, dt, transient,
     steady_from; a chain scene: name, description, path, params (chain form), discs, u, input,
-    x0, t_end, dt, benchmark."""
+    x0, t_end, dt, benchmark, chaos."""
