@@ -448,6 +448,20 @@ fn a_report_written_twice_is_the_same_bytes() {
         v.sort();
         v
     };
+    // A user's chain scene beside them (no tolerance tables: derived gates).
+    std::fs::create_dir_all(&base).unwrap();
+    let chain_scene = base.join("mychain.toml");
+    std::fs::write(
+        &chain_scene,
+        format!(
+            "name = \"mychain\"\nparams = {:?}\nu = 2.0\nt_end = 20.0\n",
+            fixtures
+                .join("../chain/params/chain3.toml")
+                .to_str()
+                .unwrap()
+        ),
+    )
+    .unwrap();
     let mut runs = Vec::new();
     for k in 0..2 {
         let dir = base.join(k.to_string());
@@ -455,6 +469,7 @@ fn a_report_written_twice_is_the_same_bytes() {
             "compare",
             fixtures.join("t1-u1.5-rest.toml").to_str().unwrap(),
             fixtures.join("st-u0.05-rest.toml").to_str().unwrap(),
+            chain_scene.to_str().unwrap(),
             "--report",
             dir.to_str().unwrap(),
         ]);
@@ -491,9 +506,10 @@ fn a_report_written_twice_is_the_same_bytes() {
     // scenarios in fixtures/) nor the suite's version.
     let opening = readme.split("\n## ").next().unwrap();
     assert!(
-        opening.contains("`t1-u1.5-rest`, `st-u0.05-rest`"),
+        opening.contains("`t1-u1.5-rest`, `st-u0.05-rest`, `mychain`"),
         "{opening}"
     );
+    assert!(readme.contains("## Chains of N discs") && names.contains(&"mychain.svg"));
     for suite_text in ["Table 1", "fixtures/scenarios", "Suite: `"] {
         assert!(!readme.contains(suite_text), "{suite_text}: {opening}");
     }

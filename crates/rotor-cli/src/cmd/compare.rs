@@ -42,12 +42,6 @@ pub(crate) fn compare(
     main_job: bool,
     threads: Option<usize>,
 ) -> Result<()> {
-    // A report of the suite opens with what Table 1 does; one of scenes given, with those.
-    let scenes = if files.is_empty() {
-        rotor_harness::compare::report::Scenes::Suite
-    } else {
-        rotor_harness::compare::report::Scenes::Given
-    };
     // The rig's scenes and the chain tier's: every one of both by default.
     let whole_suite = files.is_empty();
     let (files, chain_files): (Vec<PathBuf>, Vec<PathBuf>) = if files.is_empty() {
@@ -75,6 +69,14 @@ pub(crate) fn compare(
     if whole_suite {
         chains.retain(|c| c.chaos.is_none());
     }
+    // A report of the suite opens with what Table 1 does; one of scenes given, with those.
+    let scenes = if whole_suite {
+        rotor_harness::compare::report::Scenes::Suite
+    } else {
+        rotor_harness::compare::report::Scenes::Given {
+            chains: chains.iter().map(|c| c.name.clone()).collect(),
+        }
+    };
     let scenarios = files
         .iter()
         .map(|f| rotor_analysis::solvers::load_scenario(f))
@@ -149,8 +151,13 @@ pub(crate) fn compare(
         }
     }
     out::line(format_args!(
-        "{} scenarios, {} solvers, {:.2} s wall; report in {}",
+        "{} scenarios{}, {} solvers, {:.2} s wall; report in {}",
         results.len(),
+        if chains.is_empty() {
+            String::new()
+        } else {
+            format!(" and {} chain scene(s)", chains.len())
+        },
         rotor_analysis::solvers::SOLVERS.len(),
         wall,
         report.display()

@@ -159,7 +159,7 @@ pub fn chain_section(scenes: &[ChainScenario]) -> Section {
          α_i and ω_i over the whole run and on the time of every stick onset, stick exit and \
          reversal, pair by pair, within `2·(e_a + e_b) + 1e-12 + (η_a + η_b)·max(1, t_end)`: \
          twice the two solvers' own errors on the scene (each from its runs at tighter settings: \
-         tolerance/100; step/2 and step/4; the switch model's also with its band's error, \
+         tolerance/100; step/2, step/4 and step/8; the switch model's also with its band's error, \
          measured by a run at η/10), the rounding floor, and the switch model's stick band \
          (docs/methods.md, \"Chains in the suite\"). The *margin* is gate/difference; the \
          worst quantity of each pair is named.\n\n\
