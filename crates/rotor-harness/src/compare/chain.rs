@@ -47,7 +47,7 @@ use rotor_analysis::solvers::{SOLVERS, SolverKind, self_error, tighter_settings}
 /// pair failed its gate by 2 %. At h/8 the choice changes (9.0e-5 off), and the third
 /// difference, weighted as first order (`8·d₃`, the error at h when each halving halves it),
 /// sees it.
-fn chain_tighter(kind: SolverKind, setting: f64) -> Vec<f64> {
+pub fn chain_tighter(kind: SolverKind, setting: f64) -> Vec<f64> {
     let mut v = tighter_settings(kind, setting);
     if kind.is_fixed_step() {
         v.push(setting / 8.0);
@@ -57,7 +57,7 @@ fn chain_tighter(kind: SolverKind, setting: f64) -> Vec<f64> {
 
 /// A solver's own error in a quantity from its differences between successive settings
 /// ([`chain_tighter`]): [`self_error`], and for a time-stepper also `8·d₃`.
-fn chain_self_error(kind: SolverKind, steps: &[f64]) -> f64 {
+pub fn chain_self_error(kind: SolverKind, steps: &[f64]) -> f64 {
     let e = self_error(kind, steps);
     match steps.get(2) {
         Some(&d3) if kind.is_fixed_step() => e.max(8.0 * d3),
