@@ -988,10 +988,7 @@ fn the_chain_tiers_scenes_agree_under_derived_gates_and_a_wrong_chain_fails() {
         for kind in [SolverKind::SWITCH, SolverKind::MOREAU] {
             let off = chain_run(kind, &wrong, None).unwrap();
             let gates = gates_of(&sc, event, &off);
-            let worst = gates
-                .iter()
-                .map(|g| g.difference / g.gate)
-                .fold(0.0, f64::max);
+            let worst = gates.iter().map(|g| g.ratio()).fold(0.0, f64::max);
             eprintln!(
                 "{} {} with k_3 x 1.01: worst / gate = {worst:.1}",
                 sc.name,

@@ -112,6 +112,20 @@ pub struct ChainGate {
     pub passed: bool,
 }
 
+impl ChainGate {
+    /// difference/gate: 0 where the two agree exactly (also against a gate of 0, as two
+    /// stick fractions of a disc that never sticks), ∞ where they cannot be compared.
+    pub fn ratio(&self) -> f64 {
+        if self.difference == 0.0 {
+            0.0
+        } else if !self.difference.is_finite() {
+            f64::INFINITY
+        } else {
+            self.difference / self.gate
+        }
+    }
+}
+
 /// A chain scene through the three solvers.
 #[derive(Debug, Clone)]
 pub struct ChainComparison {
@@ -159,7 +173,7 @@ impl ChainComparison {
         self.gates
             .iter()
             .filter(|g| g.pair == pair)
-            .map(|g| (g.quantity.as_str(), g.difference / g.gate))
+            .map(|g| (g.quantity.as_str(), g.ratio()))
             .max_by(|a, b| a.1.total_cmp(&b.1))
     }
 }

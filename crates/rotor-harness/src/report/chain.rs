@@ -192,7 +192,7 @@ pub fn chain_section(scenes: &[ChainScenario]) -> Section {
             let worst = of_pair
                 .iter()
                 .filter(|g| g.quantity != "event_time")
-                .max_by(|a, b| (a.difference / a.gate).total_cmp(&(b.difference / b.gate)));
+                .max_by(|a, b| a.ratio().total_cmp(&b.ratio()));
             let ev = of_pair.iter().find(|g| g.quantity == "event_time");
             if let Some(w) = worst {
                 let _ = writeln!(
