@@ -316,13 +316,19 @@ fn scaling(
     let report = rotor_harness::bench::scaling::run(&opts, &mut |m| eprintln!("{m}"));
     std::fs::remove_dir_all(&work).ok();
     let report = report?;
-    crate::common::say(&report.to_markdown(), [json, svg, csv])?;
     let json_text = serde_json::to_string_pretty(&report)?;
-    for (path, text) in [
-        (json, json_text),
-        (svg, report.to_svg()),
-        (csv, report.to_csv()),
-    ] {
+    table_and_files(
+        &report.to_markdown(),
+        [json, svg, csv],
+        [json_text, report.to_svg(), report.to_csv()],
+    )
+}
+
+/// A study's table on stdout (unless an output is `-`) and its JSON, SVG and CSV written
+/// where asked.
+fn table_and_files(table: &str, outputs: [Option<&Path>; 3], texts: [String; 3]) -> Result<()> {
+    crate::common::say(table, outputs)?;
+    for (path, text) in outputs.into_iter().zip(texts) {
         if let Some(path) = path {
             rotor_harness::compare::report::write_output(path, text.as_bytes())
                 .with_context(|| format!("{}: cannot write", path.display()))?;
@@ -381,19 +387,12 @@ fn chain_tier([json, svg, csv]: [Option<&Path>; 3], a: &Args) -> Result<()> {
         opts.clients.len()
     );
     let report = run(&opts, &mut |m| eprintln!("{m}"))?;
-    crate::common::say(&report.to_markdown(), [json, svg, csv])?;
     let json_text = serde_json::to_string_pretty(&report)? + "\n";
-    for (path, text) in [
-        (json, json_text),
-        (svg, report.to_svg()),
-        (csv, report.to_csv()),
-    ] {
-        if let Some(path) = path {
-            rotor_harness::compare::report::write_output(path, text.as_bytes())
-                .with_context(|| format!("{}: cannot write", path.display()))?;
-        }
-    }
-    Ok(())
+    table_and_files(
+        &report.to_markdown(),
+        [json, svg, csv],
+        [json_text, report.to_svg(), report.to_csv()],
+    )
 }
 
 /// A fresh working directory for the peer's job and trace files.

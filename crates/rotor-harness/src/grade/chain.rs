@@ -39,7 +39,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::grade::check::{
     CheckError, CheckReport, FLOOR, Graded, Level, check_events, check_times, grade_events,
-    grade_stick_of, graded,
+    grade_stick_of, graded, within_stated, written_enough,
 };
 use crate::grade::reference::{
     CHECK_TOL, CrossCheck, ERROR_MARGIN, FLOOR_REL, REFERENCE_TOL, REQUIRED_DIGITS, ReferenceError,
@@ -557,15 +557,7 @@ pub fn check_chain(
     if let Some(f) = events {
         check_events(f, sc.t_end)?;
     }
-    let needed = level.digits() + 1;
-    if trace.digits < needed {
-        return Err(CheckError::Precision {
-            path: trace.path.clone(),
-            digits: trace.digits,
-            level: level.name(),
-            needed,
-        });
-    }
+    written_enough(&trace.path, trace.digits, level)?;
     // The samples and events graded one by one: the reference's span.
     let mut head = Samples::with_capacity(trace.samples.dim(), reference.samples.len());
     for r in trace.samples.iter().take(reference.samples.len()) {
@@ -693,23 +685,7 @@ fn pointwise(
             level,
         ));
     }
-    for g in &q {
-        let Some(err) = reference.error_of(&g.name) else {
-            continue;
-        };
-        let verified = -(err / g.scale).log10();
-        let most = (verified - 1.0).floor().max(0.0) as u32;
-        if level.digits() > most {
-            return Err(CheckError::BeyondReference {
-                scenario: sc.name.clone(),
-                level: level.name(),
-                asked: level.digits(),
-                quantity: g.name.clone(),
-                verified,
-                most,
-            });
-        }
-    }
+    within_stated(&sc.name, &q, level, |name| reference.error_of(name))?;
     Ok(q)
 }
 

@@ -511,15 +511,28 @@ fn within_reference(
     quantities: &[Graded],
     level: Level,
 ) -> Result<(), CheckError> {
+    within_stated(&sc.name, quantities, level, |q| {
+        reference_error(reference, q)
+    })
+}
+
+/// [`within_reference`] for any reference: `error_of` gives a quantity's stated error (`None`:
+/// not bounded by one).
+pub(crate) fn within_stated(
+    scenario: &str,
+    quantities: &[Graded],
+    level: Level,
+    error_of: impl Fn(&str) -> Option<f64>,
+) -> Result<(), CheckError> {
     for q in quantities {
-        let Some(err) = reference_error(reference, &q.name) else {
+        let Some(err) = error_of(&q.name) else {
             continue;
         };
         let verified = -(err / q.scale).log10();
         let most = (verified - 1.0).floor().max(0.0) as u32;
         if level.digits() > most {
             return Err(CheckError::BeyondReference {
-                scenario: sc.name.clone(),
+                scenario: scenario.to_owned(),
                 level: level.name(),
                 asked: level.digits(),
                 quantity: q.name.clone(),
@@ -527,6 +540,24 @@ fn within_reference(
                 most,
             });
         }
+    }
+    Ok(())
+}
+
+/// Refuses a trace written with fewer significant digits than `level` needs (its digits + 1).
+pub(crate) fn written_enough(
+    path: &std::path::Path,
+    digits: u32,
+    level: Level,
+) -> Result<(), CheckError> {
+    let needed = level.digits() + 1;
+    if digits < needed {
+        return Err(CheckError::Precision {
+            path: path.to_owned(),
+            digits,
+            level: level.name(),
+            needed,
+        });
     }
     Ok(())
 }
@@ -961,15 +992,7 @@ pub fn check(
     if let Some(f) = events {
         check_events(f, sc.t_end)?;
     }
-    let needed = level.digits() + 1;
-    if trace.digits < needed {
-        return Err(CheckError::Precision {
-            path: trace.path.clone(),
-            digits: trace.digits,
-            level: level.name(),
-            needed,
-        });
-    }
+    written_enough(&trace.path, trace.digits, level)?;
     let scale = state_scales(&reference.samples);
     let t_scale = time_scale(reference);
     let mut q = Vec::new();
