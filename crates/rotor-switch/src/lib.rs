@@ -34,8 +34,11 @@
 //!   For `η → 0` the sliver is empty.
 //! * A disc whose stick interval has zero width (`Friction::is_set_valued()` false, e.g.
 //!   Table 1's upper disc with `T_su = 0`) has no band: its law is continuous across 0, it is
-//!   always in `Slip(s)` with `s = sign ω`, and `ω = 0` is located only to flip the branch
-//!   (a kink when `Δb_u ≠ 0`) and to report a reversal.
+//!   always in `Slip(s)`, and `ω = 0` is crossed only to flip the branch (a kink when
+//!   `Δb_u ≠ 0`) and to report a reversal. The flip waits until `s·ω` is past 0 by the
+//!   absolute tolerance ν, the velocity's resolution: a sign inside it is the steps'
+//!   rounding (a disc deep in a chain just after a start from rest). The branch is then ν
+//!   late, a torque error of at most `2|Δb|·ν`, and the reversal `ν/|ω̇|` late.
 //! * **Two discs.** Each disc has its own region. The mass matrix is diagonal and each disc's
 //!   applied torque `T_ex,i` contains no friction of the other disc (the discs couple only
 //!   through α), so the stick torques of two stuck discs are independent: no coupled solve

@@ -154,7 +154,8 @@ impl Law {
 enum Guard {
     /// Set-valued disc in `Slip(s)`: `g = s·ω − η` (band entry).
     BandEntry(f64),
-    /// Smooth disc in `Slip(s)`: `g = s·ω` (branch flip, reversal).
+    /// Smooth disc in `Slip(s)`: `g = s·ω + ν` (branch flip, reversal; ν the
+    /// resolution margin, `Field::zero_margin`).
     Zero(f64),
     /// `Stick`: `g = s·(bound_s − T_ex)` (break-away toward side s).
     StickExit(f64),
@@ -181,6 +182,15 @@ struct Field<'a> {
     /// reversal (a stuck disc keeps the velocity it entered the band with, which may lie on
     /// either side of 0).
     from_rest: Vec<bool>,
+    /// ν: how far past 0 the velocity of a disc without a stick interval must go before
+    /// its branch flips, the absolute tolerance. The step control holds a velocity's error
+    /// to about that, so a sign inside it is not resolved: a disc deep in a chain just after
+    /// a start from rest has ω ~ 1e-23 rad/s whose sign the steps' rounding decides, and a
+    /// guard at exactly 0 flipped it back and forth a hundred times a millisecond. The law
+    /// is continuous across 0 there, so the branch a margin late changes the torque by at
+    /// most `2|Δb|·ν`, and the reversal is reported `ν/|ω̇|` late (a first-order error in
+    /// the tolerance, which the run at a tighter tolerance measures).
+    zero_margin: f64,
 }
 
 impl Field<'_> {
@@ -231,7 +241,7 @@ impl Field<'_> {
         let w = x[l.idx];
         match g {
             Guard::BandEntry(s) => s * w - self.eta,
-            Guard::Zero(s) => s * w,
+            Guard::Zero(s) => s * w + self.zero_margin,
             Guard::StickExit(s) => s * (l.bound(s) - self.tex(k, t, x)),
             Guard::TransOut(s) => self.eta - s * w,
             Guard::Back(s) => s * (self.tex(k, t, x) - l.bound(s)),
@@ -902,9 +912,10 @@ impl SwitchOptions {
 }
 
 impl<'a> Field<'a> {
-    /// The field of `model` at input `u` with band `eta`, every disc in `Stick` until
+    /// The field of `model` at input `u` with band `eta` and branch margin `zero_margin`
+    /// (ν), every disc in `Stick` until
     /// [`Field::start`] sets their regions.
-    fn new(model: &'a ChainModel, piece: Piece, eta: f64) -> Field<'a> {
+    fn new(model: &'a ChainModel, piece: Piece, eta: f64, zero_margin: f64) -> Field<'a> {
         let n = model.discs();
         let law = |pos: usize| {
             let f = model.friction(pos);
@@ -928,6 +939,7 @@ impl<'a> Field<'a> {
             laws: (0..n).map(law).collect(),
             regions: vec![Region::Stick; n],
             from_rest: vec![true; n],
+            zero_margin,
         }
     }
 
@@ -983,10 +995,10 @@ impl SwitchSolver {
         o.validate()?;
         let varying = scene.input.as_ref().filter(|_| scene.is_time_varying());
         let piece = scene.piece(0.0);
-        let mut field = Field::new(model, piece, o.eta);
+        let tol = scene.tol();
+        let mut field = Field::new(model, piece, o.eta, tol);
         field.start(0.0, x0.as_mut_slice());
         check_finite(0.0, x0.as_slice())?;
-        let tol = scene.tol();
         let mut rec = Recorder::new(scene, x0.as_slice(), tol, o.skip_verify);
         let dopts = Dopri5Options {
             rtol: tol,
