@@ -124,17 +124,22 @@ fn event(k: f64) -> Box<dyn Solver> {
         .ok()
         .and_then(|v| v.parse().ok())
         .unwrap_or(EventOptions::default().lift_resolution);
-    event_with(k, lift, resolution)
+    // STEP_SCALES_STEEP=1 lifts it where the steep region is out of reach
+    // (EventOptions::steep_lift); 0 keeps it there.
+    let steep =
+        std::env::var("STEP_SCALES_STEEP").map_or(EventOptions::default().steep_lift, |v| v != "0");
+    event_with(k, lift, resolution, steep)
 }
 
-/// The event solver with the bound's multiple k and its lift's ε and M (0, 0: the bound
-/// everywhere).
-fn event_with(k: f64, lift: f64, lift_resolution: f64) -> Box<dyn Solver> {
+/// The event solver with the bound's multiple k, its lift's ε and M and the lift away from
+/// the steep region (0, 0, false: the bound everywhere).
+fn event_with(k: f64, lift: f64, lift_resolution: f64, steep_lift: bool) -> Box<dyn Solver> {
     Box::new(EventSolver {
         options: EventOptions {
             h_scale: k,
             lift,
             lift_resolution,
+            steep_lift,
             // STEP_SCALES_DEFECT=inf turns the defect check at events off.
             defect_limit: std::env::var("STEP_SCALES_DEFECT")
                 .ok()
@@ -165,6 +170,11 @@ struct Tally {
     /// Draws whose error exceeds 100 tolerances, among the cycles of amplitude ≥ 1e-3 rad/s
     /// (a smaller one, onto an equilibrium, has a period conditioned as tol/amplitude).
     wrong: u32,
+    /// Draws whose error exceeds 100 tolerances times the condition of a cycle's period
+    /// read from extrema, `max(1, (1 + |ω̄|)·T/(2π²A))` (ω̄ the mean of ω_l's extremes, A
+    /// half their distance, T the period): an extremum's time moves by δω/(AΩ²) for an error
+    /// δω ≈ tol·(1 + |ω̄|) in ω.
+    beyond: u32,
     evals: u64,
     defects: u64,
     worst: usize,
@@ -211,7 +221,7 @@ fn main() {
             metrics_from: Some(50.0),
         };
         // The reference keeps the bound everywhere, whatever the variant measured.
-        let reference = event_with(2.0, 0.0, 0.0)
+        let reference = event_with(2.0, 0.0, 0.0, false)
             .simulate(
                 &m,
                 &Scene {
@@ -266,6 +276,19 @@ fn main() {
                     1.0
                 };
                 t.wrong += u32::from(amplitude >= 1e-3 && e > 100.0 * tol);
+                let condition = if reference.len() == 6 && amplitude > 0.0 {
+                    let mean = 0.5 * (reference[1] + reference[2]);
+                    let pi2 = 2.0 * std::f64::consts::PI.powi(2);
+                    ((1.0 + mean.abs()) * reference[0] / (pi2 * 0.5 * amplitude)).max(1.0)
+                } else {
+                    1.0
+                };
+                t.beyond += u32::from(e > 100.0 * tol * condition);
+                if std::env::var_os("STEP_SCALES_LIST").is_some() && e > 100.0 * tol * condition {
+                    println!(
+                        "beyond: {name} k = {k} set {n}: error {e:.1e}, condition {condition:.1e}"
+                    );
+                }
                 if std::env::var_os("STEP_SCALES_LIST").is_some()
                     && amplitude >= 1e-3
                     && e > 100.0 * tol
@@ -295,18 +318,19 @@ fn main() {
         sets.len()
     );
     println!(
-        "solver      k   max error (set)  max split  over 1e-7  err>100tol  evals/evals(k=∞)  defect rejections"
+        "solver      k   max error (set)  max split  over 1e-7  err>100tol  err>100tol·cond  evals/evals(k=∞)  defect rejections"
     );
     for (s, (name, _)) in kinds.iter().enumerate() {
         for (i, k) in ks.iter().enumerate() {
             let t = tally[s][i];
             println!(
-                "{name:<7} {k:>5}   {:9.1e} ({:>4})  {:9.1e}  {:9}  {:9}  {:.3}  {}",
+                "{name:<7} {k:>5}   {:9.1e} ({:>4})  {:9.1e}  {:9}  {:9}  {:15}  {:.3}  {}",
                 t.err,
                 t.worst,
                 t.split,
                 t.over,
                 t.wrong,
+                t.beyond,
                 t.evals as f64 / tally[s][0].evals as f64,
                 t.defects
             );

@@ -60,6 +60,14 @@ pub struct EventOptions {
     /// `EXTREMUM_RESOLUTION` = 10 tolerances are not reported). [`LIFT_RESOLUTION`] = 10 by
     /// default; 0 turns this lift off.
     pub lift_resolution: f64,
+    /// Lift the step bound while the slipping disc cannot reach its law's steep region within
+    /// the step: its speed lies beyond the region's edge at the tolerance
+    /// ([`rotor_model::Friction::steep_edge`]) by more than its velocity, predicted as for
+    /// `lift`, moves over the step. Off by default: it halves the work on a transient far from
+    /// rest (Table 1 at 6 V) and doubles it, at equal error, on an oscillation growing from an
+    /// unstable equilibrium (docs/methods.md §1a, "Only where the steep region is within
+    /// reach").
+    pub steep_lift: bool,
     /// The largest defect, in tolerances, between a step's dense output and the exact state
     /// re-taken to an event in it that lets the step stand; a larger one rejects the step
     /// ([`DEFECT_LIMIT`] by default, ∞ turns the check off).
@@ -89,6 +97,10 @@ impl Default for EventOptions {
             // (docs/methods.md §1a, "The lift").
             lift: 0.0,
             lift_resolution: LIFT_RESOLUTION,
+            // Off: measured against the bound everywhere, it costs as much on the
+            // equilibrium scenes as it saves on a transient far from rest (docs/methods.md
+            // §1a, "Only where the steep region is within reach").
+            steep_lift: false,
             defect_limit: DEFECT_LIMIT,
             max_steps: 50_000_000,
             zeno_count: 64,
@@ -135,9 +147,26 @@ impl Default for EventOptions {
 /// solver's work for nothing. ε is measured, not derived: 23 of the 25 cycles above are
 /// oscillations of 1e-3 to 1e-2 rad/s far from rest (slow spirals still decaying at
 /// 50–100 s), whose metrics err as tol/amplitude, and the bound repairs them only by its
-/// shorter steps; a lift at ε = 1e-4 let 3 of them err again, ε = 1e-5 none. Lifting while the
-/// disc cannot reach the law's steep region within the step (the region where its fast term
-/// is within `tol·T` of its limit) let 20 of them err again and was dropped.
+/// shorter steps; a lift at ε = 1e-4 let 3 of them err again, ε = 1e-5 none.
+///
+/// Off by default is the lift away from the steep region (`EventOptions::steep_lift`): the
+/// bound does not cap a step over which the disc cannot reach its law's steep region,
+/// `|ω_d| ≤ e_d` with `e_d` the edge at the tolerance ([`rotor_model::Friction::steep_edge`]):
+///
+/// ```text
+/// |ω_d| − e_d > 0  and  |ω̇_d|·h + ½|ω̈_d|·h² ≤ |ω_d| − e_d   ⇒   no bound from disc d.
+/// ```
+///
+/// Beyond the edge the law varies only on its slower scales, which the error estimate sees.
+/// What the bound guards against, a step from the flat part into the steep one, is what the
+/// lift keeps. What it gives up is the bound's shorter steps on oscillations far from rest.
+/// Their errors stay within 100 tolerances times the conditioning of what they report (a
+/// period read from extrema of an oscillation of amplitude A is conditioned as
+/// `(1 + |ω|)·T/(2π²A)`: an extremum's time moves by δω/(AΩ²)), but where the oscillation
+/// grows from an unstable equilibrium, early errors grow with it, and the bound's steps reach
+/// a given error with half the work of a tighter tolerance. On Table 1 at 6 V from rest the
+/// lift halves the work at equal error; from the unstable equilibrium at 2.5 V it doubles it
+/// (docs/methods.md §1a, "Only where the steep region is within reach").
 #[derive(Debug, Clone)]
 pub(crate) struct ScaleBound {
     /// `h_d = k·(tol/1e-10)^{1/8}·τ_fric,d` per disc (∞: no bound).
@@ -148,6 +177,9 @@ pub(crate) struct ScaleBound {
     /// `M·tol`: the bound is also lifted where the velocity moves by less than
     /// `M·tol·(1 + |ω_d|)` (0: never).
     resolution: f64,
+    /// The edge of each disc's steep region at the tolerance
+    /// ([`rotor_model::Friction::steep_edge`]); ∞: never lifted for being far from it.
+    steep: Vec<f64>,
 }
 
 /// The measured ε of the step bound's lift (`EventOptions::lift`, off by default): the bound
@@ -184,6 +216,7 @@ impl ScaleBound {
         k: f64,
         lift: f64,
         resolution: f64,
+        steep: bool,
     ) -> ScaleBound {
         let k = k * (tol / 1e-10).powf(1.0 / 8.0);
         let scales: Vec<(f64, f64)> = (0..model.discs())
@@ -199,13 +232,21 @@ impl ScaleBound {
                 })
                 .collect(),
             resolution: resolution * tol,
+            steep: (0..model.discs())
+                .map(|i| match model.friction(i).steep_edge(tol) {
+                    Some(edge) if steep => edge,
+                    _ => f64::INFINITY,
+                })
+                .collect(),
         }
     }
 
     /// The bound in `mode` at the state `x` with the field `f` there, for a step the
     /// controller would make `h` long: the shortest over the slipping discs of
     /// `max(h_d, t_lift,d)` ([`excursion_time`]), the lift's velocity change being
-    /// `max(ε·k·(tol/1e-10)^{1/8}·v_d, M·tol·(1 + |ω_d|))`. `accel(i)` gives disc i's
+    /// `max(ε·k·(tol/1e-10)^{1/8}·v_d, M·tol·(1 + |ω_d|))`, or no bound from a disc that
+    /// cannot reach its steep region within `h` (the same excursion against `|ω_d| − e_d`).
+    /// `accel(i)` gives disc i's
     /// acceleration rate `((∂f/∂x)·f)_{ω_i}` at x; it is called only for a disc whose `h_d` is
     /// shorter than `h`.
     pub(crate) fn at(
@@ -223,10 +264,18 @@ impl ScaleBound {
                 continue;
             }
             let mut h_d = h_i;
-            let k = model.omega(i);
-            let dv = lift.max(self.resolution * (1.0 + x[k].abs()));
-            if h_d < h && dv > 0.0 {
-                h_d = h_d.max(excursion_time(dv, f[k], accel(i)));
+            if h_d < h {
+                let k = model.omega(i);
+                let a = accel(i);
+                let dv = lift.max(self.resolution * (1.0 + x[k].abs()));
+                if dv > 0.0 {
+                    h_d = h_d.max(excursion_time(dv, f[k], a));
+                }
+                let far = x[k].abs() - self.steep[i];
+                if h_d < h && far > 0.0 && excursion_time(far, f[k], a) >= h {
+                    // The step cannot carry the disc into its steep region: no bound from it.
+                    h_d = f64::INFINITY;
+                }
             }
             bound = bound.min(h_d);
         }
@@ -482,6 +531,7 @@ where
                 opts.h_scale,
                 opts.lift,
                 opts.lift_resolution,
+                opts.steep_lift,
             ),
             stick_intervals: (0..n)
                 .map(|i| model.friction(i).static_interval())
@@ -1672,7 +1722,7 @@ mod tests {
 
     /// The bound (with the lift at ε) at x for a step the controller would make `h` long.
     fn bound_at(m: &Model, u: f64, tol: f64, x: &State, h: f64) -> f64 {
-        let b = ScaleBound::new(&chain(m), tol, 8.0, LIFT_FRACTION, 0.0);
+        let b = ScaleBound::new(&chain(m), tol, 8.0, LIFT_FRACTION, 0.0, false);
         bound_with(&b, m, u, x, h)
     }
 
@@ -1710,12 +1760,46 @@ mod tests {
         assert_eq!(bound_at(&m, u, tol, &off, 1.0), fixed);
         assert!((fixed - 0.20).abs() < 0.005, "{fixed}");
         // The lift at the resolution alone (M = 10: 1.2e-8 rad/s here) does the same.
-        let res = ScaleBound::new(&chain(&m), tol, 8.0, 0.0, LIFT_RESOLUTION);
+        let res = ScaleBound::new(&chain(&m), tol, 8.0, 0.0, LIFT_RESOLUTION, false);
         assert!(bound_with(&res, &m, u, &x, 1.0) >= 1.0);
         assert_eq!(bound_with(&res, &m, u, &off, 1.0), fixed);
         // Without either lift: the bound everywhere.
-        let none = ScaleBound::new(&chain(&m), tol, 8.0, 0.0, 0.0);
+        let none = ScaleBound::new(&chain(&m), tol, 8.0, 0.0, 0.0, false);
         assert_eq!(bound_with(&none, &m, u, &x, 1.0), fixed);
+    }
+
+    /// The lift away from the steep region (`EventOptions::steep_lift`): just off Table 1's
+    /// slipping equilibrium at 6 V (ω_l = 10.7 rad/s, 6.9 rad/s beyond the edge 3.78 rad/s at
+    /// tol 1e-10) a 1 s step cannot reach the steep region and stands; inside the region
+    /// (ω_l = 2 rad/s) the bound holds; and where the seed's step braked from 4.09 rad/s
+    /// at 10 rad/s² into it (2.3 rad/s beyond its edge, reached within 0.31 s) it holds too.
+    #[test]
+    fn the_steep_lift_lifts_the_bound_only_where_the_steep_region_is_out_of_reach() {
+        let (m, u, tol) = (Model::table1(), 6.0, 1e-10);
+        let steep = ScaleBound::new(&chain(&m), tol, 8.0, 0.0, 0.0, true);
+        let fixed = step_bound(&m, tol, 8.0);
+        let edge = m.friction(Disc::LOWER).steep_edge(tol).unwrap();
+        assert!((edge - 3.777).abs() < 1e-3, "{edge}");
+        let off = m.slip_equilibria(u)[0].state() + State::new(0.0, 0.0, 1e-3);
+        assert!(bound_with(&steep, &m, u, &off, 1.0) >= 1.0);
+        let near = State::new(off[0], off[1], 2.0);
+        assert_eq!(bound_with(&steep, &m, u, &near, 1.0), fixed);
+        // Off (the default): the bound everywhere.
+        let none = ScaleBound::new(&chain(&m), tol, 8.0, 0.0, 0.0, false);
+        assert_eq!(bound_with(&none, &m, u, &off, 1.0), fixed);
+
+        let (m, u) = (seed_model(), 1.5 * 1.91649573917313);
+        let w_l = 4.09;
+        let p = m.params;
+        let alpha = (m.friction(Disc::LOWER).torque(w_l, 1.0) - 10.0 * p.j_l) / p.k_theta;
+        let x = State::new(alpha, 2.0, w_l);
+        let edge = m.friction(Disc::LOWER).steep_edge(tol).unwrap();
+        assert!((edge - 2.3).abs() < 0.05, "{edge}");
+        let steep = ScaleBound::new(&chain(&m), tol, 8.0, 0.0, 0.0, true);
+        assert_eq!(
+            bound_with(&steep, &m, u, &x, 0.31),
+            step_bound(&m, tol, 8.0)
+        );
     }
 
     /// `excursion_time` bounds the velocity change of a harmonic oscillation ω = A cos(Ωt + φ)

@@ -320,6 +320,36 @@ impl Friction {
         }
     }
 
+    /// The edge of the law's steep region at tolerance `tol`: the speed `|ω|` beyond which the
+    /// terms that set [`Friction::velocity_scale`] lie within `tol·T` of their limits
+    /// (`T` = [`Friction::torque_scale`]), so that the law varies there only on its slower
+    /// scales. `None` for a law without a velocity scale.
+    ///
+    /// * Exponential family, a term `T_i·tanh(w_i|ω|/2)` with `2/w_i = v`: its distance to
+    ///   `T_i` is `2|T_i|/(1 + e^{w_i|ω|}) < 2|T_i|·e^{−w_i|ω|}`, which is `tol·T` at
+    ///   `|ω| = ln(2|T_i|/(tol·T))/w_i`;
+    /// * Stribeck family: `|T_s − T_c|·e^{−(|ω|/ω_s)^δ} = tol·T` at
+    ///   `|ω| = ω_s·ln(|T_s − T_c|/(tol·T))^{1/δ}`.
+    ///
+    /// 0 where even the term's amplitude is below `tol·T`.
+    pub fn steep_edge(&self, tol: f64) -> Option<f64> {
+        let v = self.velocity_scale()?;
+        let floor = tol * self.torque_scale();
+        let edge = match self.family {
+            Family::Upper => return None,
+            Family::Exponential => [(self.t_1, self.w_1), (self.t_2, self.w_2)]
+                .into_iter()
+                .filter(|&(t, w)| t != 0.0 && w > 0.0 && 2.0 / w <= v)
+                .map(|(t, w)| (2.0 * t.abs() / floor).ln().max(0.0) / w)
+                .fold(0.0, f64::max),
+            Family::Stribeck => {
+                let r = ((self.t_s - self.t_c).abs() / floor).ln().max(0.0);
+                self.omega_s * r.powf(1.0 / self.delta)
+            }
+        };
+        Some(edge)
+    }
+
     /// The torque scale of the law's level, in N m: its value at rest plus the amplitudes of
     /// its velocity-dependent terms, `T_s + |T_1| + |T_2|` (exponential), `T_s + |T_s − T_c|`
     /// (Stribeck), `|ΔT_s| + T_s` (upper disc). A spring torque balanced against the law at
@@ -402,6 +432,34 @@ mod tests {
             Friction::upper(st.upper),
             Friction::lower(st.lower),
         ]
+    }
+
+    /// At the steep region's edge the fast term's distance to its limit is `tol·T`, measured
+    /// on the law itself (the level with that term at its limit subtracted), and beyond the
+    /// edge it is smaller; the upper disc has no edge.
+    #[test]
+    fn at_the_steep_edge_the_fast_term_is_within_the_tolerance_of_its_limit() {
+        let [up, exp, _, strib] = laws()[..] else {
+            unreachable!()
+        };
+        assert_eq!(up.steep_edge(1e-10), None);
+        for tol in [1e-6, 1e-10, 1e-13] {
+            let t = exp.torque_scale();
+            // Table 1: the fast term is T_1 (w_1 = 5.7468), the slow one T_2 stays.
+            let gap = |w: f64| {
+                let slow = exp.t_s + exp.t_2 * (0.5 * exp.w_2 * w).tanh();
+                (exp.level(w) - slow - exp.t_1).abs()
+            };
+            let e = exp.steep_edge(tol).unwrap();
+            // 2|T_1|/(1 + e^{w ω}) against its bound 2|T_1|e^{−wω}: relative 1/e^{wω} ≤ 1e-5
+            // here; the level's own rounding, 1e-16 N m, is below 1e-3 of tol·T at 1e-13.
+            assert_relative_eq!(gap(e), tol * t, max_relative = 1e-3);
+            assert!(gap(1.1 * e) < tol * t, "{tol}");
+            let e = strib.steep_edge(tol).unwrap();
+            let t = strib.torque_scale();
+            let gap = (strib.level(e) - strib.t_c).abs();
+            assert_relative_eq!(gap, tol * t, max_relative = 1e-3);
+        }
     }
 
     #[test]
