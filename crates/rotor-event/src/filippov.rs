@@ -1772,7 +1772,8 @@ mod tests {
     /// slipping equilibrium at 6 V (ω_l = 10.7 rad/s, 6.9 rad/s beyond the edge 3.78 rad/s at
     /// tol 1e-10) a 1 s step cannot reach the steep region and stands; inside the region
     /// (ω_l = 2 rad/s) the bound holds; and where the seed's step braked from 4.09 rad/s
-    /// at 10 rad/s² into it (2.3 rad/s beyond its edge, reached within 0.31 s) it holds too.
+    /// at 10 rad/s² into it (its edge at 2.3 rad/s, reached within the 0.31 s step) it holds
+    /// too. The edges are `ln(2|T_1|/(tol·T))/w_1` evaluated by hand from the parameters.
     #[test]
     fn the_steep_lift_lifts_the_bound_only_where_the_steep_region_is_out_of_reach() {
         let (m, u, tol) = (Model::table1(), 6.0, 1e-10);
