@@ -64,9 +64,8 @@ pub struct EventOptions {
     /// the step: its speed lies beyond the region's edge at the tolerance
     /// ([`rotor_model::Friction::steep_edge`]) by more than its velocity, predicted as for
     /// `lift`, moves over the step. Off by default: it halves the work on a transient far from
-    /// rest (Table 1 at 6 V) and doubles it, at equal error, on an oscillation growing from an
-    /// unstable equilibrium (docs/methods.md §1a, "Only where the steep region is within
-    /// reach").
+    /// rest (Table 1 at 6 V) and doubles it, at equal error, on a small oscillation about an
+    /// equilibrium (docs/methods.md §1a, "Only where the steep region is within reach").
     pub steep_lift: bool,
     /// The largest defect, in tolerances, between a step's dense output and the exact state
     /// re-taken to an event in it that lets the step stand; a larger one rejects the step
@@ -162,11 +161,11 @@ impl Default for EventOptions {
 /// lift keeps. What it gives up is the bound's shorter steps on oscillations far from rest.
 /// Their errors stay within 100 tolerances times the conditioning of what they report (a
 /// period read from extrema of an oscillation of amplitude A is conditioned as
-/// `(1 + |ω|)·T/(2π²A)`: an extremum's time moves by δω/(AΩ²)), but where the oscillation
-/// grows from an unstable equilibrium, early errors grow with it, and the bound's steps reach
-/// a given error with half the work of a tighter tolerance. On Table 1 at 6 V from rest the
-/// lift halves the work at equal error; from the unstable equilibrium at 2.5 V it doubles it
-/// (docs/methods.md §1a, "Only where the steep region is within reach").
+/// `(1 + |ω|)·T/(2π²A)`: an extremum's time moves by δω/(AΩ²)), but where such a small
+/// oscillation is all that is measured, the bound's steps reach a given error with up to half
+/// the work of a tighter tolerance. On Table 1 at 6 V from rest the lift halves the work at
+/// equal error; 1e-3 rad/s from the equilibrium at 2.5 V it doubles it (docs/methods.md §1a,
+/// "Only where the steep region is within reach").
 #[derive(Debug, Clone)]
 pub(crate) struct ScaleBound {
     /// `h_d = k·(tol/1e-10)^{1/8}·τ_fric,d` per disc (∞: no bound).
