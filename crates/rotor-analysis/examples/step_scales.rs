@@ -8,7 +8,11 @@
 //! event solver's lift ε from `STEP_SCALES_LIFT` (default `EventOptions::default().lift`, off; the
 //! measured candidate is `rotor_event::LIFT_FRACTION` = 1e-5), the largest difference between the
 //! metrics-only and the full run (the stress test's gate is 1e-7), the number of draws over
-//! that gate, and the field evaluations of the full runs summed, relative to k = ∞.
+//! that gate, the draws whose error exceeds 100 tolerances (cycles of amplitude ≥ 1e-3 rad/s)
+//! and 100 tolerances times the conditioning of a period read from extrema, and the field
+//! evaluations of the full runs summed, relative to k = ∞. `STEP_SCALES_STEEP=1` turns on the
+//! lift away from the steep region (`EventOptions::steep_lift`), `STEP_SCALES_LIST=1` lists
+//! the draws over either count.
 //!
 //! `cargo run --release -p rotor-analysis --example step_scales -- [DRAWS] [SEED] [TOL]`
 
