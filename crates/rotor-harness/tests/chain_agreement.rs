@@ -6,7 +6,7 @@
 //! convergence.
 
 use rotor_analysis::solvers::SolverKind;
-use rotor_model::seam::{Accuracy, EventKind, Output, Scene, SteadyState, Trajectory};
+use rotor_model::seam::{Accuracy, EventKind, Output, Scene, SolveError, SteadyState, Trajectory};
 use rotor_model::{ChainModel, ChainParams, Params};
 
 fn run(kind: SolverKind, model: &ChainModel, accuracy: Accuracy, t_end: f64) -> Trajectory {
@@ -496,6 +496,39 @@ fn random_chain() -> impl Strategy<Value = (ChainParams, f64)> {
 
 use proptest::prelude::*;
 
+/// The event solver and the switch model on `model` from rest at input `u` over 10 s
+/// (0.01 s grid), each at tol 1e-10, and the worst ratio of their differences to the gate
+/// of [`worst_event_switch`], with each one's own error estimated against its run at tol
+/// 1e-13. The first run that fails is returned as the error.
+fn from_rest_event_and_switch(
+    model: &ChainModel,
+    u: f64,
+) -> Result<(Trajectory, Trajectory, f64), SolveError> {
+    let at = |kind: SolverKind, tol: f64| {
+        let scene = Scene {
+            u,
+            x0: vec![0.0; model.dim()],
+            t_end: 10.0,
+            accuracy: Accuracy::Tol(tol),
+            output: Output::Grid { dt: 0.01 },
+            ..Scene::default()
+        };
+        kind.simulate_chain(model, &scene)
+    };
+    let (ev, ev_t) = (at(SolverKind::EVENT, 1e-10)?, at(SolverKind::EVENT, 1e-13)?);
+    let (sw, sw_t) = (
+        at(SolverKind::SWITCH, 1e-10)?,
+        at(SolverKind::SWITCH, 1e-13)?,
+    );
+    let est: Vec<f64> = diffs(&ev, &ev_t)
+        .iter()
+        .zip(diffs(&sw, &sw_t))
+        .map(|(e, s)| e + s)
+        .collect();
+    let worst = worst_event_switch(&ev, &sw, &est);
+    Ok((ev, sw, worst))
+}
+
 proptest! {
     #![proptest_config(ProptestConfig { cases: 48, ..ProptestConfig::default() })]
 
@@ -508,34 +541,9 @@ proptest! {
     #[test]
     fn stress_random_chains_event_and_switch_agree((p, u) in random_chain()) {
         prop_assume!(p.validate().is_ok());
-        let model = ChainModel::new(&p);
-        let at = |kind: SolverKind, tol: f64| {
-            let scene = Scene {
-                u,
-                x0: vec![0.0; model.dim()],
-                t_end: 10.0,
-                accuracy: Accuracy::Tol(tol),
-                output: Output::Grid { dt: 0.01 },
-                ..Scene::default()
-            };
-            kind.simulate_chain(&model, &scene)
-        };
-        let runs = [
-            at(SolverKind::EVENT, 1e-10),
-            at(SolverKind::EVENT, 1e-13),
-            at(SolverKind::SWITCH, 1e-10),
-            at(SolverKind::SWITCH, 1e-13),
-        ];
-        for r in &runs {
-            prop_assert!(r.is_ok(), "{:?}: {:?}", p, r.as_ref().err());
-        }
-        let [ev, ev_t, sw, sw_t] = runs.map(|r| r.unwrap());
-        let est: Vec<f64> = diffs(&ev, &ev_t)
-            .iter()
-            .zip(diffs(&sw, &sw_t))
-            .map(|(e, s)| e + s)
-            .collect();
-        let worst = worst_event_switch(&ev, &sw, &est);
+        let runs = from_rest_event_and_switch(&ChainModel::new(&p), u);
+        prop_assert!(runs.is_ok(), "{:?}: {:?}", p, runs.as_ref().err());
+        let (_, _, worst) = runs.unwrap();
         prop_assert!(worst <= 1.0, "worst / gate {worst} on {p:?} at u = {u}");
     }
 }
@@ -573,20 +581,8 @@ k = 0.04
 friction = { family = "exponential", t_s = 0.0821, t_1 = 0.03015, t_2 = -0.11335, w_1 = 5.7468, w_2 = 0.2941, b = 0.00545 }
 "#;
     let p = ChainParams::from_toml_str(text, std::path::Path::new("drawn")).unwrap();
-    let model = ChainModel::new(&p);
-    let at = |kind: SolverKind, tol: f64| {
-        let scene = Scene {
-            u: 0.911599660096067,
-            x0: vec![0.0; model.dim()],
-            t_end: 10.0,
-            accuracy: Accuracy::Tol(tol),
-            output: Output::Grid { dt: 0.01 },
-            ..Scene::default()
-        };
-        kind.simulate_chain(&model, &scene).unwrap()
-    };
-    let (ev, ev_t) = (at(SolverKind::EVENT, 1e-10), at(SolverKind::EVENT, 1e-13));
-    let (sw, sw_t) = (at(SolverKind::SWITCH, 1e-10), at(SolverKind::SWITCH, 1e-13));
+    let (ev, sw, worst) =
+        from_rest_event_and_switch(&ChainModel::new(&p), 0.911599660096067).unwrap();
     // Disc 4 reverses when the two solvers both say so (it does, twice, later), never at
     // another disc's switch.
     let kinds = |t: &Trajectory| -> Vec<(EventKind, f64)> { events_by_disc(t, 5)[3].clone() };
@@ -597,12 +593,6 @@ friction = { family = "exponential", t_s = 0.0821, t_1 = 0.03015, t_2 = -0.11335
         "{ke:?} vs {ks:?}"
     );
     assert!(ke.iter().all(|e| e.1 > 3.0), "{ke:?}");
-    let est: Vec<f64> = diffs(&ev, &ev_t)
-        .iter()
-        .zip(diffs(&sw, &sw_t))
-        .map(|(e, s)| e + s)
-        .collect();
-    let worst = worst_event_switch(&ev, &sw, &est);
     assert!(worst <= 1.0, "{worst}");
 }
 
@@ -628,30 +618,11 @@ friction = { family = "viscous", b = 0.005 }
         viscous.repeat(4)
     );
     let p = ChainParams::from_toml_str(&text, std::path::Path::new("drawn")).unwrap();
-    let model = ChainModel::new(&p);
-    let at = |kind: SolverKind, tol: f64| {
-        let scene = Scene {
-            u: 0.5,
-            x0: vec![0.0; model.dim()],
-            t_end: 10.0,
-            accuracy: Accuracy::Tol(tol),
-            output: Output::Grid { dt: 0.01 },
-            ..Scene::default()
-        };
-        kind.simulate_chain(&model, &scene).unwrap()
-    };
-    let (ev, ev_t) = (at(SolverKind::EVENT, 1e-10), at(SolverKind::EVENT, 1e-13));
-    let (sw, sw_t) = (at(SolverKind::SWITCH, 1e-10), at(SolverKind::SWITCH, 1e-13));
+    let (ev, sw, worst) = from_rest_event_and_switch(&ChainModel::new(&p), 0.5).unwrap();
     for (name, t) in [("event", &ev), ("switch", &sw)] {
         let events: Vec<_> = t.events.iter().map(|e| (e.kind, e.t)).collect();
         assert!(events.is_empty(), "{name}: {events:?}");
     }
-    let est: Vec<f64> = diffs(&ev, &ev_t)
-        .iter()
-        .zip(diffs(&sw, &sw_t))
-        .map(|(e, s)| e + s)
-        .collect();
-    let worst = worst_event_switch(&ev, &sw, &est);
     assert!(worst <= 1.0, "{worst}");
 }
 
